@@ -1,0 +1,110 @@
+#pragma once
+// The one query interface every structure implements (brute force, BVH,
+// K-D tree, grid, octree, voxels, two-level, Embree). A virtual call per ray
+// (or per batch), never per node: inside, each structure runs a traversal
+// templated on whether it collects statistics, so the fast path has no
+// counters at all.
+#include "core/geometry/hit.h"
+#include "core/geometry/triangle.h"
+#include "core/math/ray.h"
+
+#include <cstdint>
+#include <exception>
+#include <functional>
+#include <map>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace accelviz {
+
+/// Per-ray traversal figures, under names common to all structures so that
+/// heatmaps compare across them. A structure leaves what it has no notion of at 0.
+struct RayStats {
+  std::uint32_t nodes_visited = 0;   ///< nodes (or cells) entered
+  std::uint32_t box_tests = 0;       ///< ray-box tests performed
+  std::uint32_t prim_tests = 0;      ///< ray-primitive tests performed
+  std::uint32_t nodes_culled = 0;    ///< children skipped: entry t beyond the closest hit so far
+  std::uint32_t nodes_missed = 0;    ///< children whose box the ray missed
+  std::uint32_t repeated_prim_tests = 0;  ///< tests of a primitive already tested by this ray
+  std::uint32_t empty_cells = 0;     ///< empty cells/voxels stepped (grids)
+
+  RayStats& operator+=(const RayStats& o) {
+    nodes_visited += o.nodes_visited;
+    box_tests += o.box_tests;
+    prim_tests += o.prim_tests;
+    nodes_culled += o.nodes_culled;
+    nodes_missed += o.nodes_missed;
+    repeated_prim_tests += o.repeated_prim_tests;
+    empty_cells += o.empty_cells;
+    return *this;
+  }
+};
+
+/// One event of a traced traversal, for the ray inspector.
+struct VisitStep {
+  enum class Kind : std::uint8_t {
+    node_entered,  ///< box hit and descended into (id = node/cell)
+    node_missed,   ///< box tested and missed
+    node_culled,   ///< box hit but its entry t lies beyond the closest hit so far
+    prim_hit,      ///< primitive test that found a (possibly later superseded) hit (id = primitive)
+    prim_miss,     ///< primitive test without a hit
+  };
+  Kind kind;
+  std::uint32_t id;
+  float t_entry;  ///< boxes: entry t; primitives: hit t (inf on a miss)
+  float t_exit;   ///< boxes: exit t; primitives: unused (inf)
+};
+
+struct VisitTrace {
+  std::vector<VisitStep> steps;
+};
+
+/// Figures every build reports. Structure-specific extras go in `extra`
+/// (e.g. "epo", "cells", "empty_cells", "mailbox").
+struct BuildStats {
+  double build_ms = 0.0;
+  std::uint64_t node_count = 0;
+  std::uint64_t leaf_count = 0;
+  std::uint32_t max_depth = 0;
+  double avg_leaf_depth = 0.0;
+  std::uint64_t memory_bytes = 0;
+  double sah_cost = 0.0;  ///< expected cost per ray under the chosen C_trav/C_isect, normalised by root area
+  std::map<std::string, double> extra;
+};
+
+/// Progress of a long build: called now and then with the fraction done
+/// (0..1). Returning false asks the builder to stop; it then throws
+/// BuildCancelled and leaves nothing half-built behind.
+using ProgressCallback = std::function<bool(double fraction)>;
+
+struct BuildCancelled : std::exception {
+  const char* what() const noexcept override { return "build cancelled"; }
+};
+
+/// Query-time choices that do not need a rebuild.
+struct QueryOptions {
+  TriangleTest triangle_test = TriangleTest::watertight;
+  bool ordered = true;  ///< front-to-back child order (false: fixed order, to show what ordering buys)
+};
+
+class Accelerator {
+ public:
+  virtual ~Accelerator() = default;
+
+  /// Short name as used on the command line ("bvh", "kdtree", "brute", ...).
+  virtual std::string name() const = 0;
+
+  /// Closest hit along [ray.tmin, ray.tmax]. `stats` and `trace` may be null;
+  /// when both are null the structure runs its counter-free fast path.
+  virtual Hit closest_hit(const Ray& ray, const QueryOptions& opts, RayStats* stats = nullptr,
+                          VisitTrace* trace = nullptr) const = 0;
+
+  /// True when anything lies in [ray.tmin, ray.tmax]; stops at the first hit found.
+  virtual bool any_hit(const Ray& ray, const QueryOptions& opts, RayStats* stats = nullptr) const = 0;
+
+  virtual const BuildStats& build_stats() const = 0;
+};
+
+}  // namespace accelviz

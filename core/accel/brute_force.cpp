@@ -1,0 +1,62 @@
+#include "core/accel/brute_force.h"
+
+#include <chrono>
+
+namespace accelviz {
+
+BruteForce::BruteForce(std::span<const Triangle> triangles, const BruteForceOptions& opts)
+    : tris_(triangles), opts_(opts) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (opts_.bbox_early_out) {
+    boxes_.reserve(tris_.size());
+    for (const Triangle& t : tris_) boxes_.push_back(t.bounds());
+  }
+  stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  stats_.node_count = 0;
+  stats_.leaf_count = 1;
+  stats_.memory_bytes = boxes_.size() * sizeof(Aabb);
+  stats_.sah_cost = static_cast<double>(tris_.size());  // every ray tests every primitive (C_isect = 1)
+}
+
+Hit BruteForce::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, VisitTrace* trace) const {
+  const WatertightRay wr(ray.direction);
+  Hit best;
+  float tmax = ray.tmax;
+  for (std::size_t i = 0; i < tris_.size(); ++i) {
+    if (opts_.bbox_early_out) {
+      SlabInterval iv;
+      if (stats) ++stats->box_tests;
+      if (!intersect_slab(boxes_[i], ray.origin, ray.inv_dir, ray.tmin, tmax, iv)) continue;
+    }
+    if (stats) ++stats->prim_tests;
+    Hit h;
+    const bool hit = intersect_triangle(qo.triangle_test, ray, wr, tris_[i], ray.tmin, tmax, h);
+    if (trace)
+      trace->steps.push_back({hit ? VisitStep::Kind::prim_hit : VisitStep::Kind::prim_miss,
+                              static_cast<std::uint32_t>(i), hit ? h.t : kInfinity, kInfinity});
+    if (hit && h.t < best.t) {
+      best = h;
+      best.prim = static_cast<std::uint32_t>(i);
+      tmax = h.t;
+    }
+  }
+  if (best.valid()) best.ng = triangle_normal(tris_[best.prim]);
+  return best;
+}
+
+bool BruteForce::any_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats) const {
+  const WatertightRay wr(ray.direction);
+  for (std::size_t i = 0; i < tris_.size(); ++i) {
+    if (opts_.bbox_early_out) {
+      SlabInterval iv;
+      if (stats) ++stats->box_tests;
+      if (!intersect_slab(boxes_[i], ray, iv)) continue;
+    }
+    if (stats) ++stats->prim_tests;
+    Hit h;
+    if (intersect_triangle(qo.triangle_test, ray, wr, tris_[i], ray.tmin, ray.tmax, h)) return true;
+  }
+  return false;
+}
+
+}  // namespace accelviz

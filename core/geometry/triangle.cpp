@@ -1,0 +1,101 @@
+#include "core/geometry/triangle.h"
+
+#include <cmath>
+
+namespace accelviz {
+
+WatertightRay::WatertightRay(const glm::vec3& dir) {
+  // Dominant axis becomes z; keep the winding by swapping x/y when dir[kz] < 0.
+  const glm::vec3 a = glm::abs(dir);
+  kz = (a.x > a.y) ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
+  kx = (kz + 1) % 3;
+  ky = (kx + 1) % 3;
+  if (dir[kz] < 0.0f) std::swap(kx, ky);
+  sx = dir[kx] / dir[kz];
+  sy = dir[ky] / dir[kz];
+  sz = 1.0f / dir[kz];
+}
+
+bool intersect_watertight(const Ray& ray, const WatertightRay& wr, const Triangle& tri, float tmin, float tmax,
+                          Hit& hit) {
+  // 1. Vertices relative to the ray origin.
+  const glm::vec3 A = tri.v0 - ray.origin;
+  const glm::vec3 B = tri.v1 - ray.origin;
+  const glm::vec3 C = tri.v2 - ray.origin;
+  // 2. Shear and scale so the ray is the +z axis through the origin.
+  const float ax = A[wr.kx] - wr.sx * A[wr.kz];
+  const float ay = A[wr.ky] - wr.sy * A[wr.kz];
+  const float bx = B[wr.kx] - wr.sx * B[wr.kz];
+  const float by = B[wr.ky] - wr.sy * B[wr.kz];
+  const float cx = C[wr.kx] - wr.sx * C[wr.kz];
+  const float cy = C[wr.ky] - wr.sy * C[wr.kz];
+  // 3. Scaled barycentrics (2D edge functions).
+  float U = cx * by - cy * bx;
+  float V = ax * cy - ay * cx;
+  float W = bx * ay - by * ax;
+  // 4. An edge function of exactly zero is ambiguous in float: redo in double.
+  if (U == 0.0f || V == 0.0f || W == 0.0f) {
+    U = static_cast<float>(static_cast<double>(cx) * by - static_cast<double>(cy) * bx);
+    V = static_cast<float>(static_cast<double>(ax) * cy - static_cast<double>(ay) * cx);
+    W = static_cast<float>(static_cast<double>(bx) * ay - static_cast<double>(by) * ax);
+  }
+  // 5. Inside test, both windings (no backface culling).
+  if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return false;
+  const float det = U + V + W;
+  if (det == 0.0f) return false;  // degenerate, or ray in the triangle's plane
+  // 6. Scaled distance, compared against the scaled interval to avoid a division on misses.
+  const float az = wr.sz * A[wr.kz];
+  const float bz = wr.sz * B[wr.kz];
+  const float cz = wr.sz * C[wr.kz];
+  const float T = U * az + V * bz + W * cz;
+  if (det > 0.0f) {
+    if (T < tmin * det || T > tmax * det) return false;
+  } else {
+    if (T > tmin * det || T < tmax * det) return false;
+  }
+  const float rcp = 1.0f / det;
+  const float t = T * rcp;
+  if (!(t >= tmin && t <= tmax)) return false;  // guards rounding of the scaled compare and inf/NaN
+  hit.t = t;
+  hit.u = V * rcp;
+  hit.v = W * rcp;
+  return true;
+}
+
+bool intersect_moller_trumbore(const Ray& ray, const Triangle& tri, float tmin, float tmax, Hit& hit) {
+  const glm::vec3 e1 = tri.v1 - tri.v0;
+  const glm::vec3 e2 = tri.v2 - tri.v0;
+  const glm::vec3 p = glm::cross(ray.direction, e2);
+  const float det = glm::dot(e1, p);
+  if (det == 0.0f) return false;
+  const float inv = 1.0f / det;
+  const glm::vec3 s = ray.origin - tri.v0;
+  const float u = glm::dot(s, p) * inv;
+  if (u < 0.0f || u > 1.0f) return false;
+  const glm::vec3 q = glm::cross(s, e1);
+  const float v = glm::dot(ray.direction, q) * inv;
+  if (v < 0.0f || u + v > 1.0f) return false;
+  const float t = glm::dot(e2, q) * inv;
+  if (!(t >= tmin && t <= tmax)) return false;
+  hit.t = t;
+  hit.u = u;
+  hit.v = v;
+  return true;
+}
+
+glm::vec3 triangle_normal(const Triangle& tri) {
+  const glm::vec3 n = tri.cross_normal();
+  const float len = glm::length(n);
+  if (!(len > 0.0f) || !std::isfinite(len)) {
+    // Very large or small coordinates can overflow/underflow the float cross
+    // product; redo it in double before giving up.
+    const glm::dvec3 a(tri.v0), b(tri.v1), c(tri.v2);
+    const glm::dvec3 nd = glm::cross(b - a, c - a);
+    const double l = glm::length(nd);
+    if (!(l > 0.0) || !std::isfinite(l)) return glm::vec3(0.0f);
+    return glm::vec3(nd / l);
+  }
+  return n / len;
+}
+
+}  // namespace accelviz

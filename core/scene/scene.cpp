@@ -1,0 +1,55 @@
+#include "core/scene/scene.h"
+
+#include <cmath>
+#include <vector>
+
+namespace accelviz {
+
+Aabb Scene::bounds() const {
+  Aabb b;
+  for (const Triangle& t : triangles) b.extend(t.bounds());
+  return b;
+}
+
+bool Scene::has_instancing() const {
+  std::vector<int> refs(meshes.size(), 0);
+  for (const Instance& inst : instances)
+    if (inst.mesh < refs.size() && ++refs[inst.mesh] > 1) return true;
+  return false;
+}
+
+static bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+void Scene::flatten() {
+  triangles.clear();
+  report.dropped_nonfinite = 0;
+  report.degenerate = 0;
+  std::size_t total = 0;
+  for (const Instance& inst : instances) total += meshes[inst.mesh].indices.size();
+  triangles.reserve(total);
+  for (Instance& inst : instances) {
+    const Mesh& mesh = meshes[inst.mesh];
+    inst.first_triangle = static_cast<std::uint32_t>(triangles.size());
+    const bool identity = inst.transform == glm::mat4(1.0f);
+    for (const glm::uvec3& idx : mesh.indices) {
+      Triangle t;
+      glm::vec3* v[3] = {&t.v0, &t.v1, &t.v2};
+      for (int k = 0; k < 3; ++k) {
+        const glm::vec3& p = mesh.positions[idx[k]];
+        *v[k] = identity ? p : glm::vec3(inst.transform * glm::vec4(p, 1.0f));
+      }
+      if (!finite3(t.v0) || !finite3(t.v1) || !finite3(t.v2)) {
+        ++report.dropped_nonfinite;
+        continue;
+      }
+      // Zero area in double precision: kept (rays miss it), but counted.
+      const glm::dvec3 a(t.v0), b(t.v1), c(t.v2);
+      const glm::dvec3 n = glm::cross(b - a, c - a);
+      if (n.x == 0.0 && n.y == 0.0 && n.z == 0.0) ++report.degenerate;
+      triangles.push_back(t);
+    }
+    inst.triangle_count = static_cast<std::uint32_t>(triangles.size()) - inst.first_triangle;
+  }
+}
+
+}  // namespace accelviz

@@ -1,0 +1,123 @@
+#pragma once
+// The in-memory scene: meshes in object space, the node graph and instances
+// that place them, and a flattened world-space triangle list that every
+// single-level structure indexes. Primitive ids number that list in load
+// order: meshes in glTF node order (depth first, scene roots in order),
+// triangles in index order.
+#include "core/geometry/triangle.h"
+#include "core/math/aabb.h"
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace accelviz {
+
+/// Every loader error: the message is one line, "<file>: <problem>".
+class SceneError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Object-space triangle mesh (one glTF mesh, all its triangle primitives merged).
+struct Mesh {
+  std::string name;
+  std::vector<glm::vec3> positions;
+  std::vector<glm::uvec3> indices;  ///< validated: every index < positions.size()
+};
+
+/// A node of the scene graph. Local transform as TRS (matrix nodes are decomposed
+/// only for display; `local` is authoritative).
+struct Node {
+  std::string name;
+  int parent = -1;
+  std::vector<int> children;
+  glm::mat4 local{1.0f};
+  glm::vec3 translation{0.0f};
+  glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};
+  glm::vec3 scale{1.0f};
+  bool has_matrix = false;  ///< true when glTF gave a matrix instead of TRS
+  int mesh = -1;
+  int camera = -1;
+  int light = -1;
+};
+
+/// One placement of a mesh in the world (a node that references it).
+struct Instance {
+  std::uint32_t mesh = 0;
+  std::uint32_t node = 0;
+  glm::mat4 transform{1.0f};          ///< object to world
+  std::uint32_t first_triangle = 0;   ///< its range in Scene::triangles
+  std::uint32_t triangle_count = 0;
+};
+
+struct Camera {
+  std::string name;
+  glm::vec3 position{0.0f, 0.0f, 5.0f};
+  glm::vec3 forward{0.0f, 0.0f, -1.0f};  ///< unit
+  glm::vec3 up{0.0f, 1.0f, 0.0f};        ///< unit, orthogonal to forward
+  float yfov = 0.8f;                     ///< vertical field of view, radians
+  float aspect = 0.0f;                   ///< 0: take it from the image size
+};
+
+struct Light {
+  enum class Kind { point, directional, spot };
+  std::string name;
+  Kind kind = Kind::point;
+  glm::vec3 position{0.0f};
+  glm::vec3 direction{0.0f, -1.0f, 0.0f};  ///< unit, the direction light travels
+  glm::vec3 color{1.0f};
+  float intensity = 1.0f;
+  float range = 0.0f;  ///< 0: unlimited
+};
+
+/// glTF animation data, kept as data (sampled by the dynamics code).
+struct AnimationChannel {
+  enum class Path { translation, rotation, scale, weights };
+  enum class Interpolation { linear, step, cubic_spline };
+  int node = -1;
+  Path path = Path::translation;
+  Interpolation interpolation = Interpolation::linear;
+  std::vector<float> times;
+  std::vector<glm::vec4> values;  ///< vec3 paths use xyz; cubic spline stores in-tangent, value, out-tangent per key
+};
+
+struct Animation {
+  std::string name;
+  std::vector<AnimationChannel> channels;
+};
+
+/// What the loader dropped, skipped or noticed. Never silent.
+struct LoadReport {
+  std::uint64_t dropped_nonfinite = 0;   ///< triangles with a NaN/inf vertex, removed
+  std::uint64_t degenerate = 0;          ///< zero-area triangles, kept
+  std::uint64_t skipped_primitives = 0;  ///< points/lines primitives skipped
+  std::vector<std::string> warnings;     ///< one line each
+};
+
+struct Scene {
+  std::string source;  ///< file path or built-in spec it came from
+  std::vector<Mesh> meshes;
+  std::vector<Node> nodes;
+  std::vector<int> roots;
+  std::vector<Instance> instances;
+  std::vector<Triangle> triangles;  ///< world space, primitive id = index
+  std::vector<Camera> cameras;
+  std::vector<Light> lights;
+  std::vector<Animation> animations;
+  LoadReport report;
+
+  /// Bounds of all world-space triangles (empty box for an empty scene).
+  Aabb bounds() const;
+  /// True when some mesh is referenced by more than one instance.
+  bool has_instancing() const;
+  /// Rebuilds `triangles` and every instance's range from meshes + instances,
+  /// dropping non-finite triangles (counted in report) and counting degenerate ones.
+  void flatten();
+};
+
+}  // namespace accelviz

@@ -1,0 +1,13 @@
+# Fails when any file under core/ includes an OpenGL, GLFW, OSMesa or ImGui header.
+file(GLOB_RECURSE files ${DIR}/*.h ${DIR}/*.cpp)
+set(bad "")
+foreach(f ${files})
+  file(STRINGS ${f} lines REGEX "#[ \t]*include[ \t]*[<\"](GL/|GLFW/|glad/|imgui|osmesa|GL/osmesa)")
+  if(lines)
+    list(APPEND bad "${f}: ${lines}")
+  endif()
+endforeach()
+if(bad)
+  message(FATAL_ERROR "core/ must not include GL/GLFW/ImGui headers:\n${bad}")
+endif()
+message(STATUS "core/ is GL-free (${CMAKE_ARGC} checked)")
