@@ -16,6 +16,37 @@ WatertightRay::WatertightRay(const glm::vec3& dir) {
   sz = 1.0f / dir[kz];
 }
 
+namespace {
+
+// The whole watertight test in double precision, for triangles whose float
+// edge functions overflow or underflow (coordinates near 1e20 or 1e-20): the
+// float products would be inf/NaN or flush to zero there. Shared vertices are
+// still sheared by one and the same computation, so neighbouring triangles
+// stay consistent with each other.
+bool intersect_watertight_double(const Ray& ray, const WatertightRay& wr, const Triangle& tri, float tmin,
+                                 float tmax, Hit& hit) {
+  const glm::dvec3 o(ray.origin), d(ray.direction);
+  const double sx = d[wr.kx] / d[wr.kz], sy = d[wr.ky] / d[wr.kz], sz = 1.0 / d[wr.kz];
+  const glm::dvec3 A = glm::dvec3(tri.v0) - o, B = glm::dvec3(tri.v1) - o, C = glm::dvec3(tri.v2) - o;
+  const double ax = A[wr.kx] - sx * A[wr.kz], ay = A[wr.ky] - sy * A[wr.kz];
+  const double bx = B[wr.kx] - sx * B[wr.kz], by = B[wr.ky] - sy * B[wr.kz];
+  const double cx = C[wr.kx] - sx * C[wr.kz], cy = C[wr.ky] - sy * C[wr.kz];
+  const double U = cx * by - cy * bx, V = ax * cy - ay * cx, W = bx * ay - by * ax;
+  if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
+  const double det = U + V + W;
+  if (det == 0.0 || !std::isfinite(det)) return false;
+  const double T = U * (sz * A[wr.kz]) + V * (sz * B[wr.kz]) + W * (sz * C[wr.kz]);
+  const double t = T / det;
+  if (!(t >= tmin && t <= tmax)) return false;
+  hit.t = static_cast<float>(t);
+  if (!(hit.t >= tmin && hit.t <= tmax)) hit.t = t < tmin ? tmin : tmax;  // keep the float t inside the interval
+  hit.u = static_cast<float>(V / det);
+  hit.v = static_cast<float>(W / det);
+  return true;
+}
+
+}  // namespace
+
 bool intersect_watertight(const Ray& ray, const WatertightRay& wr, const Triangle& tri, float tmin, float tmax,
                           Hit& hit) {
   // 1. Vertices relative to the ray origin.
@@ -33,21 +64,32 @@ bool intersect_watertight(const Ray& ray, const WatertightRay& wr, const Triangl
   float U = cx * by - cy * bx;
   float V = ax * cy - ay * cx;
   float W = bx * ay - by * ax;
-  // 4. An edge function of exactly zero is ambiguous in float: redo in double.
+  // 4. Overflow (huge coordinates): the whole test in double.
+  if (!std::isfinite(U + V + W)) return intersect_watertight_double(ray, wr, tri, tmin, tmax, hit);
+  // 5. An edge function of exactly zero is ambiguous in float: redo it in
+  //    double from the same sheared float coordinates (the products are exact
+  //    in double), as the paper prescribes.
   if (U == 0.0f || V == 0.0f || W == 0.0f) {
     U = static_cast<float>(static_cast<double>(cx) * by - static_cast<double>(cy) * bx);
     V = static_cast<float>(static_cast<double>(ax) * cy - static_cast<double>(ay) * cx);
     W = static_cast<float>(static_cast<double>(bx) * ay - static_cast<double>(by) * ax);
   }
-  // 5. Inside test, both windings (no backface culling).
+  // 6. Inside test, both windings (no backface culling).
   if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return false;
   const float det = U + V + W;
   if (det == 0.0f) return false;  // degenerate, or ray in the triangle's plane
-  // 6. Scaled distance, compared against the scaled interval to avoid a division on misses.
+  // Edge functions are quadratic and T cubic in the coordinates: near the
+  // bottom of the float range (tiny triangles, 1e-13 and below) they lose
+  // their precision in denormals; redo such a candidate in double.
+  constexpr float kLowRange = 1e-30f;
+  if (std::fabs(det) < kLowRange) return intersect_watertight_double(ray, wr, tri, tmin, tmax, hit);
+  // 7. Scaled distance, compared against the scaled interval to avoid a division on misses.
   const float az = wr.sz * A[wr.kz];
   const float bz = wr.sz * B[wr.kz];
   const float cz = wr.sz * C[wr.kz];
   const float T = U * az + V * bz + W * cz;
+  if (!std::isfinite(T) || (std::fabs(T) < kLowRange && T != 0.0f))
+    return intersect_watertight_double(ray, wr, tri, tmin, tmax, hit);
   if (det > 0.0f) {
     if (T < tmin * det || T > tmax * det) return false;
   } else {
