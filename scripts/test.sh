@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Quick start command 2: install what is missing, build, run every test.
+#   1. Release build, whole suite (core unit + differential tests, CLI tests,
+#      headless GL tests through OSMesa, GUI tests under Xvfb once they exist).
+#   2. Debug + AddressSanitizer + UndefinedBehaviorSanitizer build, whole suite
+#      again (skip with ACCELVIZ_SKIP_SANITIZERS=1 for a quick local run).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+./scripts/install-deps.sh
+
+jobs="$(nproc)"
+echo "== release build"
+cmake --preset release >/dev/null
+cmake --build --preset release -j "$jobs"
+echo "== release tests"
+ctest --preset release -j "$jobs"
+
+if [ "${ACCELVIZ_SKIP_SANITIZERS:-0}" != "1" ]; then
+  echo "== asan+ubsan build"
+  cmake --preset asan >/dev/null
+  cmake --build --preset asan -j "$jobs"
+  echo "== asan+ubsan tests"
+  ctest --preset asan -j "$jobs"
+fi
