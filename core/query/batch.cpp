@@ -1,0 +1,71 @@
+#include "core/query/batch.h"
+
+#include "core/util/parallel.h"
+
+#include <algorithm>
+#include <atomic>
+#include <stdexcept>
+
+namespace accelviz {
+
+namespace {
+
+/// Runs per_ray(i, stats_or_null) over all rays on the worker threads. Progress
+/// is reported by thread 0 only (the calling thread, which may be a GUI thread
+/// owning the callback); a cancel stops every worker at its next chunk.
+template <typename PerRay>
+bool run_batch(std::size_t n, std::span<RayStats> stats, const BatchOptions& batch, PerRay&& per_ray) {
+  std::atomic<std::size_t> done{0};
+  std::atomic<bool> cancelled{false};
+  const bool with_stats = !stats.empty();
+  auto range = [&](std::size_t begin, std::size_t end, unsigned thread) {
+    if (cancelled.load(std::memory_order_relaxed)) return;
+    if (with_stats) {
+      for (std::size_t i = begin; i < end; ++i) {
+        stats[i] = RayStats{};
+        per_ray(i, &stats[i]);
+      }
+    } else {
+      for (std::size_t i = begin; i < end; ++i) per_ray(i, nullptr);
+    }
+    const std::size_t so_far = done.fetch_add(end - begin, std::memory_order_relaxed) + (end - begin);
+    if (thread == 0 && batch.progress && !batch.progress(static_cast<double>(so_far) / static_cast<double>(n)))
+      cancelled.store(true, std::memory_order_relaxed);
+  };
+  const std::size_t chunk = std::max<std::size_t>(batch.chunk, 1);
+  if (resolve_threads(batch.threads) == 1) {
+    // parallel_for hands a single thread the whole range at once; walk it in
+    // chunks here so that progress and cancellation still work.
+    for (std::size_t b = 0; b < n && !cancelled.load(std::memory_order_relaxed); b += chunk)
+      range(b, std::min(n, b + chunk), 0u);
+  } else {
+    parallel_for(n, batch.threads, chunk, range);
+  }
+  return !cancelled.load();
+}
+
+void check_sizes(std::size_t rays, std::size_t out, std::size_t stats, const char* fn) {
+  if (out != rays) throw std::invalid_argument(std::string(fn) + ": output span size differs from the ray count");
+  if (stats != 0 && stats != rays)
+    throw std::invalid_argument(std::string(fn) + ": stats span must be empty or match the ray count");
+}
+
+}  // namespace
+
+bool trace_closest(const Accelerator& accel, std::span<const Ray> rays, std::span<Hit> hits,
+                   const QueryOptions& query, const BatchOptions& batch, std::span<RayStats> stats) {
+  check_sizes(rays.size(), hits.size(), stats.size(), "trace_closest");
+  return run_batch(rays.size(), stats, batch, [&](std::size_t i, RayStats* s) {
+    hits[i] = accel.closest_hit(rays[i], query, s, nullptr);
+  });
+}
+
+bool trace_any(const Accelerator& accel, std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+               const QueryOptions& query, const BatchOptions& batch, std::span<RayStats> stats) {
+  check_sizes(rays.size(), occluded.size(), stats.size(), "trace_any");
+  return run_batch(rays.size(), stats, batch, [&](std::size_t i, RayStats* s) {
+    occluded[i] = accel.any_hit(rays[i], query, s) ? 1 : 0;
+  });
+}
+
+}  // namespace accelviz

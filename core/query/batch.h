@@ -1,0 +1,39 @@
+#pragma once
+// Tracing a span of rays over all threads. One virtual call per ray, none per
+// node; with an empty `stats` span the structures run their counter-free fast
+// path, so a timed batch measures the product, not the instrumentation.
+#include "core/accel/accel.h"
+
+#include <cstdint>
+#include <span>
+
+namespace accelviz {
+
+struct BatchOptions {
+  unsigned threads = 0;         ///< worker threads (0: all hardware threads)
+  std::size_t chunk = 256;      ///< rays handed to a worker at a time (dynamic balancing)
+  ProgressCallback progress;    ///< optional; called from the calling thread only; false cancels
+};
+
+/// Closest hit of every ray into `hits` (same size as `rays`). When `stats` is
+/// non-empty it must have the same size and receives each ray's counters
+/// (reset first). Returns false when the progress callback cancelled: rays not
+/// yet traced are then left untouched. Throws std::invalid_argument on a size mismatch.
+bool trace_closest(const Accelerator& accel, std::span<const Ray> rays, std::span<Hit> hits,
+                   const QueryOptions& query, const BatchOptions& batch, std::span<RayStats> stats = {});
+
+/// Any hit of every ray: occluded[i] = 1 when something lies in [tmin, tmax].
+bool trace_any(const Accelerator& accel, std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+               const QueryOptions& query, const BatchOptions& batch, std::span<RayStats> stats = {});
+
+/// Shorthands with only a thread count.
+inline bool trace_closest(const Accelerator& accel, std::span<const Ray> rays, std::span<Hit> hits,
+                          const QueryOptions& query, unsigned threads, std::span<RayStats> stats = {}) {
+  return trace_closest(accel, rays, hits, query, BatchOptions{threads}, stats);
+}
+inline bool trace_any(const Accelerator& accel, std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                      const QueryOptions& query, unsigned threads, std::span<RayStats> stats = {}) {
+  return trace_any(accel, rays, occluded, query, BatchOptions{threads}, stats);
+}
+
+}  // namespace accelviz
