@@ -1,0 +1,408 @@
+#include "core/analysis/heatmap.h"
+
+#include "core/query/batch.h"
+#include "core/query/camera.h"
+#include "core/query/ray_sets.h"
+
+#include <stb_image.h>
+#include <stb_image_write.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+namespace accelviz {
+
+// ---- metrics -------------------------------------------------------------------
+
+std::string_view metric_name(HeatMetric m) {
+  switch (m) {
+    case HeatMetric::nodes: return "nodes";
+    case HeatMetric::prims: return "prims";
+    case HeatMetric::cost: return "cost";
+    case HeatMetric::shaded: return "shaded";
+    case HeatMetric::depth: return "depth";
+  }
+  return "nodes";
+}
+
+std::string_view metric_label(HeatMetric m) {
+  switch (m) {
+    case HeatMetric::nodes: return "nodes visited per ray";
+    case HeatMetric::prims: return "primitive tests per ray";
+    case HeatMetric::cost: return "cost per ray (ctrav nodes + cisect prims)";
+    case HeatMetric::shaded: return "shaded";
+    case HeatMetric::depth: return "hit distance";
+  }
+  return "";
+}
+
+std::optional<HeatMetric> parse_metric(std::string_view name) {
+  for (HeatMetric m : {HeatMetric::nodes, HeatMetric::prims, HeatMetric::cost, HeatMetric::shaded, HeatMetric::depth})
+    if (metric_name(m) == name) return m;
+  return std::nullopt;
+}
+
+bool metric_needs_stats(HeatMetric m) {
+  return m == HeatMetric::nodes || m == HeatMetric::prims || m == HeatMetric::cost;
+}
+
+float metric_value(HeatMetric m, const Ray& ray, const Hit& hit, const RayStats& stats, float c_trav,
+                   float c_isect) {
+  constexpr float kNoValue = std::numeric_limits<float>::quiet_NaN();
+  switch (m) {
+    case HeatMetric::nodes: return static_cast<float>(stats.nodes_visited);
+    case HeatMetric::prims: return static_cast<float>(stats.prim_tests);
+    case HeatMetric::cost:
+      return c_trav * static_cast<float>(stats.nodes_visited) + c_isect * static_cast<float>(stats.prim_tests);
+    case HeatMetric::shaded: {
+      if (!hit.valid()) return kNoValue;
+      // Headlight: the light sits at the eye, so N·L is the cosine between the
+      // normal and the ray; both sides of a surface are lit.
+      const float len = glm::length(ray.direction);
+      return len > 0.0f ? std::min(1.0f, std::abs(glm::dot(hit.ng, ray.direction)) / len) : 0.0f;
+    }
+    case HeatMetric::depth: return hit.valid() ? hit.t : kNoValue;
+  }
+  return kNoValue;
+}
+
+MetricImage render_metric(const Accelerator& accel, const Camera& camera, const HeatmapOptions& opts,
+                          HeatmapFigures* figures) {
+  if (opts.width <= 0 || opts.height <= 0) throw std::invalid_argument("heatmap: image size must be positive");
+  const std::vector<Ray> rays = primary_rays(camera, opts.width, opts.height);
+  std::vector<Hit> hits(rays.size());
+  std::vector<RayStats> stats(metric_needs_stats(opts.metric) ? rays.size() : 0);
+  BatchOptions batch;
+  batch.threads = opts.threads;
+  batch.progress = opts.progress;
+  // Coherent primary rays: small chunks keep neighbouring pixels on one thread
+  // while still balancing uneven regions.
+  batch.chunk = 64;
+
+  const auto t0 = std::chrono::steady_clock::now();
+  const bool done = trace_closest(accel, rays, hits, opts.query, batch, stats);
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  if (!done) throw BuildCancelled();
+
+  MetricImage img;
+  img.width = opts.width;
+  img.height = opts.height;
+  img.metric = opts.metric;
+  img.values.resize(rays.size());
+  const RayStats none;
+  double sum = 0.0, max = 0.0;
+  std::uint64_t counted = 0, hit_count = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const float v = metric_value(opts.metric, rays[i], hits[i], stats.empty() ? none : stats[i], opts.c_trav,
+                                 opts.c_isect);
+    img.values[i] = v;
+    if (hits[i].valid()) ++hit_count;
+    if (std::isfinite(v)) {
+      sum += v;
+      max = counted == 0 ? v : std::max<double>(max, v);
+      ++counted;
+    }
+  }
+  if (figures) {
+    figures->rays = rays.size();
+    figures->hits = hit_count;
+    figures->mean = counted ? sum / static_cast<double>(counted) : 0.0;
+    figures->max = max;
+    figures->render_ms = ms;
+    figures->rays_per_s = ms > 0.0 ? static_cast<double>(rays.size()) / (ms * 1e-3) : 0.0;
+  }
+  return img;
+}
+
+// ---- images --------------------------------------------------------------------
+
+RgbImage::RgbImage(int w, int h, glm::u8vec3 fill) : width(w), height(h) {
+  pixels.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 3);
+  for (std::size_t i = 0; i < pixels.size(); i += 3) {
+    pixels[i] = fill.x;
+    pixels[i + 1] = fill.y;
+    pixels[i + 2] = fill.z;
+  }
+}
+
+glm::u8vec3 RgbImage::at(int x, int y) const {
+  const std::size_t i = (static_cast<std::size_t>(y) * width + x) * 3;
+  return {pixels[i], pixels[i + 1], pixels[i + 2]};
+}
+
+void RgbImage::set(int x, int y, glm::u8vec3 c) {
+  if (x < 0 || y < 0 || x >= width || y >= height) return;
+  const std::size_t i = (static_cast<std::size_t>(y) * width + x) * 3;
+  pixels[i] = c.x;
+  pixels[i + 1] = c.y;
+  pixels[i + 2] = c.z;
+}
+
+glm::u8vec3 to_rgb8(const glm::vec3& c) {
+  auto q = [](float v) {
+    v = std::isnan(v) ? 0.0f : std::clamp(v, 0.0f, 1.0f);
+    return static_cast<std::uint8_t>(std::lround(v * 255.0f));
+  };
+  return {q(c.x), q(c.y), q(c.z)};
+}
+
+std::optional<LegendPlacement> parse_legend_placement(std::string_view name) {
+  if (name == "none") return LegendPlacement::none;
+  if (name == "bottom") return LegendPlacement::bottom;
+  if (name == "right") return LegendPlacement::right;
+  return std::nullopt;
+}
+
+float heatmap_scale_max(const MetricImage& image, float fixed_max) {
+  if (fixed_max > 0.0f && std::isfinite(fixed_max)) return fixed_max;
+  float max = 0.0f;
+  for (float v : image.values)
+    if (std::isfinite(v)) max = std::max(max, v);
+  return max > 0.0f ? max : 1.0f;
+}
+
+glm::u8vec3 heatmap_color(HeatMetric metric, float value, float scale_max, const ColorizeOptions& opts) {
+  if (!std::isfinite(value)) return to_rgb8(opts.background);
+  if (metric == HeatMetric::shaded) {
+    const float grey = 0.1f + 0.85f * std::clamp(value, 0.0f, 1.0f);
+    return to_rgb8(glm::vec3(grey));
+  }
+  return to_rgb8(colormap(opts.map, value / scale_max));
+}
+
+// ---- bitmap font -----------------------------------------------------------------
+
+namespace {
+
+/// 5×7 glyphs, one byte per row from the top, bit 4 = leftmost column. Drawn
+/// for this project (digits, lowercase letters, M and the signs a legend needs).
+struct Glyph {
+  char c;
+  std::uint8_t rows[7];
+};
+
+constexpr Glyph kFont[] = {
+    {'0', {0b01110, 0b10001, 0b10011, 0b10101, 0b11001, 0b10001, 0b01110}},
+    {'1', {0b00100, 0b01100, 0b00100, 0b00100, 0b00100, 0b00100, 0b01110}},
+    {'2', {0b01110, 0b10001, 0b00001, 0b00010, 0b00100, 0b01000, 0b11111}},
+    {'3', {0b11111, 0b00010, 0b00100, 0b00010, 0b00001, 0b10001, 0b01110}},
+    {'4', {0b00010, 0b00110, 0b01010, 0b10010, 0b11111, 0b00010, 0b00010}},
+    {'5', {0b11111, 0b10000, 0b11110, 0b00001, 0b00001, 0b10001, 0b01110}},
+    {'6', {0b00110, 0b01000, 0b10000, 0b11110, 0b10001, 0b10001, 0b01110}},
+    {'7', {0b11111, 0b00001, 0b00010, 0b00100, 0b01000, 0b01000, 0b01000}},
+    {'8', {0b01110, 0b10001, 0b10001, 0b01110, 0b10001, 0b10001, 0b01110}},
+    {'9', {0b01110, 0b10001, 0b10001, 0b01111, 0b00001, 0b00010, 0b01100}},
+    {'.', {0b00000, 0b00000, 0b00000, 0b00000, 0b00000, 0b01100, 0b01100}},
+    {'-', {0b00000, 0b00000, 0b00000, 0b11111, 0b00000, 0b00000, 0b00000}},
+    {'+', {0b00000, 0b00100, 0b00100, 0b11111, 0b00100, 0b00100, 0b00000}},
+    {':', {0b00000, 0b01100, 0b01100, 0b00000, 0b01100, 0b01100, 0b00000}},
+    {'/', {0b00000, 0b00001, 0b00010, 0b00100, 0b01000, 0b10000, 0b00000}},
+    {'(', {0b00010, 0b00100, 0b01000, 0b01000, 0b01000, 0b00100, 0b00010}},
+    {')', {0b01000, 0b00100, 0b00010, 0b00010, 0b00010, 0b00100, 0b01000}},
+    {'=', {0b00000, 0b00000, 0b11111, 0b00000, 0b11111, 0b00000, 0b00000}},
+    {',', {0b00000, 0b00000, 0b00000, 0b00000, 0b01100, 0b00100, 0b01000}},
+    {'M', {0b10001, 0b11011, 0b10101, 0b10101, 0b10001, 0b10001, 0b10001}},
+    {'a', {0b00000, 0b00000, 0b01110, 0b00001, 0b01111, 0b10001, 0b01111}},
+    {'b', {0b10000, 0b10000, 0b10110, 0b11001, 0b10001, 0b10001, 0b11110}},
+    {'c', {0b00000, 0b00000, 0b01110, 0b10000, 0b10000, 0b10001, 0b01110}},
+    {'d', {0b00001, 0b00001, 0b01101, 0b10011, 0b10001, 0b10001, 0b01111}},
+    {'e', {0b00000, 0b00000, 0b01110, 0b10001, 0b11111, 0b10000, 0b01110}},
+    {'f', {0b00110, 0b01001, 0b01000, 0b11100, 0b01000, 0b01000, 0b01000}},
+    {'g', {0b00000, 0b01111, 0b10001, 0b10001, 0b01111, 0b00001, 0b01110}},
+    {'h', {0b10000, 0b10000, 0b10110, 0b11001, 0b10001, 0b10001, 0b10001}},
+    {'i', {0b00100, 0b00000, 0b01100, 0b00100, 0b00100, 0b00100, 0b01110}},
+    {'j', {0b00010, 0b00000, 0b00110, 0b00010, 0b00010, 0b10010, 0b01100}},
+    {'k', {0b10000, 0b10000, 0b10010, 0b10100, 0b11000, 0b10100, 0b10010}},
+    {'l', {0b01100, 0b00100, 0b00100, 0b00100, 0b00100, 0b00100, 0b01110}},
+    {'m', {0b00000, 0b00000, 0b11010, 0b10101, 0b10101, 0b10001, 0b10001}},
+    {'n', {0b00000, 0b00000, 0b10110, 0b11001, 0b10001, 0b10001, 0b10001}},
+    {'o', {0b00000, 0b00000, 0b01110, 0b10001, 0b10001, 0b10001, 0b01110}},
+    {'p', {0b00000, 0b00000, 0b11110, 0b10001, 0b11110, 0b10000, 0b10000}},
+    {'q', {0b00000, 0b00000, 0b01101, 0b10011, 0b01111, 0b00001, 0b00001}},
+    {'r', {0b00000, 0b00000, 0b10110, 0b11001, 0b10000, 0b10000, 0b10000}},
+    {'s', {0b00000, 0b00000, 0b01110, 0b10000, 0b01110, 0b00001, 0b11110}},
+    {'t', {0b01000, 0b01000, 0b11100, 0b01000, 0b01000, 0b01001, 0b00110}},
+    {'u', {0b00000, 0b00000, 0b10001, 0b10001, 0b10001, 0b10011, 0b01101}},
+    {'v', {0b00000, 0b00000, 0b10001, 0b10001, 0b10001, 0b01010, 0b00100}},
+    {'w', {0b00000, 0b00000, 0b10001, 0b10001, 0b10101, 0b10101, 0b01010}},
+    {'x', {0b00000, 0b00000, 0b10001, 0b01010, 0b00100, 0b01010, 0b10001}},
+    {'y', {0b00000, 0b00000, 0b10001, 0b10001, 0b01111, 0b00001, 0b01110}},
+    {'z', {0b00000, 0b00000, 0b11111, 0b00010, 0b00100, 0b01000, 0b11111}},
+};
+
+constexpr int kGlyphW = 5, kGlyphH = 7, kAdvance = 6;
+
+const Glyph* find_glyph(char c) {
+  for (const Glyph& g : kFont)
+    if (g.c == c) return &g;
+  return nullptr;
+}
+
+void fill_rect(RgbImage& img, int x0, int y0, int w, int h, glm::u8vec3 c) {
+  for (int y = std::max(0, y0); y < std::min(img.height, y0 + h); ++y)
+    for (int x = std::max(0, x0); x < std::min(img.width, x0 + w); ++x) img.set(x, y, c);
+}
+
+}  // namespace
+
+int text_width(std::string_view text, int scale) {
+  if (text.empty()) return 0;
+  return (static_cast<int>(text.size()) * kAdvance - (kAdvance - kGlyphW)) * scale;
+}
+
+void draw_text(RgbImage& img, int x, int y, std::string_view text, glm::u8vec3 color, int scale) {
+  for (char c : text) {
+    if (const Glyph* g = find_glyph(c)) {
+      for (int row = 0; row < kGlyphH; ++row)
+        for (int col = 0; col < kGlyphW; ++col)
+          if (g->rows[row] & (1u << (kGlyphW - 1 - col))) fill_rect(img, x + col * scale, y + row * scale, scale, scale, color);
+    }
+    x += kAdvance * scale;
+  }
+}
+
+std::string format_tick(double v) {
+  if (v == 0.0 || !std::isfinite(v)) return "0";
+  const double a = std::abs(v);
+  char buf[32];
+  if (a < 1e-3) {
+    std::snprintf(buf, sizeof buf, "%.0e", v);
+  } else if (a < 999.5) {
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+  } else if (a < 1e4) {
+    std::snprintf(buf, sizeof buf, "%.0f", v);  // "2500" reads better than "2.5e+03"
+  } else if (a < 999.5e3) {
+    std::snprintf(buf, sizeof buf, "%.3gk", v / 1e3);
+  } else {
+    std::snprintf(buf, sizeof buf, "%.3gM", v / 1e6);
+  }
+  return buf;
+}
+
+// ---- colour mapping and legend ---------------------------------------------------
+
+RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
+  const int w = image.width, h = image.height;
+  const float scale_max = heatmap_scale_max(image, opts.max);
+  const LegendPlacement legend = image.metric == HeatMetric::shaded ? LegendPlacement::none : opts.legend;
+
+  // Legend geometry, in multiples of the glyph scale so it grows with the image.
+  const int s = std::max(w, h) >= 480 ? 2 : 1;
+  const int pad = 4 * s, glyph_h = kGlyphH * s, bar = 10 * s, tick = 3 * s;
+  constexpr int kTicks = 5;
+  std::string labels[kTicks];
+  int widest = 0;
+  for (int k = 0; k < kTicks; ++k) {
+    labels[k] = format_tick(static_cast<double>(scale_max) * k / (kTicks - 1));
+    widest = std::max(widest, text_width(labels[k], s));
+  }
+  int extra_w = 0, extra_h = 0;
+  if (legend == LegendPlacement::bottom) extra_h = pad + glyph_h + pad + bar + tick + s + glyph_h + pad;
+  if (legend == LegendPlacement::right)
+    extra_w = std::max(pad + bar + tick + s + widest + pad, text_width(metric_name(image.metric), s) + 2 * pad);
+
+  const glm::u8vec3 panel(24, 24, 24), ink(235, 235, 235);
+  RgbImage out(w + extra_w, h + extra_h, panel);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) out.set(x, y, heatmap_color(image.metric, image.at(x, y), scale_max, opts));
+
+  if (legend == LegendPlacement::bottom) {
+    const int y0 = h;
+    const std::string title = std::string(metric_label(image.metric)) + (opts.max > 0.0f ? "  (fixed max)" : "");
+    draw_text(out, pad, y0 + pad, title, ink, s);
+    const int margin = std::max(pad, widest / 2 + pad);
+    const int xl = margin, xr = std::max(xl + 1, w - 1 - margin);
+    const int bar_y = y0 + pad + glyph_h + pad;
+    for (int x = xl; x <= xr; ++x) {
+      const float t = static_cast<float>(x - xl) / static_cast<float>(xr - xl);
+      fill_rect(out, x, bar_y, 1, bar, to_rgb8(colormap(opts.map, t)));
+    }
+    for (int k = 0; k < kTicks; ++k) {
+      const int x = xl + static_cast<int>(std::lround(static_cast<double>(xr - xl) * k / (kTicks - 1)));
+      fill_rect(out, x - (s - 1) / 2, bar_y + bar, s, tick, ink);
+      const int lw = text_width(labels[k], s);
+      const int lx = std::clamp(x - lw / 2, 0, std::max(0, out.width - lw));
+      draw_text(out, lx, bar_y + bar + tick + s, labels[k], ink, s);
+    }
+  } else if (legend == LegendPlacement::right) {
+    const int x0 = w + pad;
+    draw_text(out, x0, pad, metric_name(image.metric), ink, s);
+    const int yt = pad + glyph_h + pad + glyph_h / 2;
+    const int yb = std::max(yt + 1, h - 1 - pad - glyph_h / 2);
+    for (int y = yt; y <= yb; ++y) {
+      const float t = static_cast<float>(yb - y) / static_cast<float>(yb - yt);  // max at the top
+      fill_rect(out, x0, y, bar, 1, to_rgb8(colormap(opts.map, t)));
+    }
+    for (int k = 0; k < kTicks; ++k) {
+      const int y = yb - static_cast<int>(std::lround(static_cast<double>(yb - yt) * k / (kTicks - 1)));
+      fill_rect(out, x0 + bar, y - (s - 1) / 2, tick, s, ink);
+      draw_text(out, x0 + bar + tick + s, std::clamp(y - glyph_h / 2, 0, std::max(0, out.height - glyph_h)),
+                labels[k], ink, s);
+    }
+  }
+  return out;
+}
+
+// ---- PNG I/O ---------------------------------------------------------------------
+
+namespace {
+
+struct FileCloser {
+  void operator()(std::FILE* f) const {
+    if (f) std::fclose(f);
+  }
+};
+
+struct WriteContext {
+  std::FILE* file;
+  bool ok;
+};
+
+void write_to_file(void* context, void* data, int size) {
+  auto* ctx = static_cast<WriteContext*>(context);
+  if (ctx->ok && size > 0)
+    ctx->ok = std::fwrite(data, 1, static_cast<std::size_t>(size), ctx->file) == static_cast<std::size_t>(size);
+}
+
+}  // namespace
+
+void write_png(const std::string& path, const RgbImage& img, bool overwrite) {
+  if (img.width <= 0 || img.height <= 0) throw std::runtime_error(path + ": cannot write an empty image");
+  // "x": the existence check and the creation are one step (no overwrite race).
+  std::unique_ptr<std::FILE, FileCloser> f(std::fopen(path.c_str(), overwrite ? "wb" : "wbx"));
+  if (!f) {
+    if (errno == EEXIST) throw std::runtime_error(path + ": exists (use --force to overwrite)");
+    throw std::runtime_error(path + ": cannot create: " + std::strerror(errno));
+  }
+  WriteContext ctx{f.get(), true};
+  const int encoded = stbi_write_png_to_func(write_to_file, &ctx, img.width, img.height, 3, img.pixels.data(),
+                                             img.width * 3);
+  const bool closed = std::fclose(f.release()) == 0;
+  if (!encoded || !ctx.ok || !closed) {
+    const int err = errno;
+    std::error_code ec;
+    std::filesystem::remove(path, ec);
+    throw std::runtime_error(path + ": write failed" + (err ? std::string(": ") + std::strerror(err) : ""));
+  }
+}
+
+RgbImage read_png(const std::string& path) {
+  int w = 0, h = 0, n = 0;
+  std::unique_ptr<stbi_uc, void (*)(void*)> data(stbi_load(path.c_str(), &w, &h, &n, 3), stbi_image_free);
+  if (!data) throw std::runtime_error(path + ": cannot read image: " + stbi_failure_reason());
+  RgbImage img;
+  img.width = w;
+  img.height = h;
+  img.pixels.assign(data.get(), data.get() + static_cast<std::size_t>(w) * h * 3);
+  return img;
+}
+
+}  // namespace accelviz

@@ -1,0 +1,128 @@
+#pragma once
+// Per-pixel metric images ("heatmaps"): one primary ray per pixel, traced on
+// all threads with per-ray statistics, turned into a value per pixel, then
+// into an RGB image through a colour map with a legend bar, written as PNG.
+// The CPU twin of the GUI's heatmap view, and what `accelviz render` writes.
+#include "core/accel/accel.h"
+#include "core/analysis/colormap.h"
+#include "core/scene/scene.h"
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace accelviz {
+
+enum class HeatMetric {
+  nodes,   ///< RayStats::nodes_visited
+  prims,   ///< RayStats::prim_tests
+  cost,    ///< c_trav · nodes_visited + c_isect · prim_tests (the SAH's cost model, per ray)
+  shaded,  ///< headlight shading |N·L| of the closest hit, grey background: a picture of the scene
+  depth,   ///< distance to the closest hit; misses have no value
+};
+
+std::string_view metric_name(HeatMetric m);                 ///< "nodes", "prims", ...
+std::string_view metric_label(HeatMetric m);                ///< legend title, e.g. "nodes visited per ray"
+std::optional<HeatMetric> parse_metric(std::string_view name);
+/// Whether the metric needs per-ray counters (a slower, instrumented pass).
+bool metric_needs_stats(HeatMetric m);
+
+struct HeatmapOptions {
+  HeatMetric metric = HeatMetric::nodes;
+  int width = 800;          ///< image size in pixels (the legend is added outside it)
+  int height = 600;
+  unsigned threads = 0;     ///< 0: all hardware threads
+  QueryOptions query;       ///< triangle test, ordered traversal
+  float c_trav = 1.0f;      ///< cost metric: cost of a node visit
+  float c_isect = 1.0f;     ///< cost metric: cost of a primitive test
+  ProgressCallback progress;  ///< optional; false cancels (render_metric then throws BuildCancelled)
+};
+
+/// One float per pixel, row-major from the top-left. NaN means "no value"
+/// (a miss, for depth and shaded), drawn as background.
+struct MetricImage {
+  int width = 0;
+  int height = 0;
+  HeatMetric metric = HeatMetric::nodes;
+  std::vector<float> values;
+
+  float at(int x, int y) const { return values[static_cast<std::size_t>(y) * width + x]; }
+};
+
+struct HeatmapFigures {
+  std::uint64_t rays = 0;
+  std::uint64_t hits = 0;
+  double mean = 0.0;        ///< mean over pixels with a value
+  double max = 0.0;         ///< maximum over pixels with a value
+  double render_ms = 0.0;   ///< wall time of the tracing pass (instrumented when the metric needs stats)
+  double rays_per_s = 0.0;  ///< rays / render time
+};
+
+/// The value a pixel gets from its ray, hit and counters.
+float metric_value(HeatMetric m, const Ray& ray, const Hit& hit, const RayStats& stats, float c_trav, float c_isect);
+
+/// Traces one primary ray per pixel and returns the metric image.
+MetricImage render_metric(const Accelerator& accel, const Camera& camera, const HeatmapOptions& opts,
+                          HeatmapFigures* figures = nullptr);
+
+// ---- images ------------------------------------------------------------------
+
+/// 8-bit RGB, row-major from the top-left, 3 bytes per pixel.
+struct RgbImage {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> pixels;
+
+  RgbImage() = default;
+  RgbImage(int w, int h, glm::u8vec3 fill = {0, 0, 0});
+  glm::u8vec3 at(int x, int y) const;
+  void set(int x, int y, glm::u8vec3 c);
+};
+
+/// [0, 1] colour to 8 bits, rounding to nearest.
+glm::u8vec3 to_rgb8(const glm::vec3& c);
+
+enum class LegendPlacement { none, bottom, right };
+std::optional<LegendPlacement> parse_legend_placement(std::string_view name);
+
+struct ColorizeOptions {
+  ColorMap map = ColorMap::viridis;
+  float max = 0.0f;  ///< top of the scale; <= 0: the image's own maximum
+  LegendPlacement legend = LegendPlacement::bottom;
+  glm::vec3 background{0.3f, 0.3f, 0.3f};  ///< pixels without a value (and the shaded metric's misses)
+};
+
+/// Top of the colour scale for `image`: `fixed_max` when > 0, else the image's
+/// maximum; never 0 (an all-zero image uses 1) so the scale stays defined.
+float heatmap_scale_max(const MetricImage& image, float fixed_max);
+
+/// Colour of one metric value under the options (what a pixel of the heatmap
+/// area gets); background for NaN; the shaded metric is drawn in grey.
+glm::u8vec3 heatmap_color(HeatMetric metric, float value, float scale_max, const ColorizeOptions& opts);
+
+/// The metric image mapped through the colour map, values clamped to
+/// [0, scale max], with a legend bar (gradient, ticks, numbers, metric name)
+/// below or to the right of the W×H picture. The shaded metric gets no legend.
+RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts);
+
+/// Tiny built-in 5×7 bitmap font (digits, lowercase letters, M and a few
+/// signs), drawn at an integer scale; unknown characters draw as blanks.
+int text_width(std::string_view text, int scale);
+void draw_text(RgbImage& img, int x, int y, std::string_view text, glm::u8vec3 color, int scale);
+
+/// A legend number: "0", "12", "0.25", "1.5k", "2.3M", "1e-05".
+std::string format_tick(double v);
+
+/// Writes a PNG (stb_image_write). Refuses, with "<file>: exists (use --force
+/// to overwrite)", when the file exists and `overwrite` is false; other failures
+/// are "<file>: <reason>". Throws std::runtime_error.
+void write_png(const std::string& path, const RgbImage& img, bool overwrite = false);
+
+/// Reads any image stb_image understands as 8-bit RGB. Throws std::runtime_error "<file>: <reason>".
+RgbImage read_png(const std::string& path);
+
+}  // namespace accelviz

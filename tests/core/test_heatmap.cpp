@@ -1,0 +1,199 @@
+#include <gtest/gtest.h>
+
+#include "core/accel/brute_force.h"
+#include "core/analysis/heatmap.h"
+#include "core/query/camera.h"
+
+#include <filesystem>
+
+#include <unistd.h>
+
+using namespace accelviz;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// A few overlapping triangles at different depths, so that per-pixel box
+/// tests, primitive tests and depths all vary across the image.
+std::vector<Triangle> tiny_scene() {
+  return {
+      {{-2, -2, 0}, {2, -2, 0}, {0, 2, 0}},
+      {{-1, -1, 1}, {1, -1, 1}, {0, 1, 1}},
+      {{0.5f, 0.5f, -1}, {2.5f, 0.5f, -1}, {1.5f, 2.5f, -1}},
+      {{-3, 1, 2}, {-1, 1, 2}, {-2, 3, 2}},
+  };
+}
+
+Camera tiny_camera() { return look_at({0.3f, 0.2f, 8.0f}, {0.0f, 0.0f, 0.0f}, 0.9f); }
+
+std::string temp_png(const std::string& name) {
+  return (fs::temp_directory_path() / ("accelviz_test_heatmap_" + std::to_string(::getpid()) + "_" + name)).string();
+}
+
+}  // namespace
+
+TEST(Heatmap, PixelValuesEqualWhatTheAcceleratorReports) {
+  const std::vector<Triangle> tris = tiny_scene();
+  const BruteForce accel(tris, BruteForceOptions{.bbox_early_out = true});
+  const Camera cam = tiny_camera();
+  for (HeatMetric metric : {HeatMetric::prims, HeatMetric::cost, HeatMetric::depth, HeatMetric::shaded}) {
+    HeatmapOptions opts;
+    opts.metric = metric;
+    opts.width = 23;
+    opts.height = 17;
+    opts.threads = 2;
+    opts.c_trav = 1.5f;
+    opts.c_isect = 0.5f;
+    HeatmapFigures fig;
+    const MetricImage img = render_metric(accel, cam, opts, &fig);
+    ASSERT_EQ(img.values.size(), 23u * 17u);
+    EXPECT_EQ(fig.rays, 23u * 17u);
+    std::uint64_t hits = 0;
+    double max = 0.0, sum = 0.0;
+    int counted = 0;
+    for (int y = 0; y < opts.height; ++y) {
+      for (int x = 0; x < opts.width; ++x) {
+        const Ray ray = primary_ray(cam, x, y, opts.width, opts.height);
+        RayStats st;
+        const Hit h = accel.closest_hit(ray, opts.query, &st);
+        hits += h.valid();
+        const float v = img.at(x, y);
+        switch (metric) {
+          case HeatMetric::prims: EXPECT_EQ(v, static_cast<float>(st.prim_tests)); break;
+          case HeatMetric::cost: EXPECT_FLOAT_EQ(v, 1.5f * st.nodes_visited + 0.5f * st.prim_tests); break;
+          case HeatMetric::depth:
+            if (h.valid()) EXPECT_EQ(v, h.t);
+            else EXPECT_TRUE(std::isnan(v));
+            break;
+          case HeatMetric::shaded:
+            if (h.valid()) EXPECT_NEAR(v, std::abs(glm::dot(h.ng, ray.direction)), 1e-6f);
+            else EXPECT_TRUE(std::isnan(v));
+            break;
+          default: break;
+        }
+        if (std::isfinite(v)) {
+          max = std::max<double>(max, v);
+          sum += v;
+          ++counted;
+        }
+      }
+    }
+    EXPECT_EQ(fig.hits, hits);
+    EXPECT_GT(hits, 0u);
+    EXPECT_LT(hits, fig.rays);  // some pixels miss: the test covers both cases
+    EXPECT_DOUBLE_EQ(fig.max, max);
+    EXPECT_NEAR(fig.mean, sum / counted, 1e-9 * std::max(1.0, max));
+    EXPECT_GT(fig.render_ms, 0.0);
+  }
+}
+
+TEST(Heatmap, PngHasTheColourTheMapGives) {
+  const std::vector<Triangle> tris = tiny_scene();
+  const BruteForce accel(tris, BruteForceOptions{.bbox_early_out = true});
+  HeatmapOptions opts;
+  opts.metric = HeatMetric::prims;
+  opts.width = 40;
+  opts.height = 30;
+  const MetricImage img = render_metric(accel, tiny_camera(), opts);
+  for (ColorMap map : {ColorMap::viridis, ColorMap::turbo}) {
+    ColorizeOptions co;
+    co.map = map;
+    const RgbImage rgb = colorize(img, co);
+    EXPECT_EQ(rgb.width, 40);
+    EXPECT_GT(rgb.height, 30);  // legend below
+    const std::string path = temp_png(std::string(colormap_name(map)) + ".png");
+    fs::remove(path);
+    write_png(path, rgb);
+    const RgbImage back = read_png(path);
+    ASSERT_EQ(back.width, rgb.width);
+    ASSERT_EQ(back.height, rgb.height);
+    EXPECT_EQ(back.pixels, rgb.pixels);
+    const float max = heatmap_scale_max(img, 0.0f);
+    for (auto [x, y] : {std::pair{20, 15}, std::pair{0, 0}, std::pair{39, 29}, std::pair{10, 20}}) {
+      const glm::u8vec3 expected = to_rgb8(colormap(map, img.at(x, y) / max));
+      EXPECT_EQ(back.at(x, y), expected) << "pixel " << x << "," << y;
+    }
+    fs::remove(path);
+  }
+}
+
+TEST(Heatmap, FixedMaxClampsAndBackgroundForMisses) {
+  MetricImage img;
+  img.width = 3;
+  img.height = 1;
+  img.metric = HeatMetric::depth;
+  img.values = {1.0f, 4.0f, std::nanf("")};
+  ColorizeOptions co;
+  co.max = 2.0f;
+  co.legend = LegendPlacement::none;
+  const RgbImage rgb = colorize(img, co);
+  ASSERT_EQ(rgb.height, 1);
+  EXPECT_EQ(rgb.at(0, 0), to_rgb8(colormap(ColorMap::viridis, 0.5f)));
+  EXPECT_EQ(rgb.at(1, 0), to_rgb8(colormap(ColorMap::viridis, 1.0f)));  // clamped
+  EXPECT_EQ(rgb.at(2, 0), to_rgb8(co.background));
+  EXPECT_FLOAT_EQ(heatmap_scale_max(img, 0.0f), 4.0f);
+}
+
+TEST(Heatmap, LegendPlacements) {
+  MetricImage img;
+  img.width = 64;
+  img.height = 48;
+  img.values.assign(64 * 48, 3.0f);
+  ColorizeOptions co;
+  co.legend = LegendPlacement::right;
+  const RgbImage right = colorize(img, co);
+  EXPECT_EQ(right.height, 48);
+  EXPECT_GT(right.width, 64);
+  co.legend = LegendPlacement::bottom;
+  const RgbImage bottom = colorize(img, co);
+  EXPECT_EQ(bottom.width, 64);
+  EXPECT_GT(bottom.height, 48);
+  // The bottom legend's gradient spans the map: its left end is the map's 0.
+  bool found_low = false;
+  for (int y = 48; y < bottom.height && !found_low; ++y)
+    for (int x = 0; x < 64 && !found_low; ++x) found_low = bottom.at(x, y) == to_rgb8(colormap(ColorMap::viridis, 0.0f));
+  EXPECT_TRUE(found_low);
+  img.metric = HeatMetric::shaded;
+  EXPECT_EQ(colorize(img, co).height, 48);  // no legend for the shaded picture
+}
+
+TEST(Heatmap, WritePngRefusesToOverwrite) {
+  const std::string path = temp_png("exists.png");
+  fs::remove(path);
+  const RgbImage img(4, 4, {10, 20, 30});
+  write_png(path, img);
+  try {
+    write_png(path, RgbImage(2, 2));
+    ADD_FAILURE() << "overwrote";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": exists (use --force to overwrite)");
+  }
+  EXPECT_EQ(read_png(path).width, 4);
+  write_png(path, RgbImage(2, 2), /*overwrite=*/true);
+  EXPECT_EQ(read_png(path).width, 2);
+  fs::remove(path);
+  EXPECT_THROW(read_png(path), std::runtime_error);
+}
+
+TEST(Heatmap, TickFormatting) {
+  EXPECT_EQ(format_tick(0.0), "0");
+  EXPECT_EQ(format_tick(12.0), "12");
+  EXPECT_EQ(format_tick(0.25), "0.25");
+  EXPECT_EQ(format_tick(2500.0), "2500");
+  EXPECT_EQ(format_tick(15300.0), "15.3k");
+  EXPECT_EQ(format_tick(2.3e6), "2.3M");
+  EXPECT_EQ(format_tick(1e-5), "1e-05");
+}
+
+TEST(Heatmap, BitmapTextDrawsKnownGlyphsOnly) {
+  RgbImage img(40, 10, {0, 0, 0});
+  draw_text(img, 0, 0, "1", {255, 255, 255}, 1);
+  // '1': the stem is column 2, rows 0-6; the base row spans columns 1-3.
+  EXPECT_EQ(img.at(2, 0), glm::u8vec3(255));
+  EXPECT_EQ(img.at(1, 6), glm::u8vec3(255));
+  EXPECT_EQ(img.at(0, 0), glm::u8vec3(0));
+  RgbImage blank(40, 10, {0, 0, 0});
+  draw_text(blank, 0, 0, "  ~", {255, 255, 255}, 1);
+  EXPECT_EQ(blank.pixels, RgbImage(40, 10, {0, 0, 0}).pixels);
+  EXPECT_EQ(text_width("12", 2), 22);
+}
