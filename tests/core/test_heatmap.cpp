@@ -62,12 +62,18 @@ TEST(Heatmap, PixelValuesEqualWhatTheAcceleratorReports) {
           case HeatMetric::prims: EXPECT_EQ(v, static_cast<float>(st.prim_tests)); break;
           case HeatMetric::cost: EXPECT_FLOAT_EQ(v, 1.5f * st.nodes_visited + 0.5f * st.prim_tests); break;
           case HeatMetric::depth:
-            if (h.valid()) EXPECT_EQ(v, h.t);
-            else EXPECT_TRUE(std::isnan(v));
+            if (h.valid()) {
+              EXPECT_EQ(v, h.t);
+            } else {
+              EXPECT_TRUE(std::isnan(v));
+            }
             break;
           case HeatMetric::shaded:
-            if (h.valid()) EXPECT_NEAR(v, std::abs(glm::dot(h.ng, ray.direction)), 1e-6f);
-            else EXPECT_TRUE(std::isnan(v));
+            if (h.valid()) {
+              EXPECT_NEAR(v, std::abs(glm::dot(h.ng, ray.direction)), 1e-6f);
+            } else {
+              EXPECT_TRUE(std::isnan(v));
+            }
             break;
           default: break;
         }

@@ -1,0 +1,352 @@
+#include "core/accel/embree_backend.h"
+
+namespace accelviz {
+
+std::string_view embree_quality_name(EmbreeQuality q) {
+  switch (q) {
+    case EmbreeQuality::low: return "low";
+    case EmbreeQuality::medium: return "medium";
+    case EmbreeQuality::high: return "high";
+  }
+  return "medium";
+}
+
+std::optional<EmbreeQuality> parse_embree_quality(std::string_view name) {
+  for (EmbreeQuality q : {EmbreeQuality::low, EmbreeQuality::medium, EmbreeQuality::high})
+    if (embree_quality_name(q) == name) return q;
+  return std::nullopt;
+}
+
+}  // namespace accelviz
+
+#ifdef ACCELVIZ_HAVE_EMBREE
+
+#include "core/analysis/sah.h"
+
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <mutex>
+#include <new>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace accelviz {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+/// A device with an error callback that keeps the first message, and a
+/// memory monitor that tracks what Embree holds. Released on destruction.
+class Device {
+ public:
+  explicit Device(unsigned threads) {
+    const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : std::string();
+    device_ = rtcNewDevice(config.empty() ? nullptr : config.c_str());
+    if (!device_) throw std::runtime_error("embree: cannot create a device (" + error_name(rtcGetDeviceError(nullptr)) + ")");
+    rtcSetDeviceErrorFunction(device_, &Device::on_error, this);
+    rtcSetDeviceMemoryMonitorFunction(device_, &Device::on_memory, this);
+  }
+  ~Device() {
+    if (device_) rtcReleaseDevice(device_);
+  }
+  Device(const Device&) = delete;
+  Device& operator=(const Device&) = delete;
+
+  RTCDevice get() const { return device_; }
+  std::int64_t bytes() const { return bytes_.load(); }
+
+  /// Throws with Embree's own message when an error was reported.
+  void check(const char* step) {
+    const RTCError code = rtcGetDeviceError(device_);
+    std::lock_guard lock(mutex_);
+    if (code != RTC_ERROR_NONE || !message_.empty()) {
+      const std::string msg = message_.empty() ? error_name(code) : message_;
+      message_.clear();
+      throw std::runtime_error(std::string("embree: ") + step + ": " + msg);
+    }
+  }
+
+ private:
+  static std::string error_name(RTCError code) {
+    switch (code) {
+      case RTC_ERROR_NONE: return "no error";
+      case RTC_ERROR_INVALID_ARGUMENT: return "invalid argument";
+      case RTC_ERROR_INVALID_OPERATION: return "invalid operation";
+      case RTC_ERROR_OUT_OF_MEMORY: return "out of memory";
+      case RTC_ERROR_UNSUPPORTED_CPU: return "unsupported CPU";
+      case RTC_ERROR_CANCELLED: return "cancelled";
+      default: return "unknown error";
+    }
+  }
+  static void on_error(void* user, RTCError code, const char* str) {
+    auto* self = static_cast<Device*>(user);
+    std::lock_guard lock(self->mutex_);
+    if (self->message_.empty()) self->message_ = str && *str ? str : error_name(code);
+  }
+  static bool on_memory(void* user, ssize_t bytes, bool /*post*/) {
+    static_cast<Device*>(user)->bytes_.fetch_add(bytes, std::memory_order_relaxed);
+    return true;  // never refuse an allocation
+  }
+
+  RTCDevice device_ = nullptr;
+  std::atomic<std::int64_t> bytes_{0};
+  std::mutex mutex_;
+  std::string message_;
+};
+
+RTCBuildQuality to_rtc(EmbreeQuality q) {
+  switch (q) {
+    case EmbreeQuality::low: return RTC_BUILD_QUALITY_LOW;
+    case EmbreeQuality::medium: return RTC_BUILD_QUALITY_MEDIUM;
+    case EmbreeQuality::high: return RTC_BUILD_QUALITY_HIGH;
+  }
+  return RTC_BUILD_QUALITY_MEDIUM;
+}
+
+}  // namespace
+
+// ---- the accelerator ---------------------------------------------------------------
+
+struct EmbreeAccelerator::Impl {
+  explicit Impl(unsigned threads) : device(threads) {}
+  ~Impl() {
+    if (scene) rtcReleaseScene(scene);
+  }
+
+  Device device;
+  RTCScene scene = nullptr;
+  // Embree reads vertex buffers with 16-byte loads: one spare float3 at the
+  // end keeps the last vertex's load inside our allocation.
+  std::vector<float> vertices;        ///< 3 per triangle corner, plus one padding vertex
+  std::vector<std::uint32_t> indices; ///< 0, 1, 2, ...: triangle i uses corners 3i..3i+2
+};
+
+EmbreeAccelerator::EmbreeAccelerator(std::span<const Triangle> triangles, const EmbreeOptions& opts)
+    : impl_(std::make_unique<Impl>(opts.threads)) {
+  const auto t0 = Clock::now();
+  const std::size_t n = triangles.size();
+  impl_->vertices.resize(9 * n + 3, 0.0f);
+  impl_->indices.resize(3 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::vec3* v[3] = {&triangles[i].v0, &triangles[i].v1, &triangles[i].v2};
+    for (int k = 0; k < 3; ++k) {
+      impl_->vertices[9 * i + 3 * k + 0] = v[k]->x;
+      impl_->vertices[9 * i + 3 * k + 1] = v[k]->y;
+      impl_->vertices[9 * i + 3 * k + 2] = v[k]->z;
+      impl_->indices[3 * i + k] = static_cast<std::uint32_t>(3 * i + k);
+    }
+  }
+
+  Device& dev = impl_->device;
+  impl_->scene = rtcNewScene(dev.get());
+  dev.check("rtcNewScene");
+  rtcSetSceneFlags(impl_->scene, opts.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
+  rtcSetSceneBuildQuality(impl_->scene, to_rtc(opts.quality));
+  if (n > 0) {
+    RTCGeometry geom = rtcNewGeometry(dev.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
+    rtcSetGeometryBuildQuality(geom, to_rtc(opts.quality));
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, impl_->vertices.data(), 0,
+                               3 * sizeof(float), 3 * n);
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, impl_->indices.data(), 0,
+                               3 * sizeof(std::uint32_t), n);
+    rtcCommitGeometry(geom);
+    rtcAttachGeometryByID(impl_->scene, geom, 0);  // geomID 0: the one geometry
+    rtcReleaseGeometry(geom);
+    dev.check("triangle geometry");
+  }
+  rtcCommitScene(impl_->scene);
+  dev.check("rtcCommitScene");
+
+  stats_.build_ms = ms_since(t0);
+  stats_.memory_bytes = static_cast<std::uint64_t>(std::max<std::int64_t>(0, dev.bytes())) +
+                        impl_->vertices.size() * sizeof(float) + impl_->indices.size() * sizeof(std::uint32_t);
+}
+
+EmbreeAccelerator::~EmbreeAccelerator() = default;
+
+namespace {
+
+void fill_ray(RTCRay& r, const Ray& ray) {
+  r.org_x = ray.origin.x;
+  r.org_y = ray.origin.y;
+  r.org_z = ray.origin.z;
+  r.tnear = ray.tmin;
+  r.dir_x = ray.direction.x;
+  r.dir_y = ray.direction.y;
+  r.dir_z = ray.direction.z;
+  r.time = 0.0f;
+  r.tfar = ray.tmax;
+  r.mask = 0xFFFFFFFFu;
+  r.id = 0;
+  r.flags = 0;
+}
+
+}  // namespace
+
+Hit EmbreeAccelerator::closest_hit(const Ray& ray, const QueryOptions&, RayStats*, VisitTrace*) const {
+  RTCRayHit rh;
+  fill_ray(rh.ray, ray);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  rtcIntersect1(impl_->scene, &context, &rh);
+  Hit hit;
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return hit;
+  hit.prim = rh.hit.primID;
+  hit.t = rh.ray.tfar;
+  hit.u = rh.hit.u;  // Embree's barycentrics follow the same convention: p = (1-u-v)v0 + u v1 + v v2
+  hit.v = rh.hit.v;
+  // Our unit normal of (v1-v0)x(v2-v0), the same for every structure (Embree's
+  // Ng is unnormalised and of the opposite orientation).
+  const float* v = impl_->vertices.data() + 9 * static_cast<std::size_t>(hit.prim);
+  hit.ng = triangle_normal({{v[0], v[1], v[2]}, {v[3], v[4], v[5]}, {v[6], v[7], v[8]}});
+  return hit;
+}
+
+bool EmbreeAccelerator::any_hit(const Ray& ray, const QueryOptions&, RayStats*) const {
+  RTCRay r;
+  fill_ray(r, ray);
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  rtcOccluded1(impl_->scene, &context, &r);
+  return r.tfar == -kInfinity;  // Embree marks an occluded ray by setting tfar to -inf
+}
+
+// ---- Embree's binary BVH builder, measured with our SAH ----------------------------
+
+namespace {
+
+/// Nodes the builder's callbacks create, in Embree's thread-local arena (freed
+/// with the RTCBVH). `leaf` distinguishes the two kinds behind a void*.
+struct BuildNode {
+  bool leaf = false;
+  std::uint32_t count = 0;        ///< leaf: primitives
+  BuildNode* children[2] = {nullptr, nullptr};
+  Aabb bounds[2];                 ///< inner: the children's boxes
+};
+
+void* create_node(RTCThreadLocalAllocator alloc, unsigned int child_count, void*) {
+  if (child_count > 2) return nullptr;  // cannot happen with maxBranchingFactor 2
+  void* mem = rtcThreadLocalAlloc(alloc, sizeof(BuildNode), alignof(BuildNode));
+  return new (mem) BuildNode{};
+}
+
+void set_children(void* node, void** children, unsigned int count, void*) {
+  auto* n = static_cast<BuildNode*>(node);
+  for (unsigned i = 0; i < count && i < 2; ++i) n->children[i] = static_cast<BuildNode*>(children[i]);
+}
+
+void set_bounds(void* node, const RTCBounds** bounds, unsigned int count, void*) {
+  auto* n = static_cast<BuildNode*>(node);
+  for (unsigned i = 0; i < count && i < 2; ++i)
+    n->bounds[i] = {{bounds[i]->lower_x, bounds[i]->lower_y, bounds[i]->lower_z},
+                    {bounds[i]->upper_x, bounds[i]->upper_y, bounds[i]->upper_z}};
+}
+
+void* create_leaf(RTCThreadLocalAllocator alloc, const RTCBuildPrimitive*, size_t count, void*) {
+  void* mem = rtcThreadLocalAlloc(alloc, sizeof(BuildNode), alignof(BuildNode));
+  auto* n = new (mem) BuildNode{};
+  n->leaf = true;
+  n->count = static_cast<std::uint32_t>(count);
+  return n;
+}
+
+}  // namespace
+
+EmbreeBvhFigures embree_binary_bvh_sah(std::span<const Triangle> triangles, float c_trav, float c_isect,
+                                       unsigned threads, int min_leaf, int max_leaf) {
+  EmbreeBvhFigures fig;
+  if (triangles.empty()) return fig;
+  if (min_leaf < 1 || max_leaf < min_leaf || max_leaf > RTC_BUILD_MAX_PRIMITIVES_PER_LEAF)
+    throw std::invalid_argument("embree_binary_bvh_sah: need 1 <= min_leaf <= max_leaf <= " +
+                                std::to_string(RTC_BUILD_MAX_PRIMITIVES_PER_LEAF));
+  Device dev(threads);
+  RTCBVH bvh = rtcNewBVH(dev.get());
+  dev.check("rtcNewBVH");
+  struct BvhReleaser {
+    RTCBVH b;
+    ~BvhReleaser() { rtcReleaseBVH(b); }
+  } releaser{bvh};
+
+  const auto t0 = Clock::now();
+  std::vector<RTCBuildPrimitive> prims(triangles.size());
+  Aabb root_bounds;
+  for (std::size_t i = 0; i < triangles.size(); ++i) {
+    const Aabb b = triangles[i].bounds();
+    root_bounds.extend(b);
+    prims[i].lower_x = b.lo.x;
+    prims[i].lower_y = b.lo.y;
+    prims[i].lower_z = b.lo.z;
+    prims[i].geomID = 0;
+    prims[i].upper_x = b.hi.x;
+    prims[i].upper_y = b.hi.y;
+    prims[i].upper_z = b.hi.z;
+    prims[i].primID = static_cast<unsigned>(i);
+  }
+  RTCBuildArguments args = rtcDefaultBuildArguments();
+  args.buildQuality = RTC_BUILD_QUALITY_MEDIUM;
+  args.maxBranchingFactor = 2;
+  args.maxDepth = 64;  // our builder's depth limit (kBvhMaxDepth)
+  args.sahBlockSize = 1;
+  args.minLeafSize = static_cast<unsigned>(min_leaf);
+  args.maxLeafSize = static_cast<unsigned>(max_leaf);
+  args.traversalCost = c_trav;
+  args.intersectionCost = c_isect;
+  args.bvh = bvh;
+  args.primitives = prims.data();
+  args.primitiveCount = prims.size();
+  args.primitiveArrayCapacity = prims.size();
+  args.createNode = create_node;
+  args.setNodeChildren = set_children;
+  args.setNodeBounds = set_bounds;
+  args.createLeaf = create_leaf;
+  auto* root = static_cast<BuildNode*>(rtcBuildBVH(&args));
+  fig.build_ms = ms_since(t0);
+  dev.check("rtcBuildBVH");
+  if (!root) throw std::runtime_error("embree: rtcBuildBVH returned no tree");
+
+  // Flatten into our layout (children adjacent, after their parent) so that the
+  // very same SAH and shape functions measure both trees.
+  std::vector<BvhNode> nodes;
+  nodes.reserve(2 * triangles.size() / static_cast<std::size_t>(min_leaf) + 1);
+  nodes.push_back({root_bounds, 0, 0});
+  std::vector<std::pair<const BuildNode*, std::uint32_t>> stack{{root, 0u}};
+  while (!stack.empty()) {
+    const auto [n, slot] = stack.back();
+    stack.pop_back();
+    if (n->leaf) {
+      nodes[slot].index = 0;
+      nodes[slot].count = n->count;
+      continue;
+    }
+    const auto first = static_cast<std::uint32_t>(nodes.size());
+    nodes[slot].index = first;
+    nodes[slot].count = 0;
+    for (int k = 0; k < 2; ++k) {
+      nodes.push_back({n->bounds[k], 0, 0});
+      stack.push_back({n->children[k], first + static_cast<std::uint32_t>(k)});
+    }
+  }
+  fig.sah_cost = bvh_sah_cost(nodes, c_trav, c_isect);
+  const TreeShape shape = bvh_tree_shape(nodes);
+  fig.node_count = nodes.size();
+  fig.leaf_count = shape.leaf_count;
+  fig.max_depth = shape.max_depth;
+  fig.avg_leaf_depth = shape.avg_leaf_depth;
+  return fig;
+}
+
+}  // namespace accelviz
+
+#endif  // ACCELVIZ_HAVE_EMBREE
