@@ -1,0 +1,10 @@
+#version 450 core
+// One triangle that covers the viewport, generated from gl_VertexID (no
+// vertex buffer). v_uv is (0,0) at the bottom-left corner, (1,1) top-right.
+out vec2 v_uv;
+
+void main() {
+  vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);
+  v_uv = p;
+  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}

@@ -1,0 +1,108 @@
+#pragma once
+// Shared by the tests in tests/gl: an OSMesa GL 4.5 core context per test,
+// a renderer on it, small synthetic scenes, and pixel helpers.
+#include "core/geometry/triangle.h"
+#include "ui/gl/osmesa_context.h"
+#include "ui/render/image.h"
+#include "ui/render/renderer.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace accelviz::test {
+
+/// Image sizes stay small: llvmpipe on two cores draws them in milliseconds.
+inline constexpr int kWidth = 128;
+inline constexpr int kHeight = 96;
+
+class GlTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    context_ = std::make_unique<OsMesaContext>(kWidth, kHeight);
+    renderer_ = std::make_unique<Renderer>();
+  }
+  void TearDown() override {
+    renderer_.reset();  // GL objects go while their context is alive
+    context_.reset();
+  }
+
+  Rgba8Image draw(const RenderView& view, int width = kWidth, int height = kHeight) {
+    renderer_->render(view, width, height);
+    return renderer_->read_pixels();
+  }
+
+  std::unique_ptr<OsMesaContext> context_;
+  std::unique_ptr<Renderer> renderer_;
+};
+
+/// A camera at `eye` looking at `target`, world +Y up.
+inline Camera look_from(const glm::vec3& eye, const glm::vec3& target, float yfov = 0.8f) {
+  Camera c;
+  c.position = eye;
+  c.forward = glm::normalize(target - eye);
+  const glm::vec3 right = glm::normalize(glm::cross(c.forward, glm::vec3(0.0f, 1.0f, 0.0f)));
+  c.up = glm::cross(right, c.forward);
+  c.yfov = yfov;
+  return c;
+}
+
+/// Two triangles making the square [x0,x1]×[y0,y1] at height z (facing +z).
+inline void add_quad_xy(std::vector<Triangle>& out, float x0, float y0, float x1, float y1, float z) {
+  out.push_back({{x0, y0, z}, {x1, y0, z}, {x1, y1, z}});
+  out.push_back({{x0, y0, z}, {x1, y1, z}, {x0, y1, z}});
+}
+
+/// The 12 triangles of a box.
+inline void add_box(std::vector<Triangle>& out, const glm::vec3& lo, const glm::vec3& hi) {
+  const glm::vec3 c[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {lo.x, hi.y, lo.z},
+                          {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}};
+  const int faces[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}};
+  for (const auto& f : faces) {
+    out.push_back({c[f[0]], c[f[1]], c[f[2]]});
+    out.push_back({c[f[0]], c[f[2]], c[f[3]]});
+  }
+}
+
+inline glm::u8vec4 to_rgba8(const glm::vec3& c) {
+  auto q = [](float v) { return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); };
+  return {q(c.x), q(c.y), q(c.z), 255};
+}
+
+/// Largest per-channel difference (RGB) between two colours.
+inline int channel_diff(glm::u8vec4 a, glm::u8vec4 b) {
+  int d = 0;
+  for (int i = 0; i < 3; ++i) d = std::max(d, std::abs(int(a[i]) - int(b[i])));
+  return d;
+}
+
+inline std::string describe(glm::u8vec4 c) {
+  return "(" + std::to_string(c.x) + "," + std::to_string(c.y) + "," + std::to_string(c.z) + ")";
+}
+
+/// A fresh empty directory under the system temp dir, removed by the destructor.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& tag) {
+    std::string pattern = (std::filesystem::temp_directory_path() / ("accelviz-" + tag + "-XXXXXX")).string();
+    if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
+    path_ = pattern;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+}  // namespace accelviz::test
