@@ -307,7 +307,7 @@ RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
   int extra_w = 0, extra_h = 0;
   if (legend == LegendPlacement::bottom) extra_h = pad + glyph_h + pad + bar + tick + s + glyph_h + pad;
   if (legend == LegendPlacement::right)
-    extra_w = std::max(pad + bar + tick + s + widest + pad, text_width(metric_name(image.metric), s) + 2 * pad);
+    extra_w = std::max(pad + bar + tick + 3 * s + widest + pad, text_width(metric_name(image.metric), s) + 2 * pad);
 
   const glm::u8vec3 panel(24, 24, 24), ink(235, 235, 235);
   RgbImage out(w + extra_w, h + extra_h, panel);
@@ -344,7 +344,8 @@ RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
     for (int k = 0; k < kTicks; ++k) {
       const int y = yb - static_cast<int>(std::lround(static_cast<double>(yb - yt) * k / (kTicks - 1)));
       fill_rect(out, x0 + bar, y - (s - 1) / 2, tick, s, ink);
-      draw_text(out, x0 + bar + tick + s, std::clamp(y - glyph_h / 2, 0, std::max(0, out.height - glyph_h)),
+      // A gap after the tick so that it does not read as a minus sign.
+      draw_text(out, x0 + bar + tick + 3 * s, std::clamp(y - glyph_h / 2, 0, std::max(0, out.height - glyph_h)),
                 labels[k], ink, s);
     }
   }

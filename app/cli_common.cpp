@@ -1,0 +1,189 @@
+#include "app/cli_common.h"
+
+#include "core/query/camera.h"
+#include "core/scene/load.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include <unistd.h>
+
+namespace accelviz::cli {
+
+namespace fs = std::filesystem;
+
+ImageSize parse_size(const std::string& text) {
+  const std::size_t x = text.find_first_of("xX");
+  auto side = [&](std::string_view s, int& out) {
+    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
+    return !s.empty() && ec == std::errc() && ptr == s.data() + s.size() && out >= 1 && out <= 16384;
+  };
+  ImageSize size;
+  if (x == std::string::npos || !side(std::string_view(text).substr(0, x), size.width) ||
+      !side(std::string_view(text).substr(x + 1), size.height))
+    throw UsageError("size '" + text + "': expected WxH with each side in 1..16384, e.g. 800x600");
+  return size;
+}
+
+CLI::Validator size_validator() {
+  return CLI::Validator(
+      [](std::string& value) -> std::string {
+        try {
+          parse_size(value);
+          return {};
+        } catch (const UsageError& e) {
+          return e.what();
+        }
+      },
+      "WxH", "size");
+}
+
+void StructureCli::add_to(CLI::App* app) {
+  app->add_option("--splitter", splitter, "BVH split strategy: binned (binned SAH), exact (full SAH sweep), median")
+      ->check(CLI::IsMember({"binned", "exact", "median"}))
+      ->capture_default_str()
+      ->group("Structure");
+  app->add_option("--buckets", buckets, "BVH binned-SAH bucket count")
+      ->check(CLI::Range(2, 256))
+      ->capture_default_str()
+      ->group("Structure");
+  app->add_option("--leaf", leaf, "BVH: nodes with at most this many triangles always become leaves")
+      ->check(CLI::Range(1, 255))
+      ->capture_default_str()
+      ->group("Structure");
+  app->add_option("--leaf-cap", leaf_cap, "BVH: SAH may keep up to this many triangles in a leaf when cheaper")
+      ->check(CLI::Range(1, 255))
+      ->capture_default_str()
+      ->group("Structure");
+  app->add_option("--ctrav", ctrav, "SAH cost of visiting an inner node (C_trav)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str()
+      ->group("Structure");
+  app->add_option("--cisect", cisect, "SAH cost of one ray-triangle test (C_isect)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str()
+      ->group("Structure");
+  app->add_option("--embree-quality", embree_quality, "Embree build quality: low, medium, high")
+      ->check(CLI::IsMember({"low", "medium", "high"}))
+      ->capture_default_str()
+      ->group("Structure");
+}
+
+StructureOptions StructureCli::to_options(unsigned threads, bool compute_epo) const {
+  StructureOptions o;
+  o.threads = threads;
+  o.bvh.splitter = splitter == "exact"    ? BvhSplitter::exact_sah
+                   : splitter == "median" ? BvhSplitter::median
+                                          : BvhSplitter::binned_sah;
+  o.bvh.buckets = buckets;
+  o.bvh.max_leaf_size = leaf;
+  // The cap can never be below the always-leaf size; raise it with --leaf.
+  o.bvh.leaf_size_cap = std::max(leaf, leaf_cap);
+  o.bvh.cost_traversal = ctrav;
+  o.bvh.cost_intersect = cisect;
+  o.bvh.compute_epo = compute_epo;
+  o.embree.quality = parse_embree_quality(embree_quality).value_or(EmbreeQuality::medium);
+  return o;
+}
+
+Camera camera_for(const std::string& spec, const Scene& scene, const ImageSize& size) {
+  try {
+    return camera_from_spec(spec, scene, static_cast<float>(size.width) / static_cast<float>(size.height));
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--camera: ") + e.what());
+  }
+}
+
+TriangleTest parse_triangle_test(const std::string& name) {
+  if (name == "watertight") return TriangleTest::watertight;
+  if (name == "fast") return TriangleTest::moller_trumbore;
+  throw UsageError("triangle test '" + name + "': expected watertight or fast");
+}
+
+Scene load_scene_noting_warnings(const std::string& spec, bool quiet) {
+  Scene scene = load_scene(spec);
+  if (!quiet && !scene.report.warnings.empty())
+    std::fprintf(stderr, "accelviz: %s: %zu loader warning(s); `accelviz info` lists them\n", spec.c_str(),
+                 scene.report.warnings.size());
+  return scene;
+}
+
+void check_output_path(const std::string& path, bool force) {
+  std::error_code ec;
+  const fs::path p(path);
+  if (fs::is_directory(p, ec)) throw std::runtime_error(path + ": is a directory");
+  if (!force && fs::exists(p, ec)) throw std::runtime_error(path + ": exists (use --force to overwrite)");
+  const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  if (!fs::is_directory(dir, ec)) throw std::runtime_error(path + ": directory " + dir.string() + " does not exist");
+}
+
+std::string absolute_path(const std::string& path) {
+  std::error_code ec;
+  const fs::path abs = fs::absolute(path, ec);
+  return ec ? path : abs.lexically_normal().string();
+}
+
+void print_json_line(const nlohmann::json& j) {
+  std::cout << j.dump() << std::endl;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+Progress::Progress(bool quiet) : quiet_(quiet), tty_(::isatty(STDERR_FILENO) == 1) {}
+
+void Progress::begin(const std::string& label) {
+  label_ = label;
+  last_ = Clock::now();
+  if (quiet_) return;
+  if (tty_) {
+    std::fprintf(stderr, "\r\033[K%s ...", label_.c_str());
+    std::fflush(stderr);
+  }
+}
+
+ProgressCallback Progress::callback() {
+  if (quiet_ || !tty_) return {};
+  return [this](double fraction) {
+    // A few updates a second are plenty; a thread that finds another one
+    // printing skips its update rather than wait.
+    std::unique_lock lock(mutex_, std::try_to_lock);
+    if (!lock.owns_lock()) return true;
+    const auto now = Clock::now();
+    if (now - last_ < std::chrono::milliseconds(200)) return true;
+    last_ = now;
+    std::fprintf(stderr, "\r\033[K%s %3.0f%%", label_.c_str(), 100.0 * std::clamp(fraction, 0.0, 1.0));
+    std::fflush(stderr);
+    return true;
+  };
+}
+
+void Progress::end(const std::string& result) {
+  if (quiet_) return;
+  if (tty_) std::fprintf(stderr, "\r\033[K");
+  std::fprintf(stderr, "%s%s%s\n", label_.c_str(), result.empty() ? "" : ": ", result.c_str());
+  std::fflush(stderr);
+}
+
+std::string format_bytes(std::uint64_t bytes) {
+  char buf[32];
+  if (bytes < 1024) {
+    std::snprintf(buf, sizeof buf, "%llu B", static_cast<unsigned long long>(bytes));
+  } else if (bytes < 1024ull * 1024) {
+    std::snprintf(buf, sizeof buf, "%.1f KiB", static_cast<double>(bytes) / 1024.0);
+  } else if (bytes < 1024ull * 1024 * 1024) {
+    std::snprintf(buf, sizeof buf, "%.1f MiB", static_cast<double>(bytes) / (1024.0 * 1024.0));
+  } else {
+    std::snprintf(buf, sizeof buf, "%.2f GiB", static_cast<double>(bytes) / (1024.0 * 1024.0 * 1024.0));
+  }
+  return buf;
+}
+
+}  // namespace accelviz::cli

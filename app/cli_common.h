@@ -1,0 +1,125 @@
+#pragma once
+// What the subcommands share: option groups, parsing of small values, output
+// file rules, progress on stderr, timing. Thin: the work happens in core/.
+#include "core/accel/factory.h"
+#include "core/geometry/triangle.h"
+#include "core/scene/scene.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <functional>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace accelviz::cli {
+
+/// A registered subcommand: its CLI11 app and what runs it once parsed.
+struct Command {
+  CLI::App* app = nullptr;
+  std::function<int()> run;
+};
+
+/// Options every subcommand sees.
+struct GlobalOptions {
+  bool quiet = false;  ///< no progress on stderr
+};
+
+Command add_info_command(CLI::App& parent, const GlobalOptions& global);
+Command add_render_command(CLI::App& parent, const GlobalOptions& global);
+Command add_bench_command(CLI::App& parent, const GlobalOptions& global);
+Command add_trace_command(CLI::App& parent, const GlobalOptions& global);
+Command add_rays_command(CLI::App& parent, const GlobalOptions& global);
+/// `accelviz` without a subcommand: the demo heatmap (until the GUI lands).
+int run_demo(const GlobalOptions& global);
+
+/// A semantic usage problem found after parsing (exit code 2, like CLI11's own).
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// ---- values ------------------------------------------------------------------
+
+struct ImageSize {
+  int width = 800;
+  int height = 600;
+};
+
+/// "800x600" (also "800X600"); each side 1..16384. Throws UsageError.
+ImageSize parse_size(const std::string& text);
+/// CLI11 validator for parse_size.
+CLI::Validator size_validator();
+
+// ---- option groups -------------------------------------------------------------
+
+/// --structure options shared by render, bench, trace and rays.
+struct StructureCli {
+  std::string splitter = "binned";
+  int buckets = BvhOptions{}.buckets;
+  int leaf = BvhOptions{}.max_leaf_size;
+  int leaf_cap = BvhOptions{}.leaf_size_cap;
+  float ctrav = BvhOptions{}.cost_traversal;
+  float cisect = BvhOptions{}.cost_intersect;
+  std::string embree_quality = "medium";
+
+  void add_to(CLI::App* app);
+  /// Options for the factory; `threads` is the build thread count.
+  StructureOptions to_options(unsigned threads, bool compute_epo) const;
+};
+
+/// camera_from_spec with a bad spec reported as a usage error.
+Camera camera_for(const std::string& spec, const Scene& scene, const ImageSize& size);
+
+/// --triangle-test watertight|fast.
+TriangleTest parse_triangle_test(const std::string& name);
+
+// ---- scenes, files, output -------------------------------------------------------
+
+/// load_scene, then a note on stderr when the loader reported warnings.
+Scene load_scene_noting_warnings(const std::string& spec, bool quiet);
+
+/// Fails early (before any long work) when `path` exists and `force` is off,
+/// or its directory does not exist: "<path>: exists (use --force to overwrite)".
+void check_output_path(const std::string& path, bool force);
+
+/// Absolute, normalised form of a path for messages.
+std::string absolute_path(const std::string& path);
+
+/// One-line JSON on stdout.
+void print_json_line(const nlohmann::json& j);
+
+/// Median of the values (mean of the two middle ones for an even count); 0 if empty.
+double median(std::vector<double> v);
+
+// ---- progress and timing -----------------------------------------------------------
+
+/// Progress on stderr: on a terminal, one line updated in place; otherwise
+/// one line per finished step. Silent when quiet.
+class Progress {
+ public:
+  explicit Progress(bool quiet);
+  void begin(const std::string& label);
+  /// A ProgressCallback for builders and batches (never cancels).
+  ProgressCallback callback();
+  void end(const std::string& result = {});
+
+ private:
+  bool quiet_;
+  bool tty_;
+  std::string label_;
+  std::chrono::steady_clock::time_point last_;
+  std::mutex mutex_;  ///< builders may report from several threads
+};
+
+using Clock = std::chrono::steady_clock;
+inline double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+/// "12.3 MiB", "512 B" for humans.
+std::string format_bytes(std::uint64_t bytes);
+
+}  // namespace accelviz::cli

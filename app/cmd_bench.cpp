@@ -1,0 +1,371 @@
+// accelviz bench SCENE: build and query figures of one or more structures on
+// the same ray sets (primary, diffuse, shadow), as medians of repeated runs,
+// quoted against Embree when it is among the structures.
+//
+// Protocol (docs/cli.md): the ray sets are generated once, from the first
+// structure's primary hits. Per structure: `repeat` builds (median build
+// time; the other build figures are deterministic and come from the last
+// build); per ray set, closest-hit and any-hit throughput on one thread and
+// on all threads, each the median of `repeat` timed passes without counters;
+// then one instrumented pass for the mean node visits and primitive tests
+// per ray, kept out of the timings.
+#include "app/cli_common.h"
+
+#include "core/query/batch.h"
+#include "core/query/camera.h"
+#include "core/query/ray_sets.h"
+#include "core/util/parallel.h"
+
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <optional>
+
+namespace accelviz::cli {
+
+namespace {
+
+struct BenchOptions {
+  std::string scene;
+  std::vector<std::string> structures;
+  std::string rays = "all";
+  std::string size = "800x600";
+  int repeat = 5;
+  unsigned threads = 0;
+  bool json = false;
+  std::string camera;
+  std::uint64_t seed = 1;
+  std::string triangle_test = "watertight";
+  bool no_epo = false;
+  StructureCli structure_opts;
+};
+
+struct RaySet {
+  std::string name;
+  std::vector<Ray> rays;
+};
+
+struct QueryFigures {
+  double closest_1t = 0, closest_nt = 0, any_1t = 0, any_nt = 0;  ///< Mrays/s, medians
+  double closest_nodes = 0, closest_prims = 0, closest_boxes = 0;  ///< per ray, instrumented pass
+  double any_nodes = 0, any_prims = 0, any_boxes = 0;
+  double hit_fraction = 0, occluded_fraction = 0;
+};
+
+struct StructureResult {
+  std::string name;
+  std::vector<double> build_ms;
+  BuildStats stats;  ///< of the last build
+  std::optional<EmbreeBvhFigures> embree_bvh;  ///< bvh only: Embree's binary rtcBuildBVH on the same input
+  std::vector<std::pair<std::string, QueryFigures>> queries;
+};
+
+double mrays(std::size_t n, double ms) { return ms > 0.0 ? static_cast<double>(n) / (ms * 1e3) : 0.0; }
+
+template <typename Trace>
+double timed_median(int repeat, std::size_t n, Trace&& trace) {
+  std::vector<double> v;
+  for (int r = 0; r < repeat; ++r) {
+    const auto t0 = Clock::now();
+    trace();
+    v.push_back(mrays(n, ms_since(t0)));
+  }
+  return median(v);
+}
+
+QueryFigures measure(const Accelerator& accel, const std::vector<Ray>& rays, const QueryOptions& q, unsigned all,
+                     int repeat, Progress& progress, const std::string& label) {
+  QueryFigures f;
+  const std::size_t n = rays.size();
+  if (n == 0) return f;
+  std::vector<Hit> hits(n);
+  std::vector<std::uint8_t> occluded(n);
+  progress.begin(label + ": closest hit, 1 thread");
+  f.closest_1t = timed_median(repeat, n, [&] { trace_closest(accel, rays, hits, q, 1u); });
+  progress.end();
+  progress.begin(label + ": closest hit, " + std::to_string(all) + " threads");
+  f.closest_nt = timed_median(repeat, n, [&] { trace_closest(accel, rays, hits, q, all); });
+  progress.end();
+  progress.begin(label + ": any hit, 1 thread");
+  f.any_1t = timed_median(repeat, n, [&] { trace_any(accel, rays, occluded, q, 1u); });
+  progress.end();
+  progress.begin(label + ": any hit, " + std::to_string(all) + " threads");
+  f.any_nt = timed_median(repeat, n, [&] { trace_any(accel, rays, occluded, q, all); });
+  progress.end();
+
+  progress.begin(label + ": counting pass");
+  std::vector<RayStats> stats(n);
+  trace_closest(accel, rays, hits, q, all, stats);
+  double nodes = 0, prims = 0, boxes = 0, hit_count = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    nodes += stats[i].nodes_visited;
+    prims += stats[i].prim_tests;
+    boxes += stats[i].box_tests;
+    hit_count += hits[i].valid();
+  }
+  f.closest_nodes = nodes / n;
+  f.closest_prims = prims / n;
+  f.closest_boxes = boxes / n;
+  f.hit_fraction = hit_count / n;
+  trace_any(accel, rays, occluded, q, all, stats);
+  nodes = prims = boxes = hit_count = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    nodes += stats[i].nodes_visited;
+    prims += stats[i].prim_tests;
+    boxes += stats[i].box_tests;
+    hit_count += occluded[i];
+  }
+  f.any_nodes = nodes / n;
+  f.any_prims = prims / n;
+  f.any_boxes = boxes / n;
+  f.occluded_fraction = hit_count / n;
+  progress.end();
+  return f;
+}
+
+nlohmann::json query_json(const QueryFigures& f) {
+  return {
+      {"closest_mrays_1t", f.closest_1t},       {"closest_mrays_nt", f.closest_nt},
+      {"any_mrays_1t", f.any_1t},               {"any_mrays_nt", f.any_nt},
+      {"closest_nodes_per_ray", f.closest_nodes}, {"closest_prims_per_ray", f.closest_prims},
+      {"closest_boxes_per_ray", f.closest_boxes}, {"any_nodes_per_ray", f.any_nodes},
+      {"any_prims_per_ray", f.any_prims},       {"any_boxes_per_ray", f.any_boxes},
+      {"hit_fraction", f.hit_fraction},         {"occluded_fraction", f.occluded_fraction},
+  };
+}
+
+double ratio(double ours, double theirs) { return theirs > 0.0 ? ours / theirs : 0.0; }
+
+int run_bench(BenchOptions o, const GlobalOptions& global) {
+  if (o.structures.empty()) o.structures = kHaveEmbree ? std::vector<std::string>{"bvh", "embree"}
+                                                       : std::vector<std::string>{"bvh"};
+  if (o.repeat < 1) throw UsageError("--repeat must be at least 1");
+  const ImageSize size = parse_size(o.size);
+  const unsigned all = resolve_threads(o.threads);
+  QueryOptions q;
+  q.triangle_test = parse_triangle_test(o.triangle_test);
+  Progress progress(global.quiet);
+
+  progress.begin("loading " + o.scene);
+  const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
+  progress.end(std::to_string(scene.triangles.size()) + " triangles");
+  const StructureOptions so = o.structure_opts.to_options(o.threads, /*compute_epo=*/!o.no_epo);
+
+  // ---- ray sets, from the first structure's primary hits ----
+  const Camera camera =
+      camera_for(o.camera, scene, size);
+  std::vector<RaySet> sets;
+  sets.push_back({"primary", primary_rays(camera, size.width, size.height)});
+  bool synthetic_light = false;
+  std::optional<glm::vec3> synthetic_position;
+  const bool want_diffuse = o.rays == "all" || o.rays == "diffuse";
+  const bool want_shadow = o.rays == "all" || o.rays == "shadow";
+  if (want_diffuse || want_shadow) {
+    progress.begin("primary hits for the secondary rays (" + o.structures.front() + ")");
+    StructureOptions quick = so;
+    quick.bvh.compute_epo = false;
+    const std::unique_ptr<Accelerator> ref = build_accelerator(o.structures.front(), scene.triangles, quick);
+    std::vector<Hit> hits(sets[0].rays.size());
+    trace_closest(*ref, sets[0].rays, hits, q, all);
+    progress.end();
+    if (want_diffuse) sets.push_back({"diffuse", diffuse_rays(scene.triangles, sets[0].rays, hits, o.seed)});
+    if (want_shadow) {
+      std::vector<Light> lights = scene.lights;
+      if (lights.empty()) {
+        // Benchmark-only stand-in, reported in the output.
+        lights.push_back(synthetic_bench_light(scene.bounds()));
+        synthetic_light = true;
+        synthetic_position = lights[0].position;
+      }
+      sets.push_back({"shadow", shadow_rays(scene.triangles, sets[0].rays, hits, lights)});
+    }
+  }
+  if (o.rays != "all" && o.rays != "primary") sets.erase(sets.begin());
+  if (synthetic_light && !global.quiet)
+    std::fprintf(stderr, "accelviz: %s has no lights: shadow rays aim at a synthetic point light at (%g, %g, %g) "
+                         "(benchmark only)\n",
+                 o.scene.c_str(), synthetic_position->x, synthetic_position->y, synthetic_position->z);
+
+  // ---- per structure ----
+  std::vector<StructureResult> results;
+  for (const std::string& name : o.structures) {
+    StructureResult r;
+    r.name = name;
+    std::unique_ptr<Accelerator> accel;
+    for (int k = 0; k < o.repeat; ++k) {
+      progress.begin("building " + name + " (" + std::to_string(k + 1) + "/" + std::to_string(o.repeat) + ")");
+      accel.reset();  // never two copies in memory
+      accel = build_accelerator(name, scene.triangles, so, progress.callback());
+      r.build_ms.push_back(accel->build_stats().build_ms);
+      progress.end(std::to_string(static_cast<long long>(r.build_ms.back())) + " ms");
+    }
+    r.stats = accel->build_stats();
+#ifdef ACCELVIZ_HAVE_EMBREE
+    if (name == "bvh" && !scene.triangles.empty()) {
+      progress.begin("Embree rtcBuildBVH binary tree for the SAH comparison");
+      r.embree_bvh = embree_binary_bvh_sah(scene.triangles, so.bvh.cost_traversal, so.bvh.cost_intersect, o.threads,
+                                           so.bvh.max_leaf_size, std::min(so.bvh.leaf_size_cap, 32));
+      progress.end();
+    }
+#endif
+    for (const RaySet& set : sets)
+      r.queries.push_back({set.name, measure(*accel, set.rays, q, all, o.repeat, progress, name + " " + set.name)});
+    results.push_back(std::move(r));
+  }
+
+  const StructureResult* embree = nullptr;
+  for (const StructureResult& r : results)
+    if (r.name == "embree") embree = &r;
+
+  // ---- JSON ----
+  nlohmann::json j;
+  j["scene"] = o.scene;
+  j["triangles"] = scene.triangles.size();
+  j["threads"] = all;
+  j["repeat"] = o.repeat;
+  j["size"] = {size.width, size.height};
+  j["triangle_test"] = o.triangle_test;
+  j["ray_sets"] = nlohmann::json::object();
+  for (const RaySet& set : sets) {
+    j["ray_sets"][set.name] = {{"rays", set.rays.size()}};
+    if (set.name == "shadow") {
+      j["ray_sets"]["shadow"]["synthetic_light"] = synthetic_light;
+      j["ray_sets"]["shadow"]["lights"] = synthetic_light ? 1 : scene.lights.size();
+    }
+    if (set.name == "diffuse") j["ray_sets"]["diffuse"]["seed"] = o.seed;
+  }
+  j["structures"] = nlohmann::json::array();
+  for (const StructureResult& r : results) {
+    nlohmann::json s;
+    s["name"] = r.name;
+    s["build"] = {
+        {"build_ms", median(r.build_ms)},     {"build_ms_runs", r.build_ms},
+        {"nodes", r.stats.node_count},        {"leaves", r.stats.leaf_count},
+        {"max_depth", r.stats.max_depth},     {"avg_leaf_depth", r.stats.avg_leaf_depth},
+        {"memory_bytes", r.stats.memory_bytes}, {"sah_cost", r.stats.sah_cost},
+    };
+    for (const auto& [k, v] : r.stats.extra) s["build"][k] = v;
+    if (r.embree_bvh) {
+      s["embree_binary_bvh"] = {
+          {"sah_cost", r.embree_bvh->sah_cost},     {"build_ms", r.embree_bvh->build_ms},
+          {"nodes", r.embree_bvh->node_count},      {"leaves", r.embree_bvh->leaf_count},
+          {"max_depth", r.embree_bvh->max_depth},   {"sah_ratio_ours_over_embree", ratio(r.stats.sah_cost, r.embree_bvh->sah_cost)},
+      };
+    }
+    // Embree keeps no per-ray counters: its *_per_ray figures are 0 and marked so.
+    s["per_ray_counters"] = r.name != "embree";
+    s["rays"] = nlohmann::json::object();
+    for (const auto& [set, f] : r.queries) s["rays"][set] = query_json(f);
+    j["structures"].push_back(s);
+  }
+  if (embree) {
+    j["ratios_vs_embree"] = nlohmann::json::object();
+    for (const StructureResult& r : results) {
+      if (&r == embree) continue;
+      nlohmann::json rr = {{"build_ms", ratio(median(r.build_ms), median(embree->build_ms))},
+                           {"memory_bytes", ratio(static_cast<double>(r.stats.memory_bytes),
+                                                  static_cast<double>(embree->stats.memory_bytes))}};
+      for (std::size_t k = 0; k < r.queries.size(); ++k) {
+        const QueryFigures& a = r.queries[k].second;
+        const QueryFigures& b = embree->queries[k].second;
+        rr[r.queries[k].first] = {{"closest_mrays_1t", ratio(a.closest_1t, b.closest_1t)},
+                                  {"closest_mrays_nt", ratio(a.closest_nt, b.closest_nt)},
+                                  {"any_mrays_1t", ratio(a.any_1t, b.any_1t)},
+                                  {"any_mrays_nt", ratio(a.any_nt, b.any_nt)}};
+      }
+      j["ratios_vs_embree"][r.name] = rr;
+    }
+  }
+  if (o.json) {
+    std::cout << j.dump(2) << std::endl;
+    return 0;
+  }
+
+  // ---- text ----
+  std::printf("scene %s: %zu triangles; %u threads; medians of %d runs; %s triangle test\n", o.scene.c_str(),
+              scene.triangles.size(), all, o.repeat, o.triangle_test.c_str());
+  for (const RaySet& set : sets)
+    std::printf("  %-8s %zu rays%s\n", set.name.c_str(), set.rays.size(),
+                set.name == "shadow" && synthetic_light ? " (to a synthetic light: the scene has none)" : "");
+  for (const StructureResult& r : results) {
+    std::printf("\n%s\n", r.name.c_str());
+    const bool has_counters = r.name != "embree";  // Embree exposes neither its tree nor per-ray counters
+    std::printf("  build %.1f ms", median(r.build_ms));
+    if (r.stats.node_count > 0)
+      std::printf(", nodes %llu, leaves %llu, depth %u", static_cast<unsigned long long>(r.stats.node_count),
+                  static_cast<unsigned long long>(r.stats.leaf_count), r.stats.max_depth);
+    std::printf(", memory %s", format_bytes(r.stats.memory_bytes).c_str());
+    if (r.stats.sah_cost > 0.0) std::printf(", SAH %.3f", r.stats.sah_cost);
+    for (const auto& [k, v] : r.stats.extra) std::printf(", %s %.4g", k.c_str(), v);
+    std::printf("\n");
+    if (r.embree_bvh)
+      std::printf("  Embree rtcBuildBVH binary tree: SAH %.3f (ours/embree %.3f), build %.1f ms, %llu leaves\n",
+                  r.embree_bvh->sah_cost, ratio(r.stats.sah_cost, r.embree_bvh->sah_cost), r.embree_bvh->build_ms,
+                  static_cast<unsigned long long>(r.embree_bvh->leaf_count));
+    const std::string closest_nt = "closest " + std::to_string(all) + "T", any_nt = "any " + std::to_string(all) + "T";
+    std::printf("  %-8s %12s %12s %12s %12s %10s %10s\n", "Mrays/s", "closest 1T", closest_nt.c_str(), "any 1T",
+                any_nt.c_str(), "nodes/ray", "prims/ray");
+    for (const auto& [set, f] : r.queries) {
+      std::printf("  %-8s %12.2f %12.2f %12.2f %12.2f", set.c_str(), f.closest_1t, f.closest_nt, f.any_1t, f.any_nt);
+      if (has_counters) {
+        std::printf(" %10.1f %10.1f\n", f.closest_nodes, f.closest_prims);
+      } else {
+        std::printf(" %10s %10s\n", "n/a", "n/a");
+      }
+    }
+  }
+  if (embree) {
+    std::printf("\nratios ours/embree (build and memory: lower is better; Mrays/s: higher is better)\n");
+    for (const StructureResult& r : results) {
+      if (&r == embree) continue;
+      std::printf("  %s: build %.2f, memory %.2f\n", r.name.c_str(), ratio(median(r.build_ms), median(embree->build_ms)),
+                  ratio(static_cast<double>(r.stats.memory_bytes), static_cast<double>(embree->stats.memory_bytes)));
+      for (std::size_t k = 0; k < r.queries.size(); ++k) {
+        const QueryFigures& a = r.queries[k].second;
+        const QueryFigures& b = embree->queries[k].second;
+        std::printf("    %-8s closest 1T %.2f, closest %uT %.2f, any 1T %.2f, any %uT %.2f\n",
+                    r.queries[k].first.c_str(), ratio(a.closest_1t, b.closest_1t), all,
+                    ratio(a.closest_nt, b.closest_nt), ratio(a.any_1t, b.any_1t), all, ratio(a.any_nt, b.any_nt));
+      }
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+
+Command add_bench_command(CLI::App& parent, const GlobalOptions& global) {
+  auto o = std::make_shared<BenchOptions>();
+  CLI::App* sub = parent.add_subcommand(
+      "bench", "Benchmark structures: build figures and closest/any-hit Mrays/s on primary, diffuse and shadow rays "
+               "(medians of repeated runs), with ratios to Embree when it is among the structures");
+  sub->add_option("SCENE", o->scene, "Scene file (.gltf, .glb, .obj) or builtin:NAME[?key=value&...]")->required();
+  sub->add_option("--structure,-s", o->structures,
+                  std::string("Comma-separated structures (default: bvh") + (kHaveEmbree ? ",embree" : "") + ")")
+      ->delimiter(',')
+      ->check(CLI::IsMember(structure_names()));
+  sub->add_option("--rays", o->rays, "Ray sets: primary, diffuse, shadow or all")
+      ->check(CLI::IsMember({"primary", "diffuse", "shadow", "all"}))
+      ->capture_default_str();
+  sub->add_option("--size", o->size, "Primary rays: one per pixel of a WxH camera image")
+      ->check(size_validator())
+      ->capture_default_str();
+  sub->add_option("--repeat,-n", o->repeat, "Runs per figure; the median is reported")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  sub->add_option("--threads,-j", o->threads, "Threads of the all-threads figures and of builds (0: all hardware threads)")
+      ->capture_default_str();
+  sub->add_flag("--json", o->json, "Print one JSON document instead of text");
+  sub->add_option("--camera", o->camera,
+                  "View: ex,ey,ez,tx,ty,tz[,fovdeg] or gltf:N; default: the scene's first camera, else a framing view");
+  sub->add_option("--seed", o->seed, "Seed of the diffuse ray directions")->capture_default_str();
+  sub->add_option("--triangle-test", o->triangle_test,
+                  "Ray-triangle test: watertight (Woop et al. 2013) or fast (Moller-Trumbore)")
+      ->check(CLI::IsMember({"watertight", "fast"}))
+      ->capture_default_str();
+  sub->add_flag("--no-epo", o->no_epo, "Skip the BVH's EPO figure (one extra pass per triangle)");
+  o->structure_opts.add_to(sub);
+  return {sub, [o, &global] { return run_bench(*o, global); }};
+}
+
+}  // namespace accelviz::cli

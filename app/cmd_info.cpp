@@ -1,0 +1,79 @@
+// accelviz info SCENE [--json]: what the loader found, dropped and noticed.
+#include "app/cli_common.h"
+
+#include <cstdio>
+#include <memory>
+
+namespace accelviz::cli {
+
+namespace {
+
+struct InfoOptions {
+  std::string scene;
+  bool json = false;
+};
+
+nlohmann::json vec_json(const glm::vec3& v) { return {v.x, v.y, v.z}; }
+
+int run_info(const InfoOptions& o, const GlobalOptions& global) {
+  const Scene scene = load_scene_noting_warnings(o.scene, /*quiet=*/true);
+  (void)global;
+  const Aabb b = scene.bounds();
+  const bool empty = b.is_empty();
+  if (o.json) {
+    nlohmann::json j;
+    j["scene"] = o.scene;
+    j["triangles"] = scene.triangles.size();
+    j["meshes"] = scene.meshes.size();
+    j["instances"] = scene.instances.size();
+    j["nodes"] = scene.nodes.size();
+    j["lights"] = scene.lights.size();
+    j["cameras"] = scene.cameras.size();
+    j["animations"] = scene.animations.size();
+    j["has_instancing"] = scene.has_instancing();
+    j["bounds"] = empty ? nlohmann::json(nullptr) : nlohmann::json{{"min", vec_json(b.lo)}, {"max", vec_json(b.hi)}};
+    j["dropped_nonfinite"] = scene.report.dropped_nonfinite;
+    j["degenerate"] = scene.report.degenerate;
+    j["skipped_primitives"] = scene.report.skipped_primitives;
+    j["warnings"] = scene.report.warnings;
+    print_json_line(j);
+    return 0;
+  }
+  std::printf("scene          %s\n", o.scene.c_str());
+  std::printf("triangles      %zu\n", scene.triangles.size());
+  std::printf("meshes         %zu\n", scene.meshes.size());
+  std::printf("instances      %zu (instancing: %s)\n", scene.instances.size(), scene.has_instancing() ? "yes" : "no");
+  std::printf("nodes          %zu\n", scene.nodes.size());
+  std::printf("lights         %zu\n", scene.lights.size());
+  std::printf("cameras        %zu\n", scene.cameras.size());
+  std::printf("animations     %zu\n", scene.animations.size());
+  if (empty) {
+    std::printf("bounds         (empty)\n");
+  } else {
+    const glm::vec3 e = b.extent();
+    std::printf("bounds         (%g, %g, %g) .. (%g, %g, %g), extent (%g, %g, %g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x,
+                b.hi.y, b.hi.z, e.x, e.y, e.z);
+  }
+  std::printf("dropped        %llu non-finite triangle(s)\n",
+              static_cast<unsigned long long>(scene.report.dropped_nonfinite));
+  std::printf("degenerate     %llu zero-area triangle(s), kept\n",
+              static_cast<unsigned long long>(scene.report.degenerate));
+  std::printf("skipped        %llu point/line primitive(s)\n",
+              static_cast<unsigned long long>(scene.report.skipped_primitives));
+  std::printf("warnings       %zu\n", scene.report.warnings.size());
+  for (const std::string& w : scene.report.warnings) std::printf("  - %s\n", w.c_str());
+  return 0;
+}
+
+}  // namespace
+
+Command add_info_command(CLI::App& parent, const GlobalOptions& global) {
+  auto o = std::make_shared<InfoOptions>();
+  CLI::App* sub = parent.add_subcommand("info", "Print what a scene contains: counts, bounds, dropped and "
+                                                "degenerate triangles, loader warnings");
+  sub->add_option("SCENE", o->scene, "Scene file (.gltf, .glb, .obj) or builtin:NAME[?key=value&...]")->required();
+  sub->add_flag("--json", o->json, "Print one JSON object instead of text");
+  return {sub, [o, &global] { return run_info(*o, global); }};
+}
+
+}  // namespace accelviz::cli

@@ -1,0 +1,190 @@
+// accelviz render: a per-pixel metric heatmap (nodes visited, primitive tests,
+// cost, shading, depth) of one structure, written as a PNG with a legend.
+// Also the no-subcommand demo, which renders the demo scene the same way.
+#include "app/cli_common.h"
+
+#include "core/analysis/heatmap.h"
+#include "core/query/camera.h"
+#include "core/scene/load.h"
+
+#include <ctime>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+namespace accelviz::cli {
+
+namespace {
+
+struct RenderOptions {
+  std::string scene;
+  std::string structure = "bvh";
+  std::string metric = "nodes";
+  std::string out;
+  std::string camera;
+  std::string size = "800x600";
+  std::string colormap = "viridis";
+  std::string legend = "bottom";
+  float max = 0.0f;
+  unsigned threads = 0;
+  std::string triangle_test = "watertight";
+  bool force = false;
+  StructureCli structure_opts;
+};
+
+/// Loads, builds, renders and colours; returns the image and the figures as JSON.
+RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohmann::json& figures) {
+  const ImageSize size = parse_size(o.size);
+  const HeatMetric metric = parse_metric(o.metric).value();
+  Progress progress(global.quiet);
+
+  progress.begin("loading " + o.scene);
+  const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
+  progress.end(std::to_string(scene.triangles.size()) + " triangles");
+
+  const Camera camera = camera_for(o.camera, scene, size);
+
+  progress.begin("building " + o.structure);
+  const StructureOptions so = o.structure_opts.to_options(o.threads, /*compute_epo=*/false);
+  const auto t0 = Clock::now();
+  const std::unique_ptr<Accelerator> accel = build_accelerator(o.structure, scene.triangles, so, progress.callback());
+  const double build_wall_ms = ms_since(t0);
+  progress.end(std::to_string(static_cast<long long>(accel->build_stats().build_ms)) + " ms");
+
+  HeatmapOptions ho;
+  ho.metric = metric;
+  ho.width = size.width;
+  ho.height = size.height;
+  ho.threads = o.threads;
+  ho.query.triangle_test = parse_triangle_test(o.triangle_test);
+  ho.c_trav = o.structure_opts.ctrav;
+  ho.c_isect = o.structure_opts.cisect;
+  progress.begin("rendering " + o.metric);
+  ho.progress = progress.callback();
+  HeatmapFigures fig;
+  const MetricImage img = render_metric(*accel, camera, ho, &fig);
+  progress.end(std::to_string(static_cast<long long>(fig.render_ms)) + " ms");
+
+  ColorizeOptions co;
+  co.map = parse_colormap(o.colormap).value();
+  co.max = o.max;
+  co.legend = parse_legend_placement(o.legend).value();
+
+  figures = {
+      {"scene", o.scene},
+      {"structure", o.structure},
+      {"metric", o.metric},
+      {"width", size.width},
+      {"height", size.height},
+      {"triangles", scene.triangles.size()},
+      {"build_ms", accel->build_stats().build_ms},
+      {"build_wall_ms", build_wall_ms},
+      {"render_ms", fig.render_ms},
+      {"rays", fig.rays},
+      {"hits", fig.hits},
+      {"rays_per_s", fig.rays_per_s},
+      {"mean", fig.mean},
+      {"max", fig.max},
+      {"scale_max", heatmap_scale_max(img, o.max)},
+      {"colormap", o.colormap},
+      {"camera",
+       {{"eye", {camera.position.x, camera.position.y, camera.position.z}},
+        {"forward", {camera.forward.x, camera.forward.y, camera.forward.z}},
+        {"yfov_deg", camera.yfov * 180.0 / 3.14159265358979}}},
+  };
+  if (metric_needs_stats(metric)) figures["instrumented"] = true;  // render_ms includes counting
+  return colorize(img, co);
+}
+
+int run_render(const RenderOptions& o, const GlobalOptions& global) {
+  check_output_path(o.out, o.force);  // before any long work
+  nlohmann::json figures;
+  const RgbImage rgb = render_job(o, global, figures);
+  write_png(o.out, rgb, o.force);
+  const std::string abs = absolute_path(o.out);
+  figures["out"] = abs;
+  std::cout << abs << "\n";
+  print_json_line(figures);
+  return 0;
+}
+
+/// accelviz-demo-YYYYmmdd-HHMMSS[-k].png in the current directory, never an existing file.
+std::string write_unique_demo_png(const RgbImage& rgb) {
+  namespace fs = std::filesystem;
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  localtime_r(&now, &tm);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &tm);
+  for (int k = 0; k < 1000; ++k) {
+    const std::string name =
+        std::string("accelviz-demo-") + stamp + (k == 0 ? "" : "-" + std::to_string(k)) + ".png";
+    std::error_code ec;
+    if (fs::exists(name, ec)) continue;
+    try {
+      write_png(name, rgb, /*overwrite=*/false);
+      return name;
+    } catch (const std::runtime_error&) {
+      if (fs::exists(name, ec)) continue;  // another process took the name in between
+      throw;
+    }
+  }
+  throw std::runtime_error(std::string("accelviz-demo-") + stamp + "-*.png: no free file name");
+}
+
+}  // namespace
+
+Command add_render_command(CLI::App& parent, const GlobalOptions& global) {
+  auto o = std::make_shared<RenderOptions>();
+  CLI::App* sub = parent.add_subcommand("render", "Render a per-pixel metric heatmap of a structure to a PNG "
+                                                  "(with a legend bar)");
+  sub->add_option("SCENE", o->scene, "Scene file (.gltf, .glb, .obj) or builtin:NAME[?key=value&...]")->required();
+  sub->add_option("--out,-o", o->out, "Output PNG file (never overwritten without --force)")->required();
+  sub->add_option("--structure,-s", o->structure, "Acceleration structure")
+      ->check(CLI::IsMember(structure_names()))
+      ->capture_default_str();
+  sub->add_option("--metric,-m", o->metric,
+                  "Per-pixel metric: nodes (nodes visited), prims (triangle tests), cost (ctrav*nodes + "
+                  "cisect*prims), shaded (headlight shading), depth (hit distance)")
+      ->check(CLI::IsMember({"nodes", "prims", "cost", "shaded", "depth"}))
+      ->capture_default_str();
+  sub->add_option("--camera", o->camera,
+                  "View: ex,ey,ez,tx,ty,tz[,fovdeg] (eye, target, vertical fov in degrees, default 45) or gltf:N "
+                  "(the scene's N-th camera); default: the scene's first camera, else a view framing the scene");
+  sub->add_option("--size", o->size, "Image size WxH (the legend is added below or beside it)")
+      ->check(size_validator())
+      ->capture_default_str();
+  sub->add_option("--colormap", o->colormap, "Colour map: viridis, inferno, turbo")
+      ->check(CLI::IsMember({"viridis", "inferno", "turbo"}))
+      ->capture_default_str();
+  sub->add_option("--max", o->max, "Top of the colour scale (default: the image's maximum); values above are clamped")
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--legend", o->legend, "Legend bar placement: bottom, right, none")
+      ->check(CLI::IsMember({"bottom", "right", "none"}))
+      ->capture_default_str();
+  sub->add_option("--threads,-j", o->threads, "Threads for building and tracing (0: all hardware threads)")
+      ->capture_default_str();
+  sub->add_option("--triangle-test", o->triangle_test,
+                  "Ray-triangle test: watertight (Woop et al. 2013) or fast (Moller-Trumbore)")
+      ->check(CLI::IsMember({"watertight", "fast"}))
+      ->capture_default_str();
+  sub->add_flag("--force,-f", o->force, "Overwrite an existing output file");
+  o->structure_opts.add_to(sub);
+  return {sub, [o, &global] { return run_render(*o, global); }};
+}
+
+int run_demo(const GlobalOptions& global) {
+  RenderOptions o;
+  o.scene = kDemoScene;
+  o.structure = "bvh";
+  o.metric = "nodes";
+  nlohmann::json figures;
+  const RgbImage rgb = render_job(o, global, figures);
+  const std::string abs = absolute_path(write_unique_demo_png(rgb));
+  figures["out"] = abs;
+  std::cout << "No window (GUI not built yet): rendered the demo heatmap to " << abs << "\n" << abs << "\n";
+  print_json_line(figures);
+  return 0;
+}
+
+}  // namespace accelviz::cli

@@ -1,0 +1,54 @@
+#include "core/accel/factory.h"
+
+#include <stdexcept>
+
+namespace accelviz {
+
+const std::vector<std::string>& structure_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n = {"brute", "brute-bbox", "bvh"};
+    if (kHaveEmbree) n.push_back("embree");
+    return n;
+  }();
+  return names;
+}
+
+std::string structure_names_joined() {
+  std::string s;
+  for (const std::string& n : structure_names()) s += (s.empty() ? "" : ", ") + n;
+  return s;
+}
+
+std::unique_ptr<Accelerator> build_accelerator(std::string_view name, std::span<const Triangle> triangles,
+                                               const StructureOptions& opts, const ProgressCallback& progress) {
+  if (name == "brute" || name == "brute-bbox") {
+    BruteForceOptions bo = opts.brute;
+    bo.bbox_early_out = name == "brute-bbox";
+    if (progress && !progress(1.0)) throw BuildCancelled();
+    return std::make_unique<BruteForce>(triangles, bo);
+  }
+  if (name == "bvh") {
+    BvhOptions bo = opts.bvh;
+    if (bo.threads == 0) bo.threads = opts.threads;
+    return std::make_unique<Bvh>(triangles, bo, progress);
+  }
+  if (name == "embree") {
+#ifdef ACCELVIZ_HAVE_EMBREE
+    EmbreeOptions eo = opts.embree;
+    if (eo.threads == 0) eo.threads = opts.threads;
+    // Embree's scene build cannot report progress through our callback; a
+    // cancel is honoured before it starts.
+    if (progress && !progress(0.0)) throw BuildCancelled();
+    auto accel = std::make_unique<EmbreeAccelerator>(triangles, eo);
+    if (progress) progress(1.0);
+    return accel;
+#else
+    throw std::invalid_argument("structure 'embree': this build has no Embree backend (configure with "
+                                "-DACCELVIZ_WITH_EMBREE=ON and libembree-dev installed)");
+#endif
+  }
+  throw std::invalid_argument("unknown structure '" + std::string(name) + "' (valid: " + structure_names_joined() +
+                              ")");
+}
+
+}  // namespace accelviz

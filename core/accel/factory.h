@@ -1,0 +1,40 @@
+#pragma once
+// The one place that turns a structure name ("bvh", "brute", "embree", ...)
+// and its options into a built accelerator, for the command line, the
+// benchmarks and the GUI alike.
+#include "core/accel/accel.h"
+#include "core/accel/brute_force.h"
+#include "core/accel/bvh/bvh.h"
+#include "core/accel/embree_backend.h"
+
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace accelviz {
+
+/// Options of every structure the factory can build; each structure reads its own.
+struct StructureOptions {
+  BvhOptions bvh;            ///< "bvh"
+  BruteForceOptions brute;   ///< "brute" (bbox_early_out is forced on for "brute-bbox")
+  EmbreeOptions embree;      ///< "embree"
+  unsigned threads = 0;      ///< build threads for structures whose own option is 0 (0: all hardware threads)
+};
+
+/// Names build_accelerator accepts, in the order `--help` lists them
+/// ("embree" only when this build has the Embree backend).
+const std::vector<std::string>& structure_names();
+
+/// "brute, brute-bbox, bvh, embree": for messages and help texts.
+std::string structure_names_joined();
+
+/// Builds the structure `name` over `triangles` (which must outlive it).
+/// Throws std::invalid_argument listing the valid names for an unknown name,
+/// and whatever the builder throws (std::invalid_argument for bad options,
+/// BuildCancelled when `progress` returns false).
+std::unique_ptr<Accelerator> build_accelerator(std::string_view name, std::span<const Triangle> triangles,
+                                               const StructureOptions& opts, const ProgressCallback& progress = {});
+
+}  // namespace accelviz

@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# Bad files and bad arguments: a one-line message on stderr that names the
+# file or the problem, exit 1 (runtime) or 2 (usage), never a crash.
+set -uo pipefail
+accelviz="$(realpath "$1")"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail=0
+
+# expect CODE NEEDLE -- ARGS...: runs accelviz, checks exit code, one stderr line containing NEEDLE.
+expect() {
+  local code="$1" needle="$2"
+  shift 3
+  "$accelviz" -q "$@" >"$tmp/stdout" 2>"$tmp/stderr"
+  local rc=$?
+  local lines
+  lines=$(wc -l <"$tmp/stderr")
+  if [ "$rc" -ne "$code" ]; then
+    echo "FAIL ($*): exit $rc, expected $code"; cat "$tmp/stderr"; fail=1; return
+  fi
+  if [ "$code" -eq 1 ] && [ "$lines" -ne 1 ]; then
+    echo "FAIL ($*): $lines stderr lines, expected 1"; cat "$tmp/stderr"; fail=1; return
+  fi
+  if ! grep -qF -- "$needle" "$tmp/stderr"; then
+    echo "FAIL ($*): stderr lacks '$needle'"; cat "$tmp/stderr"; fail=1; return
+  fi
+  echo "ok ($*): exit $rc: $(head -n 1 "$tmp/stderr")"
+}
+
+# Missing, unsupported and malformed scene files.
+expect 1 "$tmp/none.glb" -- info "$tmp/none.glb"
+echo "hello" >"$tmp/scene.txt"
+expect 1 "$tmp/scene.txt" -- info "$tmp/scene.txt"
+head -c 100 /dev/urandom >"$tmp/garbage.glb"
+expect 1 "$tmp/garbage.glb" -- info "$tmp/garbage.glb"
+printf '{"asset": {"version": "2.0"}, "meshes": [{"primitives": [{"attributes": {"POSITION": 5}}]}]}' >"$tmp/bad.gltf"
+expect 1 "$tmp/bad.gltf" -- render "$tmp/bad.gltf" --out "$tmp/x.png"
+expect 1 "builtin:nosuchscene" -- info builtin:nosuchscene
+[ -e "$tmp/x.png" ] && { echo "FAIL: a PNG was written for a bad scene"; fail=1; }
+
+# Malformed ray files name the file.
+printf 'RAYS' >"$tmp/short.rays"
+expect 1 "$tmp/short.rays" -- trace 'builtin:soup?size=10' --rays "$tmp/short.rays" --out "$tmp/o.hits"
+python3 -c "import struct,sys; open(sys.argv[1],'wb').write(b'RAYS'+struct.pack('<IQ',1,1000)+bytes(32))" "$tmp/count.rays"
+expect 1 "$tmp/count.rays" -- trace 'builtin:soup?size=10' --rays "$tmp/count.rays" --out "$tmp/o.hits"
+python3 -c "import struct,sys; open(sys.argv[1],'wb').write(b'RAYS'+struct.pack('<IQ',1,1)+struct.pack('<8f',0,0,0,0,0,0,0,1))" "$tmp/zero.rays"
+expect 1 "zero direction" -- trace 'builtin:soup?size=10' --rays "$tmp/zero.rays" --out "$tmp/o.hits"
+python3 -c "import struct,sys; open(sys.argv[1],'wb').write(b'HITS'+struct.pack('<IQ',1,0))" "$tmp/wrong.rays"
+expect 1 "$tmp/wrong.rays" -- trace 'builtin:soup?size=10' --rays "$tmp/wrong.rays" --out "$tmp/o.hits"
+[ -e "$tmp/o.hits" ] && { echo "FAIL: a HITS file was written for bad rays"; fail=1; }
+
+# Usage errors: exit 2.
+expect 2 "--size" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --size 0x10
+expect 2 "--structure" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --structure octopus
+expect 2 "--metric" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --metric colour
+expect 2 "camera" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --camera 1,2,3
+expect 2 "camera" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --camera gltf:4
+expect 2 "required" -- trace 'builtin:soup?size=10' --out "$tmp/z.hits"
+expect 2 "nosuchcommand" -- nosuchcommand
+expect 2 "--repeat" -- bench 'builtin:soup?size=10' --repeat 0
+
+# Missing output directory.
+expect 1 "$tmp/no/dir/a.png" -- render 'builtin:soup?size=10' --out "$tmp/no/dir/a.png"
+
+exit $fail

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# accelviz bench --json prints one JSON document with the documented keys.
+set -euo pipefail
+accelviz="$(realpath "$1")"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+
+"$accelviz" bench 'builtin:soup?size=2000' --structure bvh,brute-bbox --size 24x16 --repeat 2 --json \
+  >"$tmp/bench.json" 2>"$tmp/progress.txt"
+python3 -m json.tool "$tmp/bench.json" >/dev/null
+[ -s "$tmp/progress.txt" ] || { echo "FAIL: no progress on stderr"; exit 1; }
+python3 - "$tmp/bench.json" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+for k in ["scene", "triangles", "threads", "repeat", "ray_sets", "structures"]:
+    assert k in j, k
+assert set(j["ray_sets"]) == {"primary", "diffuse", "shadow"}, j["ray_sets"]
+assert j["ray_sets"]["primary"]["rays"] == 24 * 16
+names = [s["name"] for s in j["structures"]]
+assert names == ["bvh", "brute-bbox"], names
+for s in j["structures"]:
+    for k in ["build_ms", "build_ms_runs", "nodes", "leaves", "max_depth", "memory_bytes", "sah_cost"]:
+        assert k in s["build"], (s["name"], k)
+    assert len(s["build"]["build_ms_runs"]) == 2
+    for rs in ["primary", "diffuse", "shadow"]:
+        q = s["rays"][rs]
+        for k in ["closest_mrays_1t", "closest_mrays_nt", "any_mrays_1t", "any_mrays_nt",
+                  "closest_nodes_per_ray", "closest_prims_per_ray", "any_nodes_per_ray", "any_prims_per_ray"]:
+            assert k in q, (s["name"], rs, k)
+        assert q["closest_mrays_1t"] > 0
+bvh = j["structures"][0]
+assert bvh["build"]["nodes"] > 0 and bvh["build"]["sah_cost"] > 0
+assert bvh["rays"]["primary"]["closest_nodes_per_ray"] > 0
+print("bench json ok")
+PY
+
+# With Embree: ratios and Embree's binary-BVH SAH beside ours.
+if "$accelviz" render --help | grep -q embree; then
+  "$accelviz" -q bench 'builtin:soup?size=2000' --structure bvh,embree --rays primary --size 16x16 --repeat 1 --json \
+    | python3 -c '
+import json, sys
+j = json.load(sys.stdin)
+assert "ratios_vs_embree" in j and "bvh" in j["ratios_vs_embree"], j.keys()
+r = j["ratios_vs_embree"]["bvh"]
+assert "build_ms" in r and "closest_mrays_1t" in r["primary"]
+e = j["structures"][0]["embree_binary_bvh"]
+assert e["sah_cost"] > 0 and e["sah_ratio_ours_over_embree"] > 0
+assert j["structures"][1]["per_ray_counters"] is False
+print("embree ratios ok")'
+fi

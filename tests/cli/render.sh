@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# accelviz render writes a PNG, prints its path and one JSON line of figures,
+# and never overwrites an existing file without --force.
+set -euo pipefail
+accelviz="$(realpath "$1")"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+scene='builtin:teapot?size=2000'
+
+out=$("$accelviz" -q render "$scene" --metric nodes --size 64x48 --out "$tmp/a.png")
+echo "$out"
+[ "$(sed -n 1p <<<"$out")" = "$tmp/a.png" ] || { echo "FAIL: first line is not the path"; exit 1; }
+python3 - "$tmp/a.png" "$(sed -n 2p <<<"$out")" <<'PY'
+import json, struct, sys
+png = open(sys.argv[1], "rb").read()
+assert png[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
+w, h = struct.unpack(">II", png[16:24])
+assert w == 64 and h > 48, (w, h)  # legend below the 64x48 picture
+j = json.loads(sys.argv[2])
+for k in ["mean", "max", "render_ms", "rays_per_s", "build_ms", "rays", "out"]:
+    assert k in j, k
+assert j["rays"] == 64 * 48 and j["max"] >= j["mean"] > 0
+print("png and figures ok")
+PY
+
+# Refuses to overwrite; the file is untouched.
+before=$(sha256sum "$tmp/a.png")
+if "$accelviz" -q render "$scene" --metric prims --size 32x32 --out "$tmp/a.png" 2>"$tmp/err"; then
+  echo "FAIL: overwrote without --force"; exit 1
+fi
+grep -q "$tmp/a.png: exists (use --force to overwrite)" "$tmp/err" || { echo "FAIL: message"; cat "$tmp/err"; exit 1; }
+[ "$before" = "$(sha256sum "$tmp/a.png")" ] || { echo "FAIL: file changed"; exit 1; }
+
+# --force overwrites.
+"$accelviz" -q render "$scene" --metric prims --size 32x32 --out "$tmp/a.png" --force >/dev/null
+[ "$before" != "$(sha256sum "$tmp/a.png")" ] || { echo "FAIL: --force did not overwrite"; exit 1; }
+
+# Every metric, colour map and legend placement renders.
+for m in nodes prims cost shaded depth; do
+  "$accelviz" -q render "$scene" --metric "$m" --size 40x30 --out "$tmp/$m.png" --colormap turbo --legend right \
+    --structure bvh --threads 2 >/dev/null
+done
+"$accelviz" -q render "$scene" --size 40x30 --out "$tmp/fixed.png" --max 10 --colormap inferno --legend none \
+  --camera 0,5,20,0,0,0,30 --triangle-test fast --splitter median >/dev/null
+echo "render ok"
