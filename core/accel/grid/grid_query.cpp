@@ -1,0 +1,118 @@
+// Uniform grid traversal: the 3D-DDA of Amanatides & Woo (1987), with the
+// next boundary distances recomputed from the cell index at every step
+// (instead of accumulated by adding t_delta) so that rounding does not
+// drift along long rays.
+#include "core/accel/grid/grid.h"
+#include "core/accel/kdtree/spatial_traversal.h"
+
+#include <type_traits>
+
+namespace accelviz {
+
+namespace {
+struct NoTestedSet {};
+}  // namespace
+
+template <bool kCollect, bool kAnyHit>
+Hit Grid::traverse(const Ray& ray, const QueryOptions& qo, RayStats* stats, VisitTrace* trace) const {
+  Hit best;
+  if (cell_start_.empty() || !spatial::is_traversable(ray)) return best;
+
+  // 1. Clip the ray to the grid's box (robust slab test); the ray may start
+  //    inside or outside.
+  SlabInterval iv;
+  const bool in_box = intersect_slab(bounds_, ray, iv);
+  if constexpr (kCollect) {
+    if (stats) ++stats->box_tests;
+    if (!in_box) {
+      if (stats) ++stats->nodes_missed;
+      if (trace) trace->steps.push_back({VisitStep::Kind::node_missed, 0, iv.t_entry, iv.t_exit});
+    }
+  }
+  if (!in_box) return best;
+  const float t_end = iv.t_exit;
+
+  // 2. Starting cell, step direction and the distance to the next boundary
+  //    per axis. An axis with a ±0 direction component (inverse infinite) or
+  //    a single cell is never stepped along: its next boundary is at +inf.
+  const glm::vec3 entry = ray.origin + iv.t_entry * ray.direction;
+  int idx[3], step[3];
+  float t_next[3];
+  for (int a = 0; a < 3; ++a) {
+    idx[a] = cell_of(entry[a], a);
+    if (std::isinf(ray.inv_dir[a]) || res_[a] == 1) {
+      step[a] = 0;
+      t_next[a] = kInfinity;
+    } else {
+      step[a] = ray.inv_dir[a] > 0.0f ? 1 : -1;
+      t_next[a] = (plane(a, idx[a] + (step[a] > 0)) - ray.origin[a]) * ray.inv_dir[a];
+    }
+  }
+
+  const WatertightRay wr(ray.direction);
+  float tmax = ray.tmax;
+  spatial::Mailbox mailbox;
+  [[maybe_unused]] std::conditional_t<kCollect, spatial::TestedSet, NoTestedSet> tested;
+  [[maybe_unused]] float t_cell = iv.t_entry;
+
+  for (;;) {
+    // 3. The current cell covers [t_cell, t_exit] of the ray.
+    const float t_exit = std::min(std::min(t_next[0], t_next[1]), std::min(t_next[2], t_end));
+    const std::size_t cell =
+        static_cast<std::size_t>(idx[0]) + static_cast<std::size_t>(res_[0]) * (idx[1] + static_cast<std::size_t>(res_[1]) * idx[2]);
+    const std::uint32_t begin = cell_start_[cell], end = cell_start_[cell + 1];
+    if constexpr (kCollect) {
+      if (stats) {
+        ++stats->nodes_visited;
+        if (begin == end) ++stats->empty_cells;
+      }
+      if (trace) trace->steps.push_back({VisitStep::Kind::node_entered, static_cast<std::uint32_t>(cell), t_cell, t_exit});
+    }
+    for (std::uint32_t k = begin; k < end; ++k) {
+      const std::uint32_t id = refs_[k];
+      if (opts_.mailboxing && mailbox.seen(id)) continue;
+      if constexpr (kCollect) {
+        if (stats) {
+          ++stats->prim_tests;
+          if (tested.repeat(id)) ++stats->repeated_prim_tests;
+        }
+      }
+      Hit h;
+      const bool hit = intersect_triangle(qo.triangle_test, ray, wr, tris_[id], ray.tmin, tmax, h);
+      if constexpr (kCollect) {
+        if (trace)
+          trace->steps.push_back(
+              {hit ? VisitStep::Kind::prim_hit : VisitStep::Kind::prim_miss, id, hit ? h.t : kInfinity, kInfinity});
+      }
+      if (hit) {
+        best = h;
+        best.prim = id;
+        if constexpr (kAnyHit) return best;
+        tmax = h.t;
+      }
+    }
+    // 4. Done when the closest candidate lies within this cell's range (a
+    //    candidate beyond it may still be beaten in a later cell), or when
+    //    the ray leaves the grid or its segment.
+    if (tmax <= t_exit || t_exit >= t_end) break;
+    const int a = t_next[0] <= t_next[1] ? (t_next[0] <= t_next[2] ? 0 : 2) : (t_next[1] <= t_next[2] ? 1 : 2);
+    idx[a] += step[a];
+    if (step[a] == 0 || idx[a] < 0 || idx[a] >= res_[a]) break;
+    if constexpr (kCollect) t_cell = t_next[a];
+    t_next[a] = (plane(a, idx[a] + (step[a] > 0)) - ray.origin[a]) * ray.inv_dir[a];
+  }
+  if (best.valid()) best.ng = triangle_normal(tris_[best.prim]);
+  return best;
+}
+
+Hit Grid::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, VisitTrace* trace) const {
+  if (stats || trace) return traverse<true, false>(ray, qo, stats, trace);
+  return traverse<false, false>(ray, qo, nullptr, nullptr);
+}
+
+bool Grid::any_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats) const {
+  if (stats) return traverse<true, true>(ray, qo, stats, nullptr).valid();
+  return traverse<false, true>(ray, qo, nullptr, nullptr).valid();
+}
+
+}  // namespace accelviz

@@ -1,0 +1,265 @@
+// K-D tree construction: SAH over the exact event sweep (Wald & Havran 2006),
+// with perfect splits (triangles clipped to the node box, Havran 2000).
+#include "core/accel/kdtree/kdtree.h"
+#include "core/geometry/tri_box_overlap.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace accelviz {
+
+void validate(const KdTreeOptions& o) {
+  const auto positive = [](float v) { return std::isfinite(v) && v > 0.0f; };
+  if (!positive(o.cost_traversal))
+    throw std::invalid_argument("kdtree: cost_traversal must be finite and > 0, got " + std::to_string(o.cost_traversal));
+  if (!positive(o.cost_intersect))
+    throw std::invalid_argument("kdtree: cost_intersect must be finite and > 0, got " + std::to_string(o.cost_intersect));
+  if (o.max_depth < 0 || o.max_depth > kKdMaxDepth)
+    throw std::invalid_argument("kdtree: max_depth must be 0 (auto) .. " + std::to_string(kKdMaxDepth) + ", got " +
+                                std::to_string(o.max_depth));
+  if (o.max_leaf_size < 1)
+    throw std::invalid_argument("kdtree: max_leaf_size must be >= 1, got " + std::to_string(o.max_leaf_size));
+  if (!(o.empty_bonus >= 0.0f && o.empty_bonus < 1.0f))
+    throw std::invalid_argument("kdtree: empty_bonus must lie in [0, 1), got " + std::to_string(o.empty_bonus));
+}
+
+namespace {
+
+// Event types in the order Wald & Havran sort them at equal positions: ends
+// before planars before starts, so that the sweep sees, at a plane p, the
+// primitives ending at p leave the right side before those starting at p
+// join the left side.
+enum EventType : std::uint32_t { kEnd = 0, kPlanar = 1, kStart = 2 };
+
+// Float to an unsigned key with the same order (positive floats: set the
+// sign bit; negative: flip all bits), so events sort as plain integers.
+std::uint32_t orderable(float f) {
+  const std::uint32_t u = std::bit_cast<std::uint32_t>(f + 0.0f);  // -0 -> +0
+  return (u & 0x80000000u) ? ~u : (u | 0x80000000u);
+}
+float from_orderable(std::uint32_t k) {
+  return std::bit_cast<float>((k & 0x80000000u) ? (k & 0x7FFFFFFFu) : ~k);
+}
+
+struct Split {
+  int axis = -1;
+  float pos = 0.0f;
+  bool planar_left = true;
+  double cost = std::numeric_limits<double>::infinity();
+};
+
+class Builder {
+ public:
+  Builder(std::span<const Triangle> tris, const KdTreeOptions& opts, int max_depth, const ProgressCallback& progress,
+          std::vector<KdNode>& nodes, std::vector<std::uint32_t>& refs)
+      : tris_(tris), opts_(opts), max_depth_(max_depth), progress_(progress), nodes_(nodes), refs_(refs) {}
+
+  // Builds the subtree for `prims` (with their bounds clipped to `box`) at
+  // the end of the node array. Consumes `prims` and `cb`.
+  void build(std::vector<std::uint32_t>& prims, std::vector<Aabb>& cb, const Aabb& box, int depth, double weight) {
+    const std::size_t n = prims.size();
+    const std::uint32_t index = static_cast<std::uint32_t>(nodes_.size());
+    if (nodes_.size() >= (1u << 30)) throw std::length_error("kdtree: more than 2^30 nodes");
+    nodes_.emplace_back();
+    const double area = box.half_area();
+
+    Split split;
+    if (static_cast<int>(n) > opts_.max_leaf_size && depth < max_depth_ && area > 0.0) split = find_split(cb, box, area);
+    if (split.axis < 0 || split.cost >= static_cast<double>(opts_.cost_intersect) * static_cast<double>(n)) {
+      make_leaf(index, prims, box, depth, weight);
+      return;
+    }
+
+    // Classify against the chosen plane (Wald & Havran §4.3): a primitive
+    // goes left if its clipped extent reaches below the plane, right if it
+    // reaches above, both if it straddles; one lying in the plane goes to
+    // the side the SAH chose for planars.
+    const int a = split.axis;
+    const float p = split.pos;
+    Aabb left_box = box, right_box = box;
+    left_box.hi[a] = p;
+    right_box.lo[a] = p;
+    std::vector<std::uint32_t> lp, rp;
+    std::vector<Aabb> lcb, rcb;
+    for (std::size_t i = 0; i < n; ++i) {
+      const float lo = cb[i].lo[a], hi = cb[i].hi[a];
+      bool go_left = lo < p, go_right = hi > p;
+      if (lo == p && hi == p) (split.planar_left ? go_left : go_right) = true;
+      if (go_left) {
+        lp.push_back(prims[i]);
+        lcb.push_back(child_bounds(prims[i], cb[i], left_box));
+      }
+      if (go_right) {
+        rp.push_back(prims[i]);
+        rcb.push_back(child_bounds(prims[i], cb[i], right_box));
+      }
+    }
+    std::vector<std::uint32_t>().swap(prims);
+    std::vector<Aabb>().swap(cb);
+
+    sah_sum_ += static_cast<double>(opts_.cost_traversal) * area;
+    const double total = static_cast<double>(lp.size() + rp.size());
+    const double wl = total > 0.0 ? weight * static_cast<double>(lp.size()) / total : weight * 0.5;
+    build(lp, lcb, left_box, depth + 1, wl);
+    const std::uint32_t above = static_cast<std::uint32_t>(nodes_.size());
+    nodes_[index] = KdNode::inner(a, p, above);
+    build(rp, rcb, right_box, depth + 1, weight - wl);
+  }
+
+  double sah_sum_ = 0.0;
+  std::uint64_t leaves_ = 0, empty_leaves_ = 0;
+  std::uint32_t deepest_ = 0;
+  double depth_sum_ = 0.0;
+
+ private:
+  Aabb child_bounds(std::uint32_t prim, const Aabb& parent_cb, const Aabb& child_box) const {
+    if (opts_.perfect_splits) {
+      const Aabb c = clipped_triangle_bounds(tris_[prim], child_box);
+      if (!c.is_empty()) return c;
+    }
+    // Clamped bounds (or clipping that rounded to nothing at a tangency):
+    // the parent's clipped bounds cut to the child, never smaller than the
+    // truth.
+    return Aabb::intersection(parent_cb, child_box);
+  }
+
+  void make_leaf(std::uint32_t index, const std::vector<std::uint32_t>& prims, const Aabb& box, int depth,
+                 double weight) {
+    if (prims.size() >= (1u << 30)) throw std::length_error("kdtree: leaf with more than 2^30 primitives");
+    nodes_[index] = KdNode::leaf(static_cast<std::uint32_t>(refs_.size()), static_cast<std::uint32_t>(prims.size()));
+    refs_.insert(refs_.end(), prims.begin(), prims.end());
+    sah_sum_ += static_cast<double>(opts_.cost_intersect) * static_cast<double>(prims.size()) * box.half_area();
+    ++leaves_;
+    if (prims.empty()) ++empty_leaves_;
+    deepest_ = std::max(deepest_, static_cast<std::uint32_t>(depth));
+    depth_sum_ += depth;
+    report(weight);
+  }
+
+  void report(double weight) {
+    done_ += weight;
+    if (progress_ && done_ - reported_ >= 0.01) {
+      reported_ = done_;
+      if (!progress_(std::min(done_, 1.0))) throw BuildCancelled();
+    }
+  }
+
+  // The exact SAH sweep over the primitives' clipped-bound events, per axis.
+  Split find_split(const std::vector<Aabb>& cb, const Aabb& box, double area) {
+    Split best;
+    const std::size_t n = cb.size();
+    const double ct = opts_.cost_traversal, ci = opts_.cost_intersect;
+    const double bonus = 1.0 - static_cast<double>(opts_.empty_bonus);
+    const double inv_area = 1.0 / area;
+    const glm::dvec3 ext = glm::dvec3(box.hi) - glm::dvec3(box.lo);
+    for (int a = 0; a < 3; ++a) {
+      if (!(box.hi[a] > box.lo[a])) continue;  // flat axis: no plane strictly inside
+      events_.clear();
+      for (const Aabb& b : cb) {
+        const float lo = b.lo[a], hi = b.hi[a];
+        if (lo == hi) {
+          events_.push_back((std::uint64_t{orderable(lo)} << 2) | kPlanar);
+        } else {
+          events_.push_back((std::uint64_t{orderable(lo)} << 2) | kStart);
+          events_.push_back((std::uint64_t{orderable(hi)} << 2) | kEnd);
+        }
+      }
+      std::sort(events_.begin(), events_.end());
+
+      // Areas of the children as linear functions of the plane position.
+      const int b1 = (a + 1) % 3, b2 = (a + 2) % 3;
+      const double cross = ext[b1] * ext[b2];  // the face the plane cuts
+      const double perim = ext[b1] + ext[b2];
+      std::size_t nl = 0, nr = n;
+      for (std::size_t i = 0; i < events_.size();) {
+        const std::uint64_t key = events_[i] >> 2;
+        std::size_t pe = 0, pp = 0, ps = 0;
+        while (i < events_.size() && (events_[i] >> 2) == key && (events_[i] & 3u) == kEnd) ++pe, ++i;
+        while (i < events_.size() && (events_[i] >> 2) == key && (events_[i] & 3u) == kPlanar) ++pp, ++i;
+        while (i < events_.size() && (events_[i] >> 2) == key && (events_[i] & 3u) == kStart) ++ps, ++i;
+        nr -= pe + pp;
+        const float p = from_orderable(static_cast<std::uint32_t>(key));
+        // Only planes strictly inside the node: a plane on the boundary would
+        // make an empty flat child and, with the empty bonus, never stop.
+        if (p > box.lo[a] && p < box.hi[a]) {
+          const double dl = static_cast<double>(p) - box.lo[a];
+          const double dr = static_cast<double>(box.hi[a]) - p;
+          const double pl = (cross + dl * perim) * inv_area;  // half-area ratios
+          const double pr = (cross + dr * perim) * inv_area;
+          const auto sah = [&](std::size_t l, std::size_t r) {
+            const double c = ct + ci * (pl * static_cast<double>(l) + pr * static_cast<double>(r));
+            return (l == 0 || r == 0) ? c * bonus : c;
+          };
+          const double cost_l = sah(nl + pp, nr);  // planars to the left
+          const double cost_r = sah(nl, nr + pp);  // planars to the right
+          const bool left = cost_l <= cost_r;
+          const double c = left ? cost_l : cost_r;
+          if (c < best.cost) best = {a, p, left, c};
+        }
+        nl += ps + pp;
+      }
+    }
+    return best;
+  }
+
+  std::span<const Triangle> tris_;
+  const KdTreeOptions& opts_;
+  int max_depth_;
+  const ProgressCallback& progress_;
+  std::vector<KdNode>& nodes_;
+  std::vector<std::uint32_t>& refs_;
+  std::vector<std::uint64_t> events_;  // scratch, reused by every node (used before recursing)
+  double done_ = 0.0, reported_ = 0.0;
+};
+
+}  // namespace
+
+KdTree::KdTree(std::span<const Triangle> triangles, const KdTreeOptions& opts, const ProgressCallback& progress)
+    : tris_(triangles.begin(), triangles.end()), opts_(opts) {
+  validate(opts_);
+  const auto t_start = std::chrono::steady_clock::now();
+  if (tris_.size() >= (1ull << 32) - 1) throw std::length_error("kdtree: more than 2^32-2 triangles");
+
+  std::vector<std::uint32_t> prims;
+  std::vector<Aabb> cb;
+  prims.reserve(tris_.size());
+  cb.reserve(tris_.size());
+  for (std::size_t i = 0; i < tris_.size(); ++i) {
+    if (!is_finite_triangle(tris_[i])) continue;
+    prims.push_back(static_cast<std::uint32_t>(i));
+    cb.push_back(tris_[i].bounds());
+    bounds_.extend(cb.back());
+  }
+  const std::size_t n = prims.size();
+  const int max_depth =
+      opts_.max_depth > 0
+          ? opts_.max_depth
+          : std::min(kKdMaxDepth,
+                     static_cast<int>(std::lround(8.0 + 1.3 * std::log2(static_cast<double>(std::max<std::size_t>(n, 1))))));
+
+  Builder builder(tris_, opts_, max_depth, progress, nodes_, prim_refs_);
+  if (n > 0) builder.build(prims, cb, bounds_, 0, 1.0);
+  nodes_.shrink_to_fit();
+  prim_refs_.shrink_to_fit();
+
+  stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count();
+  stats_.node_count = nodes_.size();
+  stats_.leaf_count = builder.leaves_;
+  stats_.max_depth = builder.deepest_;
+  stats_.avg_leaf_depth = builder.leaves_ ? builder.depth_sum_ / static_cast<double>(builder.leaves_) : 0.0;
+  stats_.memory_bytes = nodes_.size() * sizeof(KdNode) + prim_refs_.size() * sizeof(std::uint32_t);
+  const double root_area = bounds_.half_area();
+  stats_.sah_cost = root_area > 0.0 ? builder.sah_sum_ / root_area
+                                    : static_cast<double>(opts_.cost_intersect) * static_cast<double>(n);
+  stats_.extra["references"] = static_cast<double>(prim_refs_.size());
+  stats_.extra["duplication"] = n ? static_cast<double>(prim_refs_.size()) / static_cast<double>(n) : 0.0;
+  stats_.extra["empty_leaves"] = static_cast<double>(builder.empty_leaves_);
+  stats_.extra["max_depth_limit"] = max_depth;
+  if (progress && !progress(1.0)) throw BuildCancelled();
+}
+
+}  // namespace accelviz
