@@ -4,21 +4,25 @@
 
 #include <algorithm>
 #include <atomic>
+#include <mutex>
 #include <stdexcept>
 
 namespace accelviz {
 
 namespace {
 
-/// Runs per_ray(i, stats_or_null) over all rays on the worker threads. Progress
-/// is reported by thread 0 only (the calling thread, which may be a GUI thread
-/// owning the callback); a cancel stops every worker at its next chunk.
+/// Runs per_ray(i, stats_or_null) over all rays on the worker threads.
+/// Progress is reported after each chunk by whichever worker finished it (the
+/// calling thread may get no chunk at all when the others are quicker), one
+/// call at a time: a worker that finds the callback busy skips its report
+/// rather than wait. A cancel stops every worker at its next chunk.
 template <typename PerRay>
 bool run_batch(std::size_t n, std::span<RayStats> stats, const BatchOptions& batch, PerRay&& per_ray) {
   std::atomic<std::size_t> done{0};
   std::atomic<bool> cancelled{false};
+  std::mutex progress_mutex;
   const bool with_stats = !stats.empty();
-  auto range = [&](std::size_t begin, std::size_t end, unsigned thread) {
+  auto range = [&](std::size_t begin, std::size_t end, unsigned /*thread*/) {
     if (cancelled.load(std::memory_order_relaxed)) return;
     if (with_stats) {
       for (std::size_t i = begin; i < end; ++i) {
@@ -29,8 +33,11 @@ bool run_batch(std::size_t n, std::span<RayStats> stats, const BatchOptions& bat
       for (std::size_t i = begin; i < end; ++i) per_ray(i, nullptr);
     }
     const std::size_t so_far = done.fetch_add(end - begin, std::memory_order_relaxed) + (end - begin);
-    if (thread == 0 && batch.progress && !batch.progress(static_cast<double>(so_far) / static_cast<double>(n)))
-      cancelled.store(true, std::memory_order_relaxed);
+    if (batch.progress) {
+      std::unique_lock lock(progress_mutex, std::try_to_lock);
+      if (lock.owns_lock() && !batch.progress(static_cast<double>(so_far) / static_cast<double>(n)))
+        cancelled.store(true, std::memory_order_relaxed);
+    }
   };
   const std::size_t chunk = std::max<std::size_t>(batch.chunk, 1);
   if (resolve_threads(batch.threads) == 1) {

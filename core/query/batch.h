@@ -12,7 +12,7 @@ namespace accelviz {
 struct BatchOptions {
   unsigned threads = 0;         ///< worker threads (0: all hardware threads)
   std::size_t chunk = 256;      ///< rays handed to a worker at a time (dynamic balancing)
-  ProgressCallback progress;    ///< optional; called from the calling thread only; false cancels
+  ProgressCallback progress;    ///< optional; called from worker threads, one call at a time; false cancels
 };
 
 /// Closest hit of every ray into `hits` (same size as `rays`). When `stats` is

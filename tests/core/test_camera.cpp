@@ -1,7 +1,11 @@
 #include <gtest/gtest.h>
 
 #include "core/query/camera.h"
+#include "core/accel/brute_force.h"
+#include "core/query/batch.h"
+#include "core/query/ray_sets.h"
 
+#include <algorithm>
 #include <cmath>
 
 using namespace accelviz;
@@ -150,4 +154,107 @@ TEST(Camera, BadSpecsThrowOneLine) {
       EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
     }
   }
+}
+
+// ---- ray sets built on the camera (core/query/ray_sets) ----
+
+
+namespace {
+
+/// A floor and a wall facing the camera, so primary rays hit two orientations.
+std::vector<Triangle> floor_and_wall() {
+  return {{{-5, 0, -5}, {5, 0, -5}, {-5, 0, 5}}, {{5, 0, -5}, {5, 0, 5}, {-5, 0, 5}},
+          {{-5, 0, -3}, {5, 0, -3}, {-5, 6, -3}}, {{5, 0, -3}, {5, 6, -3}, {-5, 6, -3}}};
+}
+
+}  // namespace
+
+TEST(RaySets, PrimaryRaysAreRowMajorFromTopLeft) {
+  const Camera cam = look_at({0, 2, 8}, {0, 1, 0}, 0.8f);
+  const std::vector<Ray> rays = primary_rays(cam, 7, 5);
+  ASSERT_EQ(rays.size(), 35u);
+  for (int y = 0; y < 5; ++y)
+    for (int x = 0; x < 7; ++x) EXPECT_EQ(rays[y * 7 + x].direction, primary_ray(cam, x, y, 7, 5).direction);
+}
+
+TEST(RaySets, DiffuseRaysLeaveTheSurfaceOnTheCameraSideAndAreSeeded) {
+  const std::vector<Triangle> tris = floor_and_wall();
+  const BruteForce accel(tris);
+  const std::vector<Ray> primary = primary_rays(look_at({1, 3, 9}, {0, 1, -3}, 0.9f), 32, 24);
+  std::vector<Hit> hits(primary.size());
+  trace_closest(accel, primary, hits, {}, 2u);
+  const std::size_t hit_count = std::count_if(hits.begin(), hits.end(), [](const Hit& h) { return h.valid(); });
+  ASSERT_GT(hit_count, 100u);
+
+  const std::vector<Ray> a = diffuse_rays(tris, primary, hits, 42);
+  const std::vector<Ray> b = diffuse_rays(tris, primary, hits, 42);
+  const std::vector<Ray> c = diffuse_rays(tris, primary, hits, 43);
+  ASSERT_EQ(a.size(), hit_count);
+  double mean_cos = 0.0;
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < hits.size(); ++i) {
+    if (!hits[i].valid()) continue;
+    glm::vec3 n = hits[i].ng;
+    if (glm::dot(n, primary[i].direction) > 0.0f) n = -n;
+    EXPECT_GT(glm::dot(a[k].direction, n), 0.0f);  // into the hemisphere the camera sees
+    EXPECT_NEAR(glm::length(a[k].direction), 1.0f, 1e-5f);
+    EXPECT_EQ(a[k].direction, b[k].direction);   // same seed, same rays
+    // The origin is on the camera side of the surface and leaves it: nothing at t = 0.
+    EXPECT_FALSE(accel.closest_hit(Ray(a[k].origin, a[k].direction, 0.0f, 1e-3f), {}).valid());
+    mean_cos += glm::dot(a[k].direction, n);
+    ++k;
+  }
+  // Cosine-weighted: E[cos θ] = 2/3.
+  EXPECT_NEAR(mean_cos / static_cast<double>(k), 2.0 / 3.0, 0.03);
+  std::size_t same = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) same += a[i].direction == c[i].direction;
+  EXPECT_LT(same, a.size() / 100);  // another seed, other directions
+}
+
+TEST(RaySets, ShadowRaysGoToLightsInFrontOfTheSurface) {
+  const std::vector<Triangle> tris = floor_and_wall();
+  const BruteForce accel(tris);
+  const std::vector<Ray> primary = primary_rays(look_at({1, 3, 9}, {0, 1, -3}, 0.9f), 16, 12);
+  std::vector<Hit> hits(primary.size());
+  trace_closest(accel, primary, hits, {}, 1u);
+  Light point;
+  point.position = {0, 4, 0};  // above the floor, in front of the wall
+  Light below;
+  below.position = {0, -4, 0};  // under the floor: lights nothing the camera sees on it
+  Light sun;
+  sun.kind = Light::Kind::directional;
+  sun.direction = glm::normalize(glm::vec3(0.2f, -1.0f, -0.3f));
+  const std::vector<Light> lights = {point, below, sun};
+  const std::vector<Ray> rays = shadow_rays(tris, primary, hits, lights);
+  // One ray per (hit, light) pair whose light lies on the side the camera sees.
+  std::size_t expected = 0;
+  for (std::size_t i = 0; i < hits.size(); ++i) {
+    if (!hits[i].valid()) continue;
+    glm::vec3 n = hits[i].ng;
+    if (glm::dot(n, primary[i].direction) > 0.0f) n = -n;
+    const glm::vec3 p = primary[i].at(hits[i].t);
+    expected += glm::dot(point.position - p, n) > 0.0f;
+    expected += glm::dot(below.position - p, n) > 0.0f;
+    expected += glm::dot(-sun.direction, n) > 0.0f;
+  }
+  EXPECT_EQ(rays.size(), expected);
+  std::size_t to_below = 0;
+  for (const Ray& r : rays) {
+    if (!std::isfinite(r.tmax)) {
+      EXPECT_NEAR(glm::dot(r.direction, -sun.direction), 1.0f, 1e-5f);
+      continue;
+    }
+    // tmax stops 1e-4 of the distance short of the light.
+    const glm::vec3 end = r.at(r.tmax);
+    const bool is_point = glm::distance(end, point.position) < 2e-4f * glm::distance(r.origin, point.position);
+    const bool is_below = glm::distance(end, below.position) < 2e-4f * glm::distance(r.origin, below.position);
+    EXPECT_TRUE(is_point || is_below);  // ends just short of a positional light
+    if (is_below) {
+      ++to_below;
+      EXPECT_NEAR(r.origin.z, -3.0f, 1e-3f);  // only wall points see the light under the floor
+    }
+  }
+  EXPECT_GT(to_below, 0u);
+  const Light synthetic = synthetic_bench_light(Aabb{{-5, 0, -5}, {5, 6, 5}});
+  EXPECT_GT(synthetic.position.y, 6.0f);
 }

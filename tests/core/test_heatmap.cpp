@@ -2,6 +2,8 @@
 
 #include "core/accel/brute_force.h"
 #include "core/analysis/heatmap.h"
+#include "core/query/batch.h"
+#include "core/query/ray_sets.h"
 #include "core/query/camera.h"
 
 #include <filesystem>
@@ -202,4 +204,79 @@ TEST(Heatmap, BitmapTextDrawsKnownGlyphsOnly) {
   draw_text(blank, 0, 0, "  ~", {255, 255, 255}, 1);
   EXPECT_EQ(blank.pixels, RgbImage(40, 10, {0, 0, 0}).pixels);
   EXPECT_EQ(text_width("12", 2), 22);
+}
+
+// ---- the batch tracer under the heatmap (core/query/batch) ----
+
+
+TEST(Batch, ResultsDoNotDependOnTheThreadCount) {
+  const std::vector<Triangle> tris = tiny_scene();
+  const BruteForce accel(tris, BruteForceOptions{.bbox_early_out = true});
+  const std::vector<Ray> rays = primary_rays(tiny_camera(), 37, 29);
+  std::vector<Hit> h1(rays.size()), h3(rays.size());
+  std::vector<RayStats> s1(rays.size()), s3(rays.size());
+  std::vector<std::uint8_t> o1(rays.size()), o3(rays.size());
+  ASSERT_TRUE(trace_closest(accel, rays, h1, {}, 1u, s1));
+  ASSERT_TRUE(trace_closest(accel, rays, h3, {}, BatchOptions{.threads = 3, .chunk = 7}, s3));
+  ASSERT_TRUE(trace_any(accel, rays, o1, {}, 1u));
+  ASSERT_TRUE(trace_any(accel, rays, o3, {}, BatchOptions{.threads = 3, .chunk = 5}));
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    EXPECT_EQ(h1[i].prim, h3[i].prim);
+    EXPECT_EQ(h1[i].t, h3[i].t);
+    EXPECT_EQ(s1[i].prim_tests, s3[i].prim_tests);
+    EXPECT_EQ(o1[i], o3[i]);
+    EXPECT_EQ(o1[i] != 0, h1[i].valid());
+  }
+}
+
+TEST(Batch, StatsAreResetPerRay) {
+  const std::vector<Triangle> tris = tiny_scene();
+  const BruteForce accel(tris);
+  const std::vector<Ray> rays = primary_rays(tiny_camera(), 4, 4);
+  std::vector<Hit> hits(rays.size());
+  std::vector<RayStats> stats(rays.size());
+  trace_closest(accel, rays, hits, {}, 2u, stats);
+  trace_closest(accel, rays, hits, {}, 2u, stats);  // a second pass must not accumulate
+  for (const RayStats& s : stats) EXPECT_EQ(s.prim_tests, tris.size());
+}
+
+TEST(Batch, ProgressCanCancel) {
+  const std::vector<Triangle> tris = tiny_scene();
+  const BruteForce accel(tris);
+  const std::vector<Ray> rays = primary_rays(tiny_camera(), 64, 64);
+  std::vector<Hit> hits(rays.size());
+  for (unsigned threads : {1u, 2u}) {
+    int calls = 0;
+    BatchOptions batch{.threads = threads, .chunk = 64};
+    batch.progress = [&](double fraction) {
+      EXPECT_GE(fraction, 0.0);
+      EXPECT_LE(fraction, 1.0);
+      return ++calls < 3;  // cancel at the third report
+    };
+    EXPECT_FALSE(trace_closest(accel, rays, hits, {}, batch));
+    EXPECT_GE(calls, 3);
+    int full = 0;
+    batch.progress = [&](double fraction) {
+      ++full;
+      return fraction >= 0.0;
+    };
+    EXPECT_TRUE(trace_closest(accel, rays, hits, {}, batch));
+    EXPECT_GT(full, 0);
+  }
+  HeatmapOptions ho;
+  ho.width = 32;
+  ho.height = 32;
+  ho.progress = [](double) { return false; };
+  EXPECT_THROW(render_metric(accel, tiny_camera(), ho), BuildCancelled);
+}
+
+TEST(Batch, SizeMismatchThrows) {
+  const std::vector<Triangle> tris = tiny_scene();
+  const BruteForce accel(tris);
+  const std::vector<Ray> rays(10, Ray({0, 0, 5}, {0, 0, -1}));
+  std::vector<Hit> hits(9);
+  EXPECT_THROW(trace_closest(accel, rays, hits, {}, 1u), std::invalid_argument);
+  hits.resize(10);
+  std::vector<RayStats> stats(3);
+  EXPECT_THROW(trace_closest(accel, rays, hits, {}, 1u, stats), std::invalid_argument);
 }
