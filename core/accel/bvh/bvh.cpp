@@ -1,0 +1,272 @@
+// BVH over triangles: construction wrapper, traversal and refit.
+//
+// Traversal is one function template, instantiated per
+//   closest vs any hit, ordered vs fixed child order, with or without
+//   statistics/trace (Collect), and per triangle test,
+// so that the choice is made once per ray and the fast path (Collect = false)
+// carries no counters at all.
+#include "core/accel/bvh/bvh.h"
+
+#include "core/accel/bvh/bvh_slab.h"
+
+#include "core/analysis/epo.h"
+#include "core/analysis/sah.h"
+
+#include <chrono>
+#include <stdexcept>
+#include <string>
+
+namespace accelviz {
+
+Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const ProgressCallback& progress)
+    : opts_(opts) {
+  const auto t0 = std::chrono::steady_clock::now();
+  validate(opts_);
+  std::vector<Aabb> bounds(triangles.size());
+  std::vector<glm::vec3> centroids(triangles.size());
+  for (std::size_t i = 0; i < triangles.size(); ++i) {
+    bounds[i] = triangles[i].bounds();
+    centroids[i] = triangles[i].centroid();
+  }
+  BvhTopology topo = build_bvh(bounds, centroids, opts_, progress);
+  nodes_ = std::move(topo.nodes);
+  prim_indices_ = std::move(topo.prim_indices);
+  stats_ = std::move(topo.stats);
+  // Triangles in leaf order: a leaf's triangles are contiguous in memory.
+  leaf_tris_.resize(prim_indices_.size());
+  for (std::size_t k = 0; k < prim_indices_.size(); ++k) leaf_tris_[k] = triangles[prim_indices_[k]];
+  stats_.memory_bytes += leaf_tris_.size() * sizeof(Triangle);
+  stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  update_quality_stats();
+}
+
+void Bvh::update_quality_stats() {
+  stats_.sah_cost = bvh_sah_cost(nodes_, opts_.cost_traversal, opts_.cost_intersect);
+  if (opts_.compute_epo) {
+    // Not part of build_ms: it is a measurement of the tree, not a step of
+    // making it; its own time is reported beside it.
+    const auto t0 = std::chrono::steady_clock::now();
+    stats_.extra["epo"] = bvh_epo_leaf_order(nodes_, leaf_tris_, opts_.cost_traversal, opts_.cost_intersect,
+                                             opts_.threads);
+    stats_.extra["epo_ms"] =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
+}
+
+void Bvh::refit(std::span<const Triangle> moved) {
+  if (moved.size() != leaf_tris_.size())
+    throw std::invalid_argument("Bvh::refit: expected " + std::to_string(leaf_tris_.size()) + " triangles, got " +
+                                std::to_string(moved.size()));
+  const auto t0 = std::chrono::steady_clock::now();
+  for (std::size_t k = 0; k < prim_indices_.size(); ++k) leaf_tris_[k] = moved[prim_indices_[k]];
+  // Children are stored after their parents: one reverse sweep is bottom-up.
+  for (std::size_t i = nodes_.size(); i-- > 0;) {
+    BvhNode& n = nodes_[i];
+    Aabb b;
+    if (n.count > 0) {
+      for (std::uint32_t k = n.index; k < n.index + n.count; ++k) b.extend(leaf_tris_[k].bounds());
+    } else {
+      b = Aabb::merge(nodes_[n.index].bounds, nodes_[n.index + 1].bounds);
+    }
+    n.bounds = b;
+  }
+  stats_.extra["refit_ms"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  update_quality_stats();
+}
+
+namespace {
+
+using bvh_detail::SlabRay;
+using bvh_detail::slab_test;
+using bvh_detail::slab_test_pair;
+
+struct BvhView {
+  const BvhNode* nodes;
+  const Triangle* tris;
+  const std::uint32_t* prim_ids;
+  std::size_t node_count;
+};
+
+/// Statistics and trace sink of the Collect path; the fast path never touches it.
+struct Collector {
+  RayStats* stats;
+  VisitTrace* trace;
+
+  void entered(std::uint32_t node, float t0, float t1) const {
+    ++stats->nodes_visited;
+    if (trace) trace->steps.push_back({VisitStep::Kind::node_entered, node, t0, t1});
+  }
+  void missed(std::uint32_t node, float t0, float t1) const {
+    ++stats->nodes_missed;
+    if (trace) trace->steps.push_back({VisitStep::Kind::node_missed, node, t0, t1});
+  }
+  void culled(std::uint32_t node, float t0, float t1) const {
+    ++stats->nodes_culled;
+    if (trace) trace->steps.push_back({VisitStep::Kind::node_culled, node, t0, t1});
+  }
+  void prim(std::uint32_t id, bool hit, float t) const {
+    if (trace) trace->steps.push_back({hit ? VisitStep::Kind::prim_hit : VisitStep::Kind::prim_miss, id,
+                                       hit ? t : kInfinity, kInfinity});
+  }
+};
+
+template <TriangleTest Test>
+inline bool test_triangle(const Ray& ray, const WatertightRay& wr, const Triangle& tri, float tmin, float tmax,
+                          Hit& h) {
+  if constexpr (Test == TriangleTest::watertight)
+    return intersect_watertight(ray, wr, tri, tmin, tmax, h);
+  else
+    return intersect_moller_trumbore(ray, tri, tmin, tmax, h);
+}
+
+/// Stack-based traversal (children tested at the parent; the far child is
+/// pushed with its entry distance and skipped on pop when a closer hit has
+/// been found since).
+///  - AnyHit: returns at the first hit in [tmin, tmax]; no culling.
+///  - Ordered: the child with the smaller entry distance first; otherwise
+///    left then right.
+///  - Collect: count into *c.stats and record into c.trace. Boxes are then
+///    tested against [tmin, ray.tmax] so that a box beyond the closest hit is
+///    told apart ("culled") from a box the ray misses; the fast path tests
+///    against [tmin, closest] directly. Both take the same decisions.
+/// Returns the hit with `prim` = leaf-order position (the caller maps it).
+template <bool AnyHit, bool Ordered, bool Collect, TriangleTest Test>
+Hit traverse(const BvhView& bvh, const Ray& ray, const Collector& c) {
+  Hit best;
+  if (bvh.node_count == 0) return best;
+  const SlabRay sr(ray);
+  const float tmin = ray.tmin;
+  float closest = ray.tmax;
+
+  struct Entry {
+    std::uint32_t node;
+    float t_entry;
+  };
+  Entry stack[kBvhMaxDepth];
+  float stack_exit[Collect ? kBvhMaxDepth : 1];  // only the trace needs exit distances of pushed nodes
+  unsigned sp = 0;
+
+  float r0, r1;
+  if constexpr (Collect) ++c.stats->box_tests;
+  if (!slab_test(bvh.nodes[0], sr, tmin, closest, r0, r1)) {
+    if constexpr (Collect) c.missed(0, r0, r1);
+    return best;
+  }
+  if constexpr (Collect) c.entered(0, r0, r1);
+  // Set up after the root test: most rays of a typical view miss the scene box.
+  const WatertightRay wr = Test == TriangleTest::watertight ? WatertightRay(ray.direction) : WatertightRay();
+
+  std::uint32_t node = 0;
+  for (;;) {
+    const BvhNode& n = bvh.nodes[node];
+    if (n.count == 0) {
+      const std::uint32_t i0 = n.index, i1 = n.index + 1;
+      // Collect tests against the segment's end and classifies culling itself.
+      const float box_tmax = Collect && !AnyHit ? ray.tmax : closest;
+      float te[2], tx[2];
+      const int mask = slab_test_pair(bvh.nodes + i0, sr, tmin, box_tmax, te, tx);
+      bool h0 = (mask & 1) != 0, h1 = (mask & 2) != 0;
+      const float a0 = te[0], a1 = tx[0], b0 = te[1], b1 = tx[1];
+      if constexpr (Collect) {
+        c.stats->box_tests += 2;
+        if (!h0) c.missed(i0, a0, a1);
+        else if (a0 > closest) { c.culled(i0, a0, a1); h0 = false; }
+        if (!h1) c.missed(i1, b0, b1);
+        else if (b0 > closest) { c.culled(i1, b0, b1); h1 = false; }
+      }
+      if (h0 && h1) {
+        // Written as selects rather than a swap so that the compiler can use
+        // conditional moves: which child is nearer is a coin flip per node.
+        const bool second_first = Ordered && b0 < a0;
+        const std::uint32_t near = i0 + (second_first ? 1u : 0u);
+        const std::uint32_t far = i1 - (second_first ? 1u : 0u);
+        stack[sp] = {far, second_first ? a0 : b0};
+        if constexpr (Collect) stack_exit[sp] = second_first ? a1 : b1;
+        ++sp;
+        node = near;
+        if constexpr (Collect) {
+          if (second_first) c.entered(near, b0, b1);
+          else c.entered(near, a0, a1);
+        }
+        continue;
+      }
+      if (h0 || h1) {
+        node = i0 + (h1 ? 1u : 0u);
+        if constexpr (Collect) {
+          if (h0) c.entered(i0, a0, a1);
+          else c.entered(i1, b0, b1);
+        }
+        continue;
+      }
+    } else {
+      for (std::uint32_t k = n.index, end = n.index + n.count; k < end; ++k) {
+        Hit h;
+        const bool hit = test_triangle<Test>(ray, wr, bvh.tris[k], tmin, closest, h);
+        if constexpr (Collect) {
+          ++c.stats->prim_tests;
+          c.prim(bvh.prim_ids[k], hit, h.t);
+        }
+        if constexpr (AnyHit) {
+          if (hit) {
+            best = h;
+            best.prim = k;
+            return best;
+          }
+        } else if (hit && h.t < best.t) {  // first found wins ties, as in BruteForce
+          best = h;
+          best.prim = k;
+          closest = h.t;
+        }
+      }
+    }
+    // Pop the next node whose entry still lies before the closest hit.
+    for (;;) {
+      if (sp == 0) return best;
+      --sp;
+      const Entry e = stack[sp];
+      if (!AnyHit && e.t_entry > closest) {
+        if constexpr (Collect) c.culled(e.node, e.t_entry, stack_exit[sp]);
+        continue;
+      }
+      node = e.node;
+      if constexpr (Collect) c.entered(e.node, e.t_entry, stack_exit[sp]);
+      break;
+    }
+  }
+}
+
+template <bool AnyHit, bool Collect>
+Hit dispatch(const BvhView& v, const Ray& ray, const QueryOptions& qo, const Collector& c) {
+  const bool wt = qo.triangle_test == TriangleTest::watertight;
+  if (qo.ordered)
+    return wt ? traverse<AnyHit, true, Collect, TriangleTest::watertight>(v, ray, c)
+              : traverse<AnyHit, true, Collect, TriangleTest::moller_trumbore>(v, ray, c);
+  return wt ? traverse<AnyHit, false, Collect, TriangleTest::watertight>(v, ray, c)
+            : traverse<AnyHit, false, Collect, TriangleTest::moller_trumbore>(v, ray, c);
+}
+
+}  // namespace
+
+Hit Bvh::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, VisitTrace* trace) const {
+  const BvhView v{nodes_.data(), leaf_tris_.data(), prim_indices_.data(), nodes_.size()};
+  Hit h;
+  if (stats == nullptr && trace == nullptr) {
+    h = dispatch<false, false>(v, ray, qo, Collector{nullptr, nullptr});
+  } else {
+    RayStats local;
+    h = dispatch<false, true>(v, ray, qo, Collector{stats ? stats : &local, trace});
+  }
+  if (h.valid()) {
+    h.ng = triangle_normal(leaf_tris_[h.prim]);
+    h.prim = prim_indices_[h.prim];
+  }
+  return h;
+}
+
+bool Bvh::any_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats) const {
+  const BvhView v{nodes_.data(), leaf_tris_.data(), prim_indices_.data(), nodes_.size()};
+  if (stats == nullptr) return dispatch<true, false>(v, ray, qo, Collector{nullptr, nullptr}).valid();
+  return dispatch<true, true>(v, ray, qo, Collector{stats, nullptr}).valid();
+}
+
+}  // namespace accelviz

@@ -1,0 +1,116 @@
+#pragma once
+// Bounding volume hierarchy: a binary tree of axis-aligned boxes over the
+// scene's primitives, stored as a flat array of 32-byte nodes (no pointer
+// tree), built top-down with a surface area heuristic (Goldsmith & Salmon
+// 1987, MacDonald & Booth 1990) or by median splits, traversed with a small
+// fixed-size stack.
+//
+// The builder works on primitive bounds and centroids only (build_bvh), so
+// the two-level structure reuses it over instance bounds; class Bvh wraps it
+// for triangles and adds the queries and refitting.
+#include "core/accel/accel.h"
+#include "core/math/aabb.h"
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace accelviz {
+
+/// How a node's primitives are divided between its two children.
+enum class BvhSplitter {
+  binned_sah,  ///< SAH evaluated at bucket boundaries on all three axes (Wald 2007)
+  exact_sah,   ///< SAH evaluated between every pair of neighbours in sorted order on each axis (full sweep)
+  median,      ///< equal counts on the axis of largest centroid extent (no SAH)
+};
+
+/// Short name of a splitter ("binned", "exact", "median").
+const char* to_string(BvhSplitter s);
+
+struct BvhOptions {
+  BvhSplitter splitter = BvhSplitter::binned_sah;  ///< split strategy
+  int buckets = 16;              ///< binned SAH bucket count B, 2..256
+  int max_leaf_size = 4;         ///< a node with <= this many primitives always becomes a leaf (1..255)
+  int leaf_size_cap = 16;        ///< SAH splitters may keep up to this many primitives in a leaf when that is cheaper than splitting; above it a node is always split (max_leaf_size..255)
+  float cost_traversal = 1.0f;   ///< C_trav: cost of visiting an inner node (> 0, finite)
+  float cost_intersect = 1.0f;   ///< C_isect: cost of one ray-primitive test (> 0, finite)
+  unsigned threads = 0;          ///< build threads, 0 = all hardware threads; the node array is identical for any count
+  bool compute_epo = true;       ///< Bvh only: compute the EPO metric into build_stats().extra["epo"] (costs a pass over the tree per triangle)
+};
+
+/// Throws std::invalid_argument naming the offending option when `opts` is out of range.
+void validate(const BvhOptions& opts);
+
+/// One node, 32 bytes. Inner node (count == 0): children at index and
+/// index + 1. Leaf (count > 0): primitives prim_indices[index .. index+count).
+/// Children are always stored after their parent, so a reverse sweep of the
+/// array visits children before parents (used by refit).
+struct BvhNode {
+  Aabb bounds;
+  std::uint32_t index = 0;
+  std::uint32_t count = 0;
+
+  bool is_leaf() const { return count > 0; }
+};
+static_assert(sizeof(BvhNode) == 32, "BVH node must stay 32 bytes (two per cache line)");
+
+/// Deepest node the builder creates (root at depth 0); traversal stacks hold this many entries.
+inline constexpr std::uint32_t kBvhMaxDepth = 64;
+
+/// What build_bvh produces: the node array (root at 0; empty when there are
+/// no primitives), the primitive order the leaves refer to, and the figures
+/// that do not need the primitives themselves (sah_cost, depths, counts,
+/// memory of nodes + indices, build time).
+struct BvhTopology {
+  std::vector<BvhNode> nodes;
+  std::vector<std::uint32_t> prim_indices;
+  BuildStats stats;
+};
+
+/// Builds a BVH over boxes. `bounds[i]` and `centroids[i]` describe primitive
+/// i (the sizes must match). Centroids drive the binning and partitioning;
+/// bounds drive the SAH and the node boxes. Throws std::invalid_argument for
+/// bad options or mismatched spans, BuildCancelled when `progress` returns false.
+BvhTopology build_bvh(std::span<const Aabb> bounds, std::span<const glm::vec3> centroids,
+                      const BvhOptions& opts = {}, const ProgressCallback& progress = {});
+
+/// A BVH over triangles: build_bvh plus a leaf-ordered copy of the triangles
+/// for traversal, closest/any-hit queries and refitting.
+class Bvh final : public Accelerator {
+ public:
+  Bvh(std::span<const Triangle> triangles, const BvhOptions& opts = {}, const ProgressCallback& progress = {});
+
+  std::string name() const override { return "bvh"; }
+  Hit closest_hit(const Ray& ray, const QueryOptions& opts, RayStats* stats = nullptr,
+                  VisitTrace* trace = nullptr) const override;
+  bool any_hit(const Ray& ray, const QueryOptions& opts, RayStats* stats = nullptr) const override;
+  const BuildStats& build_stats() const override { return stats_; }
+
+  std::span<const BvhNode> nodes() const { return nodes_; }
+  /// Leaf ranges index this array; its values are primitive ids in scene order.
+  std::span<const std::uint32_t> prim_indices() const { return prim_indices_; }
+  /// Triangles in leaf order: leaf_triangles()[k] is scene triangle prim_indices()[k].
+  std::span<const Triangle> leaf_triangles() const { return leaf_tris_; }
+  const BvhOptions& options() const { return opts_; }
+
+  /// After the vertices moved (same triangle count, same order as at build):
+  /// recomputes every box bottom-up in O(nodes) without changing the
+  /// topology, then sah_cost (and epo when enabled), so the degradation
+  /// against a fresh build can be shown. Throws std::invalid_argument on a
+  /// count mismatch.
+  void refit(std::span<const Triangle> moved_triangles);
+
+ private:
+  void update_quality_stats();
+
+  std::vector<BvhNode> nodes_;
+  std::vector<std::uint32_t> prim_indices_;
+  std::vector<Triangle> leaf_tris_;
+  BvhOptions opts_;
+  BuildStats stats_;
+};
+
+}  // namespace accelviz

@@ -1,0 +1,300 @@
+// Top-down BVH construction driver, shared by all splitters.
+//
+// Steps:
+//  1. Validate the options and copy bounds/centroids into BuildPrim records.
+//  2. Recurse from the root: a node becomes a leaf when it is small enough
+//     (max_leaf_size) or when the splitter's SAH says so; otherwise the
+//     splitter partitions its range in place and both children recurse.
+//     Splitters that cannot separate the primitives (all centroids equal) and
+//     nodes about to exceed the depth budget fall back to an object median
+//     split, so every build terminates with bounded leaves and depth.
+//  3. Large subtrees are built on other threads. Each thread writes its subtree
+//     into its own node vector, which the parent splices in after joining; the
+//     layout (children adjacent, left subtree before right subtree, depth
+//     first) is the same whether or not a subtree was built on another thread,
+//     so the node array does not depend on the thread count.
+//  4. Statistics over the finished array (counts, depths, SAH cost).
+#include "core/accel/bvh/bvh_build.h"
+
+#include "core/analysis/sah.h"
+#include "core/util/parallel.h"
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <chrono>
+#include <exception>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+namespace accelviz {
+
+const char* to_string(BvhSplitter s) {
+  switch (s) {
+    case BvhSplitter::binned_sah: return "binned";
+    case BvhSplitter::exact_sah: return "exact";
+    case BvhSplitter::median: return "median";
+  }
+  return "?";
+}
+
+void validate(const BvhOptions& o) {
+  const auto fail = [](const std::string& msg) { throw std::invalid_argument("BvhOptions: " + msg); };
+  if (o.splitter != BvhSplitter::binned_sah && o.splitter != BvhSplitter::exact_sah &&
+      o.splitter != BvhSplitter::median)
+    fail("unknown splitter");
+  if (o.buckets < 2 || o.buckets > 256) fail("buckets must be in 2..256, got " + std::to_string(o.buckets));
+  if (o.max_leaf_size < 1 || o.max_leaf_size > 255)
+    fail("max_leaf_size must be in 1..255, got " + std::to_string(o.max_leaf_size));
+  if (o.leaf_size_cap < o.max_leaf_size || o.leaf_size_cap > 255)
+    fail("leaf_size_cap must be in max_leaf_size..255 (" + std::to_string(o.max_leaf_size) + "..255), got " +
+         std::to_string(o.leaf_size_cap));
+  if (!(o.cost_traversal > 0.0f) || !std::isfinite(o.cost_traversal))
+    fail("cost_traversal must be finite and > 0, got " + std::to_string(o.cost_traversal));
+  if (!(o.cost_intersect > 0.0f) || !std::isfinite(o.cost_intersect))
+    fail("cost_intersect must be finite and > 0, got " + std::to_string(o.cost_intersect));
+}
+
+namespace bvh_detail {
+
+void range_bounds(std::span<const BuildPrim> prims, Aabb& bounds, Aabb& centroid_bounds) {
+  Aabb b, c;
+  for (const BuildPrim& p : prims) {
+    b.extend(p.bounds);
+    c.extend(p.centroid);
+  }
+  bounds = b;
+  centroid_bounds = c;
+}
+
+void split_object_median(std::span<BuildPrim> prims, const Aabb& centroid_bounds, SplitResult& out) {
+  const int axis = centroid_bounds.largest_axis();
+  const std::size_t mid = prims.size() / 2;
+  std::nth_element(prims.begin(), prims.begin() + static_cast<std::ptrdiff_t>(mid), prims.end(),
+                   [axis](const BuildPrim& a, const BuildPrim& b) { return centroid_less(a, b, axis); });
+  out.mid = mid;
+  range_bounds(prims.first(mid), out.bounds[0], out.centroid_bounds[0]);
+  range_bounds(prims.subspan(mid), out.bounds[1], out.centroid_bounds[1]);
+}
+
+namespace {
+
+/// Subtrees at least this large may go to another thread; below it a thread
+/// start costs more than it saves.
+constexpr std::size_t kParallelMinPrims = 4096;
+
+struct NodeWork {
+  std::uint32_t begin, end;
+  Aabb bounds, centroid_bounds;
+  std::uint32_t depth;
+};
+
+inline std::uint32_t ceil_log2(std::size_t n) {
+  return n <= 1 ? 0u : static_cast<std::uint32_t>(std::bit_width(n - 1));
+}
+
+class Builder {
+ public:
+  Builder(const SplitParams& params, SplitFn split, std::span<BuildPrim> prims, unsigned threads,
+          const ProgressCallback& progress)
+      : params_(params), split_(split), prims_(prims), max_threads_(threads), progress_(progress) {
+    report_step_ = std::max<std::uint64_t>(1, prims.size() / 128);
+  }
+
+  /// Builds the subtree of `w` into `out`, whose element `slot` is the subtree root.
+  void build(const NodeWork& w, std::vector<BvhNode>& out, std::uint32_t slot, SplitScratch& scratch) {
+    if (cancelled_.load(std::memory_order_relaxed)) return;
+    const std::size_t n = w.end - w.begin;
+    if (n <= static_cast<std::size_t>(params_.max_leaf_size)) {
+      make_leaf(w, out, slot);
+      return;
+    }
+    std::span<BuildPrim> range = prims_.subspan(w.begin, n);
+    SplitResult s;
+    // Depth budget: a node at depth d with n primitives can always finish
+    // within kBvhMaxDepth when d + ceil(log2 n) <= kBvhMaxDepth and every
+    // split from here on halves n; so once that sum reaches the budget, only
+    // median splits are allowed. Traversal stacks rely on this bound.
+    if (w.depth + ceil_log2(n) >= kBvhMaxDepth) {
+      split_object_median(range, w.centroid_bounds, s);
+    } else {
+      const SplitOutcome r = split_(params_, range, w.bounds, w.centroid_bounds, scratch, s);
+      if (r == SplitOutcome::leaf) {
+        make_leaf(w, out, slot);
+        return;
+      }
+      if (r == SplitOutcome::unsplittable) {
+        if (n <= static_cast<std::size_t>(params_.leaf_size_cap)) {
+          make_leaf(w, out, slot);
+          return;
+        }
+        split_object_median(range, w.centroid_bounds, s);
+      }
+    }
+    // Every split must separate; a splitter bug must not recurse forever.
+    if (s.mid == 0 || s.mid >= n) split_object_median(range, w.centroid_bounds, s);
+
+    const std::uint32_t mid = w.begin + static_cast<std::uint32_t>(s.mid);
+    const NodeWork left{w.begin, mid, s.bounds[0], s.centroid_bounds[0], w.depth + 1};
+    const NodeWork right{mid, w.end, s.bounds[1], s.centroid_bounds[1], w.depth + 1};
+    const auto first_child = static_cast<std::uint32_t>(out.size());
+    out.resize(out.size() + 2);
+    out[slot] = BvhNode{w.bounds, first_child, 0};
+
+    if (right.end - right.begin >= kParallelMinPrims && try_acquire_thread()) {
+      // The right subtree goes into its own vector (its root at 0) on another
+      // thread; the left one is built here, straight into `out`.
+      std::vector<BvhNode> right_nodes;
+      std::exception_ptr right_error;
+      std::thread worker([&] {
+        try {
+          SplitScratch own_scratch;
+          right_nodes.reserve(2 * (right.end - right.begin) / std::max(1, params_.max_leaf_size) + 1);
+          right_nodes.resize(1);
+          build(right, right_nodes, 0, own_scratch);
+        } catch (...) {
+          right_error = std::current_exception();
+          cancelled_.store(true);
+        }
+        release_thread();
+      });
+      try {
+        build(left, out, first_child, scratch);
+      } catch (...) {
+        cancelled_.store(true);
+        worker.join();
+        throw;
+      }
+      worker.join();
+      if (right_error) std::rethrow_exception(right_error);
+      if (cancelled_.load(std::memory_order_relaxed)) return;
+      // Splice: right_nodes[0] is the right child; its descendants follow the
+      // left subtree, so local index i (>= 1) becomes base + i - 1.
+      const auto base = static_cast<std::uint32_t>(out.size());
+      const auto rebase = [base](BvhNode nd) {
+        if (nd.count == 0) nd.index = base + nd.index - 1;
+        return nd;
+      };
+      out[first_child + 1] = rebase(right_nodes[0]);
+      out.reserve(out.size() + right_nodes.size() - 1);
+      for (std::size_t i = 1; i < right_nodes.size(); ++i) out.push_back(rebase(right_nodes[i]));
+    } else {
+      build(left, out, first_child, scratch);
+      build(right, out, first_child + 1, scratch);
+    }
+  }
+
+  /// After the build: throws what a callback threw, or BuildCancelled.
+  void finish() {
+    if (callback_error_) std::rethrow_exception(callback_error_);
+    if (cancelled_.load()) throw BuildCancelled();
+    if (progress_) {
+      bool go_on = true;
+      go_on = progress_(1.0);
+      if (!go_on) throw BuildCancelled();
+    }
+  }
+
+ private:
+  void make_leaf(const NodeWork& w, std::vector<BvhNode>& out, std::uint32_t slot) {
+    out[slot] = BvhNode{w.bounds, w.begin, w.end - w.begin};
+    if (!progress_) return;
+    const std::uint64_t n = w.end - w.begin;
+    const std::uint64_t before = placed_.fetch_add(n, std::memory_order_relaxed);
+    if (before / report_step_ == (before + n) / report_step_) return;
+    // The callback is user code: one thread at a time calls it; a thread that
+    // finds it busy skips this report rather than wait.
+    std::unique_lock lock(progress_mutex_, std::try_to_lock);
+    if (!lock.owns_lock() || cancelled_.load()) return;
+    try {
+      if (!progress_(static_cast<double>(before + n) / static_cast<double>(prims_.size())))
+        cancelled_.store(true);
+    } catch (...) {
+      callback_error_ = std::current_exception();
+      cancelled_.store(true);
+    }
+  }
+
+  bool try_acquire_thread() {
+    unsigned active = active_threads_.load();
+    while (active < max_threads_) {
+      if (active_threads_.compare_exchange_weak(active, active + 1)) return true;
+    }
+    return false;
+  }
+  void release_thread() { active_threads_.fetch_sub(1); }
+
+  const SplitParams params_;
+  const SplitFn split_;
+  std::span<BuildPrim> prims_;
+  const unsigned max_threads_;
+  const ProgressCallback& progress_;
+  std::atomic<unsigned> active_threads_{1};
+  std::atomic<bool> cancelled_{false};
+  std::atomic<std::uint64_t> placed_{0};
+  std::uint64_t report_step_ = 1;
+  std::mutex progress_mutex_;
+  std::exception_ptr callback_error_;
+};
+
+}  // namespace
+}  // namespace bvh_detail
+
+BvhTopology build_bvh(std::span<const Aabb> bounds, std::span<const glm::vec3> centroids, const BvhOptions& opts,
+                      const ProgressCallback& progress) {
+  using namespace bvh_detail;
+  const auto t0 = std::chrono::steady_clock::now();
+  validate(opts);
+  if (bounds.size() != centroids.size())
+    throw std::invalid_argument("build_bvh: " + std::to_string(bounds.size()) + " bounds but " +
+                                std::to_string(centroids.size()) + " centroids");
+  if (bounds.size() >= std::numeric_limits<std::uint32_t>::max())
+    throw std::invalid_argument("build_bvh: too many primitives for 32-bit indices");
+
+  BvhTopology topo;
+  const std::size_t n = bounds.size();
+  if (n > 0) {
+    // 1. Build records and root bounds.
+    std::vector<BuildPrim> prims(n);
+    Aabb root_bounds, root_centroids;
+    for (std::size_t i = 0; i < n; ++i) {
+      prims[i] = BuildPrim{centroids[i], static_cast<std::uint32_t>(i), bounds[i]};
+      root_bounds.extend(bounds[i]);
+      root_centroids.extend(centroids[i]);
+    }
+    // 2.-3. Recursive build.
+    const SplitParams params{opts.buckets, opts.max_leaf_size, opts.leaf_size_cap, opts.cost_traversal,
+                             opts.cost_intersect};
+    const SplitFn split = opts.splitter == BvhSplitter::binned_sah  ? split_binned_sah
+                          : opts.splitter == BvhSplitter::exact_sah ? split_exact_sah
+                                                                    : split_median;
+    Builder builder(params, split, prims, resolve_threads(opts.threads), progress);
+    topo.nodes.reserve(2 * n / static_cast<std::size_t>(opts.max_leaf_size) + 1);
+    topo.nodes.resize(1);
+    SplitScratch scratch;
+    builder.build(NodeWork{0, static_cast<std::uint32_t>(n), root_bounds, root_centroids, 0}, topo.nodes, 0,
+                  scratch);
+    builder.finish();
+    topo.nodes.shrink_to_fit();
+    topo.prim_indices.resize(n);
+    for (std::size_t i = 0; i < n; ++i) topo.prim_indices[i] = prims[i].id;
+  } else if (progress && !progress(1.0)) {
+    throw BuildCancelled();
+  }
+
+  // 4. Statistics.
+  BuildStats& st = topo.stats;
+  const TreeShape shape = bvh_tree_shape(topo.nodes);
+  st.node_count = topo.nodes.size();
+  st.leaf_count = shape.leaf_count;
+  st.max_depth = shape.max_depth;
+  st.avg_leaf_depth = shape.avg_leaf_depth;
+  st.memory_bytes = topo.nodes.size() * sizeof(BvhNode) + topo.prim_indices.size() * sizeof(std::uint32_t);
+  st.sah_cost = bvh_sah_cost(topo.nodes, opts.cost_traversal, opts.cost_intersect);
+  st.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return topo;
+}
+
+}  // namespace accelviz

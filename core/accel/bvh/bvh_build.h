@@ -1,0 +1,110 @@
+#pragma once
+// Internals shared by the top-down BVH build driver (bvh_build.cpp) and the
+// splitters (one per file: bvh_build_binned.cpp, bvh_build_exact.cpp,
+// bvh_build_median.cpp). Not part of the public API: include bvh.h instead.
+#include "core/accel/bvh/bvh.h"
+#include "core/math/aabb.h"
+
+#include <glm/glm.hpp>
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+namespace accelviz::bvh_detail {
+
+/// A primitive as the builder sees it. The builder partitions an array of
+/// these in place, so each node's primitives are contiguous in memory and
+/// binning streams through them instead of gathering through an index array
+/// (the PrimRef layout of Embree's builders; Wald 2007, section 3).
+struct BuildPrim {
+  glm::vec3 centroid;
+  std::uint32_t id;
+  Aabb bounds;
+};
+static_assert(sizeof(BuildPrim) == 40);
+
+/// The options a splitter needs, already validated.
+struct SplitParams {
+  int buckets = 16;
+  int max_leaf_size = 4;
+  int leaf_size_cap = 16;
+  float cost_traversal = 1.0f;
+  float cost_intersect = 1.0f;
+};
+
+enum class SplitOutcome {
+  split,         ///< prims partitioned: [0, mid) left, [mid, n) right
+  leaf,          ///< the SAH says a leaf is cheaper (only offered when n <= leaf_size_cap)
+  unsplittable,  ///< the splitter cannot separate these primitives (e.g. all centroids equal)
+};
+
+struct SplitResult {
+  std::size_t mid = 0;           ///< primitives in the left child
+  Aabb bounds[2];                ///< children's geometric bounds
+  Aabb centroid_bounds[2];       ///< children's centroid bounds
+};
+
+/// Per-thread buffers reused from node to node, so that the recursion does not allocate.
+struct SplitScratch {
+  std::vector<float> suffix_area;  ///< exact sweep: half area of prims [i, n)
+};
+
+/// Signature shared by the splitters. `prims` is the node's range,
+/// `bounds`/`centroid_bounds` its geometric and centroid bounds, n > max_leaf_size.
+using SplitFn = SplitOutcome (*)(const SplitParams& params, std::span<BuildPrim> prims, const Aabb& bounds,
+                                 const Aabb& centroid_bounds, SplitScratch& scratch, SplitResult& out);
+
+SplitOutcome split_binned_sah(const SplitParams& params, std::span<BuildPrim> prims, const Aabb& bounds,
+                              const Aabb& centroid_bounds, SplitScratch& scratch, SplitResult& out);
+SplitOutcome split_exact_sah(const SplitParams& params, std::span<BuildPrim> prims, const Aabb& bounds,
+                             const Aabb& centroid_bounds, SplitScratch& scratch, SplitResult& out);
+SplitOutcome split_median(const SplitParams& params, std::span<BuildPrim> prims, const Aabb& bounds,
+                          const Aabb& centroid_bounds, SplitScratch& scratch, SplitResult& out);
+
+/// Object median split: orders the range by centroid on the axis of largest
+/// centroid extent (ties by primitive id, so the result is unique) and cuts
+/// it in two halves (left gets n/2). Always separates n >= 2 primitives, which
+/// is why it is the fallback when a splitter cannot separate them and when the
+/// depth budget runs short. Fills the children's bounds.
+void split_object_median(std::span<BuildPrim> prims, const Aabb& centroid_bounds, SplitResult& out);
+
+/// Geometric and centroid bounds of a range.
+void range_bounds(std::span<const BuildPrim> prims, Aabb& bounds, Aabb& centroid_bounds);
+
+/// Sort key of a centroid coordinate: NaN maps to +inf so that comparisons stay
+/// a strict weak order even on garbage input (std::sort requires one).
+inline float sort_key(float c) { return c == c ? c : std::numeric_limits<float>::infinity(); }
+
+/// Strict "a before b" on `axis`, ties broken by id: every primitive has a unique position.
+inline bool centroid_less(const BuildPrim& a, const BuildPrim& b, int axis) {
+  const float ka = sort_key(a.centroid[axis]), kb = sort_key(b.centroid[axis]);
+  return ka < kb || (ka == kb && a.id < b.id);
+}
+
+/// The SAH termination rule: a leaf when it is no more expensive than the
+/// best split and the node is small enough to be allowed as a leaf.
+/// `split_area_count` = A_L·N_L + A_R·N_R (half areas). Compared with both
+/// sides multiplied by A_N so that a zero-area node needs no division.
+inline bool sah_prefers_leaf(const SplitParams& p, std::size_t n, float node_half_area, float split_area_count) {
+  if (n > static_cast<std::size_t>(p.leaf_size_cap)) return false;
+  const float leaf = p.cost_intersect * static_cast<float>(n) * node_half_area;
+  const float split = p.cost_traversal * node_half_area + p.cost_intersect * split_area_count;
+  return leaf <= split;
+}
+
+/// Better candidate: cheaper, or equally cheap and more balanced (keeps
+/// zero-area and all-equal-cost cases from degenerating into chains).
+/// Start a search with best_cost = +inf and best_left = 0 so that the first
+/// candidate wins even when its cost overflowed to +inf.
+inline bool better_split(float cost, std::size_t n_left, std::size_t n, float best_cost, std::size_t best_left) {
+  if (!(cost <= best_cost)) return false;  // worse, or NaN
+  if (cost < best_cost) return true;
+  const auto imbalance = [n](std::size_t l) { return l * 2 > n ? l * 2 - n : n - l * 2; };
+  return imbalance(n_left) < imbalance(best_left);
+}
+
+}  // namespace accelviz::bvh_detail

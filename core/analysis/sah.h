@@ -1,0 +1,31 @@
+#pragma once
+// Surface area heuristic cost of a finished BVH (Goldsmith & Salmon 1987,
+// MacDonald & Booth 1990): the expected cost of a long random ray that hits
+// the root box, assuming the probability of hitting a node given the root is
+// the ratio of their surface areas:
+//
+//   SAH = Σ_inner C_trav·A(n)/A(root) + Σ_leaf C_isect·N(n)·A(n)/A(root)
+//
+// Recomputed from the node array alone, independently of what the builder
+// estimated while splitting, so it also measures refitted trees.
+#include "core/accel/bvh/bvh.h"
+
+#include <cstdint>
+#include <span>
+
+namespace accelviz {
+
+/// SAH cost of `nodes` (root at 0). 0 for an empty tree. When the root box
+/// has zero area (all primitives on a point or a line) every ratio is taken
+/// as 1: every ray that hits the root then hits every node.
+double bvh_sah_cost(std::span<const BvhNode> nodes, double cost_traversal, double cost_intersect);
+
+/// Counts and depths of a node array (root depth 0).
+struct TreeShape {
+  std::uint64_t leaf_count = 0;
+  std::uint32_t max_depth = 0;
+  double avg_leaf_depth = 0.0;  ///< mean depth over leaves (each leaf counted once)
+};
+TreeShape bvh_tree_shape(std::span<const BvhNode> nodes);
+
+}  // namespace accelviz
