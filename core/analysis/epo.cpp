@@ -11,6 +11,7 @@ namespace accelviz {
 
 double clipped_triangle_area(const Triangle& tri, const Aabb& box) {
   if (box.is_empty()) return 0.0;
+  const Aabb tb = tri.bounds();
   // A convex polygon clipped by six half-spaces has at most 3 + 6 vertices.
   glm::dvec3 poly[9], next[9];
   int count = 3;
@@ -21,6 +22,10 @@ double clipped_triangle_area(const Triangle& tri, const Aabb& box) {
     const int axis = plane % 3;
     const bool upper = plane >= 3;
     const double bound = upper ? box.hi[axis] : box.lo[axis];
+    // The clipped polygon stays inside the triangle's box: a plane that box
+    // does not cross cuts nothing (the common case for nodes near the triangle).
+    if (upper ? tb.hi[axis] <= box.hi[axis] : tb.lo[axis] >= box.lo[axis]) continue;
+    if (upper ? tb.lo[axis] > box.hi[axis] : tb.hi[axis] < box.lo[axis]) return 0.0;
     // Signed distance inside (>= 0 keeps the vertex).
     const auto inside = [&](const glm::dvec3& p) { return upper ? bound - p[axis] : p[axis] - bound; };
     int m = 0;
