@@ -14,15 +14,16 @@ GLADloadfunc g_loaded_with = nullptr;
 GlContext::~GlContext() = default;
 
 void GlContext::make_current() {
-  make_native_current();
-  if (g_loaded_with != proc_loader()) {
+  const bool switching = g_loaded_with != proc_loader();
+  make_native_current(switching);
+  if (switching) {
     load_gl(proc_loader());
     g_loaded_with = proc_loader();
   }
 }
 
 void GlContext::initialise() {
-  make_native_current();
+  make_native_current(g_loaded_with != nullptr && g_loaded_with != proc_loader());
   info_ = load_gl(proc_loader());
   g_loaded_with = proc_loader();
 #ifndef NDEBUG

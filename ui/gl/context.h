@@ -42,7 +42,10 @@ class GlContext {
   /// KHR_debug output to stderr.
   void initialise();
 
-  virtual void make_native_current() = 0;
+  /// Binds the native context to the calling thread. `after_other_kind` is
+  /// true when the last context made current was of the other kind (its
+  /// binding may be stale in the implementation's own bookkeeping).
+  virtual void make_native_current(bool after_other_kind) = 0;
   virtual GLADloadfunc proc_loader() const = 0;
 
  private:

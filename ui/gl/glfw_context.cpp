@@ -80,7 +80,14 @@ void GlfwContext::swap_buffers() { glfwSwapBuffers(window_); }
 
 bool GlfwContext::should_close() const { return glfwWindowShouldClose(window_) != 0; }
 
-void GlfwContext::make_native_current() { glfwMakeContextCurrent(window_); }
+void GlfwContext::make_native_current(bool after_other_kind) {
+  // Mesa's glXMakeCurrent returns early when asked for the context it
+  // believes is current, but an OSMesa context made current meanwhile has
+  // taken over the shared dispatch (libglapi). Releasing first forces a real
+  // rebind.
+  if (after_other_kind) glfwMakeContextCurrent(nullptr);
+  glfwMakeContextCurrent(window_);
+}
 
 GLADloadfunc GlfwContext::proc_loader() const {
   // GLFWglproc and GLADapiproc are both `void (*)(void)`.

@@ -34,7 +34,7 @@ class GlfwContext final : public GlContext {
   bool should_close() const;
 
  private:
-  void make_native_current() override;
+  void make_native_current(bool after_other_kind) override;
   GLADloadfunc proc_loader() const override;
 
   GLFWwindow* window_ = nullptr;

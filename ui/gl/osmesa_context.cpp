@@ -43,7 +43,8 @@ void OsMesaContext::resize(int width, int height) {
   height_ = height;
 }
 
-void OsMesaContext::make_native_current() {
+void OsMesaContext::make_native_current(bool /*after_other_kind*/) {
+  // OSMesaMakeCurrent always rebinds, so no special case is needed.
   if (!OSMesaMakeCurrent(static_cast<OSMesaContext>(context_), default_buffer_.data(), GL_UNSIGNED_BYTE, 1, 1)) {
     throw GlError("OSMesaMakeCurrent failed");
   }

@@ -24,7 +24,7 @@ class OsMesaContext final : public GlContext {
   void resize(int width, int height);
 
  private:
-  void make_native_current() override;
+  void make_native_current(bool after_other_kind) override;
   GLADloadfunc proc_loader() const override;
 
   void* context_ = nullptr;  // OSMesaContext (kept opaque: osmesa.h drags in gl.h)

@@ -38,7 +38,8 @@ void add_rect(std::vector<OverlayVertex>& out, float x0, float y0, float x1, flo
 
 LegendLayout layout_legend(int width, int height, const glm::vec2& range, std::string_view title) {
   LegendLayout L;
-  // Same proportions as core's CPU legend (colorize), so both read alike.
+  // Proportions (glyph scale, padding, bar width, five ticks) follow core's
+  // CPU legend (colorize), so both read alike.
   const int s = std::max(width, height) >= 480 ? 2 : 1;
   const int pad = 4 * s, glyph_h = kGlyphH * s, bar_w = 10 * s, tick = 3 * s;
   constexpr int kTicks = 5;
@@ -51,7 +52,7 @@ LegendLayout layout_legend(int width, int height, const glm::vec2& range, std::s
     numbers.push_back(format_tick(v));
     widest = std::max(widest, text_width(numbers.back(), s));
   }
-  const int panel_w = std::max(pad + bar_w + tick + s + widest + pad, text_width(title, s) + 2 * pad);
+  const int panel_w = std::max(pad + tick + bar_w + pad + widest + pad, text_width(title, s) + 2 * pad);
   const int header = pad + glyph_h + pad + glyph_h / 2;  // title, then half a glyph so the top number fits
   const int footer = glyph_h / 2 + pad;
   const int bar_len = std::min(200 * s, height - 2 * pad - header - footer);
@@ -59,15 +60,17 @@ LegendLayout layout_legend(int width, int height, const glm::vec2& range, std::s
 
   L.visible = true;
   L.panel = {width - pad - panel_w, pad, width - pad, pad + header + bar_len + footer};
-  const int bar_x0 = L.panel.x0 + pad;
+  const int bar_x0 = L.panel.x0 + pad + tick;
   const int bar_top = L.panel.y0 + header;
   L.bar = {bar_x0, bar_top, bar_x0 + bar_w, bar_top + bar_len};
   L.labels.push_back({std::string(title), L.panel.x0 + pad, L.panel.y0 + pad});
   for (int k = 0; k < kTicks; ++k) {
-    // Tick k sits on the row of value k/4 of the range: the bottom row is the low end.
+    // Tick k sits on the row of value k/4 of the range: the bottom row is the
+    // low end. Ticks stick out on the bar's left: on the right, next to the
+    // numbers, they would read as minus signs.
     const int y = L.bar.y1 - 1 - (bar_len - 1) * k / (kTicks - 1);
-    L.ticks.push_back({L.bar.x1, y, L.bar.x1 + tick, y + s});
-    L.labels.push_back({numbers[k], L.bar.x1 + tick + s, y - glyph_h / 2});
+    L.ticks.push_back({L.bar.x0 - tick, y, L.bar.x0, y + s});
+    L.labels.push_back({numbers[k], L.bar.x1 + pad, y - glyph_h / 2});
   }
   return L;
 }
