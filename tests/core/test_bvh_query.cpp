@@ -1,0 +1,362 @@
+// BVH queries: the SIMD slab test against its scalar twin, statistics and
+// visit traces, ordered vs unordered traversal, any-hit, ids and normals,
+// deep trees, and refitting.
+#include <gtest/gtest.h>
+
+#include "core/accel/brute_force.h"
+#include "core/accel/bvh/bvh.h"
+#include "core/accel/bvh/bvh_slab.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <vector>
+
+using namespace accelviz;
+
+namespace {
+
+float uniform(std::mt19937& rng) { return static_cast<float>(rng() >> 8) * (1.0f / 16777216.0f); }
+
+glm::vec3 random_direction(std::mt19937& rng) {
+  for (;;) {
+    const glm::vec3 d(2 * uniform(rng) - 1, 2 * uniform(rng) - 1, 2 * uniform(rng) - 1);
+    const float l = glm::length(d);
+    if (l > 0.05f && l <= 1.0f) return d / l;
+  }
+}
+
+std::vector<Triangle> soup(std::size_t n, std::uint32_t seed, float size = 0.08f) {
+  std::mt19937 rng(seed);
+  std::vector<Triangle> tris(n);
+  for (Triangle& t : tris) {
+    const glm::vec3 c(uniform(rng), uniform(rng), uniform(rng));
+    t = {c + size * random_direction(rng), c + size * random_direction(rng), c + size * random_direction(rng)};
+  }
+  return tris;
+}
+
+std::vector<Ray> rays_through_unit_cube(std::size_t n, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::vector<Ray> rays;
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::vec3 target(uniform(rng), uniform(rng), uniform(rng));
+    const glm::vec3 o = glm::vec3(0.5f) + 2.0f * random_direction(rng);
+    rays.emplace_back(o, glm::normalize(target - o));
+  }
+  return rays;
+}
+
+BvhOptions quiet() {
+  BvhOptions o;
+  o.compute_epo = false;
+  return o;
+}
+
+bool same_answer(const Hit& a, const Hit& b) {
+  if (a.valid() != b.valid()) return false;
+  if (!a.valid()) return true;
+  return a.prim == b.prim || std::fabs(a.t - b.t) <= 1e-6f * std::max(1.0f, std::fabs(b.t));
+}
+
+}  // namespace
+
+// ---- The SIMD slab test and its scalar twin ----
+
+TEST(BvhSlab, SimdAgreesWithScalarTwinOnRandomAndAdversarialInput) {
+  std::mt19937 rng(1);
+  const float specials[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, kInfinity, -kInfinity, 1e-30f, 1e30f};
+  std::size_t checked = 0;
+  for (int i = 0; i < 200000; ++i) {
+    BvhNode pair[2];
+    for (BvhNode& n : pair) {
+      glm::vec3 a(uniform(rng), uniform(rng), uniform(rng)), b(uniform(rng), uniform(rng), uniform(rng));
+      if (i % 5 == 1) b[static_cast<int>(rng() % 3)] = a[static_cast<int>(rng() % 3)];  // flat on some axis
+      if (i % 7 == 2) std::swap(a, b);                                                  // possibly empty
+      if (i % 11 == 3) a[static_cast<int>(rng() % 3)] = -kInfinity;                    // unbounded
+      n.bounds = {glm::min(a, b), glm::max(a, b)};
+      if (i % 7 == 2) n.bounds = {a, b};
+      n.index = rng();  // garbage in the lane the loads pick up
+      n.count = rng() % 2;
+    }
+    glm::vec3 o(2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f);
+    glm::vec3 d = random_direction(rng);
+    for (int a = 0; a < 3; ++a) {
+      const unsigned r = rng() % 8;
+      if (r == 0) d[a] = (rng() & 1) ? 0.0f : -0.0f;         // axis-parallel
+      if (r == 1) o[a] = pair[0].bounds.lo[a];               // on a face plane
+      if (r == 2) o[a] = pair[0].bounds.hi[a];
+      if (r == 3) d[a] = specials[rng() % 9];
+    }
+    const Ray ray(o, d, (i % 3 == 0) ? -1.0f : 0.0f, (i % 4 == 0) ? 1.5f : kInfinity);
+    const bvh_detail::SlabRay sr(ray);
+    float s0[2], s1[2], v0[2], v1[2];
+    bool scalar_hit[2];
+    for (int c = 0; c < 2; ++c) {
+      scalar_hit[c] = bvh_detail::slab_test_scalar(pair[c], ray, ray.tmin, ray.tmax, s0[c], s1[c]);
+      float t0, t1;
+      const bool simd_hit = bvh_detail::slab_test(pair[c], sr, ray.tmin, ray.tmax, t0, t1);
+      ASSERT_EQ(simd_hit, scalar_hit[c]) << "case " << i;
+      // Equal values (+0 and -0 may differ in sign, which no comparison sees).
+      ASSERT_TRUE(t0 == s0[c] || (std::isnan(t0) && std::isnan(s0[c]))) << "case " << i << ": " << t0 << " vs " << s0[c];
+      ASSERT_TRUE(t1 == s1[c] || (std::isnan(t1) && std::isnan(s1[c]))) << "case " << i << ": " << t1 << " vs " << s1[c];
+    }
+    const int mask = bvh_detail::slab_test_pair(pair, sr, ray.tmin, ray.tmax, v0, v1);
+    ASSERT_EQ(mask, (scalar_hit[0] ? 1 : 0) | (scalar_hit[1] ? 2 : 0)) << "case " << i;
+    for (int c = 0; c < 2; ++c) {
+      ASSERT_TRUE(v0[c] == s0[c] || (std::isnan(v0[c]) && std::isnan(s0[c]))) << "case " << i;
+      ASSERT_TRUE(v1[c] == s1[c] || (std::isnan(v1[c]) && std::isnan(s1[c]))) << "case " << i;
+    }
+    ++checked;
+  }
+  EXPECT_EQ(checked, 200000u);
+}
+
+TEST(BvhSlab, RayInAFacePlaneTouchesTheBox) {
+  BvhNode n;
+  n.bounds = {glm::vec3(0), glm::vec3(1)};
+  const Ray along_face({-1.0f, 0.0f, 0.5f}, {1.0f, 0.0f, 0.0f});  // y = lo.y exactly, dy = +0
+  const bvh_detail::SlabRay sr(along_face);
+  float t0, t1;
+  EXPECT_TRUE(bvh_detail::slab_test(n, sr, 0.0f, kInfinity, t0, t1));
+  EXPECT_EQ(t0, 1.0f);
+  const Ray beside({-1.0f, -0.001f, 0.5f}, {1.0f, 0.0f, 0.0f});
+  EXPECT_FALSE(bvh_detail::slab_test(n, bvh_detail::SlabRay(beside), 0.0f, kInfinity, t0, t1));
+}
+
+// ---- Basic answers ----
+
+TEST(BvhQuery, SingleTriangleHitAndMiss) {
+  const std::vector<Triangle> one = {{{-1, -1, 5}, {1, -1, 5}, {0, 1, 5}}};
+  const Bvh bvh(one, quiet());
+  const Hit h = bvh.closest_hit(Ray({0, 0, 0}, {0, 0, 1}), {});
+  ASSERT_TRUE(h.valid());
+  EXPECT_EQ(h.prim, 0u);
+  EXPECT_FLOAT_EQ(h.t, 5.0f);
+  EXPECT_FLOAT_EQ(std::fabs(h.ng.z), 1.0f);
+  EXPECT_FALSE(bvh.closest_hit(Ray({0, 0, 0}, {0, 0, -1}), {}).valid());
+  EXPECT_FALSE(bvh.closest_hit(Ray({0, 0, 0}, {0, 0, 1}, 0.0f, 4.9f), {}).valid());  // segment ends before
+  EXPECT_FALSE(bvh.closest_hit(Ray({0, 0, 0}, {0, 0, 1}, 5.1f), {}).valid());        // starts after
+  EXPECT_TRUE(bvh.any_hit(Ray({0, 0, 0}, {0, 0, 1}), {}));
+  EXPECT_FALSE(bvh.any_hit(Ray({3, 0, 0}, {0, 0, 1}), {}));
+}
+
+TEST(BvhQuery, ReportsSceneIdsAndNormalsOfTheSceneTriangles) {
+  // Two parallel layers; ids must come back in scene order whatever the leaf order.
+  const auto tris = soup(2000, 3);
+  const Bvh bvh(tris, quiet());
+  const BruteForce bf(tris);
+  for (const Ray& r : rays_through_unit_cube(2000, 4)) {
+    const Hit h = bvh.closest_hit(r, {});
+    const Hit ref = bf.closest_hit(r, {});
+    ASSERT_TRUE(same_answer(h, ref));
+    if (!h.valid()) continue;
+    EXPECT_EQ(h.ng, triangle_normal(tris[h.prim]));
+    if (h.prim == ref.prim) {
+      EXPECT_EQ(h.u, ref.u);
+      EXPECT_EQ(h.v, ref.v);
+    }
+    EXPECT_EQ(h.instance, kInvalidId);
+  }
+}
+
+TEST(BvhQuery, NameIsBvh) {
+  const std::vector<Triangle> none;
+  EXPECT_EQ(Bvh(none).name(), "bvh");
+}
+
+// ---- Statistics and traces ----
+
+TEST(BvhQuery, StatisticsAgreeWithTheVisitTrace) {
+  const auto tris = soup(3000, 5);
+  const Bvh bvh(tris, quiet());
+  std::size_t culled_total = 0;
+  for (bool ordered : {true, false}) {
+    QueryOptions q;
+    q.ordered = ordered;
+    for (const Ray& r : rays_through_unit_cube(1000, 6)) {
+      RayStats st;
+      VisitTrace tr;
+      const Hit h = bvh.closest_hit(r, q, &st, &tr);
+      std::uint32_t entered = 0, missed = 0, culled = 0, tested = 0, inner_entered = 0;
+      float best = kInfinity;
+      for (const VisitStep& s : tr.steps) {
+        switch (s.kind) {
+          case VisitStep::Kind::node_entered:
+            ++entered;
+            ASSERT_LT(s.id, bvh.nodes().size());
+            if (bvh.nodes()[s.id].count == 0) ++inner_entered;
+            EXPECT_LE(s.t_entry, s.t_exit);
+            EXPECT_LE(s.t_entry, best);  // never entered beyond the closest hit found so far
+            break;
+          case VisitStep::Kind::node_missed:
+            ++missed;
+            break;
+          case VisitStep::Kind::node_culled:
+            ++culled;
+            EXPECT_GT(s.t_entry, best);  // culled: its entry lies beyond the closest hit so far
+            EXPECT_GT(s.t_entry, h.t);
+            break;
+          case VisitStep::Kind::prim_hit:
+            ++tested;
+            ASSERT_LT(s.id, tris.size());
+            best = std::min(best, s.t_entry);
+            break;
+          case VisitStep::Kind::prim_miss:
+            ++tested;
+            EXPECT_EQ(s.t_entry, kInfinity);
+            break;
+        }
+      }
+      EXPECT_EQ(st.nodes_visited, entered);
+      EXPECT_EQ(st.nodes_missed, missed);
+      EXPECT_EQ(st.nodes_culled, culled);
+      EXPECT_EQ(st.prim_tests, tested);
+      EXPECT_EQ(st.box_tests, 1 + 2 * inner_entered);  // the root, then both children of every inner node entered
+      EXPECT_EQ(st.repeated_prim_tests, 0u);           // a BVH references each primitive once
+      EXPECT_EQ(h.valid() ? h.t : kInfinity, best);    // the closest of the hits recorded
+      culled_total += culled;
+      // Stats alone, trace alone: same answer.
+      RayStats only;
+      EXPECT_EQ(bvh.closest_hit(r, q, &only).prim, h.prim);
+      EXPECT_EQ(only.nodes_visited, st.nodes_visited);
+      VisitTrace only_trace;
+      EXPECT_EQ(bvh.closest_hit(r, q, nullptr, &only_trace).prim, h.prim);
+      EXPECT_EQ(only_trace.steps.size(), tr.steps.size());
+    }
+  }
+  EXPECT_GT(culled_total, 0u);
+}
+
+TEST(BvhQuery, OrderedTraversalVisitsFewerNodes) {
+  const auto tris = soup(5000, 7, 0.03f);
+  const Bvh bvh(tris, quiet());
+  RayStats ordered, unordered;
+  QueryOptions q;
+  for (const Ray& r : rays_through_unit_cube(3000, 8)) {
+    q.ordered = true;
+    const Hit a = bvh.closest_hit(r, q, &ordered);
+    q.ordered = false;
+    const Hit b = bvh.closest_hit(r, q, &unordered);
+    ASSERT_TRUE(same_answer(a, b));
+  }
+  EXPECT_LT(ordered.nodes_visited, unordered.nodes_visited);
+  EXPECT_LT(ordered.prim_tests, unordered.prim_tests);
+  EXPECT_GT(ordered.nodes_culled, 0u);
+}
+
+TEST(BvhQuery, AnyHitStopsAtTheFirstHit) {
+  const auto tris = soup(5000, 9, 0.03f);
+  const Bvh bvh(tris, quiet());
+  RayStats closest, any;
+  std::size_t hits = 0;
+  for (const Ray& r : rays_through_unit_cube(2000, 10)) {
+    const bool c = bvh.closest_hit(r, {}, &closest).valid();
+    RayStats one;
+    const bool a = bvh.any_hit(r, {}, &one);
+    any += one;
+    ASSERT_EQ(a, c);
+    hits += a;
+    EXPECT_EQ(one.nodes_culled, 0u);  // nothing to cull without a closest hit
+  }
+  EXPECT_GT(hits, 500u);
+  EXPECT_LT(any.prim_tests, closest.prim_tests);
+  EXPECT_LT(any.nodes_visited, closest.nodes_visited);
+}
+
+TEST(BvhQuery, TraversalOfATreeAtTheDepthBudget) {
+  // Exponentially spaced slivers drive a two-bucket build to the depth budget;
+  // the fixed traversal stack must still hold.
+  std::vector<Triangle> tris;
+  for (int i = 0; i < 400; ++i) {
+    const float x = std::ldexp(1.0f, i / 4 - 60) * (1.0f + 0.25f * static_cast<float>(i % 4));
+    tris.push_back({{x, -1, -1}, {x, 1, -1}, {x, 0, 1}});
+  }
+  BvhOptions o = quiet();
+  o.buckets = 2;
+  o.max_leaf_size = 1;
+  o.leaf_size_cap = 1;
+  const Bvh bvh(tris, o);
+  EXPECT_GT(bvh.build_stats().max_depth, 40u);
+  const BruteForce bf(tris);
+  std::mt19937 rng(11);
+  for (int i = 0; i < 2000; ++i) {
+    // From the far end back toward 0, through the dense region.
+    const float x0 = std::ldexp(1.0f, static_cast<int>(rng() % 40));
+    const Ray r({x0, 0.5f * uniform(rng) - 0.25f, 0.5f * uniform(rng) - 0.25f}, {-1, 0.001f * uniform(rng), 0});
+    EXPECT_TRUE(same_answer(bvh.closest_hit(r, {}), bf.closest_hit(r, {})));
+    RayStats st;
+    EXPECT_TRUE(same_answer(bvh.closest_hit(r, {}, &st), bf.closest_hit(r, {})));
+  }
+}
+
+// ---- Refit ----
+
+TEST(BvhRefit, AnswersLikeAFreshBuildAfterVerticesMove) {
+  auto tris = soup(4000, 12, 0.03f);
+  Bvh bvh(tris, quiet());
+  std::mt19937 rng(13);
+  for (Triangle& t : tris) {
+    const glm::vec3 shift = 0.2f * random_direction(rng);
+    t = {t.v0 + shift, t.v1 + shift, t.v2 + 0.05f * random_direction(rng) + shift};
+  }
+  const auto before = std::vector<BvhNode>(bvh.nodes().begin(), bvh.nodes().end());
+  bvh.refit(tris);
+  // Topology unchanged, bounds tight around the moved triangles.
+  ASSERT_EQ(bvh.nodes().size(), before.size());
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    const BvhNode& n = bvh.nodes()[i];
+    EXPECT_EQ(n.index, before[i].index);
+    EXPECT_EQ(n.count, before[i].count);
+    Aabb expect;
+    if (n.count > 0)
+      for (std::uint32_t k = n.index; k < n.index + n.count; ++k) expect.extend(tris[bvh.prim_indices()[k]].bounds());
+    else
+      expect = Aabb::merge(bvh.nodes()[n.index].bounds, bvh.nodes()[n.index + 1].bounds);
+    EXPECT_TRUE(expect.lo == n.bounds.lo && expect.hi == n.bounds.hi) << "node " << i;
+  }
+  const Bvh fresh(tris, quiet());
+  const BruteForce bf(tris);
+  for (const Ray& r : rays_through_unit_cube(3000, 14)) {
+    const Hit ref = bf.closest_hit(r, {});
+    EXPECT_TRUE(same_answer(bvh.closest_hit(r, {}), ref));
+    EXPECT_TRUE(same_answer(fresh.closest_hit(r, {}), ref));
+    EXPECT_EQ(bvh.any_hit(r, {}), ref.valid());
+  }
+  // Moving every triangle independently loosens the old grouping.
+  EXPECT_GT(bvh.build_stats().sah_cost, fresh.build_stats().sah_cost);
+  EXPECT_GE(bvh.build_stats().extra.at("refit_ms"), 0.0);
+}
+
+TEST(BvhRefit, RefitToTheSamePositionsRestoresTheBuild) {
+  const auto tris = soup(3000, 15);
+  BvhOptions o;  // EPO on: refit recomputes it too
+  Bvh bvh(tris, o);
+  const std::vector<BvhNode> built(bvh.nodes().begin(), bvh.nodes().end());
+  const double sah = bvh.build_stats().sah_cost;
+  const double epo = bvh.build_stats().extra.at("epo");
+  auto moved = tris;
+  for (Triangle& t : moved) t.v0 *= 1.5f;
+  bvh.refit(moved);
+  EXPECT_NE(bvh.build_stats().sah_cost, sah);
+  bvh.refit(tris);
+  ASSERT_EQ(bvh.nodes().size(), built.size());
+  EXPECT_EQ(std::memcmp(bvh.nodes().data(), built.data(), built.size() * sizeof(BvhNode)), 0);
+  EXPECT_EQ(bvh.build_stats().sah_cost, sah);
+  EXPECT_EQ(bvh.build_stats().extra.at("epo"), epo);
+}
+
+TEST(BvhRefit, RejectsADifferentTriangleCount) {
+  const auto tris = soup(100, 16);
+  Bvh bvh(tris, quiet());
+  const std::vector<Triangle> fewer(tris.begin(), tris.begin() + 99);
+  EXPECT_THROW(bvh.refit(fewer), std::invalid_argument);
+}
+
+TEST(BvhRefit, EmptyTreeRefitsToNothing) {
+  const std::vector<Triangle> none;
+  Bvh bvh(none, quiet());
+  EXPECT_NO_THROW(bvh.refit(none));
+  EXPECT_TRUE(bvh.nodes().empty());
+}
