@@ -9,13 +9,11 @@
 namespace accelviz {
 namespace {
 
-// A hand-made tree:           0
-//                          /     \
-//                         1       2
-//                       /   \   (leaf)
-//                      3     4
-//                   (leaf)  /  \
-//                          5    6   (leaves)
+// A hand-made tree (depth in brackets):
+//   0 [0] inner, children 1 and 2
+//   1 [1] inner, children 3 and 4      2 [1] leaf
+//   3 [2] leaf                         4 [2] inner, children 5 and 6
+//   5 [3] leaf                         6 [3] leaf
 std::vector<BvhNode> sample_tree() {
   auto box = [](float i) { return Aabb{{i, 0.0f, 0.0f}, {i + 1.0f, 1.0f, 1.0f}}; };
   std::vector<BvhNode> n(7);
