@@ -1,0 +1,350 @@
+// Wavefront OBJ loading through tinyobjloader, with the validation it lacks.
+//
+// tinyobjloader (Debian 2.0.0rc10) is forgiving in ways that would corrupt
+// a measurement silently: an unparsable coordinate becomes 0, "nan"/"inf"
+// become 0, a face with an out-of-range index is skipped with a warning, and
+// polygons go through an ear-clipper that may emit fewer than n-2 triangles.
+// So the steps are:
+//   1. our own line scan: every `v` line has numeric coordinates, every
+//      `f` line has at least three well-formed vertex references that
+//      resolve to existing vertices (negative = relative, OBJ style);
+//      `l`/`p` elements are counted as skipped primitives;
+//   2. tinyobjloader parses the same bytes into shapes (one per o/g group,
+//      split again where `usemtl` changes) without triangulating; a missing
+//      .mtl is only a warning;
+//   3. each shape becomes one Mesh with its own compacted vertices and an
+//      identity instance; polygons are fan-triangulated (v0, vi, vi+1), so a
+//      polygon of n vertices always gives n-2 triangles in file order;
+//   4. coordinates our scan read as NaN/inf are restored, so flatten() drops
+//      those triangles and counts them instead of placing them at the origin.
+#include "core/scene/load.h"
+
+#include <tiny_obj_loader.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <climits>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace accelviz {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr std::size_t kMaxMessageChars = 300;
+
+std::string one_line(const std::string& text) {
+  std::string line;
+  for (const char c : text) {
+    if (c == '\n' || c == '\r') {
+      if (line.find_first_not_of(" \t") != std::string::npos) break;
+      line.clear();
+      continue;
+    }
+    line += c;
+  }
+  const auto first = line.find_first_not_of(" \t");
+  if (first == std::string::npos) return "unknown error";
+  line = line.substr(first, line.find_last_not_of(" \t") - first + 1);
+  if (line.size() > kMaxMessageChars) line = line.substr(0, kMaxMessageChars) + "...";
+  return line;
+}
+
+[[noreturn]] void fail(const std::string& path, const std::string& problem) {
+  throw SceneError(path + ": " + one_line(problem));
+}
+
+/// A token as it appears in a message: cut short, control bytes shown as '?'.
+std::string quoted(std::string_view token) {
+  constexpr std::size_t kMaxToken = 40;
+  std::string s(token.substr(0, kMaxToken));
+  for (char& c : s)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7F) c = '?';
+  if (token.size() > kMaxToken) s += "...";
+  return "'" + s + "'";
+}
+
+/// Splits on spaces and tabs (tinyobjloader's separators).
+std::vector<std::string_view> tokens_of(std::string_view line) {
+  std::vector<std::string_view> out;
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+    const std::size_t start = i;
+    while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
+    if (i > start) out.push_back(line.substr(start, i - start));
+  }
+  return out;
+}
+
+/// An OBJ coordinate: decimal with optional exponent, or nan/inf/infinity
+/// (any case, signed). Hex floats and trailing junk are rejected because
+/// tinyobjloader would read them as something else.
+bool parse_coordinate(std::string_view token, double& value) {
+  std::string s(token);
+  std::string lower = s;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  std::string_view body = lower;
+  if (!body.empty() && (body[0] == '+' || body[0] == '-')) body.remove_prefix(1);
+  if (body == "nan" || body == "inf" || body == "infinity") {
+    value = body == "nan" ? std::numeric_limits<double>::quiet_NaN() : std::numeric_limits<double>::infinity();
+    if (lower[0] == '-') value = -value;
+    return true;
+  }
+  bool digits = false;
+  for (const char c : body) {
+    if (c >= '0' && c <= '9') {
+      digits = true;
+    } else if (c != '.' && c != 'e' && c != '+' && c != '-') {
+      return false;
+    }
+  }
+  if (!digits) return false;
+  errno = 0;
+  char* end = nullptr;
+  value = std::strtod(s.c_str(), &end);
+  return end == s.c_str() + s.size();  // ERANGE overflow gives ±inf: kept, dropped later
+}
+
+/// A signed decimal integer that fits in long long; false otherwise.
+bool parse_integer(std::string_view token, long long& value) {
+  if (token.empty()) return false;
+  std::size_t i = (token[0] == '+' || token[0] == '-') ? 1 : 0;
+  if (i == token.size()) return false;
+  for (std::size_t k = i; k < token.size(); ++k)
+    if (token[k] < '0' || token[k] > '9') return false;
+  if (token.size() - i > 18) return false;  // beyond any real vertex count; avoids overflow
+  value = std::strtoll(std::string(token).c_str(), nullptr, 10);
+  return true;
+}
+
+struct ObjScan {
+  std::size_t vertex_count = 0;
+  std::size_t face_count = 0;
+  std::uint64_t lines_and_points = 0;
+  /// (vertex index, xyz as read) for every vertex with a NaN/inf coordinate.
+  std::vector<std::pair<std::size_t, glm::vec3>> nonfinite;
+};
+
+/// Step 1: validates `v` and `f` lines; reports the first problem with its
+/// line number. Positive indices may refer forward (tinyobjloader allows it),
+/// so they are checked against the final vertex count.
+ObjScan scan_obj(const std::string& path, const std::string& text) {
+  ObjScan scan;
+  long long max_forward = 0;
+  std::size_t max_forward_line = 0;
+  std::size_t line_number = 0;
+  std::size_t pos = 0;
+  while (pos < text.size()) {
+    // Lines end in \n, \r\n or a lone \r, as tinyobjloader reads them.
+    std::size_t end = text.find_first_of("\r\n", pos);
+    if (end == std::string::npos) end = text.size();
+    const std::string_view line(text.data() + pos, end - pos);
+    pos = end + (text.compare(end, 2, "\r\n") == 0 ? 2 : 1);
+    ++line_number;
+    const std::vector<std::string_view> tok = tokens_of(line);
+    if (tok.empty() || tok[0][0] == '#') continue;
+    const std::string where = "line " + std::to_string(line_number) + ": ";
+
+    if (tok[0] == "v") {
+      if (tok.size() < 4)
+        fail(path, where + "vertex has " + std::to_string(tok.size() - 1) + " coordinates (expected at least 3)");
+      double xyz[3] = {0, 0, 0};
+      for (std::size_t k = 1; k < tok.size(); ++k) {
+        double value = 0;
+        if (!parse_coordinate(tok[k], value)) fail(path, where + "vertex coordinate " + quoted(tok[k]) + " is not a number");
+        if (k <= 3) xyz[k - 1] = value;
+      }
+      if (!std::isfinite(xyz[0]) || !std::isfinite(xyz[1]) || !std::isfinite(xyz[2]))
+        scan.nonfinite.emplace_back(scan.vertex_count, glm::vec3(float(xyz[0]), float(xyz[1]), float(xyz[2])));
+      ++scan.vertex_count;
+      if (scan.vertex_count > std::size_t(INT_MAX)) fail(path, where + "more than 2^31 vertices");
+      continue;
+    }
+
+    const bool face = tok[0] == "f";
+    if (face || tok[0] == "l" || tok[0] == "p") {
+      const std::size_t refs = tok.size() - 1;
+      if (face && refs < 3) fail(path, where + "face has " + std::to_string(refs) + " vertices (expected at least 3)");
+      if (!face && refs < 1) fail(path, where + "'" + std::string(tok[0]) + "' element has no vertices");
+      for (std::size_t k = 1; k < tok.size(); ++k) {
+        // v, v/vt, v//vn or v/vt/vn; only v is used, but all must be integers.
+        const std::string_view ref = tok[k];
+        std::string_view parts[3];
+        std::size_t count = 0, start = 0;
+        for (std::size_t i = 0; i <= ref.size(); ++i) {
+          if (i == ref.size() || ref[i] == '/') {
+            if (count == 3) fail(path, where + "malformed vertex reference " + quoted(ref));
+            parts[count++] = ref.substr(start, i - start);
+            start = i + 1;
+          }
+        }
+        long long v = 0, other = 0;
+        if (!parse_integer(parts[0], v)) fail(path, where + "malformed vertex reference " + quoted(ref));
+        // Only the texture slot of v//vn may be empty; "v/" and "v/vt/" are malformed.
+        for (std::size_t p = 1; p < count; ++p) {
+          if (parts[p].empty() && p == 1 && count == 3) continue;
+          if (!parse_integer(parts[p], other)) fail(path, where + "malformed vertex reference " + quoted(ref));
+          if (other == 0) fail(path, where + "texture/normal index 0 in " + quoted(ref) + " is invalid (OBJ indices start at 1)");
+        }
+        if (v == 0) fail(path, where + "vertex index 0 is invalid (OBJ indices start at 1)");
+        if (v < 0 && -v > static_cast<long long>(scan.vertex_count))
+          fail(path, where + "relative vertex index " + std::to_string(v) + " is out of range (only " +
+                         std::to_string(scan.vertex_count) + " vertices so far)");
+        if (v > max_forward) {
+          max_forward = v;
+          max_forward_line = line_number;
+        }
+      }
+      if (face) {
+        ++scan.face_count;
+      } else {
+        ++scan.lines_and_points;
+      }
+    }
+  }
+  if (max_forward > static_cast<long long>(scan.vertex_count))
+    fail(path, "line " + std::to_string(max_forward_line) + ": vertex index " + std::to_string(max_forward) +
+                   " is out of range (the file has " + std::to_string(scan.vertex_count) + " vertices)");
+  return scan;
+}
+
+std::string read_text(const std::string& path) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (ec || !fs::exists(st)) fail(path, "no such file");
+  if (fs::is_directory(st)) fail(path, "is a directory, not a file");
+  if (!fs::is_regular_file(st)) fail(path, "is not a regular file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, "cannot open for reading");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) fail(path, "read error");
+  return std::move(ss).str();
+}
+
+/// A file can produce a warning per line (say, a missing material on every
+/// `usemtl`); keep the first few and say how many more there were.
+void cap_warnings(LoadReport& report) {
+  constexpr std::size_t kMaxWarnings = 100;
+  if (report.warnings.size() <= kMaxWarnings) return;
+  const std::size_t more = report.warnings.size() - kMaxWarnings;
+  report.warnings.resize(kMaxWarnings);
+  report.warnings.push_back("... and " + std::to_string(more) + " more warnings");
+}
+
+std::vector<std::string> warning_lines(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line))
+    if (line.find_first_not_of(" \t\r.") != std::string::npos) out.push_back(one_line(line));
+  return out;
+}
+
+}  // namespace
+
+Scene load_obj(const std::string& path) {
+  const std::string text = read_text(path);
+  const ObjScan scan = scan_obj(path, text);
+
+  // Step 2: tinyobjloader over the same bytes. Materials are resolved next to
+  // the .obj; a missing .mtl only adds a warning.
+  tinyobj::attrib_t attrib;
+  std::vector<tinyobj::shape_t> shapes;
+  std::vector<tinyobj::material_t> materials;
+  std::string warn, err;
+  std::istringstream stream(text);
+  std::string base_dir = fs::path(path).parent_path().string();
+  if (base_dir.empty()) base_dir = ".";
+  tinyobj::MaterialFileReader material_reader(base_dir + "/");
+  const bool ok = tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &stream, &material_reader,
+                                   /*triangulate=*/false, /*default_vcols_fallback=*/false);
+  if (!ok) fail(path, err.empty() ? "tinyobjloader failed" : err);
+
+  Scene scene;
+  scene.source = path;
+  for (const std::string& line : warning_lines(warn)) scene.report.warnings.push_back(line);
+  for (const std::string& line : warning_lines(err)) scene.report.warnings.push_back(line);
+  if (scan.lines_and_points > 0) {
+    scene.report.skipped_primitives = scan.lines_and_points;
+    scene.report.warnings.push_back(std::to_string(scan.lines_and_points) +
+                                    " line/point elements skipped (only faces are traced)");
+  }
+
+  std::vector<float>& v = attrib.vertices;
+  if (v.size() != scan.vertex_count * 3)
+    fail(path, "tinyobjloader read " + std::to_string(v.size() / 3) + " vertices, the file has " +
+                   std::to_string(scan.vertex_count));
+  // Step 4 (early, so that the meshes copy the right values).
+  for (const auto& [index, xyz] : scan.nonfinite) {
+    v[3 * index + 0] = xyz.x;
+    v[3 * index + 1] = xyz.y;
+    v[3 * index + 2] = xyz.z;
+  }
+
+  // Step 3: one Mesh per shape, vertices compacted. `slot` maps a global
+  // vertex to its index in the current mesh; `owner` says which mesh set it,
+  // so that the map never needs clearing between shapes.
+  const std::size_t nv = scan.vertex_count;
+  std::vector<std::uint32_t> slot(nv, 0);
+  std::vector<std::uint32_t> owner(nv, std::numeric_limits<std::uint32_t>::max());
+  for (const tinyobj::shape_t& shape : shapes) {
+    const tinyobj::mesh_t& sm = shape.mesh;
+    if (sm.num_face_vertices.empty()) continue;
+    const auto mesh_id = std::uint32_t(scene.meshes.size());
+    Mesh mesh;
+    mesh.name = shape.name;
+    auto local = [&](const tinyobj::index_t& idx) -> std::uint32_t {
+      const int g = idx.vertex_index;
+      if (g < 0 || std::size_t(g) >= nv)  // the scan makes this unreachable; never index out of bounds
+        fail(path, "vertex index " + std::to_string(g + 1) + " is out of range in shape '" + shape.name + "'");
+      if (owner[std::size_t(g)] != mesh_id) {
+        owner[std::size_t(g)] = mesh_id;
+        slot[std::size_t(g)] = std::uint32_t(mesh.positions.size());
+        mesh.positions.emplace_back(v[3 * std::size_t(g)], v[3 * std::size_t(g) + 1], v[3 * std::size_t(g) + 2]);
+      }
+      return slot[std::size_t(g)];
+    };
+    std::size_t offset = 0;
+    for (const unsigned int n : sm.num_face_vertices) {
+      if (offset + n > sm.indices.size()) fail(path, "tinyobjloader returned inconsistent face data");
+      if (n >= 3) {
+        const std::uint32_t first = local(sm.indices[offset]);
+        std::uint32_t prev = local(sm.indices[offset + 1]);
+        for (unsigned int k = 2; k < n; ++k) {
+          const std::uint32_t next = local(sm.indices[offset + k]);
+          mesh.indices.emplace_back(first, prev, next);
+          prev = next;
+        }
+      }
+      offset += n;
+    }
+    Node node;
+    node.name = shape.name;
+    node.mesh = int(mesh_id);
+    scene.roots.push_back(int(scene.nodes.size()));
+    Instance inst;
+    inst.mesh = mesh_id;
+    inst.node = std::uint32_t(scene.nodes.size());
+    scene.nodes.push_back(node);
+    scene.instances.push_back(inst);
+    scene.meshes.push_back(std::move(mesh));
+  }
+
+  scene.flatten();
+  if (scene.triangles.empty()) fail(path, "scene contains no triangles");
+  cap_warnings(scene.report);
+  return scene;
+}
+
+}  // namespace accelviz

@@ -1,0 +1,211 @@
+// load_obj: every fixture is written by the test into its own temp directory.
+#include <gtest/gtest.h>
+
+#include "core/scene/load.h"
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <unistd.h>
+
+using namespace accelviz;
+namespace fs = std::filesystem;
+
+namespace {
+
+void expect_vec3_near(const glm::vec3& a, const glm::vec3& b, float eps = 1e-6f) {
+  EXPECT_NEAR(a.x, b.x, eps);
+  EXPECT_NEAR(a.y, b.y, eps);
+  EXPECT_NEAR(a.z, b.z, eps);
+}
+
+class ObjLoader : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() / ("accelviz_test_obj_loader_" + std::to_string(::getpid())) / info->name();
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_.parent_path(), ec);
+  }
+
+  std::string write(const std::string& text, const std::string& name = "scene.obj") {
+    std::ofstream out(dir_ / name, std::ios::binary);
+    out << text;
+    return (dir_ / name).string();
+  }
+
+  void expect_error(const std::string& file, const std::string& problem) {
+    try {
+      load_obj(file);
+      ADD_FAILURE() << "no error loading " << file << " (expected '" << problem << "')";
+    } catch (const SceneError& e) {
+      const std::string msg = e.what();
+      RecordProperty("message", msg);
+      EXPECT_EQ(msg.rfind(file + ": ", 0), 0u) << msg;
+      EXPECT_NE(msg.find(problem), std::string::npos) << "message: " << msg << "\nexpected: " << problem;
+      EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    }
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(ObjLoader, SingleTriangle) {
+  const std::string file = write("# a comment\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const Scene s = load_obj(file);
+  EXPECT_EQ(s.source, file);
+  ASSERT_EQ(s.triangles.size(), 1u);
+  expect_vec3_near(s.triangles[0].v1, {1, 0, 0});
+  ASSERT_EQ(s.instances.size(), 1u);
+  EXPECT_EQ(s.instances[0].transform, glm::mat4(1.0f));
+  EXPECT_EQ(s.roots, std::vector<int>{0});
+  EXPECT_FALSE(s.has_instancing());
+}
+
+TEST_F(ObjLoader, PolygonsAreFanTriangulatedInFileOrder) {
+  // A quad and a pentagon: 2 + 3 triangles, fans from each face's first vertex.
+  const Scene s = load_obj(write(
+      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 3 0 0\nv 3 1 0\nv 2.5 2 0\nv 2 1 0\n"
+      "f 1 2 3 4\nf 5 6 7 8 9\n"));
+  ASSERT_EQ(s.meshes.size(), 1u);
+  const Mesh& m = s.meshes[0];
+  ASSERT_EQ(m.indices.size(), 5u);
+  EXPECT_EQ(m.indices[0], glm::uvec3(0, 1, 2));
+  EXPECT_EQ(m.indices[1], glm::uvec3(0, 2, 3));
+  EXPECT_EQ(m.indices[2], glm::uvec3(4, 5, 6));
+  EXPECT_EQ(m.indices[4], glm::uvec3(4, 7, 8));
+  EXPECT_EQ(s.triangles.size(), 5u);
+}
+
+TEST_F(ObjLoader, OneMeshPerShapeWithCompactedVertices) {
+  const Scene s = load_obj(write(
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 5\nv 1 0 5\nv 0 1 5\n"
+      "o first\nf 1 2 3\no second\nf 4 5 6\nf 6 5 4\n"));
+  ASSERT_EQ(s.meshes.size(), 2u);
+  EXPECT_EQ(s.meshes[0].name, "first");
+  EXPECT_EQ(s.meshes[1].name, "second");
+  EXPECT_EQ(s.meshes[1].positions.size(), 3u);  // only the vertices it uses
+  EXPECT_EQ(s.meshes[1].indices[0], glm::uvec3(0, 1, 2));
+  ASSERT_EQ(s.instances.size(), 2u);
+  EXPECT_EQ(s.instances[1].first_triangle, 1u);
+  EXPECT_EQ(s.instances[1].triangle_count, 2u);
+  ASSERT_EQ(s.nodes.size(), 2u);
+  EXPECT_EQ(s.nodes[1].name, "second");
+  EXPECT_EQ(s.nodes[1].mesh, 1);
+  EXPECT_FLOAT_EQ(s.triangles[1].v0.z, 5.0f);  // primitive ids in file order
+}
+
+TEST_F(ObjLoader, RelativeIndicesAndTextureNormalReferences) {
+  const Scene s = load_obj(write(
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n"
+      "f -3/1/1 -2/1/1 -1/1/1\nf 1//1 2//1 3//1\nf 1/1 2/1 3/1\n"));
+  ASSERT_EQ(s.triangles.size(), 3u);
+  expect_vec3_near(s.triangles[0].v2, {0, 1, 0});
+}
+
+TEST_F(ObjLoader, ForwardReferencesAreAllowed) {
+  const Scene s = load_obj(write("f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"));
+  EXPECT_EQ(s.triangles.size(), 1u);
+}
+
+TEST_F(ObjLoader, CrLfAndLoneCrLineEndings) {
+  EXPECT_EQ(load_obj(write("v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\n")).triangles.size(), 1u);
+  EXPECT_EQ(load_obj(write("v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r", "mac.obj")).triangles.size(), 1u);
+  // Line numbers count \r\n once.
+  expect_error(write("v 0 0 0\r\nv 1 0 0\r\nf 1 2 5\r\n", "numbers.obj"), "line 3: vertex index 5");
+}
+
+TEST_F(ObjLoader, ManyWarningsAreCapped) {
+  std::string text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  for (int i = 0; i < 150; ++i) text += "usemtl missing" + std::to_string(i) + "\nf 1 2 3\n";
+  const Scene s = load_obj(write(text));
+  EXPECT_EQ(s.triangles.size(), 151u);
+  ASSERT_EQ(s.report.warnings.size(), 101u);
+  EXPECT_NE(s.report.warnings.back().find("more warnings"), std::string::npos) << s.report.warnings.back();
+}
+
+TEST_F(ObjLoader, MissingMaterialLibraryIsOnlyAWarning) {
+  const Scene s = load_obj(write("mtllib absent.mtl\nusemtl red\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"));
+  EXPECT_EQ(s.triangles.size(), 1u);
+  std::string all;
+  for (const std::string& w : s.report.warnings) {
+    EXPECT_EQ(w.find('\n'), std::string::npos);
+    all += w + "|";
+  }
+  EXPECT_NE(all.find("absent.mtl"), std::string::npos) << all;
+}
+
+TEST_F(ObjLoader, PresentMaterialLibraryLoadsQuietly) {
+  write("newmtl red\nKd 1 0 0\n", "colours.mtl");
+  const Scene s = load_obj(write("mtllib colours.mtl\nusemtl red\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"));
+  EXPECT_EQ(s.triangles.size(), 1u);
+  for (const std::string& w : s.report.warnings) EXPECT_EQ(w.find("colours.mtl"), std::string::npos) << w;
+}
+
+TEST_F(ObjLoader, LinesAndPointsAreSkippedWithAWarning) {
+  const Scene s = load_obj(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\np 3\nf 1 2 3\n"));
+  EXPECT_EQ(s.triangles.size(), 1u);
+  EXPECT_EQ(s.report.skipped_primitives, 2u);
+  ASSERT_FALSE(s.report.warnings.empty());
+  EXPECT_NE(s.report.warnings.back().find("2 line/point elements skipped"), std::string::npos);
+}
+
+TEST_F(ObjLoader, NonFiniteVerticesAreDroppedAndCounted) {
+  // tinyobjloader alone would read "nan" and "inf" as 0 and keep the triangles.
+  const Scene s = load_obj(write(
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv nan 0 0\nv 0 -inf 0\nv 1e999 0 0\n"
+      "f 1 2 3\nf 1 2 4\nf 1 5 3\nf 6 2 3\n"));
+  EXPECT_EQ(s.triangles.size(), 1u);
+  EXPECT_EQ(s.report.dropped_nonfinite, 3u);
+}
+
+TEST_F(ObjLoader, DegenerateTrianglesAreKeptAndCounted) {
+  const Scene s = load_obj(write("v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n"));
+  EXPECT_EQ(s.triangles.size(), 2u);
+  EXPECT_EQ(s.report.degenerate, 1u);
+}
+
+// --- errors ---------------------------------------------------------------------
+
+TEST_F(ObjLoader, MissingFile) { expect_error((dir_ / "absent.obj").string(), "no such file"); }
+
+TEST_F(ObjLoader, IndexOutOfRange) {
+  expect_error(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"),
+               "line 4: vertex index 9 is out of range (the file has 3 vertices)");
+}
+
+TEST_F(ObjLoader, RelativeIndexOutOfRange) {
+  expect_error(write("v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\n"),
+               "line 3: relative vertex index -3 is out of range (only 2 vertices so far)");
+}
+
+TEST_F(ObjLoader, ZeroIndex) {
+  expect_error(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"), "line 4: vertex index 0 is invalid");
+}
+
+TEST_F(ObjLoader, MalformedVertexLine) {
+  expect_error(write("v 0 0 0\nv 1 zero 0\n"), "line 2: vertex coordinate 'zero' is not a number");
+  expect_error(write("v 0 0\n", "short.obj"), "line 1: vertex has 2 coordinates (expected at least 3)");
+  expect_error(write("v 0x10 0 0\n", "hex.obj"), "vertex coordinate '0x10' is not a number");
+  expect_error(write(std::string("v 1 2\0 3\n", 10), "nul.obj"), "vertex coordinate '2?' is not a number");
+}
+
+TEST_F(ObjLoader, MalformedFaceLine) {
+  expect_error(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 three\n"), "line 4: malformed vertex reference 'three'");
+  expect_error(write("v 0 0 0\nv 1 0 0\nf 1 2\n", "two.obj"), "line 3: face has 2 vertices (expected at least 3)");
+  expect_error(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1/1 2 3\n", "four.obj"), "malformed vertex reference '1/1/1/1'");
+  expect_error(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/ 2 3\n", "slash.obj"), "malformed vertex reference '1/'");
+  expect_error(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1/ 2 3\n", "trailing.obj"), "malformed vertex reference '1/1/'");
+  expect_error(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//0 2 3\n", "normal.obj"), "texture/normal index 0 in '1//0' is invalid");
+}
+
+TEST_F(ObjLoader, EmptySceneIsAnError) {
+  expect_error(write(""), "scene contains no triangles");
+  expect_error(write("v 0 0 0\nv 1 0 0\nl 1 2\n", "lines.obj"), "scene contains no triangles");
+  expect_error(write("v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "allnan.obj"), "scene contains no triangles");
+}
+
+}  // namespace
