@@ -6,7 +6,7 @@ namespace accelviz {
 
 const std::vector<std::string>& structure_names() {
   static const std::vector<std::string> names = [] {
-    std::vector<std::string> n = {"brute", "brute-bbox", "bvh"};
+    std::vector<std::string> n = {"brute", "brute-bbox", "bvh", "kdtree", "grid", "octree", "voxels"};
     if (kHaveEmbree) n.push_back("embree");
     return n;
   }();
@@ -32,6 +32,10 @@ std::unique_ptr<Accelerator> build_accelerator(std::string_view name, std::span<
     if (bo.threads == 0) bo.threads = opts.threads;
     return std::make_unique<Bvh>(triangles, bo, progress);
   }
+  if (name == "kdtree") return std::make_unique<KdTree>(triangles, opts.kdtree, progress);
+  if (name == "grid") return std::make_unique<Grid>(triangles, opts.grid, progress);
+  if (name == "octree") return std::make_unique<Octree>(triangles, opts.octree, progress);
+  if (name == "voxels") return std::make_unique<Voxels>(triangles, opts.voxels, progress);
   if (name == "embree") {
 #ifdef ACCELVIZ_HAVE_EMBREE
     EmbreeOptions eo = opts.embree;

@@ -6,6 +6,10 @@
 #include "core/accel/brute_force.h"
 #include "core/accel/bvh/bvh.h"
 #include "core/accel/embree_backend.h"
+#include "core/accel/grid/grid.h"
+#include "core/accel/kdtree/kdtree.h"
+#include "core/accel/octree/octree.h"
+#include "core/accel/voxels/voxels.h"
 
 #include <memory>
 #include <span>
@@ -19,6 +23,10 @@ namespace accelviz {
 struct StructureOptions {
   BvhOptions bvh;            ///< "bvh"
   BruteForceOptions brute;   ///< "brute" (bbox_early_out is forced on for "brute-bbox")
+  KdTreeOptions kdtree;      ///< "kdtree"
+  GridOptions grid;          ///< "grid"
+  OctreeOptions octree;      ///< "octree"
+  VoxelOptions voxels;       ///< "voxels" (hits are voxels, not triangles: see voxels.h)
   EmbreeOptions embree;      ///< "embree"
   unsigned threads = 0;      ///< build threads for structures whose own option is 0 (0: all hardware threads)
 };
@@ -27,7 +35,7 @@ struct StructureOptions {
 /// ("embree" only when this build has the Embree backend).
 const std::vector<std::string>& structure_names();
 
-/// "brute, brute-bbox, bvh, embree": for messages and help texts.
+/// "brute, brute-bbox, bvh, kdtree, ...": for messages and help texts.
 std::string structure_names_joined();
 
 /// Builds the structure `name` over `triangles` (which must outlive it).

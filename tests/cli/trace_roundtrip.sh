@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Ray files through `trace`: brute force and the BVH give the same closest
-# hits (up to ties in t) and identical occlusion; Embree, when built, agrees
-# within float tolerance.
+# Ray files through `trace`: brute force, the BVH, the K-D tree, the grid and
+# the octree give the same closest hits (up to ties in t) and identical
+# occlusion; Embree, when built, agrees within float tolerance.
 set -euo pipefail
 accelviz="$(realpath "$1")"
 tmp=$(mktemp -d)
@@ -14,7 +14,7 @@ done
 # The generator refuses to overwrite, like every writer.
 if "$accelviz" -q rays "$scene" --out "$tmp/primary.rays" 2>/dev/null; then echo "FAIL: rays overwrote"; exit 1; fi
 
-structures="brute bvh"
+structures="brute bvh kdtree grid octree"
 "$accelviz" info 'builtin:soup?size=10' >/dev/null
 if "$accelviz" --help | grep -q embree || "$accelviz" render --help | grep -q embree; then structures="$structures embree"; fi
 
