@@ -84,7 +84,15 @@ inline int channel_diff(glm::u8vec4 a, glm::u8vec4 b) {
 }
 
 inline std::string describe(glm::u8vec4 c) {
-  return "(" + std::to_string(c.x) + "," + std::to_string(c.y) + "," + std::to_string(c.z) + ")";
+  // Appended piecewise: GCC 12 warns (-Wrestrict, a known false positive) on "(" + std::string.
+  std::string s = "(";
+  s += std::to_string(c.x);
+  s += ',';
+  s += std::to_string(c.y);
+  s += ',';
+  s += std::to_string(c.z);
+  s += ')';
+  return s;
 }
 
 /// A fresh empty directory under the system temp dir, removed by the destructor.

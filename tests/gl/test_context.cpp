@@ -39,20 +39,26 @@ TEST(OsMesaContext, ComputeShadersAreAvailable) {
 TEST(OsMesaContext, RejectsAnEmptyImageSize) { EXPECT_THROW(OsMesaContext(0, 10), GlError); }
 
 TEST(OsMesaContext, TwoContextsTakeTurns) {
+  // GL objects belong to their context: each renderer is used and destroyed
+  // with its own context current.
   OsMesaContext a(32, 32);
   OsMesaContext b(16, 16);
   a.make_current();
-  Renderer ra;
+  auto ra = std::make_unique<Renderer>();
   RenderView view;
   view.background = {1.0f, 0.0f, 0.0f};
-  ra.render(view, 8, 8);
+  ra->render(view, 8, 8);
   b.make_current();
-  Renderer rb;
-  view.background = {0.0f, 0.0f, 1.0f};
-  rb.render(view, 8, 8);
-  EXPECT_EQ(rb.read_pixels().at(3, 3), glm::u8vec4(0, 0, 255, 255));
+  {
+    Renderer rb;
+    view.background = {0.0f, 0.0f, 1.0f};
+    rb.render(view, 8, 8);
+    EXPECT_EQ(rb.read_pixels().at(3, 3), glm::u8vec4(0, 0, 255, 255));
+  }
   a.make_current();
-  EXPECT_EQ(ra.read_pixels().at(3, 3), glm::u8vec4(255, 0, 0, 255));
+  EXPECT_EQ(ra->read_pixels().at(3, 3), glm::u8vec4(255, 0, 0, 255));
+  ra.reset();
+  check_gl_errors("renderer teardown");
 }
 
 TEST(GlErrors, CheckNamesTheErrorAndThePass) {
