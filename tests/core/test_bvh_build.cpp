@@ -157,7 +157,18 @@ TEST(BvhBuild, StatsMatchTheNodeArray) {
   EXPECT_EQ(st.leaf_count, leaves);
   EXPECT_EQ(st.max_depth, max_depth);
   EXPECT_NEAR(st.avg_leaf_depth, depth_sum / static_cast<double>(leaves), 1e-9);
-  EXPECT_EQ(st.memory_bytes, bvh.nodes().size() * 32 + tris.size() * 4 + tris.size() * sizeof(Triangle));
+  // Nodes, indices, the leaf-order triangles, and the 4-wide copy (128-byte
+  // nodes plus the binary id each of its four slots copies).
+  const std::size_t wide = static_cast<std::size_t>(st.extra.at("wide_nodes"));
+  EXPECT_GT(wide, 0u);
+  EXPECT_LT(wide, bvh.nodes().size() / 2);
+  EXPECT_EQ(st.memory_bytes,
+            bvh.nodes().size() * 32 + tris.size() * 4 + tris.size() * sizeof(Triangle) + wide * (128 + 16));
+  o.wide_traversal = false;
+  const Bvh binary_only(tris, o);
+  EXPECT_EQ(binary_only.build_stats().memory_bytes,
+            bvh.nodes().size() * 32 + tris.size() * 4 + tris.size() * sizeof(Triangle));
+  EXPECT_EQ(binary_only.build_stats().extra.count("wide_nodes"), 0u);
   EXPECT_GE(st.build_ms, 0.0);
   EXPECT_GT(st.sah_cost, 0.0);
   EXPECT_EQ(st.extra.count("epo"), 0u);  // compute_epo = false

@@ -1,7 +1,8 @@
 // Differential test: the BVH must answer exactly as brute force.
 //
 // For every splitter and several option sets (B = 2, 16, 256; leaf sizes 1,
-// 4, 16; ordered and unordered traversal; watertight and Moller-Trumbore)
+// 4, 16; ordered and unordered traversal; watertight and Moller-Trumbore;
+// the 4-wide fast path and the binary one)
 // closest_hit must return the same primitive as BruteForce, or, where two
 // primitives tie, a hit at the same distance (|t - t_ref| <= 1e-6·max(1,|t|));
 // any_hit must equal closest.valid(). Rays are seeded and adversarial:
@@ -197,6 +198,15 @@ std::vector<BvhOptions> option_sets() {
     o.splitter = BvhSplitter::median;
     v.push_back(o);
   }
+  // The binary fast path too (the default walks the 4-wide copy).
+  for (BvhSplitter s : {BvhSplitter::binned_sah, BvhSplitter::exact_sah, BvhSplitter::median}) {
+    BvhOptions o;
+    o.compute_epo = false;
+    o.threads = 1;
+    o.splitter = s;
+    o.wide_traversal = false;
+    v.push_back(o);
+  }
   return v;
 }
 
@@ -249,6 +259,7 @@ void check_scene(const std::string& name, std::span<const Triangle> tris, std::s
           if (!ok && ++tally.mismatches <= 10) {
             const Ray& ray = rays[i];
             ADD_FAILURE() << name << " " << to_string(o.splitter) << " B=" << o.buckets << " leaf=" << o.max_leaf_size
+                          << (o.wide_traversal ? " wide" : " binary")
                           << (ordered ? " ordered" : " unordered")
                           << (test == TriangleTest::watertight ? " watertight" : " MT") << " ray " << i << " o=("
                           << ray.origin.x << "," << ray.origin.y << "," << ray.origin.z << ") d=(" << ray.direction.x
@@ -301,21 +312,29 @@ TEST(BvhDifferential, MatchesBruteForceOnALargerSoupWithThreadedBuild) {
 
 TEST(BvhDifferential, StatisticsPathAnswersAsTheFastPath) {
   // The counting traversal tests boxes against the segment end and classifies
-  // culling itself; it must take the same decisions as the fast path.
+  // culling itself; it must take the same decisions as the binary fast path.
   const std::vector<Triangle> tris = soup(1000, 5);
   const std::vector<Ray> rays = adversarial_rays(tris, 3000, 105);
   for (const BvhOptions& o : option_sets()) {
     const Bvh bvh(tris, o);
+    BvhOptions binary_options = o;
+    binary_options.wide_traversal = false;
+    const Bvh binary(tris, binary_options);
     for (bool ordered : {true, false}) {
       QueryOptions q;
       q.ordered = ordered;
       for (const Ray& ray : rays) {
         RayStats st;
         VisitTrace trace;
-        const Hit fast = bvh.closest_hit(ray, q);
+        const Hit fast = binary.closest_hit(ray, q);
         const Hit counted = bvh.closest_hit(ray, q, &st, &trace);
         ASSERT_EQ(fast.prim, counted.prim);
         ASSERT_EQ(fast.t, counted.t);
+        // The wide fast path finds the same hit (a tie could pick the other
+        // triangle at the same t; this soup has none).
+        const Hit wide = bvh.closest_hit(ray, q);
+        ASSERT_EQ(wide.prim, counted.prim);
+        ASSERT_EQ(wide.t, counted.t);
         RayStats any_st;
         ASSERT_EQ(bvh.any_hit(ray, q), bvh.any_hit(ray, q, &any_st));
       }

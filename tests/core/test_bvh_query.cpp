@@ -1,11 +1,12 @@
-// BVH queries: the SIMD slab test against its scalar twin, statistics and
-// visit traces, ordered vs unordered traversal, any-hit, ids and normals,
-// deep trees, and refitting.
+// BVH queries: the SIMD slab tests against their scalar twins, the 4-wide
+// collapse, statistics and visit traces, ordered vs unordered traversal,
+// any-hit, ids and normals, deep trees, and refitting.
 #include <gtest/gtest.h>
 
 #include "core/accel/brute_force.h"
 #include "core/accel/bvh/bvh.h"
 #include "core/accel/bvh/bvh_slab.h"
+#include "core/accel/bvh/bvh_wide.h"
 
 #include <algorithm>
 #include <cmath>
@@ -123,6 +124,103 @@ TEST(BvhSlab, RayInAFacePlaneTouchesTheBox) {
   EXPECT_EQ(t0, 1.0f);
   const Ray beside({-1.0f, -0.001f, 0.5f}, {1.0f, 0.0f, 0.0f});
   EXPECT_FALSE(bvh_detail::slab_test(n, bvh_detail::SlabRay(beside), 0.0f, kInfinity, t0, t1));
+}
+
+TEST(BvhSlab, WideTestAgreesWithScalarTwinPerSlot) {
+  std::mt19937 rng(2);
+  const float specials[] = {0.0f, -0.0f, 1.0f, -1.0f, kInfinity, -kInfinity, 1e-30f};
+  for (int i = 0; i < 100000; ++i) {
+    bvh_detail::WideNode n;
+    for (int s = 0; s < 4; ++s) {
+      glm::vec3 a(uniform(rng), uniform(rng), uniform(rng)), b(uniform(rng), uniform(rng), uniform(rng));
+      if (i % 5 == 1) b[static_cast<int>(rng() % 3)] = a[static_cast<int>(rng() % 3)];
+      Aabb box{glm::min(a, b), glm::max(a, b)};
+      if (i % 7 == 2 && s == 1) box = Aabb::empty();
+      for (int r = 0; r < 3; ++r) {
+        n.bounds[r][s] = box.lo[r];
+        n.bounds[3 + r][s] = box.hi[r];
+      }
+      n.child[s] = rng();
+      n.meta[s] = (i % 9 == 4 && s == 3) ? bvh_detail::kWideEmpty : rng() % 5;
+    }
+    glm::vec3 o(2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f);
+    glm::vec3 d = random_direction(rng);
+    for (int a = 0; a < 3; ++a) {
+      const unsigned r = rng() % 8;
+      if (r == 0) d[a] = (rng() & 1) ? 0.0f : -0.0f;
+      if (r == 1) o[a] = n.bounds[a][0];  // on a face plane of slot 0
+      if (r == 2) d[a] = specials[rng() % 7];
+    }
+    const Ray ray(o, d, (i % 3 == 0) ? -1.0f : 0.0f, (i % 4 == 0) ? 1.5f : kInfinity);
+    float se[4], sx[4], ve[4], vx[4];
+    int scalar = bvh_detail::wide_slab_test_scalar(n, ray, ray.tmin, ray.tmax, se, sx);
+    for (int s = 0; s < 4; ++s)
+      if (n.meta[s] == bvh_detail::kWideEmpty) scalar &= ~(1 << s);
+    const int simd = bvh_detail::wide_slab_test(n, bvh_detail::WideSlabRay(ray), ray.tmin, ray.tmax, ve, vx);
+    ASSERT_EQ(simd, scalar) << "case " << i;
+    for (int s = 0; s < 4; ++s) {
+      // Same operations in the same order: bit-identical per slot.
+      ASSERT_EQ(std::memcmp(&ve[s], &se[s], 4), 0) << "case " << i << " slot " << s;
+      ASSERT_EQ(std::memcmp(&vx[s], &sx[s], 4), 0) << "case " << i << " slot " << s;
+    }
+  }
+}
+
+TEST(BvhWide, CollapseKeepsEveryLeafOnceWithItsBox) {
+  for (int leaf : {1, 4}) {
+    const auto tris = soup(3000, 20 + leaf);
+    BvhOptions o = quiet();
+    o.max_leaf_size = leaf;
+    const Bvh bvh(tris, o);
+    const auto nodes = bvh.nodes();
+    const bvh_detail::WideBvh wide = bvh_detail::collapse_to_wide(nodes);
+    ASSERT_EQ(wide.source.size(), 4 * wide.nodes.size());
+    std::vector<int> leaf_seen(nodes.size(), 0);
+    std::vector<int> wide_parents(wide.nodes.size(), 0);
+    for (std::size_t w = 0; w < wide.nodes.size(); ++w) {
+      int used = 0;
+      for (int s = 0; s < 4; ++s) {
+        const std::uint32_t src = wide.source[4 * w + s];
+        const bvh_detail::WideNode& n = wide.nodes[w];
+        if (n.meta[s] == bvh_detail::kWideEmpty) {
+          EXPECT_EQ(src, bvh_detail::kWideEmpty);
+          continue;
+        }
+        ++used;
+        ASSERT_LT(src, nodes.size());
+        const Aabb& b = nodes[src].bounds;
+        EXPECT_EQ(n.bounds[0][s], b.lo.x);
+        EXPECT_EQ(n.bounds[4][s], b.hi.y);
+        EXPECT_EQ(n.bounds[5][s], b.hi.z);
+        if (n.meta[s] == 0) {
+          ASSERT_GT(n.child[s], w);  // wide children after their parent
+          ASSERT_LT(n.child[s], wide.nodes.size());
+          ++wide_parents[n.child[s]];
+          EXPECT_EQ(nodes[src].count, 0u);
+        } else {
+          EXPECT_EQ(n.meta[s], nodes[src].count);
+          EXPECT_EQ(n.child[s], nodes[src].index);
+          ++leaf_seen[src];
+        }
+      }
+      EXPECT_GE(used, 2);
+    }
+    for (std::size_t i = 0; i < nodes.size(); ++i) EXPECT_EQ(leaf_seen[i], nodes[i].count > 0 ? 1 : 0) << i;
+    for (std::size_t w = 1; w < wide.nodes.size(); ++w) EXPECT_EQ(wide_parents[w], 1);
+    // Mostly full nodes: about a third as many as binary inner nodes.
+    EXPECT_LT(wide.nodes.size(), nodes.size() / 4);
+  }
+}
+
+TEST(BvhWide, SingleLeafTreeCollapsesToOneSlot) {
+  const std::vector<Triangle> tris(3, Triangle{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
+  const Bvh bvh(tris, quiet());
+  const bvh_detail::WideBvh wide = bvh_detail::collapse_to_wide(bvh.nodes());
+  ASSERT_EQ(wide.nodes.size(), 1u);
+  EXPECT_EQ(wide.nodes[0].meta[0], 3u);
+  EXPECT_EQ(wide.nodes[0].meta[1], bvh_detail::kWideEmpty);
+  EXPECT_TRUE(bvh.any_hit(Ray({0.2f, 0.2f, -1}, {0, 0, 1}), {}));
+  EXPECT_TRUE(bvh_detail::collapse_to_wide({}).nodes.empty());
 }
 
 // ---- Basic answers ----
@@ -345,6 +443,13 @@ TEST(BvhRefit, RefitToTheSamePositionsRestoresTheBuild) {
   EXPECT_EQ(std::memcmp(bvh.nodes().data(), built.data(), built.size() * sizeof(BvhNode)), 0);
   EXPECT_EQ(bvh.build_stats().sah_cost, sah);
   EXPECT_EQ(bvh.build_stats().extra.at("epo"), epo);
+  // The wide copy follows the refit too: answers equal a fresh build's.
+  const Bvh fresh(tris, o);
+  for (const Ray& r : rays_through_unit_cube(2000, 17)) {
+    const Hit a = bvh.closest_hit(r, {}), b = fresh.closest_hit(r, {});
+    EXPECT_EQ(a.prim, b.prim);
+    EXPECT_EQ(a.t, b.t);
+  }
 }
 
 TEST(BvhRefit, RejectsADifferentTriangleCount) {

@@ -8,10 +8,12 @@
 #include "core/accel/bvh/bvh.h"
 
 #include "core/accel/bvh/bvh_slab.h"
+#include "core/accel/bvh/bvh_wide.h"
 
 #include "core/analysis/epo.h"
 #include "core/analysis/sah.h"
 
+#include <bit>
 #include <chrono>
 #include <stdexcept>
 #include <string>
@@ -36,9 +38,18 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
   leaf_tris_.resize(prim_indices_.size());
   for (std::size_t k = 0; k < prim_indices_.size(); ++k) leaf_tris_[k] = triangles[prim_indices_[k]];
   stats_.memory_bytes += leaf_tris_.size() * sizeof(Triangle);
+  if (opts_.wide_traversal && !nodes_.empty()) {
+    wide_ = std::make_unique<bvh_detail::WideBvh>(bvh_detail::collapse_to_wide(nodes_));
+    stats_.memory_bytes += wide_->nodes.size() * sizeof(bvh_detail::WideNode) + wide_->source.size() * sizeof(std::uint32_t);
+    stats_.extra["wide_nodes"] = static_cast<double>(wide_->nodes.size());
+  }
   stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   update_quality_stats();
 }
+
+Bvh::~Bvh() = default;
+Bvh::Bvh(Bvh&&) noexcept = default;
+Bvh& Bvh::operator=(Bvh&&) noexcept = default;
 
 void Bvh::update_quality_stats() {
   stats_.sah_cost = bvh_sah_cost(nodes_, opts_.cost_traversal, opts_.cost_intersect);
@@ -70,6 +81,7 @@ void Bvh::refit(std::span<const Triangle> moved) {
     }
     n.bounds = b;
   }
+  if (wide_) bvh_detail::refit_wide(*wide_, nodes_);
   stats_.extra["refit_ms"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   update_quality_stats();
 }
@@ -246,6 +258,108 @@ Hit traverse(const BvhView& bvh, const Ray& ray, const Collector& c) {
   }
 }
 
+/// Fast-path traversal of the 4-wide copy (no statistics). Same contract as
+/// traverse<AnyHit, Ordered, false, Test>: hits on the same triangles, ties
+/// kept by "first found at the smallest t".
+///  - Ordered: hit children sorted by entry distance, nearest taken, the
+///    others pushed farthest first; on pop a child whose entry lies beyond
+///    the closest hit is skipped.
+///  - Unordered: slot order.
+/// Stack: at most three entries per wide level, and a wide path is no longer
+/// than the binary one (kBvhMaxDepth).
+template <bool AnyHit, bool Ordered, TriangleTest Test>
+Hit traverse_wide(const bvh_detail::WideNode* wide, const BvhView& bvh, const Ray& ray) {
+  using bvh_detail::WideNode;
+  Hit best;
+  const bvh_detail::WideSlabRay wr4(ray);
+  const float tmin = ray.tmin;
+  float closest = ray.tmax;
+  WatertightRay wr;
+  bool wr_ready = Test != TriangleTest::watertight;
+
+  struct Entry {
+    std::uint32_t child, meta;
+    float t_entry;
+  };
+  Entry stack[3 * kBvhMaxDepth + 1];
+  unsigned sp = 0;
+  std::uint32_t child = 0, meta = 0;  // the wide root
+  for (;;) {
+    if (meta == 0) {
+      const WideNode& n = wide[child];
+      alignas(16) float te[4];
+      int mask = bvh_detail::wide_slab_test(n, wr4, tmin, closest, te);
+      if (mask != 0) {
+        if ((mask & (mask - 1)) == 0) {  // one child: no ordering, no push
+          const int s = std::countr_zero(static_cast<unsigned>(mask));
+          child = n.child[s];
+          meta = n.meta[s];
+          continue;
+        }
+        int slot[4], k = 0;
+        while (mask != 0) {
+          slot[k++] = std::countr_zero(static_cast<unsigned>(mask));
+          mask &= mask - 1;
+        }
+        if constexpr (Ordered) {
+          // Insertion sort by entry distance; equal distances keep slot order.
+          for (int i = 1; i < k; ++i) {
+            const int v = slot[i];
+            int j = i;
+            while (j > 0 && te[slot[j - 1]] > te[v]) {
+              slot[j] = slot[j - 1];
+              --j;
+            }
+            slot[j] = v;
+          }
+        }
+        for (int j = k - 1; j >= 1; --j) stack[sp++] = {n.child[slot[j]], n.meta[slot[j]], te[slot[j]]};
+        child = n.child[slot[0]];
+        meta = n.meta[slot[0]];
+        continue;
+      }
+    } else {
+      if (!wr_ready) {
+        wr = WatertightRay(ray.direction);
+        wr_ready = true;
+      }
+      for (std::uint32_t k = child, end = child + meta; k < end; ++k) {
+        Hit h;
+        const bool hit = test_triangle<Test>(ray, wr, bvh.tris[k], tmin, closest, h);
+        if constexpr (AnyHit) {
+          if (hit) {
+            best = h;
+            best.prim = k;
+            return best;
+          }
+        } else if (hit && h.t < best.t) {
+          best = h;
+          best.prim = k;
+          closest = h.t;
+        }
+      }
+    }
+    for (;;) {
+      if (sp == 0) return best;
+      const Entry e = stack[--sp];
+      if (!AnyHit && e.t_entry > closest) continue;
+      child = e.child;
+      meta = e.meta;
+      break;
+    }
+  }
+}
+
+template <bool AnyHit>
+Hit dispatch_wide(const bvh_detail::WideNode* wide, const BvhView& v, const Ray& ray, const QueryOptions& qo) {
+  const bool wt = qo.triangle_test == TriangleTest::watertight;
+  if (qo.ordered)
+    return wt ? traverse_wide<AnyHit, true, TriangleTest::watertight>(wide, v, ray)
+              : traverse_wide<AnyHit, true, TriangleTest::moller_trumbore>(wide, v, ray);
+  return wt ? traverse_wide<AnyHit, false, TriangleTest::watertight>(wide, v, ray)
+            : traverse_wide<AnyHit, false, TriangleTest::moller_trumbore>(wide, v, ray);
+}
+
 template <bool AnyHit, bool Collect>
 Hit dispatch(const BvhView& v, const Ray& ray, const QueryOptions& qo, const Collector& c) {
   const bool wt = qo.triangle_test == TriangleTest::watertight;
@@ -262,7 +376,8 @@ Hit Bvh::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, Vi
   const BvhView v{nodes_.data(), leaf_tris_.data(), prim_indices_.data(), nodes_.size()};
   Hit h;
   if (stats == nullptr && trace == nullptr) {
-    h = dispatch<false, false>(v, ray, qo, Collector{nullptr, nullptr});
+    h = wide_ ? dispatch_wide<false>(wide_->nodes.data(), v, ray, qo)
+              : dispatch<false, false>(v, ray, qo, Collector{nullptr, nullptr});
   } else {
     RayStats local;
     h = dispatch<false, true>(v, ray, qo, Collector{stats ? stats : &local, trace});
@@ -276,7 +391,9 @@ Hit Bvh::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, Vi
 
 bool Bvh::any_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats) const {
   const BvhView v{nodes_.data(), leaf_tris_.data(), prim_indices_.data(), nodes_.size()};
-  if (stats == nullptr) return dispatch<true, false>(v, ray, qo, Collector{nullptr, nullptr}).valid();
+  if (stats == nullptr)
+    return wide_ ? dispatch_wide<true>(wide_->nodes.data(), v, ray, qo).valid()
+                 : dispatch<true, false>(v, ray, qo, Collector{nullptr, nullptr}).valid();
   return dispatch<true, true>(v, ray, qo, Collector{stats, nullptr}).valid();
 }
 

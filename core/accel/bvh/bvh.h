@@ -11,6 +11,8 @@
 #include "core/accel/accel.h"
 #include "core/math/aabb.h"
 
+#include <memory>
+
 #include <glm/glm.hpp>
 
 #include <cstdint>
@@ -19,6 +21,10 @@
 #include <vector>
 
 namespace accelviz {
+
+namespace bvh_detail {
+struct WideBvh;
+}
 
 /// How a node's primitives are divided between its two children.
 enum class BvhSplitter {
@@ -39,6 +45,7 @@ struct BvhOptions {
   float cost_intersect = 1.0f;   ///< C_isect: cost of one ray-primitive test (> 0, finite)
   unsigned threads = 0;          ///< build threads, 0 = all hardware threads; the node array is identical for any count
   bool compute_epo = true;       ///< Bvh only: compute the EPO metric into build_stats().extra["epo"] (costs a pass over the tree per triangle)
+  bool wide_traversal = true;    ///< Bvh only: uninstrumented queries walk a 4-wide collapse of the tree (faster); statistics and traces always walk the binary tree
 };
 
 /// Throws std::invalid_argument naming the offending option when `opts` is out of range.
@@ -82,6 +89,9 @@ BvhTopology build_bvh(std::span<const Aabb> bounds, std::span<const glm::vec3> c
 class Bvh final : public Accelerator {
  public:
   Bvh(std::span<const Triangle> triangles, const BvhOptions& opts = {}, const ProgressCallback& progress = {});
+  ~Bvh() override;
+  Bvh(Bvh&&) noexcept;
+  Bvh& operator=(Bvh&&) noexcept;
 
   std::string name() const override { return "bvh"; }
   Hit closest_hit(const Ray& ray, const QueryOptions& opts, RayStats* stats = nullptr,
@@ -109,6 +119,7 @@ class Bvh final : public Accelerator {
   std::vector<BvhNode> nodes_;
   std::vector<std::uint32_t> prim_indices_;
   std::vector<Triangle> leaf_tris_;
+  std::unique_ptr<bvh_detail::WideBvh> wide_;  ///< 4-wide copy for the fast path (null when disabled or empty)
   BvhOptions opts_;
   BuildStats stats_;
 };

@@ -12,6 +12,7 @@
 // adversarial boxes and rays (±0 directions, origins on face planes, flat,
 // empty and infinite boxes).
 #include "core/accel/bvh/bvh.h"
+#include "core/accel/bvh/bvh_wide.h"
 #include "core/math/aabb.h"
 #include "core/math/ray.h"
 
@@ -102,6 +103,45 @@ struct SlabRay {
   return _mm_movemask_ps(_mm_cmple_ps(e, x)) & 3;
 }
 
+/// Per-ray constants of the four-box test: origin and inverse direction
+/// broadcast per axis, and which row of WideNode::bounds is near/far.
+struct WideSlabRay {
+  __m128 origin[3], inv_dir[3];
+  int near_row[3], far_row[3];
+
+  explicit WideSlabRay(const Ray& r) {
+    for (int a = 0; a < 3; ++a) {
+      origin[a] = _mm_set1_ps(r.origin[a]);
+      inv_dir[a] = _mm_set1_ps(r.inv_dir[a]);
+      const bool neg = r.inv_dir[a] < 0.0f;  // as intersect_slab: hi is near
+      near_row[a] = neg ? 3 + a : a;
+      far_row[a] = neg ? a : 3 + a;
+    }
+  }
+};
+
+/// Four boxes of a wide node at once, lane s = slot s, the axes in the same
+/// order and with the same operations as intersect_slab, so each lane is bit
+/// for bit the scalar result. Unused slots are masked out. Returns the hit
+/// mask; entry (and exit) distances per slot in the arrays.
+[[gnu::always_inline]] inline int wide_slab_test(const WideNode& node, const WideSlabRay& r, float tmin, float tmax,
+                                                 float* t_entry, float* t_exit = nullptr) {
+  const __m128 scale = _mm_set1_ps(kSlabExitScale);
+  __m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax);
+  for (int a = 0; a < 3; ++a) {
+    const __m128 tn = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.near_row[a]]), r.origin[a]), r.inv_dir[a]);
+    const __m128 tf =
+        _mm_mul_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.far_row[a]]), r.origin[a]), r.inv_dir[a]), scale);
+    t0 = _mm_max_ps(tn, t0);
+    t1 = _mm_min_ps(tf, t1);
+  }
+  _mm_storeu_ps(t_entry, t0);
+  if (t_exit) _mm_storeu_ps(t_exit, t1);
+  const __m128i empty = _mm_cmpeq_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(node.meta)),
+                                        _mm_set1_epi32(static_cast<int>(kWideEmpty)));
+  return _mm_movemask_ps(_mm_andnot_ps(_mm_castsi128_ps(empty), _mm_cmple_ps(t0, t1)));
+}
+
 #else
 
 struct SlabRay {
@@ -118,6 +158,20 @@ inline int slab_test_pair(const BvhNode* children, const SlabRay& r, float tmin,
   const bool h0 = slab_test_scalar(children[0], *r.ray, tmin, tmax, t_entry[0], t_exit[0]);
   const bool h1 = slab_test_scalar(children[1], *r.ray, tmin, tmax, t_entry[1], t_exit[1]);
   return (h0 ? 1 : 0) | (h1 ? 2 : 0);
+}
+
+struct WideSlabRay {
+  const Ray* ray;
+  explicit WideSlabRay(const Ray& r) : ray(&r) {}
+};
+
+inline int wide_slab_test(const WideNode& node, const WideSlabRay& r, float tmin, float tmax, float* t_entry,
+                          float* t_exit = nullptr) {
+  float exits[4];
+  int mask = wide_slab_test_scalar(node, *r.ray, tmin, tmax, t_entry, t_exit ? t_exit : exits);
+  for (int s = 0; s < 4; ++s)
+    if (node.meta[s] == kWideEmpty) mask &= ~(1 << s);
+  return mask;
 }
 
 #endif
