@@ -117,6 +117,9 @@ class Builder {
 
  private:
   Aabb child_bounds(std::uint32_t prim, const Aabb& parent_cb, const Aabb& child_box) const {
+    // The part inside the parent lies wholly on this side of the plane: it
+    // is also the part inside the child (most primitives; no clipping).
+    if (child_box.contains(parent_cb)) return parent_cb;
     if (opts_.perfect_splits) {
       const Aabb c = clipped_triangle_bounds(tris_[prim], child_box);
       if (!c.is_empty()) return c;
