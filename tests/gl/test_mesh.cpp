@@ -25,7 +25,9 @@ glm::vec3 pixel_on_plane(const Camera& cam, int x, int y, const glm::vec3& n, fl
   return r.at(t);
 }
 
-TEST_F(GlTest, HeadlightFlatShadingFollowsTheGeometricNormal) {
+class MeshPassTest : public GlTest {};
+
+TEST_F(MeshPassTest, HeadlightFlatShadingFollowsTheGeometricNormal) {
   // A wall tilted 50 degrees about the y axis: its brightness changes across
   // the image only through the direction to the eye.
   const float a = 50.0f * 3.14159265f / 180.0f;
@@ -50,7 +52,7 @@ TEST_F(GlTest, HeadlightFlatShadingFollowsTheGeometricNormal) {
   EXPECT_GE(checked, 4);
 }
 
-TEST_F(GlTest, BackFacesAreShadedLikeFrontFaces) {
+TEST_F(MeshPassTest, BackFacesAreShadedLikeFrontFaces) {
   // The same wall wound the other way round: identical picture.
   std::vector<Triangle> front, back;
   add_quad_xy(front, -3.0f, -3.0f, 3.0f, 3.0f, 0.0f);
@@ -64,7 +66,7 @@ TEST_F(GlTest, BackFacesAreShadedLikeFrontFaces) {
   EXPECT_TRUE(a.pixels == b.pixels);
 }
 
-TEST_F(GlTest, WireframeDrawsTheTriangleEdges) {
+TEST_F(MeshPassTest, WireframeDrawsTheTriangleEdges) {
   std::vector<Triangle> wall;
   add_quad_xy(wall, -1.5f, -1.0f, 1.5f, 1.0f, 0.0f);  // diagonal from (-1.5,-1) to (1.5,1)
   renderer_->set_triangles(wall);
@@ -93,7 +95,7 @@ TEST_F(GlTest, WireframeDrawsTheTriangleEdges) {
   EXPECT_FALSE(draw(view).pixels == img.pixels);
 }
 
-TEST_F(GlTest, FullScreenHeatmapKeepsTheMeshDepthForOverlays) {
+TEST_F(MeshPassTest, FullScreenHeatmapKeepsTheMeshDepthForOverlays) {
   std::vector<Triangle> wall;
   add_quad_xy(wall, -3.0f, -3.0f, 3.0f, 3.0f, 0.0f);
   renderer_->set_triangles(wall);
@@ -118,7 +120,7 @@ TEST_F(GlTest, FullScreenHeatmapKeepsTheMeshDepthForOverlays) {
   EXPECT_LE(channel_diff(img.at(64, 48), to_rgba8(colormap(ColorMap::viridis, 0.5f / 0.5f))), kTolerance);
 }
 
-TEST_F(GlTest, MultisampledFrameResolvesWithSmoothEdges) {
+TEST_F(MeshPassTest, MultisampledFrameResolvesWithSmoothEdges) {
   std::vector<Triangle> tri = {{{-1.0f, -1.0f, 0.0f}, {1.2f, -0.7f, 0.0f}, {-0.2f, 1.1f, 0.0f}}};
   renderer_->set_triangles(tri);
   RenderView view;
