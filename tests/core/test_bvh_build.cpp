@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "core/accel/bvh/bvh.h"
+#include "core/accel/bvh/bvh_build.h"
 
 #include <algorithm>
 #include <atomic>
@@ -469,6 +470,39 @@ TEST(BvhBuild, ExceptionFromProgressCallbackPropagates) {
     return true;
   };
   EXPECT_THROW(Bvh(tris, o, throwing), std::runtime_error);
+}
+
+TEST(BvhBuild, SimdBinningAgreesWithScalarTwin) {
+  std::mt19937 rng(30);
+  for (int round = 0; round < 50; ++round) {
+    const int buckets = 2 + static_cast<int>(rng() % 255);
+    std::vector<bvh_detail::BuildPrim> prims(500);
+    for (std::uint32_t i = 0; i < prims.size(); ++i) {
+      const glm::vec3 a(uniform(rng), uniform(rng), uniform(rng)), b(uniform(rng), uniform(rng), uniform(rng));
+      prims[i] = {(a + b) * 0.5f, i, Aabb{glm::min(a, b), glm::max(a, b)}};
+      if (i % 17 == 0) prims[i].centroid.x = -1.0f;  // below the origin: bucket 0
+      if (i % 19 == 0) prims[i].centroid.y = 5.0f;   // beyond the top: bucket B-1
+    }
+    const glm::vec3 origin(0.0f);
+    const float k[3] = {static_cast<float>(buckets), static_cast<float>(buckets) * 0.9f, static_cast<float>(buckets)};
+    bvh_detail::Bins simd, scalar;
+    bvh_detail::clear_bins(simd, buckets);
+    bvh_detail::clear_bins(scalar, buckets);
+    bvh_detail::bin_primitives(prims, origin, k, buckets, simd);
+    bvh_detail::bin_primitives_scalar(prims, origin, k, buckets, scalar);
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < buckets; ++b) {
+        ASSERT_EQ(simd.count[a][b], scalar.count[a][b]) << a << " " << b;
+        for (int l = 0; l < 3; ++l) {
+          ASSERT_EQ(simd.lo[a][b][l], scalar.lo[a][b][l]);
+          ASSERT_EQ(simd.hi[a][b][l], scalar.hi[a][b][l]);
+        }
+      }
+    // Every primitive lands where bucket_of puts it.
+    std::vector<std::uint32_t> expect(static_cast<std::size_t>(buckets), 0);
+    for (const auto& p : prims) ++expect[bvh_detail::bucket_of(p.centroid.y, origin.y, k[1], buckets)];
+    for (int b = 0; b < buckets; ++b) EXPECT_EQ(simd.count[1][b], expect[b]);
+  }
 }
 
 // ---- Quality ordering between splitters ----

@@ -65,6 +65,37 @@ SplitOutcome split_exact_sah(const SplitParams& params, std::span<BuildPrim> pri
 SplitOutcome split_median(const SplitParams& params, std::span<BuildPrim> prims, const Aabb& bounds,
                           const Aabb& centroid_bounds, SplitScratch& scratch, SplitResult& out);
 
+/// Bucket contents of one binned SAH pass: bounds (lanes 0..2 used; 16-byte
+/// rows so that the SIMD pass can load and store them whole) and counts, per
+/// axis and bucket.
+inline constexpr int kMaxBuckets = 256;
+struct Bins {
+  alignas(16) float lo[3][kMaxBuckets][4];
+  alignas(16) float hi[3][kMaxBuckets][4];
+  std::uint32_t count[3][kMaxBuckets];
+};
+
+/// Bucket of a centroid coordinate: floor((c - lo)·k), clamped to [0, B-1];
+/// a NaN lands in bucket 0. The binning passes and the partition use it (or
+/// its SIMD equivalent), so they agree exactly.
+inline int bucket_of(float c, float lo, float k, int buckets) {
+  const float x = (c - lo) * k;
+  if (!(x >= 0.0f)) return 0;
+  const float top = static_cast<float>(buckets - 1);
+  return x < top ? static_cast<int>(x) : buckets - 1;
+}
+
+/// Resets the first `buckets` buckets of every axis to empty.
+void clear_bins(Bins& bins, int buckets);
+/// Adds every primitive to its bucket on all three axes (Wald 2007):
+/// bucket = bucket_of(centroid[a], origin[a], k[a], buckets).
+/// bin_primitives uses SSE2 where available (three axes per instruction);
+/// bin_primitives_scalar is its twin, and the tests check they agree.
+void bin_primitives(std::span<const BuildPrim> prims, const glm::vec3& origin, const float k[3], int buckets,
+                    Bins& bins);
+void bin_primitives_scalar(std::span<const BuildPrim> prims, const glm::vec3& origin, const float k[3], int buckets,
+                           Bins& bins);
+
 /// Object median split: orders the range by centroid on the axis of largest
 /// centroid extent (ties by primitive id, so the result is unique) and cuts
 /// it in two halves (left gets n/2). Always separates n >= 2 primitives, which

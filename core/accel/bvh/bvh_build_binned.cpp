@@ -12,33 +12,79 @@
 #include <array>
 #include <utility>
 
+#if defined(__SSE2__) && !defined(ACCELVIZ_NO_SIMD)
+#include <emmintrin.h>
+#endif
+
 namespace accelviz::bvh_detail {
+
+void clear_bins(Bins& bins, int buckets) {
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < buckets; ++b) {
+      for (int l = 0; l < 4; ++l) {
+        bins.lo[a][b][l] = kInfinity;
+        bins.hi[a][b][l] = -kInfinity;
+      }
+      bins.count[a][b] = 0;
+    }
+}
+
+void bin_primitives_scalar(std::span<const BuildPrim> prims, const glm::vec3& origin, const float k[3], int buckets,
+                           Bins& bins) {
+  for (const BuildPrim& p : prims) {
+    for (int a = 0; a < 3; ++a) {
+      const int b = bucket_of(p.centroid[a], origin[a], k[a], buckets);
+      float* lo = bins.lo[a][b];
+      float* hi = bins.hi[a][b];
+      for (int l = 0; l < 3; ++l) {
+        lo[l] = lo[l] < p.bounds.lo[l] ? lo[l] : p.bounds.lo[l];  // minps semantics
+        hi[l] = hi[l] > p.bounds.hi[l] ? hi[l] : p.bounds.hi[l];  // maxps semantics
+      }
+      ++bins.count[a][b];
+    }
+  }
+}
+
+#if defined(__SSE2__) && !defined(ACCELVIZ_NO_SIMD)
+void bin_primitives(std::span<const BuildPrim> prims, const glm::vec3& origin, const float k[3], int buckets,
+                    Bins& bins) {
+  // The three bucket indices in one go: (c - origin)·k, clamped to
+  // [0, B-1] by max/min (a NaN or negative lane gives 0, as bucket_of), then
+  // truncated. Lane 3 reads the id and is ignored.
+  const __m128 o = _mm_setr_ps(origin.x, origin.y, origin.z, 0.0f);
+  const __m128 kv = _mm_setr_ps(k[0], k[1], k[2], 0.0f);
+  const __m128 top = _mm_set1_ps(static_cast<float>(buckets - 1));
+  alignas(16) int idx[4];
+  for (const BuildPrim& p : prims) {
+    const __m128 x = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(&p.centroid.x), o), kv);
+    _mm_store_si128(reinterpret_cast<__m128i*>(idx), _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(x, _mm_setzero_ps()), top)));
+    // lo.xyz (+ hi.x), and hi.xyz rotated out of (lo.z, hi.x, hi.y, hi.z):
+    // both loads stay inside the 40-byte record.
+    const __m128 lo = _mm_loadu_ps(&p.bounds.lo.x);
+    const __m128 hz = _mm_loadu_ps(&p.bounds.lo.z);
+    const __m128 hi = _mm_shuffle_ps(hz, hz, _MM_SHUFFLE(0, 3, 2, 1));
+    for (int a = 0; a < 3; ++a) {
+      float* bl = bins.lo[a][idx[a]];
+      float* bh = bins.hi[a][idx[a]];
+      _mm_store_ps(bl, _mm_min_ps(_mm_load_ps(bl), lo));
+      _mm_store_ps(bh, _mm_max_ps(_mm_load_ps(bh), hi));
+      ++bins.count[a][idx[a]];
+    }
+  }
+}
+#else
+void bin_primitives(std::span<const BuildPrim> prims, const glm::vec3& origin, const float k[3], int buckets,
+                    Bins& bins) {
+  bin_primitives_scalar(prims, origin, k, buckets, bins);
+}
+#endif
+
 namespace {
 
-constexpr int kMaxBuckets = 256;
-
-/// No default member initialisers on purpose: a node initialises only the B
-/// buckets it uses, not all 3×256.
-struct Bucket {
-  glm::vec3 lo, hi;
-  std::uint32_t count;
-
-  void reset() {
-    lo = glm::vec3(kInfinity);
-    hi = glm::vec3(-kInfinity);
-    count = 0;
-  }
-  Aabb box() const { return Aabb{lo, hi}; }
-};
-
-/// Bucket of a centroid coordinate: floor((c - lo)·k), clamped to [0, B-1].
-/// The same function places a primitive while binning and while
-/// partitioning, so both passes agree exactly. A NaN lands in bucket 0.
-inline int bucket_of(float c, float lo, float k, int buckets) {
-  const float x = (c - lo) * k;
-  if (!(x >= 0.0f)) return 0;
-  const float top = static_cast<float>(buckets - 1);
-  return x < top ? static_cast<int>(x) : buckets - 1;
+Aabb bucket_box(const Bins& bins, int axis, int b) {
+  const float* lo = bins.lo[axis][b];
+  const float* hi = bins.hi[axis][b];
+  return Aabb{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}};
 }
 
 }  // namespace
@@ -61,19 +107,12 @@ SplitOutcome split_binned_sah(const SplitParams& params, std::span<BuildPrim> pr
   }
   if (!any_usable) return SplitOutcome::unsplittable;
 
-  // 2. Binning: one pass, all three axes.
-  std::array<std::array<Bucket, kMaxBuckets>, 3> bins;
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < nb; ++b) bins[a][b].reset();
+  // 2. Binning: one pass, all three axes. (Bins is left uninitialised: only
+  //    the B buckets in use are cleared.)
+  Bins bins;
+  clear_bins(bins, nb);
   const glm::vec3 lo = centroid_bounds.lo;
-  for (const BuildPrim& p : prims) {
-    for (int a = 0; a < 3; ++a) {
-      Bucket& bk = bins[a][bucket_of(p.centroid[a], lo[a], k[a], nb)];
-      bk.lo = glm::min(bk.lo, p.bounds.lo);
-      bk.hi = glm::max(bk.hi, p.bounds.hi);
-      ++bk.count;
-    }
-  }
+  bin_primitives(prims, lo, k, nb, bins);
 
   // 3. SAH at every bucket boundary: a right-to-left sweep stores the right
   //    side's area and count, a left-to-right sweep completes the cost
@@ -89,16 +128,16 @@ SplitOutcome split_binned_sah(const SplitParams& params, std::span<BuildPrim> pr
     Aabb acc;
     std::uint32_t cnt = 0;
     for (int b = nb - 1; b > 0; --b) {
-      acc.extend(bins[a][b].box());
-      cnt += bins[a][b].count;
+      acc.extend(bucket_box(bins, a, b));
+      cnt += bins.count[a][b];
       right_area[b - 1] = acc.half_area();
       right_count[b - 1] = cnt;
     }
     acc = Aabb{};
     cnt = 0;
     for (int b = 0; b < nb - 1; ++b) {
-      acc.extend(bins[a][b].box());
-      cnt += bins[a][b].count;
+      acc.extend(bucket_box(bins, a, b));
+      cnt += bins.count[a][b];
       if (cnt == 0 || right_count[b] == 0) continue;
       const float cost =
           acc.half_area() * static_cast<float>(cnt) + right_area[b] * static_cast<float>(right_count[b]);
@@ -115,7 +154,7 @@ SplitOutcome split_binned_sah(const SplitParams& params, std::span<BuildPrim> pr
 
   // 4. Children's bounds are the unions of their buckets' bounds.
   Aabb child_bounds[2];
-  for (int b = 0; b < nb; ++b) child_bounds[b <= best_bucket ? 0 : 1].extend(bins[best_axis][b].box());
+  for (int b = 0; b < nb; ++b) child_bounds[b <= best_bucket ? 0 : 1].extend(bucket_box(bins, best_axis, b));
 
   // 5. In-place two-ended partition (Hoare), gathering the children's
   //    centroid bounds on the way; each primitive is classified once.
