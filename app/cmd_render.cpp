@@ -2,6 +2,7 @@
 // cost, shading, depth) of one structure, written as a PNG with a legend.
 // Also the no-subcommand demo, which renders the demo scene the same way.
 #include "app/cli_common.h"
+#include "app/render_raster.h"
 
 #include "core/analysis/heatmap.h"
 #include "core/query/camera.h"
@@ -30,7 +31,56 @@ struct RenderOptions {
   std::string triangle_test = "watertight";
   bool force = false;
   StructureCli structure_opts;
+  std::string view = "heatmap";
+  RasterOptions raster;
+  std::string ray_pixel;
 };
+
+/// --ray-pixel "X,Y".
+std::pair<int, int> parse_pixel(const std::string& text) {
+  const auto comma = text.find(',');
+  try {
+    if (comma == std::string::npos) throw std::invalid_argument("no comma");
+    std::size_t used_x = 0, used_y = 0;
+    const int x = std::stoi(text.substr(0, comma), &used_x);
+    const int y = std::stoi(text.substr(comma + 1), &used_y);
+    if (used_x != comma || used_y != text.size() - comma - 1) throw std::invalid_argument("trailing characters");
+    return {x, y};
+  } catch (const std::logic_error&) {
+    throw UsageError("--ray-pixel: expected X,Y (two integers), got '" + text + "'");
+  }
+}
+
+/// The overlay view through the GL renderer (OSMesa), written to o.out.
+int run_render_raster(const RenderOptions& o, const GlobalOptions& global) {
+  const ImageSize size = parse_size(o.size);
+  Progress progress(global.quiet);
+  progress.begin("loading " + o.scene);
+  const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
+  progress.end(std::to_string(scene.triangles.size()) + " triangles");
+  const Camera camera = camera_for(o.camera, scene, size);
+  progress.begin("building " + o.structure);
+  const StructureOptions so = o.structure_opts.to_options(o.threads, /*compute_epo=*/false);
+  const std::unique_ptr<Accelerator> accel = build_accelerator(o.structure, scene.triangles, so, progress.callback());
+  progress.end(std::to_string(static_cast<long long>(accel->build_stats().build_ms)) + " ms");
+
+  RasterOptions ro = o.raster;
+  if (!o.ray_pixel.empty()) ro.ray_pixel = parse_pixel(o.ray_pixel);
+  QueryOptions query;
+  query.triangle_test = parse_triangle_test(o.triangle_test);
+  nlohmann::json figures = {{"scene", o.scene}, {"structure", o.structure}, {"width", size.width},
+                            {"height", size.height}, {"triangles", scene.triangles.size()},
+                            {"build_ms", accel->build_stats().build_ms}};
+  progress.begin("drawing the raster view");
+  render_raster(scene, *accel, camera, size, ro, o.metric, o.colormap, o.max, query, o.structure_opts.ctrav,
+                o.structure_opts.cisect, o.threads, o.out, o.force, figures);
+  progress.end();
+  const std::string abs = absolute_path(o.out);
+  figures["out"] = abs;
+  std::cout << abs << "\n";
+  print_json_line(figures);
+  return 0;
+}
 
 /// Loads, builds, renders and colours; returns the image and the figures as JSON.
 RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohmann::json& figures) {
@@ -98,6 +148,10 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
 
 int run_render(const RenderOptions& o, const GlobalOptions& global) {
   check_output_path(o.out, o.force);  // before any long work
+  if (o.view == "raster") return run_render_raster(o, global);
+  if (o.raster.box_depth >= 0 || o.raster.leaves || !o.ray_pixel.empty() || o.raster.blend > 0.0f ||
+      o.raster.wireframe)
+    throw UsageError("--depth, --depth-last, --leaves, --ray-pixel, --blend and --wireframe need --view raster");
   nlohmann::json figures;
   const RgbImage rgb = render_job(o, global, figures);
   write_png(o.out, rgb, o.force);
@@ -169,6 +223,24 @@ Command add_render_command(CLI::App& parent, const GlobalOptions& global) {
       ->check(CLI::IsMember({"watertight", "fast"}))
       ->capture_default_str();
   sub->add_flag("--force,-f", o->force, "Overwrite an existing output file");
+  sub->add_option("--view", o->view,
+                  "heatmap: the per-pixel metric image traced on the CPU; raster: the overlay view drawn by the "
+                  "OpenGL renderer headless (mesh, node boxes, a ray path, heatmap blend)")
+      ->check(CLI::IsMember({"heatmap", "raster"}))
+      ->capture_default_str();
+  sub->add_option("--depth", o->raster.box_depth, "raster: draw the BVH node boxes at this depth (root = 0)")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--depth-last", o->raster.box_depth_last,
+                  "raster: with --depth, draw every depth from --depth to this one (inclusive)")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_flag("--leaves", o->raster.leaves, "raster: draw every leaf box");
+  sub->add_option("--ray-pixel", o->ray_pixel,
+                  "raster: draw the primary ray of pixel X,Y (row 0 at the top): its path, hit, normal, the boxes "
+                  "it entered in order and the primitives it tested");
+  sub->add_option("--blend", o->raster.blend,
+                  "raster: blend the --metric heatmap over the mesh with this opacity (0: none, 1: full screen)")
+      ->check(CLI::Range(0.0f, 1.0f));
+  sub->add_flag("--wireframe", o->raster.wireframe, "raster: draw triangle edges over the mesh");
   o->structure_opts.add_to(sub);
   return {sub, [o, &global] { return run_render(*o, global); }};
 }
@@ -182,7 +254,7 @@ int run_demo(const GlobalOptions& global) {
   const RgbImage rgb = render_job(o, global, figures);
   const std::string abs = absolute_path(write_unique_demo_png(rgb));
   figures["out"] = abs;
-  std::cout << "No window (GUI not built yet): rendered the demo heatmap to " << abs << "\n" << abs << "\n";
+  std::cout << "No display: rendered the demo heatmap to " << abs << "\n" << abs << "\n";
   print_json_line(figures);
   return 0;
 }

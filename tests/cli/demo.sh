@@ -10,7 +10,7 @@ cd "$tmp"
 first=$("$accelviz" -q)
 second=$("$accelviz" -q)
 echo "$first"
-grep -q "^No window (GUI not built yet): rendered the demo heatmap to $tmp/accelviz-demo-.*\.png$" <<<"$first" \
+grep -q "^No display: rendered the demo heatmap to $tmp/accelviz-demo-.*\.png$" <<<"$first" \
   || { echo "FAIL: message"; exit 1; }
 a=$(sed -n 2p <<<"$first")
 b=$(sed -n 2p <<<"$second")

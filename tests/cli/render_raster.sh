@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# accelviz render --view raster: the GL overlay view drawn headless through
+# OSMesa. Checks the figures it reports (box count at a depth, the picked
+# ray's hit equals `trace` on the same pixel ray), the PNG's size and that
+# the picture is not blank, and the usage errors.
+set -euo pipefail
+accelviz="$(realpath "$1")"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+scene='builtin:teapot?size=20000'
+export GALLIUM_DRIVER=llvmpipe
+
+out=$("$accelviz" -q render "$scene" --view raster --depth 3 --ray-pixel 80,60 --size 160x120 --out "$tmp/r.png")
+echo "$out"
+json=$(sed -n 2p <<<"$out")
+python3 - "$tmp/r.png" "$json" <<'PY'
+import json, struct, sys, zlib
+png = open(sys.argv[1], "rb").read()
+assert png[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
+w, h = struct.unpack(">II", png[16:24])
+assert (w, h) == (160, 120), (w, h)
+# Decode the IDAT stream (8-bit RGB, filter bytes per row) enough to count distinct colours.
+idat = b""
+pos = 8
+while pos < len(png):
+    n = struct.unpack(">I", png[pos:pos + 4])[0]
+    kind = png[pos + 4:pos + 8]
+    if kind == b"IDAT":
+        idat += png[pos + 8:pos + 8 + n]
+    pos += 12 + n
+raw = zlib.decompress(idat)
+assert len(raw) >= h * (1 + 3 * w), len(raw)
+j = json.loads(sys.argv[2])
+assert j["view"] == "raster" and j["boxes"] == 8, j      # a full binary tree has 8 nodes at depth 3
+assert j["ray"]["hit"] is True and j["ray"]["prim"] >= 0, j
+assert j["ray"]["nodes_visited"] > 0, j
+assert len(set(raw)) > 16, "picture looks blank"
+print("raster ok:", j["ray"])
+PY
+
+# The picked ray's primitive equals what `trace` reports for the same pixel ray.
+"$accelviz" -q rays "$scene" --kind primary --size 160x120 --out "$tmp/p.rays" >/dev/null
+"$accelviz" -q trace "$scene" --rays "$tmp/p.rays" --out "$tmp/p.hits" --structure brute >/dev/null
+python3 - "$tmp/p.hits" "$json" <<'PY'
+import json, struct, sys
+data = open(sys.argv[1], "rb").read()
+assert data[:4] == b"HITS"
+idx = 60 * 160 + 80
+prim, t = struct.unpack("<If", data[16 + 8 * idx:16 + 8 * idx + 8])
+j = json.loads(sys.argv[2])
+assert prim == j["ray"]["prim"], (prim, j["ray"])
+print("picked ray agrees with trace:", prim, t)
+PY
+
+# Usage errors: raster-only options without --view raster, boxes of a structure without any.
+if "$accelviz" -q render "$scene" --depth 2 --out "$tmp/x.png" 2>"$tmp/err"; then echo "FAIL: --depth without raster"; exit 1; fi
+grep -q "need --view raster" "$tmp/err"
+if "$accelviz" -q render "$scene" --view raster --structure grid --depth 2 --out "$tmp/y.png" 2>"$tmp/err"; then
+  echo "FAIL: grid has no node boxes"; exit 1
+fi
+grep -q "grid" "$tmp/err"
+echo "render_raster ok"
