@@ -1,10 +1,11 @@
-// BVH over triangles: construction wrapper, traversal and refit.
+// BVH over triangles: construction wrapper, traversals and refit.
 //
-// Traversal is one function template, instantiated per
-//   closest vs any hit, ordered vs fixed child order, with or without
-//   statistics/trace (Collect), and per triangle test,
-// so that the choice is made once per ray and the fast path (Collect = false)
-// carries no counters at all.
+// Two traversals, each a function template instantiated per closest vs any
+// hit, ordered vs fixed child order and triangle test, so that every choice
+// is made once per ray:
+//  - traverse: the binary node array, also instantiated with Collect = true
+//    for statistics and traces (Collect = false carries no counters at all);
+//  - traverse_wide: the 4-wide copy (bvh_wide.h), the default fast path.
 #include "core/accel/bvh/bvh.h"
 
 #include "core/accel/bvh/bvh_slab.h"
