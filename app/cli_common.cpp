@@ -186,4 +186,9 @@ std::string format_bytes(std::uint64_t bytes) {
   return buf;
 }
 
+std::vector<CommandFactory>& registered_commands() {
+  static std::vector<CommandFactory> commands;  // function-local: safe from static initialisation order
+  return commands;
+}
+
 }  // namespace accelviz::cli

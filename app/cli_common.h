@@ -32,8 +32,18 @@ Command add_render_command(CLI::App& parent, const GlobalOptions& global);
 Command add_bench_command(CLI::App& parent, const GlobalOptions& global);
 Command add_trace_command(CLI::App& parent, const GlobalOptions& global);
 Command add_rays_command(CLI::App& parent, const GlobalOptions& global);
-/// `accelviz` without a subcommand: the demo heatmap (until the GUI lands).
+/// `accelviz` without a subcommand and no display: the demo heatmap as a PNG.
 int run_demo(const GlobalOptions& global);
+
+/// Further subcommands register themselves from their own file, so adding
+/// one never touches main.cpp:
+///   static const CommandRegistration reg{add_sweep_command};
+/// main() adds them after the built-in ones, in registration order.
+using CommandFactory = Command (*)(CLI::App& parent, const GlobalOptions& global);
+std::vector<CommandFactory>& registered_commands();
+struct CommandRegistration {
+  explicit CommandRegistration(CommandFactory factory) { registered_commands().push_back(factory); }
+};
 
 /// A semantic usage problem found after parsing (exit code 2, like CLI11's own).
 class UsageError : public std::runtime_error {

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <new>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -42,10 +43,11 @@ int main(int argc, char** argv) {
   cli::GlobalOptions global;
   app.add_flag("-q,--quiet", global.quiet, "No progress messages on stderr");
 
-  const cli::Command commands[] = {
+  std::vector<cli::Command> commands = {
       cli::add_info_command(app, global),  cli::add_render_command(app, global), cli::add_bench_command(app, global),
       cli::add_trace_command(app, global), cli::add_rays_command(app, global),
   };
+  for (cli::CommandFactory factory : cli::registered_commands()) commands.push_back(factory(app, global));
 
   try {
     app.parse(argc, argv);
