@@ -17,6 +17,8 @@ PACKAGES=(
   libembree-dev libbenchmark-dev libgtest-dev libgmock-dev
   # GUI tests in a real window
   xvfb xauth
+  # libFuzzer targets (clang's -fsanitize=fuzzer) for the loaders and ray files
+  clang libclang-rt-14-dev
 )
 
 missing=()
