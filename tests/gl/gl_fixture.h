@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -74,6 +75,17 @@ inline void add_box(std::vector<Triangle>& out, const glm::vec3& lo, const glm::
 inline glm::u8vec4 to_rgba8(const glm::vec3& c) {
   auto q = [](float v) { return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); };
   return {q(c.x), q(c.y), q(c.z), 255};
+}
+
+/// The pixel containing continuous image point p (as project_to_pixel
+/// returns); throws std::out_of_range outside the image, so a test that
+/// looks off-screen fails instead of reading past the pixels.
+inline glm::u8vec4 pixel_at(const Rgba8Image& img, glm::vec2 p) {
+  const int x = static_cast<int>(std::floor(p.x)), y = static_cast<int>(std::floor(p.y));
+  if (x < 0 || y < 0 || x >= img.width || y >= img.height) {
+    throw std::out_of_range("pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") is outside the image");
+  }
+  return img.at(x, y);
 }
 
 /// Largest per-channel difference (RGB) between two colours.

@@ -175,8 +175,7 @@ TEST_F(BoxOverlay, BvhDepthSelectionDrawsThoseNodes) {
   EXPECT_TRUE(neighbourhood_has(img, *project_to_pixel(m, {1.4f, 0.0f, 0.4f}), depth1));
   // The root's outline is not drawn.
   EXPECT_FALSE(neighbourhood_has(img, *project_to_pixel(m, {-1.6f, 0.0f, 0.5f}), depth1, 0));
-  EXPECT_EQ(img.at(static_cast<int>(project_to_pixel(m, {-1.6f, 0.0f, 0.5f})->x), kHeight / 2),
-            to_rgba8(kBlack));
+  EXPECT_EQ(pixel_at(img, *project_to_pixel(m, {-1.6f, 0.0f, 0.5f})), to_rgba8(kBlack));
 }
 
 }  // namespace

@@ -79,9 +79,9 @@ TEST_F(MeshPassTest, WireframeDrawsTheTriangleEdges) {
   const glm::u8vec4 red(255, 0, 0, 255);
   auto near_red = [&](const glm::vec3& world) {
     const glm::vec2 p = *project_to_pixel(m, world);
-    for (int y = int(p.y) - 1; y <= int(p.y) + 1; ++y)
-      for (int x = int(p.x) - 1; x <= int(p.x) + 1; ++x)
-        if (img.at(x, y) == red) return true;
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        if (pixel_at(img, p + glm::vec2(dx, dy)) == red) return true;
     return false;
   };
   EXPECT_TRUE(near_red({0.0f, 0.0f, 0.0f}));    // the shared diagonal
@@ -90,7 +90,7 @@ TEST_F(MeshPassTest, WireframeDrawsTheTriangleEdges) {
   EXPECT_TRUE(near_red({0.0f, -1.0f, 0.0f}));   // the bottom border
   // Inside a triangle, away from the edges: shaded, not red.
   const glm::vec2 inside = *project_to_pixel(m, {0.8f, -0.5f, 0.0f});
-  EXPECT_GT(channel_diff(img.at(int(inside.x), int(inside.y)), red), 100);
+  EXPECT_GT(channel_diff(pixel_at(img, inside), red), 100);
   view.show_wireframe = false;
   EXPECT_FALSE(draw(view).pixels == img.pixels);
 }

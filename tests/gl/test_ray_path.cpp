@@ -79,8 +79,8 @@ TEST_F(RayPathTest, PathFromAKnownPixelIsDrawnThroughTheExpectedPixels) {
 
   // The hit marker is a 7-pixel square centred on the projected hit point.
   ASSERT_TRUE(inside(b, 4));
-  EXPECT_LE(channel_diff(img.at(int(b.x), int(b.y)), rgb(path.style.hit_marker)), 2) << describe(img.at(int(b.x), int(b.y)));
-  EXPECT_LE(channel_diff(img.at(int(b.x) + 2, int(b.y) - 2), rgb(path.style.hit_marker)), 2);
+  EXPECT_LE(channel_diff(pixel_at(img, b), rgb(path.style.hit_marker)), 2) << describe(pixel_at(img, b));
+  EXPECT_LE(channel_diff(pixel_at(img, b + glm::vec2(2.0f, -2.0f)), rgb(path.style.hit_marker)), 2);
 
   // The normal (+z, facing the ray) leaves the marker.
   EXPECT_EQ(path.hit_normal, glm::vec3(0.0f, 0.0f, 1.0f));
@@ -118,15 +118,16 @@ TEST_F(RayPathTest, VisitedBoxesFadeInOrderAndTestedPrimitivesAreHighlighted) {
   EXPECT_FALSE(neighbourhood_has(img, *project_to_pixel(m, {2.5f, 0.3f, 0.5f}), rgb(path.style.first_visit)));
 
   // Triangle 0 ((-3,-3), (3,-3), (3,3)) is highlighted; triangle 1 is not.
-  const glm::vec2 in_tri0 = *project_to_pixel(m, {1.5f, -2.0f, 0.0f});
-  const glm::vec2 in_tri1 = *project_to_pixel(m, {-1.0f, 2.5f, 0.0f});
-  EXPECT_LE(channel_diff(img.at(int(in_tri0.x), int(in_tri0.y)), rgb(path.style.highlight)), 2);
-  EXPECT_GT(channel_diff(img.at(int(in_tri1.x), int(in_tri1.y)), rgb(path.style.highlight)), 50);
+  // (The frame shows about |x| < 2.8, |y| < 2.1 of the wall.)
+  const glm::vec2 in_tri0 = *project_to_pixel(m, {1.5f, -1.5f, 0.0f});
+  const glm::vec2 in_tri1 = *project_to_pixel(m, {-1.5f, 1.2f, 0.0f});
+  EXPECT_LE(channel_diff(pixel_at(img, in_tri0), rgb(path.style.highlight)), 2);
+  EXPECT_GT(channel_diff(pixel_at(img, in_tri1), rgb(path.style.highlight)), 50);
 
   // Hiding the layer removes all of it.
   view.show_ray_path = false;
   const Rgba8Image hidden = draw(view);
-  EXPECT_GT(channel_diff(hidden.at(int(in_tri0.x), int(in_tri0.y)), rgb(path.style.highlight)), 50);
+  EXPECT_GT(channel_diff(pixel_at(hidden, in_tri0), rgb(path.style.highlight)), 50);
   EXPECT_GT(channel_diff(hidden.at(kPixelX, kPixelY), rgb(path.style.hit_marker)), 50);
 }
 

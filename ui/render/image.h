@@ -4,6 +4,7 @@
 // ray convention and in PNG files), 4 bytes per pixel, no padding.
 #include <glm/glm.hpp>
 
+#include <cassert>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -20,10 +21,12 @@ struct Rgba8Image {
 
   bool empty() const { return width <= 0 || height <= 0; }
   glm::u8vec4 at(int x, int y) const {
+    assert(x >= 0 && y >= 0 && x < width && y < height);
     const std::size_t i = (static_cast<std::size_t>(y) * width + x) * 4;
     return {pixels[i], pixels[i + 1], pixels[i + 2], pixels[i + 3]};
   }
   void set(int x, int y, glm::u8vec4 c) {
+    assert(x >= 0 && y >= 0 && x < width && y < height);
     const std::size_t i = (static_cast<std::size_t>(y) * width + x) * 4;
     pixels[i] = c.x;
     pixels[i + 1] = c.y;

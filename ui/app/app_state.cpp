@@ -1,0 +1,311 @@
+#include "ui/app/app_state.h"
+
+#include "core/query/camera.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace accelviz {
+namespace {
+
+float aspect_of(int w, int h) { return w > 0 && h > 0 ? static_cast<float>(w) / static_cast<float>(h) : 1.0f; }
+
+}  // namespace
+
+AppState::AppState(AppSettings settings, BuildWorker::LoadFn load, BuildWorker::BuildFn build)
+    : settings_(std::move(settings)), builds_(std::move(load), std::move(build)) {}
+
+void AppState::open_scene(const std::string& spec) {
+  wanted_scene_ = spec;
+  reload_ = true;
+  set_message("loading " + spec);
+}
+
+std::string AppState::set_option(std::string_view key, std::string_view value) {
+  const std::string e = apply_option(settings_.config, key, value);
+  if (!e.empty()) set_error(e);
+  return e;
+}
+
+void AppState::cancel_build() {
+  builds_.cancel();
+  // What is shown becomes what is wanted, so the cancelled choice is not
+  // requested again next frame.
+  if (current_) {
+    requested_ = current_->choice;
+    requested_scene_ = wanted_scene_ = current_->scene->spec;
+    settings_.config.structure.name = current_->choice.name;
+    settings_.config.structure.options = current_->choice.options;
+  } else {
+    requested_.reset();
+    wanted_scene_.clear();
+  }
+  reload_ = false;
+  set_message("build cancelled");
+}
+
+void AppState::set_error(std::string e) {
+  error_ = std::move(e);
+  if (!error_.empty()) new_errors_.push_back(error_);
+}
+
+void AppState::set_message(std::string m) {
+  message_ = std::move(m);
+  error_.clear();
+}
+
+std::vector<std::string> AppState::take_new_errors() {
+  std::vector<std::string> out;
+  out.swap(new_errors_);
+  return out;
+}
+
+AppState::HeatmapKey AppState::heatmap_key(int w, int h) const {
+  HeatmapKey k;
+  k.structure = current_.get();
+  const Camera cam = camera();
+  k.position = cam.position;
+  k.forward = cam.forward;
+  k.up = cam.up;
+  k.yfov = cam.yfov;
+  k.width = w;
+  k.height = h;
+  k.metric = config().view.metric;
+  k.test = config().structure.query.triangle_test;
+  k.ordered = config().structure.query.ordered;
+  // The cost metric weighs with the BVH's C_trav/C_isect, as `render --ctrav/--cisect` does.
+  k.c_trav = config().structure.options.bvh.cost_traversal;
+  k.c_isect = config().structure.options.bvh.cost_intersect;
+  return k;
+}
+
+AppState::FrameUpdate AppState::update(int view_width, int view_height) {
+  FrameUpdate u;
+  view_w_ = view_width;
+  view_h_ = view_height;
+
+  // 1. A build when what is wanted differs from what was asked for last.
+  const StructureChoice& wanted = config().structure;
+  if (!wanted_scene_.empty() &&
+      (reload_ || wanted_scene_ != requested_scene_ || !requested_ || !same_build(*requested_, wanted))) {
+    request_id_ = builds_.request({wanted_scene_, wanted, reload_});
+    requested_scene_ = wanted_scene_;
+    requested_ = wanted;
+    reload_ = false;
+  }
+
+  // 2. Finished builds: only the latest request counts.
+  for (BuildOutcome& o : builds_.take_outcomes()) {
+    if (o.id != request_id_) continue;
+    if (o.result == BuildOutcome::Result::built) {
+      const bool new_scene = !current_ || current_->scene != o.built->scene;
+      current_ = std::move(o.built);
+      u.structure_changed = true;
+      const Scene& scene = current_->scene->scene;
+      if (new_scene) {
+        u.scene_changed = true;
+        camera_ = ViewCamera::scene_default(scene, aspect_of(view_w_, view_h_));
+        clear_inspection();
+        settings_.last_scene = current_->scene->spec;
+        add_recent(settings_, current_->scene->spec);
+        std::string m = "opened " + current_->scene->spec + " (" + std::to_string(scene.triangles.size()) +
+                        " triangles)";
+        if (!scene.report.warnings.empty())
+          m += ", " + std::to_string(scene.report.warnings.size()) + " loader warning(s): " +
+               scene.report.warnings.front();
+        set_message(m);
+      } else {
+        set_message("built " + describe_structure(current_->choice) + " in " +
+                    std::to_string(static_cast<long long>(std::lround(current_->wall_ms))) + " ms");
+        recast();
+      }
+    } else if (o.result == BuildOutcome::Result::failed) {
+      set_error(o.error);
+      if (o.scene_error) {
+        // Keep the scene that is shown; later structure changes build over it.
+        wanted_scene_ = requested_scene_ = scene_spec();
+        if (current_)
+          requested_ = current_->choice;
+        else
+          requested_.reset();
+      }
+    }
+  }
+
+  // 3. The heatmap of this view, restarted whenever anything it shows changed.
+  if (current_ && view_w_ > 0 && view_h_ > 0) {
+    const HeatmapKey key = heatmap_key(view_w_, view_h_);
+    if (!heatmap_requested_ || !(*heatmap_requested_ == key)) {
+      HeatmapRequest r;
+      r.structure = current_;
+      r.camera = camera();
+      r.width = view_w_;
+      r.height = view_h_;
+      r.metric = key.metric;
+      r.query = config().structure.query;
+      r.c_trav = key.c_trav;
+      r.c_isect = key.c_isect;
+      r.threads = settings_.config.structure.options.threads;
+      heatmaps_.request(std::move(r));
+      heatmap_requested_ = key;
+    }
+    // Query options changed: the inspected ray is re-cast with them.
+    const QueryOptions& q = config().structure.query;
+    if (inspection_ && (q.triangle_test != inspected_query_.triangle_test || q.ordered != inspected_query_.ordered))
+      recast();
+  }
+  if (auto latest = heatmaps_.latest(); latest != heatmap_) {
+    heatmap_ = std::move(latest);
+    u.heatmap_changed = true;
+  }
+  return u;
+}
+
+bool AppState::settled() const {
+  if (!builds_.idle()) return false;
+  const StructureChoice& wanted = config().structure;
+  if (!wanted_scene_.empty() &&
+      (reload_ || wanted_scene_ != requested_scene_ || !requested_ || !same_build(*requested_, wanted)))
+    return false;
+  if (!current_ || view_w_ <= 0 || view_h_ <= 0) return true;
+  if (!heatmap_requested_ || !(*heatmap_requested_ == heatmap_key(view_w_, view_h_))) return false;
+  return heatmap_ && heatmap_->id == heatmaps_.latest_request() && heatmap_->complete;
+}
+
+void AppState::reset_camera() {
+  if (const Scene* s = scene()) camera_ = ViewCamera::scene_default(*s, aspect_of(view_w_, view_h_));
+}
+
+void AppState::frame_selection() {
+  const Scene* s = scene();
+  if (!s) return;
+  Aabb box = s->bounds();
+  const ViewSettings& v = config().view;
+  if (v.show_boxes && v.box_mode == BoxMode::subtree)
+    if (const auto b = current_->nodes.box(static_cast<std::uint32_t>(v.box_node))) box = *b;
+  camera_.unfix();
+  camera_.orbit.frame(box, aspect_of(view_w_, view_h_));
+}
+
+void AppState::use_scene_camera(int index) {
+  const Scene* s = scene();
+  if (!s || index < 0 || index >= static_cast<int>(s->cameras.size())) return;
+  camera_ = ViewCamera::scene_camera_view(*s, index);
+}
+
+void AppState::set_camera_spec(const std::string& spec) {
+  const Scene* s = scene();
+  if (!s) throw std::invalid_argument("no scene loaded yet (use wait after open)");
+  camera_ = ViewCamera::from_spec(spec, *s, aspect_of(view_w_, view_h_));
+}
+
+std::optional<glm::vec3> AppState::pick(int x, int y) const {
+  if (!current_ || x < 0 || y < 0 || x >= view_w_ || y >= view_h_) return std::nullopt;
+  const Ray ray = primary_ray(camera(), x, y, view_w_, view_h_);
+  const Hit hit = current_->accel->closest_hit(ray, config().structure.query);
+  if (!hit.valid()) return std::nullopt;
+  return ray.at(hit.t);
+}
+
+std::string AppState::cast_ray(int x, int y) {
+  if (!current_) return "no structure yet (use wait after open)";
+  if (x < 0 || y < 0 || x >= view_w_ || y >= view_h_)
+    return "pixel " + std::to_string(x) + "," + std::to_string(y) + " is outside the " + std::to_string(view_w_) +
+           "x" + std::to_string(view_h_) + " view";
+  inspection_ = inspect_pixel(*current_, camera(), x, y, view_w_, view_h_, config().structure.query);
+  inspected_query_ = config().structure.query;
+  replay_step_ = inspection_->trace.steps.empty() ? 0 : inspection_->trace.steps.size() - 1;
+  return {};
+}
+
+void AppState::recast() {
+  if (!inspection_ || !current_) return;
+  inspection_ = inspect_ray(*current_, *inspection_, config().structure.query);
+  inspected_query_ = config().structure.query;
+  replay_step_ = inspection_->trace.steps.empty() ? 0 : inspection_->trace.steps.size() - 1;
+}
+
+void AppState::set_replay_step(std::size_t step) {
+  if (!inspection_) return;
+  const std::size_t n = inspection_->trace.steps.size();
+  replay_step_ = n == 0 ? 0 : std::min(step, n - 1);
+}
+
+void AppState::clear_inspection() {
+  inspection_.reset();
+  replay_step_ = 0;
+}
+
+nlohmann::json AppState::stats_json() const {
+  nlohmann::json j;
+  j["scene"] = scene_spec();
+  j["triangles"] = current_ ? current_->scene->scene.triangles.size() : 0;
+  j["error"] = error_;
+  j["message"] = message_;
+  const BuildWorker::Status st = builds_.status();
+  j["building"] = st.busy;
+  j["camera"] = camera_.spec();
+  j["view"] = nullptr;
+  j["build"] = nullptr;
+  j["structure"] = current_ ? current_->choice.name : std::string();
+  if (current_) {
+    AppConfig c;
+    c.structure = current_->choice;
+    nlohmann::json options = nlohmann::json::object();
+    for (std::string_view key : structure_option_keys(c.structure.name))
+      options[std::string(key)] = option_value(c, key);
+    j["options"] = options;
+    const BuildStats& b = current_->accel->build_stats();
+    j["build"] = {{"build_ms", b.build_ms},
+                  {"wall_ms", current_->wall_ms},
+                  {"nodes", b.node_count},
+                  {"leaves", b.leaf_count},
+                  {"max_depth", b.max_depth},
+                  {"avg_leaf_depth", b.avg_leaf_depth},
+                  {"memory_bytes", b.memory_bytes},
+                  {"sah_cost", b.sah_cost},
+                  {"extra", b.extra}};
+  }
+  if (heatmap_) {
+    const HeatmapSummary& s = heatmap_->summary;
+    j["view"] = {{"width", heatmap_->image.width},
+                 {"height", heatmap_->image.height},
+                 {"structure", heatmap_->request.structure ? heatmap_->request.structure->accel->name() : ""},
+                 {"metric", metric_name(heatmap_->image.metric)},
+                 {"complete", heatmap_->complete},
+                 {"stride", heatmap_->stride},
+                 {"rays", s.rays},
+                 {"hits", s.hits},
+                 {"mean_nodes", s.mean_nodes},
+                 {"max_nodes", s.max_nodes},
+                 {"mean_prims", s.mean_prims},
+                 {"max_prims", s.max_prims},
+                 {"mean_value", s.mean_value},
+                 {"max_value", s.max_value},
+                 {"render_ms", s.render_ms},
+                 {"rays_per_s", s.rays_per_s}};
+  }
+  return j;
+}
+
+ScreenshotInfo AppState::screenshot_info(float scale_min, float scale_max) const {
+  ScreenshotInfo info;
+  info.scene = scene_spec();
+  info.triangles = current_ ? current_->scene->scene.triangles.size() : 0;
+  info.camera_spec = camera_.spec();
+  info.camera = camera();
+  info.width = view_w_;
+  info.height = view_h_;
+  info.config = config();
+  // The structure shown, which may lag behind the one being built.
+  if (current_) {
+    info.config.structure.name = current_->choice.name;
+    info.config.structure.options = current_->choice.options;
+  }
+  info.scale_min = scale_min;
+  info.scale_max = scale_max;
+  if (inspection_) info.ray_pixel = std::make_pair(inspection_->x, inspection_->y);
+  return info;
+}
+
+}  // namespace accelviz

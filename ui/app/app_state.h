@@ -1,0 +1,149 @@
+#pragma once
+// The app's model, GL-free: settings and the current choice, the scene and
+// structure being shown, the build and heatmap workers, the camera, the
+// inspected ray and the status line. The GUI main loop calls update() once
+// per frame, turns user input into calls here, and draws what it finds;
+// scripts drive the same calls, so a scripted run exercises the product.
+#include "ui/app/app_config.h"
+#include "ui/app/build_worker.h"
+#include "ui/app/heatmap_worker.h"
+#include "ui/app/orbit_camera.h"
+#include "ui/app/ray_inspection.h"
+#include "ui/app/screenshot_files.h"
+#include "ui/app/settings.h"
+
+#include <nlohmann/json.hpp>
+
+#include <memory>
+#include <optional>
+#include <string>
+
+namespace accelviz {
+
+class AppState {
+ public:
+  /// Starts the workers. Nothing is loaded until open_scene().
+  explicit AppState(AppSettings settings, BuildWorker::LoadFn load = {}, BuildWorker::BuildFn build = {});
+
+  AppSettings& settings() { return settings_; }
+  const AppSettings& settings() const { return settings_; }
+  AppConfig& config() { return settings_.config; }
+  const AppConfig& config() const { return settings_.config; }
+
+  // ---- requests -------------------------------------------------------------
+  /// Loads `spec` (again, if it is the current scene) and builds the chosen
+  /// structure over it in the background; the current scene stays until then.
+  void open_scene(const std::string& spec);
+  /// `set KEY VALUE`: "" or the one-line error (also shown on the status line).
+  std::string set_option(std::string_view key, std::string_view value);
+  /// Cancels the build in progress (the current structure stays).
+  void cancel_build();
+
+  // ---- once per frame ---------------------------------------------------------
+  struct FrameUpdate {
+    bool scene_changed = false;      ///< a new scene is shown (upload its triangles)
+    bool structure_changed = false;  ///< a new structure is shown (re-select boxes)
+    bool heatmap_changed = false;    ///< a newer heatmap level is available
+  };
+  /// Requests a build when the wanted scene/structure differ from the last
+  /// request, takes finished builds, requests the heatmap for the current
+  /// view (W×H pixels) when anything it depends on changed, and picks up the
+  /// newest heatmap level.
+  FrameUpdate update(int view_width, int view_height);
+
+  // ---- what is shown -----------------------------------------------------------
+  const std::shared_ptr<const BuiltStructure>& current() const { return current_; }
+  const Scene* scene() const { return current_ ? &current_->scene->scene : nullptr; }
+  /// The scene shown ("" before the first one is ready).
+  std::string scene_spec() const { return current_ ? current_->scene->spec : std::string(); }
+  /// The scene asked for last (shown in the path field while it loads).
+  const std::string& wanted_scene() const { return wanted_scene_; }
+  const std::shared_ptr<const HeatmapFrame>& heatmap() const { return heatmap_; }
+  BuildWorker::Status build_status() const { return builds_.status(); }
+  bool heatmap_busy() const { return heatmaps_.busy(); }
+  /// No build queued or running and the heatmap of the current view
+  /// complete (what the script's `wait` waits for).
+  bool settled() const;
+
+  /// One-line status: the last error (shown in red) or message.
+  const std::string& error() const { return error_; }
+  const std::string& message() const { return message_; }
+  void set_error(std::string e);
+  void set_message(std::string m);
+  /// Errors reported since the last call, for stderr (each once).
+  std::vector<std::string> take_new_errors();
+
+  // ---- camera -------------------------------------------------------------------
+  ViewCamera& view_camera() { return camera_; }
+  const ViewCamera& view_camera() const { return camera_; }
+  Camera camera() const { return camera_.camera(); }
+  int view_width() const { return view_w_; }
+  int view_height() const { return view_h_; }
+  /// R / Home: the scene's default view.
+  void reset_camera();
+  /// F: frame the selected node (subtree mode) or else the scene, keeping the direction.
+  void frame_selection();
+  /// A camera of the scene (Scene::cameras index).
+  void use_scene_camera(int index);
+  /// A `--camera` spec; throws std::invalid_argument for a bad one.
+  void set_camera_spec(const std::string& spec);
+  /// The surface point under pixel (x, y), if any (double-click pivot).
+  std::optional<glm::vec3> pick(int x, int y) const;
+
+  // ---- click to cast --------------------------------------------------------------
+  /// Casts pixel (x, y) of the current view; "" or an error message.
+  std::string cast_ray(int x, int y);
+  const std::optional<RayInspection>& inspection() const { return inspection_; }
+  std::size_t replay_step() const { return replay_step_; }
+  /// Moves the replay to `step` (clamped to the trace).
+  void set_replay_step(std::size_t step);
+  void clear_inspection();
+
+  // ---- reports ----------------------------------------------------------------------
+  /// dump-stats' document: scene, structure, options, build figures, the
+  /// current view's heatmap figures, status.
+  nlohmann::json stats_json() const;
+  /// What a screenshot of the current view shows, with the heatmap range drawn.
+  ScreenshotInfo screenshot_info(float scale_min, float scale_max) const;
+
+ private:
+  struct HeatmapKey {
+    const BuiltStructure* structure = nullptr;
+    glm::vec3 position{0.0f}, forward{0.0f}, up{0.0f};
+    float yfov = 0.0f;
+    int width = 0, height = 0;
+    HeatMetric metric = HeatMetric::nodes;
+    TriangleTest test = TriangleTest::watertight;
+    bool ordered = true;
+    float c_trav = 1.0f, c_isect = 1.0f;
+    bool operator==(const HeatmapKey&) const = default;
+  };
+  HeatmapKey heatmap_key(int w, int h) const;
+  void recast();
+
+  AppSettings settings_;
+  BuildWorker builds_;
+  HeatmapWorker heatmaps_;
+
+  std::string wanted_scene_;
+  bool reload_ = false;
+  std::string requested_scene_;              ///< of the last build request
+  std::optional<StructureChoice> requested_; ///< of the last build request
+  std::uint64_t request_id_ = 0;
+
+  std::shared_ptr<const BuiltStructure> current_;
+  std::shared_ptr<const HeatmapFrame> heatmap_;
+  std::optional<HeatmapKey> heatmap_requested_;
+
+  ViewCamera camera_;
+  int view_w_ = 0, view_h_ = 0;
+
+  std::optional<RayInspection> inspection_;
+  QueryOptions inspected_query_;  ///< the query options inspection_ was cast with
+  std::size_t replay_step_ = 0;
+
+  std::string error_, message_;
+  std::vector<std::string> new_errors_;
+};
+
+}  // namespace accelviz

@@ -1,0 +1,213 @@
+#include "ui/app/heatmap_worker.h"
+
+#include "core/query/camera.h"
+#include "core/util/parallel.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace accelviz {
+namespace {
+
+struct Accumulator {
+  std::uint64_t rays = 0, hits = 0, valued = 0;
+  double sum_nodes = 0.0, sum_prims = 0.0, sum_value = 0.0, max_value = 0.0;
+  std::uint32_t max_nodes = 0, max_prims = 0;
+
+  void add(const PixelFigures& p) {
+    ++rays;
+    if (p.prim != kInvalidId) ++hits;
+    sum_nodes += p.nodes;
+    sum_prims += p.prims;
+    max_nodes = std::max(max_nodes, p.nodes);
+    max_prims = std::max(max_prims, p.prims);
+    if (!std::isnan(p.value)) {
+      ++valued;
+      sum_value += p.value;
+      max_value = std::max(max_value, static_cast<double>(p.value));
+    }
+  }
+  void merge(const Accumulator& o) {
+    rays += o.rays;
+    hits += o.hits;
+    valued += o.valued;
+    sum_nodes += o.sum_nodes;
+    sum_prims += o.sum_prims;
+    sum_value += o.sum_value;
+    max_value = std::max(max_value, o.max_value);
+    max_nodes = std::max(max_nodes, o.max_nodes);
+    max_prims = std::max(max_prims, o.max_prims);
+  }
+};
+
+HeatmapSummary summarise(const Accumulator& a, double render_ms) {
+  HeatmapSummary s;
+  s.rays = a.rays;
+  s.hits = a.hits;
+  if (a.rays > 0) {
+    s.mean_nodes = a.sum_nodes / static_cast<double>(a.rays);
+    s.mean_prims = a.sum_prims / static_cast<double>(a.rays);
+  }
+  s.max_nodes = a.max_nodes;
+  s.max_prims = a.max_prims;
+  if (a.valued > 0) s.mean_value = a.sum_value / static_cast<double>(a.valued);
+  s.max_value = a.max_value;
+  s.render_ms = render_ms;
+  s.rays_per_s = render_ms > 0.0 ? static_cast<double>(a.rays) / (render_ms * 1e-3) : 0.0;
+  return s;
+}
+
+}  // namespace
+
+bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::function<bool()>& keep_going,
+                       const std::function<void(std::shared_ptr<const HeatmapFrame>)>& publish) {
+  const int w = r.width, h = r.height;
+  if (w <= 0 || h <= 0 || !r.structure || !r.structure->accel) return true;
+  const Accelerator& accel = *r.structure->accel;
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+
+  MetricImage image;
+  image.width = w;
+  image.height = h;
+  image.metric = r.metric;
+  image.values.assign(n, std::numeric_limits<float>::quiet_NaN());
+  std::vector<PixelFigures> pixels(n);
+  const unsigned threads = resolve_threads(r.threads);
+
+  int coarsest = 1;
+  while (coarsest * 2 <= std::max(1, r.coarsest)) coarsest *= 2;
+
+  Accumulator total;
+  double render_ms = 0.0;
+  for (int s = coarsest; s >= 1; s /= 2) {
+    // Lattice s: rows y ≡ 0 (mod s). Below the coarsest level, rows that
+    // were already lattice rows of 2s only need their odd multiples of s.
+    std::vector<int> rows;
+    for (int y = 0; y < h; y += s) rows.push_back(y);
+    std::vector<Accumulator> acc(threads);
+    std::atomic<bool> stopped{false};
+    const auto t0 = std::chrono::steady_clock::now();
+    parallel_for(rows.size(), threads, 1, [&](std::size_t b, std::size_t e, unsigned ti) {
+      for (std::size_t i = b; i < e; ++i) {
+        if (stopped.load(std::memory_order_relaxed) || !keep_going()) {
+          stopped = true;
+          return;
+        }
+        const int y = rows[i];
+        const bool done_before = s < coarsest && y % (2 * s) == 0;
+        for (int x = done_before ? s : 0; x < w; x += done_before ? 2 * s : s) {
+          const Ray ray = primary_ray(r.camera, x, y, w, h);
+          RayStats stats;
+          const Hit hit = accel.closest_hit(ray, r.query, &stats);
+          PixelFigures& p = pixels[static_cast<std::size_t>(y) * w + x];
+          p.value = metric_value(r.metric, ray, hit, stats, r.c_trav, r.c_isect);
+          p.nodes = stats.nodes_visited;
+          p.prims = stats.prim_tests;
+          p.prim = hit.prim;
+          p.t = hit.t;
+          image.values[static_cast<std::size_t>(y) * w + x] = p.value;
+          acc[ti].add(p);
+        }
+      }
+    });
+    render_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (stopped) return false;
+    for (const Accumulator& a : acc) total.merge(a);
+
+    // Every lattice point fills its s×s block; the finer lattices inside
+    // the block are traced later and overwrite their own pixels then.
+    if (s > 1)
+      for (int y = 0; y < h; y += s)
+        for (int x = 0; x < w; x += s) {
+          const std::size_t src = static_cast<std::size_t>(y) * w + x;
+          for (int by = y; by < std::min(h, y + s); ++by)
+            for (int bx = x; bx < std::min(w, x + s); ++bx) {
+              const std::size_t dst = static_cast<std::size_t>(by) * w + bx;
+              if (dst == src) continue;
+              pixels[dst] = pixels[src];
+              image.values[dst] = image.values[src];
+            }
+        }
+
+    auto frame = std::make_shared<HeatmapFrame>();
+    frame->id = id;
+    frame->stride = s;
+    frame->complete = s == 1;
+    frame->image = image;
+    frame->pixels = pixels;
+    frame->summary = summarise(total, render_ms);
+    frame->request = r;
+    publish(std::move(frame));
+  }
+  return true;
+}
+
+HeatmapWorker::HeatmapWorker() : thread_([this] { run(); }) {}
+
+HeatmapWorker::~HeatmapWorker() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+    queued_.reset();
+  }
+  cancel_upto_ = ~std::uint64_t{0};
+  wake_.notify_all();
+  thread_.join();
+}
+
+std::uint64_t HeatmapWorker::request(HeatmapRequest r) {
+  std::uint64_t id;
+  {
+    std::lock_guard lock(mutex_);
+    id = next_id_.fetch_add(1);
+    queued_.emplace(id, std::move(r));
+    cancel_upto_ = id - 1;
+  }
+  wake_.notify_all();
+  return id;
+}
+
+void HeatmapWorker::cancel() {
+  std::lock_guard lock(mutex_);
+  queued_.reset();
+  cancel_upto_ = next_id_.load() - 1;
+}
+
+std::shared_ptr<const HeatmapFrame> HeatmapWorker::latest() const {
+  std::lock_guard lock(mutex_);
+  return latest_;
+}
+
+bool HeatmapWorker::busy() const {
+  std::lock_guard lock(mutex_);
+  return running_ || queued_.has_value();
+}
+
+void HeatmapWorker::run() {
+  for (;;) {
+    std::pair<std::uint64_t, HeatmapRequest> job;
+    {
+      std::unique_lock lock(mutex_);
+      wake_.wait(lock, [&] { return stop_ || queued_.has_value(); });
+      if (stop_) return;
+      job = std::move(*queued_);
+      queued_.reset();
+      running_ = true;
+    }
+    const std::uint64_t id = job.first;
+    trace_progressive(
+        job.second, id, [&] { return id > cancel_upto_.load(std::memory_order_relaxed); },
+        [&](std::shared_ptr<const HeatmapFrame> f) {
+          std::lock_guard lock(mutex_);
+          if (id > cancel_upto_.load()) latest_ = std::move(f);
+        });
+    {
+      std::lock_guard lock(mutex_);
+      running_ = false;
+    }
+  }
+}
+
+}  // namespace accelviz

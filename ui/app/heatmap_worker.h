@@ -1,0 +1,109 @@
+#pragma once
+// The per-pixel metric of the current view, traced on a worker thread and
+// refined progressively: first one primary ray per 8×8 block, then the
+// pixels of the 4-, 2- and 1-pixel lattices that are still missing (each
+// pixel is traced exactly once overall), every level published as soon as
+// it is done with each traced value filling its block. A new request (the
+// camera moved, the structure or metric changed) cancels the one running,
+// so turning the camera stays smooth and the picture sharpens when it stops.
+//
+// Rays are core's primary_ray(camera, x, y, W, H): pixel centres, row 0 at
+// the top, the same convention as `accelviz render` and the GL camera.
+#include "core/accel/accel.h"
+#include "core/analysis/heatmap.h"
+#include "ui/app/build_worker.h"
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <vector>
+
+namespace accelviz {
+
+struct HeatmapRequest {
+  std::shared_ptr<const BuiltStructure> structure;
+  Camera camera;
+  int width = 0;
+  int height = 0;
+  HeatMetric metric = HeatMetric::nodes;
+  QueryOptions query;
+  float c_trav = 1.0f;   ///< cost metric weights
+  float c_isect = 1.0f;
+  unsigned threads = 0;  ///< 0: all hardware threads
+  int coarsest = 8;      ///< first lattice spacing (a power of two >= 1)
+};
+
+/// What one pixel's ray found (the hover tooltip shows these).
+struct PixelFigures {
+  float value = 0.0f;        ///< the metric (NaN: no value)
+  std::uint32_t nodes = 0;   ///< RayStats::nodes_visited
+  std::uint32_t prims = 0;   ///< RayStats::prim_tests
+  std::uint32_t prim = 0xFFFFFFFFu;  ///< hit primitive (kInvalidId: miss)
+  float t = 0.0f;            ///< hit distance (inf: miss)
+};
+
+/// Figures over the pixels traced so far (all of them once complete).
+struct HeatmapSummary {
+  std::uint64_t rays = 0;
+  std::uint64_t hits = 0;
+  double mean_nodes = 0.0, mean_prims = 0.0;
+  std::uint32_t max_nodes = 0, max_prims = 0;
+  double mean_value = 0.0, max_value = 0.0;  ///< of the metric, over pixels with a value
+  double render_ms = 0.0;    ///< tracing time of all levels so far (instrumented)
+  double rays_per_s = 0.0;
+};
+
+struct HeatmapFrame {
+  std::uint64_t id = 0;
+  int stride = 0;          ///< lattice spacing of this level (1 = every pixel traced)
+  bool complete = false;   ///< stride 1 done
+  MetricImage image;       ///< W×H, block-filled below stride 1
+  std::vector<PixelFigures> pixels;  ///< W×H, row 0 at the top, block-filled like the image
+  HeatmapSummary summary;
+  HeatmapRequest request;  ///< what it shows (structure, camera, size, metric)
+
+  const PixelFigures& at(int x, int y) const { return pixels[static_cast<std::size_t>(y) * image.width + x]; }
+};
+
+/// Traces request `r` level by level, synchronously, calling `publish`
+/// after each level; stops early (returning false) when `keep_going`
+/// returns false. The worker's engine, exposed for tests.
+bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::function<bool()>& keep_going,
+                       const std::function<void(std::shared_ptr<const HeatmapFrame>)>& publish);
+
+class HeatmapWorker {
+ public:
+  HeatmapWorker();
+  ~HeatmapWorker();
+  HeatmapWorker(const HeatmapWorker&) = delete;
+  HeatmapWorker& operator=(const HeatmapWorker&) = delete;
+
+  /// Replaces whatever is queued or running with `r`; returns its id.
+  std::uint64_t request(HeatmapRequest r);
+  /// Stops the running job and drops the queued one.
+  void cancel();
+  /// The newest published level of any job (null before the first).
+  std::shared_ptr<const HeatmapFrame> latest() const;
+  /// A job is queued or running.
+  bool busy() const;
+  std::uint64_t latest_request() const { return next_id_.load() - 1; }
+
+ private:
+  void run();
+
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  std::optional<std::pair<std::uint64_t, HeatmapRequest>> queued_;
+  bool running_ = false;
+  std::shared_ptr<const HeatmapFrame> latest_;
+  std::atomic<std::uint64_t> next_id_{1};
+  std::atomic<std::uint64_t> cancel_upto_{0};
+  bool stop_ = false;
+  std::thread thread_;
+};
+
+}  // namespace accelviz

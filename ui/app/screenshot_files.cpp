@@ -1,0 +1,258 @@
+#include "ui/app/screenshot_files.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+
+namespace accelviz {
+namespace fs = std::filesystem;
+namespace {
+
+// Single-quoted for a POSIX shell ('...' with ' written as '\'').
+std::string shell_quote(const std::string& s) {
+  bool plain = !s.empty();
+  for (char c : s)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || std::string_view("-_./,:=+").find(c) != std::string_view::npos))
+      plain = false;
+  if (plain) return s;
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+struct FileCloser {
+  void operator()(std::FILE* f) const { std::fclose(f); }
+};
+
+// Creates `path` exclusively and writes `text`; "" or one line of error
+// (EEXIST is reported as "exists (not overwritten)").
+std::string write_text_exclusive(const fs::path& path, const std::string& text) {
+  std::unique_ptr<std::FILE, FileCloser> f(std::fopen(path.c_str(), "wbx"));
+  if (!f) return path.string() + (errno == EEXIST ? ": exists (not overwritten)" : ": cannot be created");
+  if (std::fwrite(text.data(), 1, text.size(), f.get()) != text.size()) return path.string() + ": write failed";
+  return {};
+}
+
+std::string heatmap_display_name(HeatmapDisplay d) {
+  switch (d) {
+    case HeatmapDisplay::off: return "off";
+    case HeatmapDisplay::full_screen: return "full";
+    case HeatmapDisplay::blend: return "blend";
+  }
+  return "off";
+}
+
+// Writes PNG then side-car, both exclusively; on EEXIST the caller moves on.
+SavedScreenshot write_pair(const ScreenshotPaths& paths, const RgbImage& frame, const ScreenshotInfo& info,
+                           bool* name_taken) {
+  SavedScreenshot r;
+  r.png = paths.png;
+  r.json = paths.json;
+  *name_taken = false;
+  std::error_code ec;
+  if (fs::exists(paths.json, ec)) {
+    *name_taken = true;
+    r.error = paths.json.string() + ": exists (not overwritten)";
+    return r;
+  }
+  try {
+    write_png(paths.png.string(), add_caption(frame, screenshot_caption(info.config)), /*overwrite=*/false);
+  } catch (const std::exception& e) {
+    // core's message for an existing file speaks of --force; say it the GUI's way.
+    *name_taken = fs::exists(paths.png, ec);
+    r.error = *name_taken ? paths.png.string() + ": exists (not overwritten)" : std::string(e.what());
+    return r;
+  }
+  const std::string error = write_text_exclusive(paths.json, screenshot_sidecar(info, paths.png).dump(2) + "\n");
+  if (!error.empty()) {
+    r.error = error;
+    return r;  // the PNG stays: it is the user's picture, and it was new
+  }
+  r.ok = true;
+  return r;
+}
+
+}  // namespace
+
+fs::path default_screenshot_dir() {
+  if (const char* p = std::getenv("XDG_PICTURES_DIR"); p && *p == '/') return fs::path(p) / "accelviz";
+  const char* home = std::getenv("HOME");
+  return fs::path(home && *home ? home : ".") / "Pictures" / "accelviz";
+}
+
+std::string screenshot_timestamp(std::time_t t) {
+  std::tm tm{};
+  localtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y%m%d-%H%M%S", &tm);
+  return buf;
+}
+
+ScreenshotPaths unique_screenshot_paths(const fs::path& dir, const std::string& stamp) {
+  for (int k = 1;; ++k) {
+    const std::string stem = "accelviz-" + stamp + (k == 1 ? "" : "-" + std::to_string(k));
+    ScreenshotPaths p{dir / (stem + ".png"), dir / (stem + ".json")};
+    std::error_code ec;
+    if (!fs::exists(p.png, ec) && !fs::exists(p.json, ec)) return p;
+  }
+}
+
+RgbImage add_caption(const RgbImage& frame, const std::string& caption) {
+  const int scale = frame.width >= 1000 ? 2 : 1;
+  const int pad = 4 * scale;
+  const int strip = pad + 7 * scale + pad;
+  RgbImage out(frame.width, frame.height + strip, glm::u8vec3(28, 30, 34));
+  std::copy(frame.pixels.begin(), frame.pixels.end(), out.pixels.begin());
+  // The legend font has lower-case letters only (and M); everything else
+  // it lacks draws as a blank, so lower-case the caption first.
+  std::string text;
+  for (char c : caption) text += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const int max_chars = std::max(0, (frame.width - 2 * pad) / (6 * scale));
+  if (static_cast<int>(text.size()) > max_chars) text = text.substr(0, std::max(0, max_chars - 2)) + "..";
+  draw_text(out, pad, frame.height + pad, text, glm::u8vec3(225, 228, 232), scale);
+  return out;
+}
+
+std::string render_command(const ScreenshotInfo& info, bool raster, const std::string& out,
+                           std::vector<std::string>* notes) {
+  const AppConfig& c = info.config;
+  const StructureChoice& s = c.structure;
+  std::string cmd = "accelviz render " + shell_quote(info.scene) + " --structure " + s.name;
+  if (!info.camera_spec.empty()) cmd += " --camera " + shell_quote(info.camera_spec);
+  cmd += " --size " + std::to_string(info.width) + "x" + std::to_string(info.height);
+  cmd += " --metric " + std::string(metric_name(c.view.metric));
+  cmd += " --colormap " + std::string(colormap_name(c.view.colormap));
+  cmd += " --triangle-test " + option_value(c, "triangle-test");
+  if (!c.view.auto_scale) {
+    cmd += " --max " + format_number(c.view.scale_max);
+    if (notes && c.view.scale_min != 0.0f)
+      notes->push_back("the heatmap range starts at " + format_number(c.view.scale_min) +
+                       "; `render --max` always starts at 0");
+  }
+  // The BVH's options are command-line options of `render`; they also carry
+  // the cost metric's weights for every structure.
+  for (const char* key : {"splitter", "buckets", "leaf", "leaf-cap", "ctrav", "cisect"})
+    cmd += std::string(" --") + key + " " + option_value(c, key);
+  if (s.name == "embree") cmd += " --embree-quality " + option_value(c, "embree-quality");
+  if (notes) {
+    const AppConfig defaults;
+    for (std::string_view key : structure_option_keys(s.name)) {
+      if (s.name == "bvh" || s.name == "embree") break;
+      if (option_value(c, key) != option_value(defaults, key))
+        notes->push_back(std::string(key) + "=" + option_value(c, key) +
+                         " is not a command-line option of render (it builds " + s.name +
+                         " with defaults): replay the `script` instead");
+    }
+    if (!s.query.ordered) notes->push_back("unordered traversal is not a command-line option of render");
+  }
+  if (raster) {
+    cmd += " --view raster";
+    const ViewSettings& v = c.view;
+    if (v.show_boxes) {
+      switch (v.box_mode) {
+        case BoxMode::depth: cmd += " --depth " + std::to_string(v.box_depth); break;
+        case BoxMode::depth_range:
+          cmd += " --depth " + std::to_string(v.box_depth) + " --depth-last " + std::to_string(v.box_depth_last);
+          break;
+        case BoxMode::leaves: cmd += " --leaves"; break;
+        case BoxMode::subtree:
+          if (notes) notes->push_back("raster: a subtree selection has no command-line option");
+          break;
+      }
+      if (notes && v.box_color != BoxColorBy::depth)
+        notes->push_back("raster: boxes are coloured by depth on the command line");
+    }
+    if (v.show_wireframe) cmd += " --wireframe";
+    if (v.heatmap == HeatmapDisplay::blend) cmd += " --blend " + format_number(v.opacity);
+    if (v.heatmap == HeatmapDisplay::full_screen) cmd += " --blend 1";
+    if (info.ray_pixel && v.show_ray_path)
+      cmd += " --ray-pixel " + std::to_string(info.ray_pixel->first) + "," + std::to_string(info.ray_pixel->second);
+  }
+  return cmd + " --out " + shell_quote(out);
+}
+
+nlohmann::json screenshot_sidecar(const ScreenshotInfo& info, const fs::path& png) {
+  const AppConfig& c = info.config;
+  nlohmann::json structure_options = nlohmann::json::object();
+  for (std::string_view key : structure_option_keys(c.structure.name))
+    structure_options[std::string(key)] = option_value(c, key);
+  nlohmann::json all_options = nlohmann::json::object();
+  for (const auto& [key, value] : option_values(c)) all_options[key] = value;
+
+  const Camera& cam = info.camera;
+  auto vec = [](const glm::vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); };
+
+  std::vector<std::string> notes;
+  const std::string stem = png.stem().string();
+  const std::string heatmap_cmd = render_command(info, false, stem + "-heatmap.png", &notes);
+  const std::string raster_cmd = render_command(info, true, stem + "-raster.png", &notes);
+
+  // A script replays the picture in the app itself, with every option.
+  std::vector<std::string> script = {"open " + info.scene,
+                                     "size " + std::to_string(info.width) + " " + std::to_string(info.height)};
+  for (const auto& [key, value] : option_values(c)) script.push_back("set " + key + " " + value);
+  if (!info.camera_spec.empty()) script.push_back("camera " + info.camera_spec);
+  script.push_back("wait");
+  if (info.ray_pixel)
+    script.push_back("click " + std::to_string(info.ray_pixel->first) + " " + std::to_string(info.ray_pixel->second));
+  script.push_back("screenshot " + stem + "-replay.png");
+  script.push_back("quit");
+
+  return {
+      {"png", fs::absolute(png).string()},
+      {"caption", screenshot_caption(c)},
+      {"scene", info.scene},
+      {"triangles", info.triangles},
+      {"size", {{"width", info.width}, {"height", info.height}}},
+      {"camera",
+       {{"spec", info.camera_spec},
+        {"eye", vec(cam.position)},
+        {"forward", vec(cam.forward)},
+        {"up", vec(cam.up)},
+        {"yfov_deg", cam.yfov * 180.0 / 3.14159265358979}}},
+      {"structure", {{"name", c.structure.name}, {"options", structure_options}}},
+      {"query",
+       {{"triangle_test", option_value(c, "triangle-test")}, {"ordered", c.structure.query.ordered}}},
+      {"heatmap",
+       {{"display", heatmap_display_name(c.view.heatmap)},
+        {"metric", metric_name(c.view.metric)},
+        {"colormap", colormap_name(c.view.colormap)},
+        {"scale", option_value(c, "scale")},
+        {"range", {info.scale_min, info.scale_max}},
+        {"opacity", c.view.opacity},
+        {"legend", c.view.show_legend}}},
+      {"options", all_options},
+      {"ray_pixel", info.ray_pixel ? nlohmann::json::array({info.ray_pixel->first, info.ray_pixel->second})
+                                   : nlohmann::json(nullptr)},
+      {"reproduce",
+       {{"render_heatmap", heatmap_cmd}, {"render_raster", raster_cmd}, {"notes", notes}, {"script", script}}},
+  };
+}
+
+SavedScreenshot save_screenshot(const fs::path& dir, const RgbImage& frame, const ScreenshotInfo& info,
+                                std::time_t now) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) return {false, {}, {}, dir.string() + ": " + ec.message()};
+  const std::string stamp = screenshot_timestamp(now);
+  // A name can be taken between the check and the exclusive create (another
+  // instance, a second F12 in the same second): move on to the next one.
+  for (int attempt = 0; attempt < 1000; ++attempt) {
+    bool taken = false;
+    SavedScreenshot r = write_pair(unique_screenshot_paths(dir, stamp), frame, info, &taken);
+    if (r.ok || !taken) return r;
+  }
+  return {false, {}, {}, dir.string() + ": no free screenshot name"};
+}
+
+SavedScreenshot save_screenshot_as(const fs::path& png, const RgbImage& frame, const ScreenshotInfo& info) {
+  fs::path json = png;
+  json.replace_extension(".json");
+  bool taken = false;
+  return write_pair({png, json}, frame, info, &taken);
+}
+
+}  // namespace accelviz

@@ -1,0 +1,86 @@
+#pragma once
+// `accelviz --script FILE`: a session driven by a small command list, one
+// command per line, run by the real window's main loop between frames (see
+// docs/gui.md for the language). Parsing and sequencing live here, GL-free;
+// the GUI implements ScriptHost to carry commands out.
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace accelviz {
+
+struct ScriptCommand {
+  enum class Kind { open, structure, set, camera, size, wait, click, step, screenshot, dump_ray, dump_stats, quit };
+  Kind kind = Kind::wait;
+  int line = 0;              ///< 1-based line in the script file
+  std::string text;          ///< the line as written (trimmed), for messages
+  std::string arg;           ///< open: scene; structure: name; set: key; camera: spec; step: N|next|prev|first|last; screenshot/dump-*: path
+  std::string value;         ///< set: value
+  int x = 0, y = 0;          ///< size: width, height; click: pixel
+};
+
+/// The command's name as written in scripts ("dump-ray").
+std::string_view command_name(ScriptCommand::Kind kind);
+
+/// A parse or run error; what() is "FILE:LINE: message".
+class ScriptError : public std::runtime_error {
+ public:
+  ScriptError(const std::string& file, int line, const std::string& message)
+      : std::runtime_error(file + ":" + std::to_string(line) + ": " + message), line_(line) {}
+  int line() const { return line_; }
+
+ private:
+  int line_;
+};
+
+/// Parses a script; `file` names it in errors. Blank lines and lines
+/// starting with '#' are skipped. Checks every command's arguments (counts,
+/// integers, option keys and values, structure names, camera syntax) and
+/// throws ScriptError at the first bad line.
+std::vector<ScriptCommand> parse_script(std::string_view text, const std::string& file);
+/// Reads and parses a file (ScriptError "FILE:0: cannot be read" when missing).
+std::vector<ScriptCommand> load_script(const std::filesystem::path& path);
+
+/// Carries commands out. `execute` is called once per frame for the command
+/// at hand until it returns done; it throws (any std::exception) to fail the
+/// script with that message.
+class ScriptHost {
+ public:
+  enum class Status { done, again };
+  virtual ~ScriptHost() = default;
+  virtual Status execute(const ScriptCommand& command) = 0;
+};
+
+class ScriptRunner {
+ public:
+  enum class State { running, finished, failed };
+
+  /// `timeout_s`: a command still answering "again" after this long (a
+  /// `wait` on a build that never ends) fails the script.
+  ScriptRunner(std::vector<ScriptCommand> commands, std::string file, double timeout_s = 300.0);
+
+  /// Runs commands until one needs another frame, the script ends (`quit`
+  /// or the last line) or a command fails. `now_s` is a monotonic clock in
+  /// seconds (passed in so the sequencing is testable without sleeping).
+  State advance(ScriptHost& host, double now_s);
+
+  State state() const { return state_; }
+  /// "FILE:LINE: message" once failed.
+  const std::string& error() const { return error_; }
+  /// Index of the next command to run.
+  std::size_t position() const { return next_; }
+
+ private:
+  std::vector<ScriptCommand> commands_;
+  std::string file_;
+  double timeout_s_;
+  std::size_t next_ = 0;
+  bool started_ = false;  ///< the command at next_ has been tried before
+  double started_at_ = 0.0;
+  State state_ = State::running;
+  std::string error_;
+};
+
+}  // namespace accelviz

@@ -1,0 +1,150 @@
+#include "ui/app/settings.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace accelviz {
+
+void add_recent(AppSettings& s, const std::string& spec) {
+  if (spec.empty()) return;
+  s.recent.erase(std::remove(s.recent.begin(), s.recent.end(), spec), s.recent.end());
+  s.recent.insert(s.recent.begin(), spec);
+  if (s.recent.size() > AppSettings::kMaxRecent) s.recent.resize(AppSettings::kMaxRecent);
+}
+
+std::filesystem::path config_dir() {
+  // The spec says a relative XDG_CONFIG_HOME is invalid and must be ignored.
+  if (const char* xdg = std::getenv("XDG_CONFIG_HOME"); xdg && *xdg == '/') return std::filesystem::path(xdg) / "accelviz";
+  const char* home = std::getenv("HOME");
+  return std::filesystem::path(home && *home ? home : ".") / ".config" / "accelviz";
+}
+
+nlohmann::json settings_to_json(const AppSettings& s) {
+  nlohmann::json options = nlohmann::json::object();
+  for (const auto& [key, value] : option_values(s.config)) options[key] = value;
+  return {{"version", 1},
+          {"last_scene", s.last_scene},
+          {"recent", s.recent},
+          {"screenshot_dir", s.screenshot_dir},
+          {"window", {{"width", s.window_width}, {"height", s.window_height}}},
+          {"options", options}};
+}
+
+AppSettings settings_from_json(const nlohmann::json& j) {
+  using std::runtime_error;
+  if (!j.is_object()) throw runtime_error("not a JSON object");
+  AppSettings s;
+  if (j.contains("version") && (!j["version"].is_number_integer() || j["version"].get<int>() != 1))
+    throw runtime_error("unsupported version " + j["version"].dump());
+  auto string_field = [&](const char* key, std::string& out) {
+    if (!j.contains(key)) return;
+    if (!j[key].is_string()) throw runtime_error(std::string(key) + ": expected a string");
+    out = j[key].get<std::string>();
+  };
+  string_field("last_scene", s.last_scene);
+  string_field("screenshot_dir", s.screenshot_dir);
+  if (j.contains("recent")) {
+    if (!j["recent"].is_array()) throw runtime_error("recent: expected an array of strings");
+    for (const auto& r : j["recent"]) {
+      if (!r.is_string()) throw runtime_error("recent: expected an array of strings");
+      if (s.recent.size() < AppSettings::kMaxRecent) s.recent.push_back(r.get<std::string>());
+    }
+  }
+  if (j.contains("window")) {
+    const auto& w = j["window"];
+    auto side = [&](const char* key, int& out) {
+      if (!w.is_object() || !w.contains(key)) return;
+      if (!w[key].is_number_integer() || w[key].get<long long>() < 100 || w[key].get<long long>() > 16384)
+        throw runtime_error(std::string("window.") + key + ": expected an integer in 100..16384");
+      out = w[key].get<int>();
+    };
+    side("width", s.window_width);
+    side("height", s.window_height);
+  }
+  if (j.contains("options")) {
+    const auto& o = j["options"];
+    if (!o.is_object()) throw runtime_error("options: expected an object");
+    // "structure" first: nothing else depends on it, but "leaf" before
+    // "leaf-cap" matters, and table order guarantees that; iterate the table.
+    for (const OptionInfo& info : option_table()) {
+      const auto it = o.find(std::string(info.key));
+      if (it == o.end()) continue;
+      if (!it->is_string()) throw runtime_error("options." + std::string(info.key) + ": expected a string");
+      const std::string error = apply_option(s.config, info.key, it->get<std::string>());
+      if (!error.empty()) throw runtime_error("options." + error);
+    }
+    for (const auto& [key, value] : o.items()) {
+      const auto& table = option_table();
+      if (std::none_of(table.begin(), table.end(), [&](const OptionInfo& i) { return i.key == key; }))
+        throw runtime_error("options: unknown option '" + key + "'");
+    }
+  }
+  return s;
+}
+
+LoadedSettings load_settings(const std::filesystem::path& file) {
+  LoadedSettings out;
+  std::ifstream in(file, std::ios::binary);
+  if (!in) {
+    std::error_code ec;
+    if (std::filesystem::exists(file, ec)) out.error = file.string() + ": cannot be read (using defaults)";
+    return out;
+  }
+  std::stringstream text;
+  text << in.rdbuf();
+  try {
+    out.settings = settings_from_json(nlohmann::json::parse(text.str()));
+  } catch (const std::exception& e) {
+    std::string what = e.what();
+    std::replace(what.begin(), what.end(), '\n', ' ');
+    out.settings = AppSettings{};
+    out.error = file.string() + ": " + what + " (using defaults)";
+  }
+  return out;
+}
+
+std::string write_file_atomic(const std::filesystem::path& file, std::string_view content) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path dir = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  fs::create_directories(dir, ec);
+  if (ec) return dir.string() + ": " + ec.message();
+  // Same folder as the target, so rename() stays within one file system and
+  // is atomic; the pid keeps two running instances from sharing a name.
+  const fs::path tmp = dir / ("." + file.filename().string() + ".tmp-" + std::to_string(::getpid()));
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return tmp.string() + ": " + std::strerror(errno);
+  const char* p = content.data();
+  std::size_t left = content.size();
+  std::string error;
+  while (left > 0) {
+    const ssize_t n = ::write(fd, p, left);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      error = tmp.string() + ": " + std::strerror(errno);
+      break;
+    }
+    p += n;
+    left -= static_cast<std::size_t>(n);
+  }
+  // fsync before rename: otherwise a crash can leave the new name pointing at
+  // an empty file on some file systems.
+  if (error.empty() && ::fsync(fd) != 0) error = tmp.string() + ": " + std::strerror(errno);
+  if (::close(fd) != 0 && error.empty()) error = tmp.string() + ": " + std::strerror(errno);
+  if (error.empty() && std::rename(tmp.c_str(), file.c_str()) != 0) error = file.string() + ": " + std::strerror(errno);
+  if (!error.empty()) fs::remove(tmp, ec);
+  return error;
+}
+
+std::string save_settings(const std::filesystem::path& file, const AppSettings& s) {
+  return write_file_atomic(file, settings_to_json(s).dump(2) + "\n");
+}
+
+}  // namespace accelviz

@@ -1,0 +1,303 @@
+#include "ui/app/structure_nodes.h"
+
+#include "core/accel/bvh/bvh.h"
+#include "core/accel/grid/grid.h"
+#include "core/accel/kdtree/kdtree.h"
+#include "core/accel/octree/octree.h"
+#include "core/accel/voxels/voxels.h"
+
+#include <algorithm>
+
+namespace accelviz {
+namespace {
+
+constexpr std::uint32_t kNone = 0xFFFFFFFFu;
+
+// Tables are filled by an explicit stack (no recursion): K-D trees and
+// degenerate BVHs can be 64 deep, and a corrupt array must not blow the stack.
+struct Pending {
+  std::uint32_t id;
+  Aabb box;
+  std::uint32_t depth;
+  std::uint32_t parent;
+};
+
+}  // namespace
+
+StructureNodes StructureNodes::of(const Accelerator& accel) {
+  StructureNodes t;
+  if (const auto* bvh = dynamic_cast<const Bvh*>(&accel)) {
+    t.kind_ = "bvh";
+    const auto nodes = bvh->nodes();
+    t.nodes_.resize(nodes.size());
+    // Children come after their parent, so one forward sweep sets depths.
+    for (std::uint32_t i = 0; i < nodes.size(); ++i) {
+      StructureNode& n = t.nodes_[i];
+      n.bounds = nodes[i].bounds;
+      n.leaf = nodes[i].is_leaf();
+      n.prims = n.leaf ? nodes[i].count : 0;
+      if (!n.leaf)
+        for (std::uint32_t c : {nodes[i].index, nodes[i].index + 1})
+          if (c > i && c < nodes.size()) {
+            t.nodes_[c].parent = i;
+            t.nodes_[c].depth = n.depth + 1;
+          }
+    }
+    t.finish(bvh->options().cost_traversal, bvh->options().cost_intersect);
+  } else if (const auto* kd = dynamic_cast<const KdTree*>(&accel)) {
+    t.kind_ = "kdtree";
+    const auto nodes = kd->nodes();
+    t.nodes_.resize(nodes.size());
+    std::vector<Pending> stack;
+    if (!nodes.empty()) stack.push_back({0, kd->bounds(), 0, kNone});
+    while (!stack.empty()) {
+      const Pending p = stack.back();
+      stack.pop_back();
+      if (p.id >= nodes.size()) continue;
+      StructureNode& n = t.nodes_[p.id];
+      n.bounds = p.box;
+      n.depth = p.depth;
+      n.parent = p.parent;
+      const KdNode& k = nodes[p.id];
+      n.leaf = k.is_leaf();
+      if (n.leaf) {
+        n.prims = k.prim_count();
+        continue;
+      }
+      Aabb below = p.box, above = p.box;
+      below.hi[k.axis()] = k.split();
+      above.lo[k.axis()] = k.split();
+      if (k.above_child() > p.id) stack.push_back({k.above_child(), above, p.depth + 1, p.id});
+      stack.push_back({p.id + 1, below, p.depth + 1, p.id});
+    }
+    t.finish(kd->options().cost_traversal, kd->options().cost_intersect);
+  } else if (const auto* oct = dynamic_cast<const Octree*>(&accel)) {
+    t.kind_ = "octree";
+    const auto nodes = oct->nodes();
+    t.nodes_.resize(nodes.size());
+    std::vector<Pending> stack;
+    if (!nodes.empty()) stack.push_back({0, oct->root_box(), 0, kNone});
+    while (!stack.empty()) {
+      const Pending p = stack.back();
+      stack.pop_back();
+      if (p.id >= nodes.size()) continue;
+      StructureNode& n = t.nodes_[p.id];
+      n.bounds = p.box;
+      n.depth = p.depth;
+      n.parent = p.parent;
+      n.leaf = nodes[p.id].is_leaf();
+      if (n.leaf) {
+        n.prims = nodes[p.id].count;
+        continue;
+      }
+      for (int o = 7; o >= 0; --o) {
+        const std::uint32_t c = nodes[p.id].index + static_cast<std::uint32_t>(o);
+        if (c > p.id) stack.push_back({c, Octree::child_box(p.box, o), p.depth + 1, p.id});
+      }
+    }
+    t.finish(1.0f, 1.0f);  // the octree's SAH figure uses unit costs too
+  } else if (const auto* vox = dynamic_cast<const Voxels*>(&accel)) {
+    t.kind_ = "voxels";
+    const auto nodes = vox->nodes();
+    const VoxelDomain& dom = vox->domain();
+    // Interior nodes keep their ids (what the trace reports); full blocks,
+    // which have no node, are appended after them.
+    t.nodes_.resize(nodes.size());
+    struct VPending {
+      std::uint32_t id;
+      std::uint32_t corner[3];
+      std::uint32_t size;
+      std::uint32_t depth;
+      std::uint32_t parent;
+    };
+    std::vector<VPending> stack;
+    std::vector<bool> seen(nodes.size(), false);  // a malformed array must not loop
+    if (vox->root() == Voxels::Root::interior && !nodes.empty()) {
+      stack.push_back({static_cast<std::uint32_t>(nodes.size() - 1), {0, 0, 0}, dom.resolution, 0, kNone});
+      seen.back() = true;
+    }
+    if (vox->root() == Voxels::Root::full) {
+      StructureNode n;
+      n.bounds = dom.box();
+      n.leaf = true;
+      t.nodes_.push_back(n);
+    }
+    while (!stack.empty()) {
+      const VPending p = stack.back();
+      stack.pop_back();
+      if (p.id >= nodes.size()) continue;
+      {
+        StructureNode& n = t.nodes_[p.id];
+        n.bounds = dom.block_box(p.corner[0], p.corner[1], p.corner[2], p.size);
+        n.depth = p.depth;
+        n.parent = p.parent;
+      }
+      const VoxelNode& vn = nodes[p.id];
+      const std::uint32_t half = p.size / 2;
+      for (int o = 7; o >= 0; --o) {
+        if (!((vn.valid >> o) & 1u)) continue;
+        std::uint32_t c[3];
+        for (int a = 0; a < 3; ++a) c[a] = p.corner[a] + (((o >> a) & 1) ? half : 0);
+        if ((vn.full >> o) & 1u) {
+          StructureNode leaf;
+          leaf.bounds = dom.block_box(c[0], c[1], c[2], half);
+          leaf.depth = p.depth + 1;
+          leaf.parent = p.id;
+          leaf.leaf = true;
+          t.nodes_.push_back(leaf);
+        } else {
+          const std::uint32_t child = vn.child(o);
+          if (child < nodes.size() && !seen[child]) {
+            seen[child] = true;
+            stack.push_back({child, {c[0], c[1], c[2]}, half, p.depth + 1, p.id});
+          }
+        }
+      }
+    }
+    t.finish(1.0f, 1.0f);
+  } else if (const auto* grid = dynamic_cast<const Grid*>(&accel)) {
+    t.kind_ = "grid";
+    GridCells g;
+    g.res = grid->resolution();
+    g.bounds = grid->bounds();
+    for (int a = 0; a < 3; ++a)
+      for (int i = 0; i <= g.res[a]; ++i) g.planes[a].push_back(grid->plane(a, i));
+    const auto start = grid->cell_start();
+    g.counts.resize(start.empty() ? 0 : start.size() - 1);
+    for (std::size_t c = 0; c < g.counts.size(); ++c) g.counts[c] = start[c + 1] - start[c];
+    t.grid_ = std::move(g);
+    t.max_depth_ = 1;
+  }
+  return t;
+}
+
+void StructureNodes::finish(float c_trav, float c_isect) {
+  // Children lists (CSR by parent), depth and the SAH shares.
+  child_start_.assign(nodes_.size() + 1, 0);
+  for (const StructureNode& n : nodes_)
+    if (n.parent < nodes_.size()) ++child_start_[n.parent + 1];
+  for (std::size_t i = 0; i < nodes_.size(); ++i) child_start_[i + 1] += child_start_[i];
+  children_.assign(child_start_.back(), 0);
+  std::vector<std::uint32_t> fill(child_start_.begin(), child_start_.end() - 1);
+  for (std::uint32_t i = 0; i < nodes_.size(); ++i)
+    if (nodes_[i].parent < nodes_.size()) children_[fill[nodes_[i].parent]++] = i;
+
+  max_depth_ = 0;
+  double total = 0.0;
+  const float root_area = nodes_.empty() ? 0.0f : nodes_.front().bounds.surface_area();
+  // The voxel octree's root is its last interior node, not node 0.
+  float area_ref = root_area;
+  for (const StructureNode& n : nodes_)
+    if (n.parent == kNone && n.depth == 0) area_ref = std::max(area_ref, n.bounds.surface_area());
+  for (StructureNode& n : nodes_) {
+    max_depth_ = std::max(max_depth_, n.depth);
+    const float ratio = area_ref > 0.0f ? n.bounds.surface_area() / area_ref : 1.0f;
+    n.sah_share = (n.leaf ? c_isect * static_cast<float>(n.prims) : c_trav) * ratio;
+    total += n.sah_share;
+  }
+  if (total > 0.0)
+    for (StructureNode& n : nodes_) n.sah_share = static_cast<float>(n.sah_share / total);
+}
+
+std::uint64_t StructureNodes::size() const {
+  return grid_ ? grid_->counts.size() : nodes_.size();
+}
+
+std::optional<Aabb> StructureNodes::box(std::uint32_t id) const {
+  if (grid_) {
+    const auto& g = *grid_;
+    if (id >= g.counts.size()) return std::nullopt;
+    const int x = static_cast<int>(id % static_cast<std::uint32_t>(g.res[0]));
+    const int y = static_cast<int>((id / static_cast<std::uint32_t>(g.res[0])) % static_cast<std::uint32_t>(g.res[1]));
+    const int z = static_cast<int>(id / static_cast<std::uint32_t>(g.res[0] * g.res[1]));
+    return Aabb{{g.planes[0][x], g.planes[1][y], g.planes[2][z]},
+                {g.planes[0][x + 1], g.planes[1][y + 1], g.planes[2][z + 1]}};
+  }
+  if (id >= nodes_.size()) return std::nullopt;
+  return nodes_[id].bounds;
+}
+
+std::vector<std::uint32_t> StructureNodes::children(std::uint32_t id) const {
+  if (id >= nodes_.size() || child_start_.empty()) return {};
+  return {children_.begin() + child_start_[id], children_.begin() + child_start_[id + 1]};
+}
+
+StructureNodes::Selection StructureNodes::select(const NodeSelection& sel, std::size_t limit) const {
+  Selection out;
+  auto add = [&](const NodeBox& b) {
+    ++out.matched;
+    if (out.boxes.size() < limit)
+      out.boxes.push_back(b);
+    else
+      out.truncated = true;
+  };
+  if (grid_) {
+    const auto& g = *grid_;
+    if (sel.mode == BoxMode::depth && sel.depth == 0) {
+      add({g.bounds, 0, 0, false, 1.0f});
+      return out;
+    }
+    if (sel.mode == BoxMode::subtree) {
+      if (const auto b = box(sel.node)) add({*b, sel.node, 1, true, 0.0f});
+      return out;
+    }
+    if (sel.mode == BoxMode::depth_range && sel.depth == 0) add({g.bounds, 0, 0, false, 1.0f});
+    if (sel.mode == BoxMode::depth && sel.depth > 1) return out;
+    double total = 0.0;
+    for (std::uint32_t c : g.counts) total += c;
+    for (std::uint32_t c = 0; c < g.counts.size(); ++c)
+      if (g.counts[c] > 0)
+        add({*box(c), c, 1, true, total > 0.0 ? static_cast<float>(g.counts[c] / total) : 0.0f});
+    return out;
+  }
+  auto to_box = [&](std::uint32_t i) {
+    const StructureNode& n = nodes_[i];
+    return NodeBox{n.bounds, i, n.depth, n.leaf, n.sah_share};
+  };
+  if (sel.mode == BoxMode::subtree) {
+    if (sel.node >= nodes_.size()) return out;
+    std::vector<std::uint32_t> stack{sel.node};
+    while (!stack.empty()) {
+      const std::uint32_t i = stack.back();
+      stack.pop_back();
+      add(to_box(i));
+      const auto kids = children(i);
+      for (auto it = kids.rbegin(); it != kids.rend(); ++it) stack.push_back(*it);
+    }
+    return out;
+  }
+  // Depth-first order from the roots, so boxes come parent before child
+  // whatever the id layout (the voxel octree stores its root last).
+  std::vector<std::uint32_t> stack;
+  for (std::uint32_t i = nodes_.size(); i-- > 0;)
+    if (nodes_[i].parent == kNone) stack.push_back(i);
+  while (!stack.empty()) {
+    const std::uint32_t i = stack.back();
+    stack.pop_back();
+    const StructureNode& n = nodes_[i];
+    bool match = false;
+    bool deeper = true;
+    switch (sel.mode) {
+      case BoxMode::depth:
+        match = n.depth == sel.depth;
+        deeper = n.depth < sel.depth;
+        break;
+      case BoxMode::depth_range:
+        match = n.depth >= sel.depth && n.depth <= sel.depth_last;
+        deeper = n.depth < sel.depth_last;
+        break;
+      case BoxMode::leaves:
+        match = n.leaf;
+        break;
+      case BoxMode::subtree:
+        break;
+    }
+    if (match) add(to_box(i));
+    if (!deeper) continue;
+    const auto kids = children(i);
+    for (auto it = kids.rbegin(); it != kids.rend(); ++it) stack.push_back(*it);
+  }
+  return out;
+}
+
+}  // namespace accelviz

@@ -1,0 +1,77 @@
+#include "ui/imgui/imgui_context.h"
+
+#include "ui/app/settings.h"
+#include "ui/gl/gl.h"
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <imgui_impl_opengl3.h>
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+
+namespace accelviz {
+
+ImGuiContextGuard::ImGuiContextGuard(GLFWwindow* window, std::optional<std::filesystem::path> ini)
+    : ini_(std::move(ini)) {
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGuiIO& io = ImGui::GetIO();
+  io.IniFilename = nullptr;  // the app persists the layout itself (see header)
+  io.ConfigFlags |= ImGuiConfigFlags_NavEnableKeyboard;
+  if (ini_) {
+    std::ifstream in(*ini_, std::ios::binary);
+    if (in) {
+      std::stringstream text;
+      text << in.rdbuf();
+      const std::string s = text.str();
+      ImGui::LoadIniSettingsFromMemory(s.c_str(), s.size());
+    }
+  }
+  // HiDPI: GLFW reports the monitor's content scale (2 on a "Retina" or
+  // 200 % display). The framebuffer is already in pixels; ImGui's sizes are
+  // in window coordinates, so scale fonts and paddings by it.
+  float sx = 1.0f, sy = 1.0f;
+  glfwGetWindowContentScale(window, &sx, &sy);
+  scale_ = std::clamp(std::max(sx, sy), 1.0f, 4.0f);
+  ImGui::StyleColorsDark();
+  ImGui::GetStyle().ScaleAllSizes(scale_);
+  io.FontGlobalScale = scale_;
+  ImGui_ImplGlfw_InitForOpenGL(window, /*install_callbacks=*/true);
+  if (!ImGui_ImplOpenGL3_Init("#version 450 core")) {
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+    throw GlError("ImGui's OpenGL 3 backend could not initialise");
+  }
+}
+
+ImGuiContextGuard::~ImGuiContextGuard() {
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+}
+
+void ImGuiContextGuard::new_frame() {
+  ImGui_ImplOpenGL3_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  ImGui::NewFrame();
+}
+
+void ImGuiContextGuard::render() {
+  ImGui::Render();
+  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+}
+
+std::string ImGuiContextGuard::save_layout(bool force) {
+  ImGuiIO& io = ImGui::GetIO();
+  if (!ini_ || (!io.WantSaveIniSettings && !force)) return {};
+  io.WantSaveIniSettings = false;
+  std::size_t size = 0;
+  const char* data = ImGui::SaveIniSettingsToMemory(&size);
+  return write_file_atomic(*ini_, std::string_view(data, size));
+}
+
+}  // namespace accelviz

@@ -1,0 +1,614 @@
+#include "ui/panels/panels.h"
+
+#include "core/accel/factory.h"
+#include "core/scene/load.h"
+#include "ui/app/shortcuts.h"
+
+#include <imgui.h>
+#include <imgui_stdlib.h>
+
+#include <algorithm>
+#include <cinttypes>
+#include <cstdarg>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <thread>
+
+namespace accelviz::panels {
+namespace {
+
+// First-use placement in a 1280×800 window: scene and structure on the left,
+// stats and view on the right, ray inspector at the bottom left. ImGui's
+// saved layout replaces this afterwards.
+void place(const PanelLayout& l, float x, float y, float w, float h) {
+  const float s = l.scale;
+  const float px = x >= 0.0f ? x * s : l.width + x * s;
+  ImGui::SetNextWindowPos(ImVec2(px, y * s), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(w * s, h * s), ImGuiCond_FirstUseEver);
+}
+
+std::string bytes_text(std::uint64_t b) {
+  char buf[64];
+  if (b >= (1ull << 30))
+    std::snprintf(buf, sizeof buf, "%.2f GiB", static_cast<double>(b) / (1ull << 30));
+  else if (b >= (1ull << 20))
+    std::snprintf(buf, sizeof buf, "%.2f MiB", static_cast<double>(b) / (1ull << 20));
+  else if (b >= 1024)
+    std::snprintf(buf, sizeof buf, "%.1f KiB", static_cast<double>(b) / 1024.0);
+  else
+    std::snprintf(buf, sizeof buf, "%" PRIu64 " B", b);
+  return buf;
+}
+
+void row(const char* name, const char* fmt, ...) IM_FMTARGS(2);
+void row(const char* name, const char* fmt, ...) {
+  ImGui::TableNextRow();
+  ImGui::TableSetColumnIndex(0);
+  ImGui::TextUnformatted(name);
+  ImGui::TableSetColumnIndex(1);
+  va_list args;
+  va_start(args, fmt);
+  ImGui::TextV(fmt, args);
+  va_end(args);
+}
+
+// A combo over a fixed list of names; returns true when the index changed.
+bool combo(const char* label, int& index, const std::vector<const char*>& names) {
+  return ImGui::Combo(label, &index, names.data(), static_cast<int>(names.size()));
+}
+
+bool float_positive(const char* label, float& v, float speed, const char* help) {
+  float x = v;
+  const bool changed = ImGui::DragFloat(label, &x, speed, 1e-3f, 1e4f, "%.3g", ImGuiSliderFlags_AlwaysClamp);
+  if (help && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", help);
+  if (changed && x > 0.0f && std::isfinite(x) && x != v) {
+    v = x;
+    return true;
+  }
+  return false;
+}
+
+// ImGui 1.86 has no SeparatorText (1.89): a rule and a label.
+void section(const char* label) {
+  ImGui::Separator();
+  ImGui::TextDisabled("%s", label);
+}
+
+bool checkbox(const char* label, bool& v, const char* help = nullptr) {
+  const bool changed = ImGui::Checkbox(label, &v);
+  if (help && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", help);
+  return changed;
+}
+
+// Sliders that commit only when released would hide the supersession the
+// app is built for; a drag rebuilds at every new value and each newer build
+// cancels the older one.
+bool slider_int(const char* label, int& v, int lo, int hi, const char* help = nullptr) {
+  const bool changed = ImGui::SliderInt(label, &v, lo, hi, "%d", ImGuiSliderFlags_AlwaysClamp);
+  if (help && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", help);
+  return changed;
+}
+
+}  // namespace
+
+// ---- Scene ------------------------------------------------------------------------
+
+SceneAction scene_panel(std::string& path_field, const std::vector<std::string>& recent, const Scene* scene,
+                        const std::string& shown_spec, int active_camera, const PanelLayout& layout) {
+  SceneAction a;
+  place(layout, 8, 8, 340, 300);
+  if (!ImGui::Begin("Scene")) {
+    ImGui::End();
+    return a;
+  }
+  ImGui::TextWrapped("%s", shown_spec.empty() ? "(loading...)" : shown_spec.c_str());
+  ImGui::SetNextItemWidth(-70.0f * layout.scale);
+  const bool enter = ImGui::InputTextWithHint("##path", ".gltf/.glb/.obj or builtin:NAME?size=N", &path_field,
+                                              ImGuiInputTextFlags_EnterReturnsTrue);
+  ImGui::SameLine();
+  if ((ImGui::Button("Open") || enter) && !path_field.empty()) a.open = path_field;
+
+  if (ImGui::BeginCombo("Built-in", "choose...")) {
+    for (const BuiltinSceneInfo& b : builtin_scenes()) {
+      if (ImGui::Selectable(b.name.c_str())) {
+        path_field = "builtin:" + b.name;
+        a.open = path_field;
+      }
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s\n%s", b.description.c_str(), b.parameters.c_str());
+    }
+    ImGui::EndCombo();
+  }
+  if (ImGui::BeginCombo("Recent", recent.empty() ? "(none)" : "choose...")) {
+    for (const std::string& r : recent)
+      if (ImGui::Selectable(r.c_str())) {
+        path_field = r;
+        a.open = r;
+      }
+    ImGui::EndCombo();
+  }
+
+  if (scene) {
+    ImGui::Separator();
+    ImGui::Text("%zu triangles, %zu meshes, %zu instances", scene->triangles.size(), scene->meshes.size(),
+                scene->instances.size());
+    ImGui::Text("%zu lights, %zu cameras", scene->lights.size(), scene->cameras.size());
+    if (scene->report.dropped_nonfinite || scene->report.degenerate)
+      ImGui::Text("%" PRIu64 " dropped (non-finite), %" PRIu64 " degenerate", scene->report.dropped_nonfinite,
+                  scene->report.degenerate);
+    for (const std::string& w : scene->report.warnings) ImGui::TextWrapped("warning: %s", w.c_str());
+    if (!scene->cameras.empty()) {
+      ImGui::TextUnformatted("Cameras:");
+      for (std::size_t i = 0; i < scene->cameras.size(); ++i) {
+        const std::string label = std::to_string(i) + ": " +
+                                  (scene->cameras[i].name.empty() ? std::string("camera") : scene->cameras[i].name);
+        if (ImGui::RadioButton(label.c_str(), active_camera == static_cast<int>(i))) a.camera = static_cast<int>(i);
+      }
+    }
+    if (ImGui::Button("Reset view (R)")) a.reset_view = true;
+  }
+  ImGui::End();
+  return a;
+}
+
+// ---- Structure -------------------------------------------------------------------------
+
+bool structure_panel(StructureChoice& choice, const BuildProgress& progress, bool& cancel, const PanelLayout& layout) {
+  cancel = false;
+  bool changed = false;
+  place(layout, 8, 316, 340, 380);
+  if (!ImGui::Begin("Structure")) {
+    ImGui::End();
+    return false;
+  }
+  const std::vector<std::string>& names = structure_names();
+  if (ImGui::BeginCombo("Type", choice.name.c_str())) {
+    for (const std::string& n : names)
+      if (ImGui::Selectable(n.c_str(), n == choice.name) && n != choice.name) {
+        choice.name = n;
+        changed = true;
+      }
+    ImGui::EndCombo();
+  }
+
+  StructureOptions& o = choice.options;
+  if (choice.name == "bvh") {
+    BvhOptions& b = o.bvh;
+    int splitter = static_cast<int>(b.splitter);
+    if (combo("Splitter", splitter, {"binned SAH", "exact SAH", "median"})) {
+      b.splitter = static_cast<BvhSplitter>(splitter);
+      changed = true;
+    }
+    if (b.splitter == BvhSplitter::binned_sah) changed |= slider_int("Buckets", b.buckets, 2, 256, "binned SAH bucket count");
+    if (slider_int("Max leaf size", b.max_leaf_size, 1, 255, "nodes with at most this many triangles are leaves")) {
+      b.leaf_size_cap = std::max(b.leaf_size_cap, b.max_leaf_size);
+      changed = true;
+    }
+    changed |= slider_int("Leaf size cap", b.leaf_size_cap, b.max_leaf_size, 255,
+                          "largest leaf the SAH may keep when cheaper than a split");
+    changed |= float_positive("C_trav", b.cost_traversal, 0.01f, "SAH cost of an inner-node visit");
+    changed |= float_positive("C_isect", b.cost_intersect, 0.01f, "SAH cost of a triangle test");
+    changed |= checkbox("EPO", b.compute_epo, "compute the effective primitive overlap (Aila 2013) after the build");
+  } else if (choice.name == "kdtree") {
+    KdTreeOptions& k = o.kdtree;
+    changed |= float_positive("C_trav", k.cost_traversal, 0.01f, nullptr);
+    changed |= float_positive("C_isect", k.cost_intersect, 0.01f, nullptr);
+    changed |= slider_int("Max depth", k.max_depth, 0, kKdMaxDepth, "0: automatic, 8 + 1.3 log2 N");
+    changed |= slider_int("Max leaf size", k.max_leaf_size, 1, 64, nullptr);
+    changed |= ImGui::SliderFloat("Empty bonus", &k.empty_bonus, 0.0f, 1.0f, "%.2f", ImGuiSliderFlags_AlwaysClamp);
+    changed |= checkbox("Perfect splits", k.perfect_splits, "clip triangles to the node box (Havran 2000)");
+    changed |= checkbox("Mailboxing", k.mailboxing, nullptr);
+  } else if (choice.name == "grid") {
+    GridOptions& g = o.grid;
+    bool automatic = g.resolution[0] == 0;
+    if (checkbox("Automatic resolution", automatic, "about lambda * N cells, shaped to the bounds")) {
+      g.resolution = automatic ? std::array<int, 3>{0, 0, 0} : std::array<int, 3>{16, 16, 16};
+      changed = true;
+    }
+    if (automatic) {
+      changed |= float_positive("Lambda", g.lambda, 0.05f, "cells per triangle");
+    } else {
+      int r[3] = {g.resolution[0], g.resolution[1], g.resolution[2]};
+      if (ImGui::InputInt3("Cells x,y,z", r)) {
+        for (int a = 0; a < 3; ++a) g.resolution[a] = std::clamp(r[a], 1, 4096);
+        changed = true;
+      }
+    }
+    changed |= checkbox("Exact overlap", g.exact_overlap, "reference a triangle only in cells it really overlaps");
+    changed |= checkbox("Mailboxing", g.mailboxing, nullptr);
+  } else if (choice.name == "octree") {
+    OctreeOptions& t = o.octree;
+    changed |= slider_int("Max depth", t.max_depth, 0, kOctreeMaxDepth, nullptr);
+    changed |= slider_int("Max leaf size", t.max_leaf_size, 1, 64, "cells with more triangles are split");
+    changed |= checkbox("Mailboxing", t.mailboxing, nullptr);
+    changed |= checkbox("Cost termination", t.cost_termination, "stop where the SAH rates the split no cheaper");
+  } else if (choice.name == "voxels") {
+    changed |= slider_int("Level", o.voxels.level, 0, kVoxelMaxLevel, "2^level voxels per axis");
+  } else if (choice.name == "embree") {
+    int q = static_cast<int>(o.embree.quality);
+    if (combo("Quality", q, {"low (Morton)", "medium (binned SAH)", "high (spatial splits)"})) {
+      o.embree.quality = static_cast<EmbreeQuality>(q);
+      changed = true;
+    }
+    changed |= checkbox("Robust", o.embree.robust, nullptr);
+  } else {
+    ImGui::TextDisabled("no build options");
+  }
+  if (choice.name != "brute" && choice.name != "brute-bbox") {
+    int threads = static_cast<int>(o.threads);
+    const int hw = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    if (slider_int("Threads", threads, 0, hw, "build threads; 0 = all hardware threads")) {
+      o.threads = static_cast<unsigned>(threads);
+      changed = true;
+    }
+  }
+
+  section("Query");
+  int test = choice.query.triangle_test == TriangleTest::watertight ? 0 : 1;
+  bool query_changed = ImGui::RadioButton("Watertight", &test, 0);
+  ImGui::SameLine();
+  query_changed |= ImGui::RadioButton("Fast (Moller-Trumbore)", &test, 1);
+  if (query_changed) choice.query.triangle_test = test == 0 ? TriangleTest::watertight : TriangleTest::moller_trumbore;
+  query_changed |= checkbox("Ordered traversal", choice.query.ordered, "front-to-back child order (off: fixed order)");
+  changed |= query_changed;
+
+  ImGui::Separator();
+  ImGui::TextWrapped("Shown: %s", progress.shown.empty() ? "(none yet)" : progress.shown.c_str());
+  if (progress.busy) {
+    ImGui::ProgressBar(static_cast<float>(progress.fraction), ImVec2(-80.0f * layout.scale, 0.0f),
+                       progress.stage.c_str());
+    ImGui::SameLine();
+    if (ImGui::Button("Cancel")) cancel = true;
+  }
+  ImGui::End();
+  return changed;
+}
+
+// ---- Stats ---------------------------------------------------------------------------------
+
+void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const PanelLayout& layout) {
+  place(layout, -328, 8, 320, 360);
+  if (!ImGui::Begin("Stats")) {
+    ImGui::End();
+    return;
+  }
+  if (!built) {
+    ImGui::TextDisabled("no structure yet");
+    ImGui::End();
+    return;
+  }
+  const BuildStats& b = built->accel->build_stats();
+  ImGui::Text("%s", built->accel->name().c_str());
+  if (ImGui::BeginTable("build", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV)) {
+    row("build ms", "%.2f", b.build_ms);
+    row("wall ms", "%.2f", built->wall_ms);
+    row("nodes", "%" PRIu64, b.node_count);
+    row("leaves", "%" PRIu64, b.leaf_count);
+    row("max depth", "%u", b.max_depth);
+    row("avg leaf depth", "%.2f", b.avg_leaf_depth);
+    row("memory", "%s", bytes_text(b.memory_bytes).c_str());
+    row("SAH cost", "%.4g", b.sah_cost);
+    if (const auto it = b.extra.find("epo"); it != b.extra.end()) row("EPO", "%.4g", it->second);
+    for (const auto& [k, v] : b.extra)
+      if (k != "epo") row(k.c_str(), "%.6g", v);
+    ImGui::EndTable();
+  }
+  section("Current view");
+  if (!view) {
+    ImGui::TextDisabled("tracing...");
+  } else {
+    const HeatmapSummary& s = view->summary;
+    if (ImGui::BeginTable("view", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV)) {
+      row("pixels", "%d x %d%s", view->image.width, view->image.height,
+          view->complete ? "" : (" (1 in " + std::to_string(view->stride * view->stride) + ")").c_str());
+      row("nodes / pixel", "mean %.2f, max %u", s.mean_nodes, s.max_nodes);
+      row("prim tests / pixel", "mean %.2f, max %u", s.mean_prims, s.max_prims);
+      row("hits", "%" PRIu64 " of %" PRIu64, s.hits, s.rays);
+      row("heatmap ms", "%.1f", s.render_ms);
+      row("rays / s", "%.3g", s.rays_per_s);
+      ImGui::EndTable();
+    }
+  }
+  ImGui::End();
+}
+
+// ---- View -----------------------------------------------------------------------------------
+
+bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout) {
+  bool changed = false;
+  place(layout, -328, 376, 320, 420);
+  if (!ImGui::Begin("View")) {
+    ImGui::End();
+    return false;
+  }
+  changed |= checkbox("Mesh", v.show_mesh);
+  ImGui::SameLine();
+  changed |= checkbox("Wireframe", v.show_wireframe);
+  ImGui::SameLine();
+  changed |= checkbox("Ray path", v.show_ray_path);
+
+  section("Node boxes");
+  changed |= checkbox("Boxes", v.show_boxes);
+  if (info.node_kind.empty()) {
+    ImGui::SameLine();
+    ImGui::TextDisabled("(this structure has none)");
+  }
+  int mode = static_cast<int>(v.box_mode);
+  if (combo("Show", mode, {"one depth", "depth range", "leaves", "selected subtree"})) {
+    v.box_mode = static_cast<BoxMode>(mode);
+    changed = true;
+  }
+  const int max_depth = static_cast<int>(info.max_depth);
+  switch (v.box_mode) {
+    case BoxMode::depth: changed |= slider_int("Depth", v.box_depth, 0, std::max(max_depth, 1)); break;
+    case BoxMode::depth_range:
+      changed |= slider_int("First depth", v.box_depth, 0, std::max(max_depth, 1));
+      changed |= slider_int("Last depth", v.box_depth_last, 0, std::max(max_depth, 1));
+      break;
+    case BoxMode::leaves: break;
+    case BoxMode::subtree: {
+      int node = v.box_node;
+      if (ImGui::InputInt("Node", &node)) {
+        v.box_node = std::clamp(node, 0, static_cast<int>(std::min<std::uint64_t>(
+                                             info.node_count > 0 ? info.node_count - 1 : 0, 0x7FFFFFFF)));
+        changed = true;
+      }
+      ImGui::TextDisabled("F frames it; the Ray panel's node ids work here");
+      break;
+    }
+  }
+  int color = static_cast<int>(v.box_color);
+  if (combo("Colour by", color, {"depth", "share of the SAH cost"})) {
+    v.box_color = static_cast<BoxColorBy>(color);
+    changed = true;
+  }
+  changed |= checkbox("Through mesh", v.boxes_through_mesh, "boxes are not hidden by the mesh");
+  if (!info.node_kind.empty())
+    ImGui::TextDisabled("%" PRIu64 " boxes drawn%s", info.boxes_drawn, info.boxes_truncated ? " (list cut)" : "");
+
+  section("Heatmap");
+  int display = static_cast<int>(v.heatmap);
+  bool hm = ImGui::RadioButton("Off", &display, 0);
+  ImGui::SameLine();
+  hm |= ImGui::RadioButton("Full", &display, 1);
+  ImGui::SameLine();
+  hm |= ImGui::RadioButton("Blend", &display, 2);
+  if (hm) {
+    v.heatmap = static_cast<HeatmapDisplay>(display);
+    changed = true;
+  }
+  int metric = static_cast<int>(v.metric);
+  if (combo("Metric", metric, {"nodes visited", "primitive tests", "cost", "shaded", "depth"})) {
+    v.metric = static_cast<HeatMetric>(metric);
+    changed = true;
+  }
+  int map = static_cast<int>(v.colormap);
+  if (combo("Colour map", map, {"viridis", "inferno", "turbo"})) {
+    v.colormap = static_cast<ColorMap>(map);
+    changed = true;
+  }
+  if (v.heatmap == HeatmapDisplay::blend)
+    changed |= ImGui::SliderFloat("Opacity", &v.opacity, 0.0f, 1.0f, "%.2f", ImGuiSliderFlags_AlwaysClamp);
+  bool locked = !v.auto_scale;
+  if (checkbox("Lock scale", locked, "keep the colour range fixed while the view changes")) {
+    v.auto_scale = !locked;
+    if (locked) {  // lock at what is shown now
+      v.scale_min = info.range_min;
+      v.scale_max = info.range_max;
+    }
+    changed = true;
+  }
+  if (locked) {
+    float r[2] = {v.scale_min, v.scale_max};
+    if (ImGui::DragFloat2("Range", r, 0.1f) && r[1] > r[0]) {
+      v.scale_min = r[0];
+      v.scale_max = r[1];
+      changed = true;
+    }
+  } else {
+    ImGui::TextDisabled("range %.4g .. %.4g (auto)", info.range_min, info.range_max);
+  }
+  changed |= checkbox("Legend", v.show_legend);
+
+  section("Quality");
+  int msaa_index = v.msaa >= 8 ? 3 : v.msaa >= 4 ? 2 : v.msaa >= 2 ? 1 : 0;
+  if (combo("MSAA", msaa_index, {"off", "2x", "4x", "8x"})) {
+    v.msaa = 1 << msaa_index;
+    changed = true;
+  }
+  ImGui::End();
+  return changed;
+}
+
+// ---- Ray ---------------------------------------------------------------------------------------
+
+std::optional<std::size_t> ray_panel(const RayInspection* ray, std::size_t step, const StructureNodes* nodes,
+                                     const PanelLayout& layout) {
+  std::optional<std::size_t> moved;
+  // Along the bottom edge, between the left and right columns.
+  ImGui::SetNextWindowSize(ImVec2(560 * layout.scale, 300 * layout.scale), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowPos(ImVec2(356 * layout.scale, layout.height - 308 * layout.scale), ImGuiCond_FirstUseEver);
+  if (!ImGui::Begin("Ray")) {
+    ImGui::End();
+    return moved;
+  }
+  if (!ray) {
+    ImGui::TextWrapped("Click the 3D view (without dragging) to cast that pixel's ray.");
+    ImGui::End();
+    return moved;
+  }
+  ImGui::Text("pixel %d, %d of %d x %d   structure %s", ray->x, ray->y, ray->width, ray->height,
+              ray->structure.c_str());
+  ImGui::Text("origin    %.5g, %.5g, %.5g", ray->ray.origin.x, ray->ray.origin.y, ray->ray.origin.z);
+  ImGui::Text("direction %.5g, %.5g, %.5g", ray->ray.direction.x, ray->ray.direction.y, ray->ray.direction.z);
+  if (ray->hit.valid())
+    ImGui::Text("hit prim %u at t = %.6g, barycentrics u = %.4f, v = %.4f", ray->hit.prim, ray->hit.t, ray->hit.u,
+                ray->hit.v);
+  else
+    ImGui::TextUnformatted("miss");
+  const RayStats& s = ray->stats;
+  ImGui::Text("nodes %u, box tests %u, prim tests %u, culled %u, missed %u, repeated %u, empty cells %u",
+              s.nodes_visited, s.box_tests, s.prim_tests, s.nodes_culled, s.nodes_missed, s.repeated_prim_tests,
+              s.empty_cells);
+  for (const ShadowRay& sh : ray->shadows)
+    ImGui::Text("shadow ray to light %zu%s%s: %s (nodes %u, prim tests %u)", sh.light, sh.light_name.empty() ? "" : " ",
+                sh.light_name.c_str(), sh.occluded ? "occluded" : "lit", sh.stats.nodes_visited, sh.stats.prim_tests);
+
+  const auto& steps = ray->trace.steps;
+  if (steps.empty()) {
+    ImGui::TextDisabled("no traversal steps (this structure keeps no trace)");
+    ImGui::End();
+    return moved;
+  }
+  section("Traversal");
+  const std::size_t last = steps.size() - 1;
+  if (ImGui::ArrowButton("##first", ImGuiDir_Left)) moved = 0;
+  ImGui::SameLine();
+  if (ImGui::Button("Prev") && step > 0) moved = step - 1;
+  ImGui::SameLine();
+  if (ImGui::Button("Next") && step < last) moved = step + 1;
+  ImGui::SameLine();
+  if (ImGui::ArrowButton("##last", ImGuiDir_Right)) moved = last;
+  ImGui::SameLine();
+  int s_i = static_cast<int>(step);
+  ImGui::SetNextItemWidth(-1.0f);
+  if (ImGui::SliderInt("##step", &s_i, 0, static_cast<int>(last), "step %d")) moved = static_cast<std::size_t>(s_i);
+
+  if (ImGui::BeginTable("steps", 5,
+                        ImGuiTableFlags_ScrollY | ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV |
+                            ImGuiTableFlags_SizingFixedFit)) {
+    ImGui::TableSetupScrollFreeze(0, 1);
+    ImGui::TableSetupColumn("#");
+    ImGui::TableSetupColumn("event");
+    ImGui::TableSetupColumn("id");
+    ImGui::TableSetupColumn("t entry / hit");
+    ImGui::TableSetupColumn("t exit / box");
+    ImGui::TableHeadersRow();
+    ImGuiListClipper clipper;
+    clipper.Begin(static_cast<int>(steps.size()));
+    while (clipper.Step())
+      for (int i = clipper.DisplayStart; i < clipper.DisplayEnd; ++i) {
+        const VisitStep& st = steps[static_cast<std::size_t>(i)];
+        ImGui::TableNextRow();
+        ImGui::TableSetColumnIndex(0);
+        char label[32];
+        std::snprintf(label, sizeof label, "%d", i);
+        if (ImGui::Selectable(label, static_cast<std::size_t>(i) == step, ImGuiSelectableFlags_SpanAllColumns))
+          moved = static_cast<std::size_t>(i);
+        ImGui::TableSetColumnIndex(1);
+        ImGui::TextUnformatted(step_kind_name(st.kind));
+        ImGui::TableSetColumnIndex(2);
+        ImGui::Text("%u", st.id);
+        ImGui::TableSetColumnIndex(3);
+        if (std::isfinite(st.t_entry))
+          ImGui::Text("%.5g", st.t_entry);
+        else
+          ImGui::TextDisabled("-");
+        ImGui::TableSetColumnIndex(4);
+        const bool box_step = st.kind == VisitStep::Kind::node_entered || st.kind == VisitStep::Kind::node_missed ||
+                              st.kind == VisitStep::Kind::node_culled;
+        if (box_step && std::isfinite(st.t_exit)) {
+          ImGui::Text("%.5g", st.t_exit);
+          if (nodes && ImGui::IsItemHovered())
+            if (const auto b = nodes->box(st.id))
+              ImGui::SetTooltip("box %.4g,%.4g,%.4g .. %.4g,%.4g,%.4g", b->lo.x, b->lo.y, b->lo.z, b->hi.x, b->hi.y,
+                                b->hi.z);
+        } else {
+          ImGui::TextDisabled("-");
+        }
+      }
+    // Keep the current step in view while stepping with the buttons/keys.
+    if (moved) ImGui::SetScrollY(static_cast<float>(*moved) * ImGui::GetTextLineHeightWithSpacing() -
+                                 ImGui::GetWindowHeight() * 0.4f);
+    ImGui::EndTable();
+  }
+  ImGui::End();
+  return moved;
+}
+
+// ---- Screenshot, help, status --------------------------------------------------------------------
+
+bool screenshot_panel(std::string& folder, const std::string& last_written, const PanelLayout& layout) {
+  place(layout, 8, 704, 340, 88);
+  bool pressed = false;
+  if (ImGui::Begin("Screenshot")) {
+    ImGui::SetNextItemWidth(-1.0f);
+    ImGui::InputTextWithHint("##folder", "folder", &folder);
+    pressed = ImGui::Button("Screenshot (F12)");
+    if (!last_written.empty()) {
+      ImGui::SameLine();
+      ImGui::TextDisabled("%s", last_written.c_str());
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", last_written.c_str());
+    }
+  }
+  ImGui::End();
+  return pressed;
+}
+
+void help_panel(bool& open, const PanelLayout& layout) {
+  if (!open) return;
+  ImGui::SetNextWindowPos(ImVec2(layout.width * 0.5f, layout.height * 0.5f), ImGuiCond_Appearing, ImVec2(0.5f, 0.5f));
+  ImGui::SetNextWindowSize(ImVec2(560 * layout.scale, 0), ImGuiCond_Appearing);
+  if (ImGui::Begin("Help", &open)) {
+    if (ImGui::BeginTable("keys", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV)) {
+      ImGui::TableSetupColumn("input", ImGuiTableColumnFlags_WidthFixed);
+      ImGui::TableSetupColumn("does");
+      ImGui::TableHeadersRow();
+      for (const Shortcut& s : shortcuts()) {
+        ImGui::TableNextRow();
+        ImGui::TableSetColumnIndex(0);
+        ImGui::TextUnformatted(s.keys.data(), s.keys.data() + s.keys.size());
+        ImGui::TableSetColumnIndex(1);
+        ImGui::TextUnformatted(s.action.data(), s.action.data() + s.action.size());
+      }
+      ImGui::EndTable();
+    }
+    ImGui::TextWrapped("Hovering the view with the heatmap on shows that pixel's figures. Panels keep the mouse "
+                       "and keyboard while they are hovered or focused. Documentation: docs/gui.md.");
+  }
+  ImGui::End();
+}
+
+void status_bar(const std::string& message, const std::string& error, const BuildProgress& progress,
+                bool heatmap_busy, const PanelLayout& layout) {
+  const float h = ImGui::GetFrameHeightWithSpacing() + 4.0f * layout.scale;
+  ImGui::SetNextWindowPos(ImVec2(0.0f, layout.height - h));
+  ImGui::SetNextWindowSize(ImVec2(layout.width, h));
+  ImGui::SetNextWindowBgAlpha(0.75f);
+  const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove |
+                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
+                                 ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoBringToFrontOnFocus;
+  if (ImGui::Begin("##status", nullptr, flags)) {
+    if (progress.busy) {
+      ImGui::ProgressBar(static_cast<float>(progress.fraction), ImVec2(160.0f * layout.scale, 0.0f),
+                         progress.stage.c_str());
+      ImGui::SameLine();
+    }
+    if (!error.empty())
+      ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.35f, 1.0f), "%s", error.c_str());
+    else
+      ImGui::TextUnformatted(message.c_str());
+    if (heatmap_busy) {
+      ImGui::SameLine();
+      ImGui::TextDisabled("  (refining heatmap)");
+    }
+  }
+  ImGui::End();
+}
+
+void pixel_tooltip(int x, int y, const PixelFigures& p, HeatMetric metric, bool exact) {
+  ImGui::BeginTooltip();
+  ImGui::Text("pixel %d, %d%s", x, y, exact ? "" : " (coarse)");
+  if (std::isnan(p.value))
+    ImGui::Text("%s: no value", std::string(metric_name(metric)).c_str());
+  else
+    ImGui::Text("%s: %.4g", std::string(metric_name(metric)).c_str(), p.value);
+  ImGui::Text("nodes visited %u, prim tests %u", p.nodes, p.prims);
+  if (p.prim != kInvalidId)
+    ImGui::Text("hit prim %u at t = %.5g", p.prim, p.t);
+  else
+    ImGui::TextUnformatted("miss");
+  ImGui::EndTooltip();
+}
+
+}  // namespace accelviz::panels

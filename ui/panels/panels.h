@@ -1,0 +1,87 @@
+#pragma once
+// The app's ImGui panels: thin free functions over explicit state. Each one
+// draws its window and reports what the user changed (a bool "changed", or
+// an action value); none of them builds, loads, traces or touches GL; the
+// main loop (app/gui/) carries the actions out through AppState.
+#include "core/scene/scene.h"
+#include "ui/app/app_config.h"
+#include "ui/app/build_worker.h"
+#include "ui/app/heatmap_worker.h"
+#include "ui/app/ray_inspection.h"
+#include "ui/app/settings.h"
+#include "ui/app/structure_nodes.h"
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace accelviz::panels {
+
+/// Where panels start on first use (later the user's layout from imgui.ini wins).
+struct PanelLayout {
+  float scale = 1.0f;  ///< HiDPI content scale
+  float width = 1280.0f, height = 800.0f;  ///< window size in ImGui units
+};
+
+// ---- Scene ----------------------------------------------------------------------
+struct SceneAction {
+  std::optional<std::string> open;  ///< a scene to open (path field, built-in list, recent files)
+  std::optional<int> camera;        ///< a scene camera chosen
+  bool reset_view = false;
+};
+/// Path field with Open, the built-in scenes, recent files, and what the
+/// shown scene holds (triangles, lights, its cameras).
+SceneAction scene_panel(std::string& path_field, const std::vector<std::string>& recent, const Scene* scene,
+                        const std::string& shown_spec, int active_camera, const PanelLayout& layout);
+
+// ---- Structure --------------------------------------------------------------------
+struct BuildProgress {
+  bool busy = false;
+  double fraction = 0.0;
+  std::string stage;
+  std::string shown;  ///< describe_structure() of the structure shown now
+};
+/// Type (every name the factory builds), every option of the chosen type,
+/// the query choices, and the background build's progress with Cancel.
+/// Returns true when `choice` changed; `cancel` is set when Cancel was pressed.
+bool structure_panel(StructureChoice& choice, const BuildProgress& progress, bool& cancel, const PanelLayout& layout);
+
+// ---- Stats ---------------------------------------------------------------------------
+/// Build figures (BuildStats with its extras) of the structure shown, and
+/// the current view's per-pixel figures from the heatmap pass.
+void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const PanelLayout& layout);
+
+// ---- View ------------------------------------------------------------------------------
+struct ViewInfo {
+  std::string node_kind;         ///< StructureNodes::kind() ("" when the structure has none)
+  std::uint32_t max_depth = 0;
+  std::uint64_t node_count = 0;
+  std::uint64_t boxes_drawn = 0;
+  bool boxes_truncated = false;
+  float range_min = 0.0f, range_max = 1.0f;  ///< the heatmap range in use
+};
+/// Every renderer layer: mesh, wireframe, node boxes (selection, colouring),
+/// heatmap (display, metric, colour map, scale, opacity, legend), ray path,
+/// multisampling. Returns true when `view` changed.
+bool view_panel(ViewSettings& view, const ViewInfo& info, const PanelLayout& layout);
+
+// ---- Ray -------------------------------------------------------------------------------
+/// Origin, direction, hit, barycentrics, counters, shadow rays, and the
+/// traversal as a list with step-through replay. Returns the replay step
+/// the user moved to, if any.
+std::optional<std::size_t> ray_panel(const RayInspection* ray, std::size_t step, const StructureNodes* nodes,
+                                     const PanelLayout& layout);
+
+// ---- Screenshot, help, status ---------------------------------------------------------------
+/// Folder field, the Screenshot button and the last file written. True when pressed.
+bool screenshot_panel(std::string& folder, const std::string& last_written, const PanelLayout& layout);
+/// Every shortcut (ui/app/shortcuts.h).
+void help_panel(bool& open, const PanelLayout& layout);
+/// One line at the bottom: the error (red) or message, and the build's progress.
+void status_bar(const std::string& message, const std::string& error, const BuildProgress& progress,
+                bool heatmap_busy, const PanelLayout& layout);
+/// The figures of one heatmap pixel, as a tooltip at the mouse.
+void pixel_tooltip(int x, int y, const PixelFigures& p, HeatMetric metric, bool exact);
+
+}  // namespace accelviz::panels
