@@ -39,7 +39,12 @@ std::optional<bool> to_bool(std::string_view s) {
   return std::nullopt;
 }
 
-std::string quoted(std::string_view v) { return "'" + std::string(v) + "'"; }
+std::string quoted(std::string_view v) {
+  std::string q(1, '\'');
+  q += v;
+  q += '\'';
+  return q;
+}
 
 const char* on_off(bool b) { return b ? "on" : "off"; }
 

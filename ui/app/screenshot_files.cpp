@@ -93,7 +93,11 @@ std::string screenshot_timestamp(std::time_t t) {
 
 ScreenshotPaths unique_screenshot_paths(const fs::path& dir, const std::string& stamp) {
   for (int k = 1;; ++k) {
-    const std::string stem = "accelviz-" + stamp + (k == 1 ? "" : "-" + std::to_string(k));
+    std::string stem = "accelviz-" + stamp;
+    if (k > 1) {
+      stem += '-';
+      stem += std::to_string(k);
+    }
     ScreenshotPaths p{dir / (stem + ".png"), dir / (stem + ".json")};
     std::error_code ec;
     if (!fs::exists(p.png, ec) && !fs::exists(p.json, ec)) return p;

@@ -118,7 +118,11 @@ std::string write_file_atomic(const std::filesystem::path& file, std::string_vie
   if (ec) return dir.string() + ": " + ec.message();
   // Same folder as the target, so rename() stays within one file system and
   // is atomic; the pid keeps two running instances from sharing a name.
-  const fs::path tmp = dir / ("." + file.filename().string() + ".tmp-" + std::to_string(::getpid()));
+  std::string tmp_name = ".";
+  tmp_name += file.filename().string();
+  tmp_name += ".tmp-";
+  tmp_name += std::to_string(::getpid());
+  const fs::path tmp = dir / tmp_name;
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) return tmp.string() + ": " + std::strerror(errno);
   const char* p = content.data();
