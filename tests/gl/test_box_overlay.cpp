@@ -78,8 +78,8 @@ class BoxOverlay : public GlTest {
       for (float t = 0.05f; t <= 0.951f; t += 0.05f) {
         const glm::vec2 p = glm::mix(px[a], px[b], t);
         if (p.x < 1 || p.y < 1 || p.x > kWidth - 1 || p.y > kHeight - 1) continue;
-        EXPECT_TRUE(neighbourhood_has(img, p, line)) << "no line pixel near (" << p.x << "," << p.y << ") on edge "
-                                                     << a << "-" << b;
+        EXPECT_TRUE(neighbourhood_has(img, p, line))
+            << "no line pixel near (" << p.x << "," << p.y << ") on edge " << a << "-" << b;
       }
     }
     // Every pixel away from the edges, inside or outside the box's outline, is background.

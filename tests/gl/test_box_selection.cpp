@@ -84,7 +84,9 @@ TEST(BoxSelection, EmptyArraySelectsNothing) {
   EXPECT_EQ(bvh_max_depth({}), 0u);
 }
 
-TEST(BoxSelection, MaxDepth) { EXPECT_EQ(bvh_max_depth(sample_tree()), 3u); }
+TEST(BoxSelection, MaxDepth) {
+  EXPECT_EQ(bvh_max_depth(sample_tree()), 3u);
+}
 
 TEST(BoxSelection, ChildOutOfRangeIsReported) {
   auto tree = sample_tree();

@@ -47,8 +47,8 @@ TEST(CameraView, ProjectedPixelIsThePixelWhoseRayPassesThroughThePoint) {
     for (int i = 0; i < 200; ++i) {
       const int x = px(rng), y = py(rng);
       // A point on the ray through pixel (x, y)'s centre...
-      const glm::vec3 p = c.camera.position + depth(rng) * cpu_ray_direction(c.camera, x + 0.5f, y + 0.5f, c.width,
-                                                                                c.height);
+      const glm::vec3 p =
+          c.camera.position + depth(rng) * cpu_ray_direction(c.camera, x + 0.5f, y + 0.5f, c.width, c.height);
       // ...projects back onto that centre through the GL matrices.
       const std::optional<glm::vec2> q = project_to_pixel(m, p);
       ASSERT_TRUE(q.has_value());

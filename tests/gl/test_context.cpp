@@ -36,7 +36,9 @@ TEST(OsMesaContext, ComputeShadersAreAvailable) {
   EXPECT_GE(max_invocations, 1024);  // the minimum 4.3+ guarantees
 }
 
-TEST(OsMesaContext, RejectsAnEmptyImageSize) { EXPECT_THROW(OsMesaContext(0, 10), GlError); }
+TEST(OsMesaContext, RejectsAnEmptyImageSize) {
+  EXPECT_THROW(OsMesaContext(0, 10), GlError);
+}
 
 TEST(OsMesaContext, TwoContextsTakeTurns) {
   // GL objects belong to their context: each renderer is used and destroyed
@@ -103,8 +105,8 @@ TEST(Linking, NoLibGLIsLoadedForHeadlessRendering) {
 }
 
 TEST(ShaderLog, ParsesMesaLines) {
-  const auto d = parse_shader_log(
-      "0:12(5): error: syntax error, unexpected IDENTIFIER\n0:3(1): warning: unused variable\n");
+  const auto d =
+      parse_shader_log("0:12(5): error: syntax error, unexpected IDENTIFIER\n0:3(1): warning: unused variable\n");
   ASSERT_EQ(d.size(), 2u);
   EXPECT_EQ(d[0].line, 12);
   EXPECT_EQ(d[0].column, 5);

@@ -170,8 +170,8 @@ TEST_F(Golden, RayInspectorWithSplitPlane) {
   path.visited = {scene_.nodes[0].bounds, scene_.nodes[2].bounds, scene_.nodes[3].bounds, scene_.nodes[5].bounds};
   path.highlighted = {hit.prim};
   renderer_->set_ray_path(path);
-  const TranslucentQuad plane = split_plane_quad(scene_.nodes[0].bounds, 0, 0.0f, {0.3f, 0.6f, 1.0f, 0.25f},
-                                                 {0.3f, 0.6f, 1.0f, 0.8f});
+  const TranslucentQuad plane =
+      split_plane_quad(scene_.nodes[0].bounds, 0, 0.0f, {0.3f, 0.6f, 1.0f, 0.25f}, {0.3f, 0.6f, 1.0f, 0.8f});
   renderer_->set_quads(std::span(&plane, 1));
   RenderView view;
   view.camera = scene_.camera;

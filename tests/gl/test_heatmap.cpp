@@ -90,9 +90,9 @@ TEST_F(Heatmap, FixedRangeClampsAndNanShowsTheBackground) {
   view.heatmap.range_max = 50.0f;
   const Rgba8Image img = draw(view);
   auto want = [&](float v) { return to_rgba8(colormap(ColorMap::viridis, (v - 10.0f) / 40.0f)); };
-  EXPECT_LE(channel_diff(img.at(2, 0), want(10.0f)), kTolerance);      // below the range: first colour
-  EXPECT_LE(channel_diff(img.at(120, 50), want(50.0f)), kTolerance);   // above: last colour
-  EXPECT_LE(channel_diff(img.at(30, 0), want(30.0f)), kTolerance);     // inside
+  EXPECT_LE(channel_diff(img.at(2, 0), want(10.0f)), kTolerance);     // below the range: first colour
+  EXPECT_LE(channel_diff(img.at(120, 50), want(50.0f)), kTolerance);  // above: last colour
+  EXPECT_LE(channel_diff(img.at(30, 0), want(30.0f)), kTolerance);    // inside
   EXPECT_EQ(img.at(20, 10), to_rgba8(view.background));               // no value
 }
 

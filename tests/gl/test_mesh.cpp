@@ -33,7 +33,8 @@ TEST_F(MeshPassTest, HeadlightFlatShadingFollowsTheGeometricNormal) {
   const float a = 50.0f * 3.14159265f / 180.0f;
   const glm::vec3 n(std::sin(a), 0.0f, std::cos(a));
   const glm::vec3 u(std::cos(a), 0.0f, -std::sin(a)), v(0.0f, 1.0f, 0.0f);
-  const glm::vec3 c0 = -3.0f * u - 3.0f * v, c1 = 3.0f * u - 3.0f * v, c2 = 3.0f * u + 3.0f * v, c3 = -3.0f * u + 3.0f * v;
+  const glm::vec3 c0 = -3.0f * u - 3.0f * v, c1 = 3.0f * u - 3.0f * v, c2 = 3.0f * u + 3.0f * v,
+                  c3 = -3.0f * u + 3.0f * v;
   const std::vector<Triangle> wall = {{c0, c1, c2}, {c0, c2, c3}};
   renderer_->set_triangles(wall);
   RenderView view;
@@ -46,8 +47,8 @@ TEST_F(MeshPassTest, HeadlightFlatShadingFollowsTheGeometricNormal) {
     if (std::abs(glm::dot(p, u)) > 2.9f || std::abs(p.y) > 2.9f) continue;  // off the wall
     ++checked;
     const glm::u8vec4 want = to_rgba8(headlight(view.mesh_color, n, p, view.camera.position));
-    EXPECT_LE(channel_diff(img.at(x, y), want), kTolerance) << x << "," << y << ": " << describe(img.at(x, y))
-                                                            << " want " << describe(want);
+    EXPECT_LE(channel_diff(img.at(x, y), want), kTolerance)
+        << x << "," << y << ": " << describe(img.at(x, y)) << " want " << describe(want);
   }
   EXPECT_GE(checked, 4);
 }
@@ -84,10 +85,10 @@ TEST_F(MeshPassTest, WireframeDrawsTheTriangleEdges) {
         if (pixel_at(img, p + glm::vec2(dx, dy)) == red) return true;
     return false;
   };
-  EXPECT_TRUE(near_red({0.0f, 0.0f, 0.0f}));    // the shared diagonal
+  EXPECT_TRUE(near_red({0.0f, 0.0f, 0.0f}));  // the shared diagonal
   EXPECT_TRUE(near_red({0.75f, 0.5f, 0.0f}));
-  EXPECT_TRUE(near_red({1.5f, 0.0f, 0.0f}));    // the right border
-  EXPECT_TRUE(near_red({0.0f, -1.0f, 0.0f}));   // the bottom border
+  EXPECT_TRUE(near_red({1.5f, 0.0f, 0.0f}));   // the right border
+  EXPECT_TRUE(near_red({0.0f, -1.0f, 0.0f}));  // the bottom border
   // Inside a triangle, away from the edges: shaded, not red.
   const glm::vec2 inside = *project_to_pixel(m, {0.8f, -0.5f, 0.0f});
   EXPECT_GT(channel_diff(pixel_at(img, inside), red), 100);

@@ -25,7 +25,9 @@ bool inside(glm::vec2 p, int margin = 2) {
   return p.x >= margin && p.y >= margin && p.x < kWidth - margin && p.y < kHeight - margin;
 }
 
-glm::u8vec4 rgb(const glm::vec4& c) { return to_rgba8(glm::vec3(c)); }
+glm::u8vec4 rgb(const glm::vec4& c) {
+  return to_rgba8(glm::vec3(c));
+}
 
 class RayPathTest : public GlTest {
  protected:

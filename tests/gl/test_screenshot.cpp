@@ -64,7 +64,8 @@ TEST_F(Screenshot, PngRoundTripKeepsEveryPixel) {
   ASSERT_EQ(back.height, kHeight);
   EXPECT_TRUE(back.pixels == frame.pixels) << "PNG differs from the frame read back";
   // Row 0 of the file is the top of the picture: the legend panel is at the top right.
-  const LegendLayout legend = renderer_->legend_layout(RenderView{.heatmap = {.mode = HeatmapMode::blend}}, kWidth, kHeight);
+  const LegendLayout legend =
+      renderer_->legend_layout(RenderView{.heatmap = {.mode = HeatmapMode::blend}}, kWidth, kHeight);
   ASSERT_TRUE(legend.visible);
   EXPECT_LT(legend.panel.y0, kHeight / 4);
   EXPECT_EQ(back.at(legend.bar.x0 + 2, legend.bar.y0), frame.at(legend.bar.x0 + 2, legend.bar.y0));
@@ -92,9 +93,7 @@ TEST_F(Screenshot, RefusesToOverwriteUnlessAsked) {
   const Rgba8Image frame = busy_frame();
   TempDir dir("screenshot");
   const auto path = dir.path() / "frame.png";
-  {
-    std::ofstream(path) << "precious";
-  }
+  { std::ofstream(path) << "precious"; }
   const SaveResult refused = write_screenshot_png(path, frame);
   EXPECT_FALSE(refused);
   EXPECT_EQ(refused.error, path.string() + ": exists (not overwritten)");

@@ -91,7 +91,8 @@ TEST_F(ShaderErrors, UnknownShaderIsReported) {
 }
 
 TEST_F(ShaderErrors, OverrideDirectoryWinsOnlyForFilesItHas) {
-  write_file(dir_.path() / "color.frag", "#version 450 core\nout vec4 frag_color;\nvoid main() { frag_color = vec4(1); }\n");
+  write_file(dir_.path() / "color.frag",
+             "#version 450 core\nout vec4 frag_color;\nvoid main() { frag_color = vec4(1); }\n");
   ShaderDirOverride env(dir_.path());
   EXPECT_EQ(load_shader_source("color.frag").path, (dir_.path() / "color.frag").string());
   EXPECT_EQ(load_shader_source("mesh.vert").path, "shaders/mesh.vert");

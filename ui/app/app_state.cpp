@@ -214,6 +214,7 @@ std::string AppState::cast_ray(int x, int y) {
            "x" + std::to_string(view_h_) + " view";
   inspection_ = inspect_pixel(*current_, camera(), x, y, view_w_, view_h_, config().structure.query);
   inspected_query_ = config().structure.query;
+  ++inspection_version_;
   replay_step_ = inspection_->trace.steps.empty() ? 0 : inspection_->trace.steps.size() - 1;
   return {};
 }
@@ -222,6 +223,7 @@ void AppState::recast() {
   if (!inspection_ || !current_) return;
   inspection_ = inspect_ray(*current_, *inspection_, config().structure.query);
   inspected_query_ = config().structure.query;
+  ++inspection_version_;
   replay_step_ = inspection_->trace.steps.empty() ? 0 : inspection_->trace.steps.size() - 1;
 }
 
@@ -232,6 +234,7 @@ void AppState::set_replay_step(std::size_t step) {
 }
 
 void AppState::clear_inspection() {
+  if (inspection_) ++inspection_version_;
   inspection_.reset();
   replay_step_ = 0;
 }

@@ -94,6 +94,8 @@ class AppState {
   /// Casts pixel (x, y) of the current view; "" or an error message.
   std::string cast_ray(int x, int y);
   const std::optional<RayInspection>& inspection() const { return inspection_; }
+  /// Changes whenever the inspection is cast, re-cast or cleared (for redraws).
+  std::uint64_t inspection_version() const { return inspection_version_; }
   std::size_t replay_step() const { return replay_step_; }
   /// Moves the replay to `step` (clamped to the trace).
   void set_replay_step(std::size_t step);
@@ -141,6 +143,7 @@ class AppState {
   std::optional<RayInspection> inspection_;
   QueryOptions inspected_query_;  ///< the query options inspection_ was cast with
   std::size_t replay_step_ = 0;
+  std::uint64_t inspection_version_ = 0;
 
   std::string error_, message_;
   std::vector<std::string> new_errors_;

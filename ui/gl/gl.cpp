@@ -8,15 +8,24 @@ namespace accelviz {
 
 std::string_view gl_error_name(GLenum error) {
   switch (error) {
-    case GL_NO_ERROR: return "GL_NO_ERROR";
-    case GL_INVALID_ENUM: return "GL_INVALID_ENUM";
-    case GL_INVALID_VALUE: return "GL_INVALID_VALUE";
-    case GL_INVALID_OPERATION: return "GL_INVALID_OPERATION";
-    case GL_INVALID_FRAMEBUFFER_OPERATION: return "GL_INVALID_FRAMEBUFFER_OPERATION";
-    case GL_OUT_OF_MEMORY: return "GL_OUT_OF_MEMORY";
-    case GL_STACK_UNDERFLOW: return "GL_STACK_UNDERFLOW";
-    case GL_STACK_OVERFLOW: return "GL_STACK_OVERFLOW";
-    default: return "GL_UNKNOWN_ERROR";
+    case GL_NO_ERROR:
+      return "GL_NO_ERROR";
+    case GL_INVALID_ENUM:
+      return "GL_INVALID_ENUM";
+    case GL_INVALID_VALUE:
+      return "GL_INVALID_VALUE";
+    case GL_INVALID_OPERATION:
+      return "GL_INVALID_OPERATION";
+    case GL_INVALID_FRAMEBUFFER_OPERATION:
+      return "GL_INVALID_FRAMEBUFFER_OPERATION";
+    case GL_OUT_OF_MEMORY:
+      return "GL_OUT_OF_MEMORY";
+    case GL_STACK_UNDERFLOW:
+      return "GL_STACK_UNDERFLOW";
+    case GL_STACK_OVERFLOW:
+      return "GL_STACK_OVERFLOW";
+    default:
+      return "GL_UNKNOWN_ERROR";
   }
 }
 
@@ -64,12 +73,18 @@ namespace {
 
 const char* debug_source_name(GLenum source) {
   switch (source) {
-    case GL_DEBUG_SOURCE_API: return "api";
-    case GL_DEBUG_SOURCE_SHADER_COMPILER: return "shader compiler";
-    case GL_DEBUG_SOURCE_WINDOW_SYSTEM: return "window system";
-    case GL_DEBUG_SOURCE_THIRD_PARTY: return "third party";
-    case GL_DEBUG_SOURCE_APPLICATION: return "application";
-    default: return "other";
+    case GL_DEBUG_SOURCE_API:
+      return "api";
+    case GL_DEBUG_SOURCE_SHADER_COMPILER:
+      return "shader compiler";
+    case GL_DEBUG_SOURCE_WINDOW_SYSTEM:
+      return "window system";
+    case GL_DEBUG_SOURCE_THIRD_PARTY:
+      return "third party";
+    case GL_DEBUG_SOURCE_APPLICATION:
+      return "application";
+    default:
+      return "other";
   }
 }
 

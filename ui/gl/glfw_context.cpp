@@ -12,7 +12,9 @@ namespace {
 int g_glfw_users = 0;
 std::string g_last_glfw_error;
 
-void record_glfw_error(int /*code*/, const char* description) { g_last_glfw_error = description ? description : ""; }
+void record_glfw_error(int /*code*/, const char* description) {
+  g_last_glfw_error = description ? description : "";
+}
 
 void acquire_glfw() {
   if (g_glfw_users == 0) {
@@ -76,9 +78,13 @@ int GlfwContext::height() const {
   return h;
 }
 
-void GlfwContext::swap_buffers() { glfwSwapBuffers(window_); }
+void GlfwContext::swap_buffers() {
+  glfwSwapBuffers(window_);
+}
 
-bool GlfwContext::should_close() const { return glfwWindowShouldClose(window_) != 0; }
+bool GlfwContext::should_close() const {
+  return glfwWindowShouldClose(window_) != 0;
+}
 
 void GlfwContext::make_native_current(bool after_other_kind) {
   // Mesa's glXMakeCurrent returns early when asked for the context it

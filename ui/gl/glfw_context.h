@@ -10,11 +10,11 @@ struct GLFWwindow;
 namespace accelviz {
 
 struct WindowOptions {
-  int width = 1280;                ///< initial size in screen coordinates
+  int width = 1280;  ///< initial size in screen coordinates
   int height = 800;
   std::string title = "accelviz";
-  bool visible = true;             ///< false: an offscreen window (still needs a display)
-  bool vsync = true;               ///< swap interval 1
+  bool visible = true;  ///< false: an offscreen window (still needs a display)
+  bool vsync = true;    ///< swap interval 1
 };
 
 class GlfwContext final : public GlContext {

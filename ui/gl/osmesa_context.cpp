@@ -14,7 +14,9 @@
 // program shows the same), which LeakSanitizer reports at exit. The
 // suppression names the library, so leaks in our code are still reported.
 // Sanitizer builds only: it is the hook LSan looks up by this name.
-extern "C" const char* __lsan_default_suppressions() { return "leak:libOSMesa.so\n"; }
+extern "C" const char* __lsan_default_suppressions() {
+  return "leak:libOSMesa.so\n";
+}
 #endif
 
 namespace accelviz {
@@ -22,12 +24,18 @@ namespace accelviz {
 OsMesaContext::OsMesaContext(int width, int height) : width_(width), height_(height) {
   if (width <= 0 || height <= 0) throw GlError("OSMesa context: image size must be positive");
   const int attribs[] = {
-      OSMESA_FORMAT, OSMESA_RGBA,
-      OSMESA_DEPTH_BITS, 24,
-      OSMESA_STENCIL_BITS, 8,
-      OSMESA_PROFILE, OSMESA_CORE_PROFILE,
-      OSMESA_CONTEXT_MAJOR_VERSION, 4,
-      OSMESA_CONTEXT_MINOR_VERSION, 5,
+      OSMESA_FORMAT,
+      OSMESA_RGBA,
+      OSMESA_DEPTH_BITS,
+      24,
+      OSMESA_STENCIL_BITS,
+      8,
+      OSMESA_PROFILE,
+      OSMESA_CORE_PROFILE,
+      OSMESA_CONTEXT_MAJOR_VERSION,
+      4,
+      OSMESA_CONTEXT_MINOR_VERSION,
+      5,
       0,
   };
   context_ = OSMesaCreateContextAttribs(attribs, nullptr);

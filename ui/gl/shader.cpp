@@ -197,7 +197,9 @@ ShaderProgram& ShaderProgram::operator=(ShaderProgram&& o) noexcept {
   return *this;
 }
 
-void ShaderProgram::set(const char* name, int v) const { glProgramUniform1i(id_, glGetUniformLocation(id_, name), v); }
+void ShaderProgram::set(const char* name, int v) const {
+  glProgramUniform1i(id_, glGetUniformLocation(id_, name), v);
+}
 void ShaderProgram::set(const char* name, float v) const {
   glProgramUniform1f(id_, glGetUniformLocation(id_, name), v);
 }

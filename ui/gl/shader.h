@@ -57,8 +57,8 @@ class ShaderError : public std::runtime_error {
 
 /// One message of a driver info log.
 struct ShaderDiagnostic {
-  int line = 0;    ///< 1-based line in the shader file; 0 when unknown
-  int column = 0;  ///< 1-based column; 0 when unknown
+  int line = 0;         ///< 1-based line in the shader file; 0 when unknown
+  int column = 0;       ///< 1-based column; 0 when unknown
   std::string message;  ///< "error: syntax error, unexpected ..." as the driver wrote it
 };
 /// Parses an info log: Mesa writes "0:LINE(COL): error: ...", NVIDIA

@@ -528,12 +528,14 @@ std::optional<std::size_t> ray_panel(const RayInspection* ray, std::size_t step,
 
 // ---- Screenshot, help, status --------------------------------------------------------------------
 
-bool screenshot_panel(std::string& folder, const std::string& last_written, const PanelLayout& layout) {
+bool screenshot_panel(std::string& folder, const std::string& default_folder, const std::string& last_written,
+                      const PanelLayout& layout) {
   place(layout, 8, 704, 340, 88);
   bool pressed = false;
   if (ImGui::Begin("Screenshot")) {
     ImGui::SetNextItemWidth(-1.0f);
-    ImGui::InputTextWithHint("##folder", "folder", &folder);
+    ImGui::InputTextWithHint("##folder", default_folder.c_str(), &folder);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("folder for screenshots (empty: %s)", default_folder.c_str());
     pressed = ImGui::Button("Screenshot (F12)");
     if (!last_written.empty()) {
       ImGui::SameLine();

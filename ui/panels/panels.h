@@ -75,7 +75,9 @@ std::optional<std::size_t> ray_panel(const RayInspection* ray, std::size_t step,
 
 // ---- Screenshot, help, status ---------------------------------------------------------------
 /// Folder field, the Screenshot button and the last file written. True when pressed.
-bool screenshot_panel(std::string& folder, const std::string& last_written, const PanelLayout& layout);
+/// `folder` "" means `default_folder`.
+bool screenshot_panel(std::string& folder, const std::string& default_folder, const std::string& last_written,
+                      const PanelLayout& layout);
 /// Every shortcut (ui/app/shortcuts.h).
 void help_panel(bool& open, const PanelLayout& layout);
 /// One line at the bottom: the error (red) or message, and the build's progress.

@@ -55,10 +55,18 @@ std::vector<SelectedBox> select_bvh_boxes(std::span<const BvhNode> nodes, const 
     const BvhNode& n = nodes[i];
     bool take = false;
     switch (sel.mode) {
-      case BoxSelection::Mode::depth: take = depth == sel.depth; break;
-      case BoxSelection::Mode::depth_range: take = depth >= sel.depth && depth <= sel.depth_last; break;
-      case BoxSelection::Mode::leaves: take = n.count > 0; break;
-      case BoxSelection::Mode::subtree: take = in_subtree; break;
+      case BoxSelection::Mode::depth:
+        take = depth == sel.depth;
+        break;
+      case BoxSelection::Mode::depth_range:
+        take = depth >= sel.depth && depth <= sel.depth_last;
+        break;
+      case BoxSelection::Mode::leaves:
+        take = n.count > 0;
+        break;
+      case BoxSelection::Mode::subtree:
+        take = in_subtree;
+        break;
     }
     if (take) out.push_back({n.bounds, i, depth, n.count > 0});
   });
@@ -93,11 +101,14 @@ std::vector<ColoredBox> color_boxes(std::span<const SelectedBox> boxes, const Bo
   for (const SelectedBox& b : boxes) {
     glm::vec3 c = coloring.color;
     switch (coloring.kind) {
-      case BoxColoring::Kind::depth_qualitative: c = qualitative_color(b.depth); break;
+      case BoxColoring::Kind::depth_qualitative:
+        c = qualitative_color(b.depth);
+        break;
       case BoxColoring::Kind::depth_sequential:
         c = colormap(coloring.map, hi > lo ? static_cast<float>(b.depth - lo) / static_cast<float>(hi - lo) : 0.0f);
         break;
-      case BoxColoring::Kind::uniform: break;
+      case BoxColoring::Kind::uniform:
+        break;
     }
     out.push_back({b.bounds, glm::vec4(c, coloring.alpha)});
   }

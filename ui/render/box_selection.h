@@ -62,7 +62,7 @@ struct BoxColoring {
     uniform,            ///< `color` for every box
   };
   Kind kind = Kind::depth_qualitative;
-  ColorMap map = ColorMap::viridis;  ///< depth_sequential
+  ColorMap map = ColorMap::viridis;   ///< depth_sequential
   glm::vec3 color{1.0f, 0.8f, 0.2f};  ///< uniform
   float alpha = 1.0f;                 ///< every box's opacity
 };

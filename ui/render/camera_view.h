@@ -24,7 +24,7 @@ struct CameraMatrices {
   glm::mat4 projection{1.0f};
   glm::mat4 view_projection{1.0f};
   glm::vec3 eye{0.0f};
-  int width = 0;   ///< image size the projection was made for
+  int width = 0;  ///< image size the projection was made for
   int height = 0;
 };
 

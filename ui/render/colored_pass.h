@@ -13,7 +13,7 @@
 namespace accelviz {
 
 struct ColoredGeometry {
-  std::vector<ColoredVertex> lines;      ///< pairs
+  std::vector<ColoredVertex> lines;  ///< pairs
   std::vector<ColoredVertex> points;
   std::vector<ColoredVertex> triangles;  ///< triples
 

@@ -44,7 +44,9 @@ void HeatmapPass::set_lut(std::span<const glm::vec3> lut) {
   check_gl_errors("colour-map upload");
 }
 
-GLuint HeatmapPass::lut_texture() const { return metric_ == HeatMetric::shaded ? grey_lut_.id() : lut_.id(); }
+GLuint HeatmapPass::lut_texture() const {
+  return metric_ == HeatMetric::shaded ? grey_lut_.id() : lut_.id();
+}
 
 void HeatmapPass::upload(const MetricImage& image) {
   if (image.width <= 0 || image.height <= 0 ||

@@ -30,7 +30,7 @@ struct LegendLayout {
   bool visible = false;  ///< false when the viewport is too small for it
   int scale = 1;         ///< glyph scale: 2 when the image is at least 480 pixels wide or tall
   Rect panel;
-  Rect bar;              ///< bottom row shows the range's low end, top row the high end
+  Rect bar;  ///< bottom row shows the range's low end, top row the high end
   std::vector<Rect> ticks;
   std::vector<Label> labels;  ///< title first, then the tick numbers from low to high
 };
@@ -41,8 +41,7 @@ LegendLayout layout_legend(int width, int height, const glm::vec2& range, std::s
 class LegendPass {
  public:
   LegendPass();
-  void draw(const ShaderProgram& program, const LegendLayout& layout, GLuint lut_texture, int width,
-            int height) const;
+  void draw(const ShaderProgram& program, const LegendLayout& layout, GLuint lut_texture, int width, int height) const;
 
  private:
   GlObject vao_;

@@ -27,7 +27,7 @@ static_assert(sizeof(ColoredVertex) == 28, "ColoredVertex is uploaded as is: xyz
 /// A planar quad drawn translucent (no depth writes, so what lies behind
 /// stays visible), with an optional opaque-ish outline.
 struct TranslucentQuad {
-  std::array<glm::vec3, 4> corners{};      ///< in order around the quad
+  std::array<glm::vec3, 4> corners{};  ///< in order around the quad
   glm::vec4 fill{0.3f, 0.6f, 1.0f, 0.25f};
   glm::vec4 outline{0.3f, 0.6f, 1.0f, 0.0f};  ///< alpha 0: no outline
 };
@@ -51,9 +51,9 @@ struct RayPath {
   std::vector<glm::vec3> polyline;  ///< origin, ..., end (hit point, or where the ray leaves the scene)
   bool hit = false;
   glm::vec3 hit_point{0.0f};
-  glm::vec3 hit_normal{0.0f};  ///< unit, facing back along the ray
-  float normal_length = 1.0f;  ///< world units
-  std::vector<Aabb> visited;   ///< boxes in visiting order (drawn fading from first to last)
+  glm::vec3 hit_normal{0.0f};              ///< unit, facing back along the ray
+  float normal_length = 1.0f;              ///< world units
+  std::vector<Aabb> visited;               ///< boxes in visiting order (drawn fading from first to last)
   std::vector<std::uint32_t> highlighted;  ///< primitive ids (indices into the scene's triangles)
   RayPathStyle style;
 };

@@ -9,8 +9,8 @@ namespace {
 void check_complete(GLuint fbo, const char* what) {
   const GLenum status = glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE) {
-    throw GlError(std::string(what) + " framebuffer incomplete (glCheckFramebufferStatus " +
-                  std::to_string(status) + ")");
+    throw GlError(std::string(what) + " framebuffer incomplete (glCheckFramebufferStatus " + std::to_string(status) +
+                  ")");
   }
 }
 
@@ -92,8 +92,8 @@ Rgba8Image RenderTarget::read_pixels() const {
 void RenderTarget::blit_to_default(int dst_width, int dst_height) const {
   if (!resolved_fbo_) return;  // nothing rendered yet
   const GLenum filter = (dst_width == width_ && dst_height == height_) ? GL_NEAREST : GL_LINEAR;
-  glBlitNamedFramebuffer(resolved_fbo_.id(), 0, 0, 0, width_, height_, 0, 0, dst_width, dst_height,
-                         GL_COLOR_BUFFER_BIT, filter);
+  glBlitNamedFramebuffer(resolved_fbo_.id(), 0, 0, 0, width_, height_, 0, 0, dst_width, dst_height, GL_COLOR_BUFFER_BIT,
+                         filter);
   check_gl_errors("present (blit to the window)");
 }
 

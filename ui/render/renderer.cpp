@@ -14,16 +14,22 @@ Renderer::Programs Renderer::Programs::build() {
   return p;
 }
 
-Renderer::Renderer() : programs_(Programs::build()) { check_gl_errors("renderer setup"); }
+Renderer::Renderer() : programs_(Programs::build()) {
+  check_gl_errors("renderer setup");
+}
 
 void Renderer::reload_shaders() {
   Programs fresh = Programs::build();  // throws before anything is replaced
   programs_ = std::move(fresh);
 }
 
-void Renderer::set_triangles(std::span<const Triangle> triangles) { mesh_.upload(triangles); }
+void Renderer::set_triangles(std::span<const Triangle> triangles) {
+  mesh_.upload(triangles);
+}
 
-void Renderer::set_boxes(std::span<const ColoredBox> boxes) { boxes_.upload(boxes); }
+void Renderer::set_boxes(std::span<const ColoredBox> boxes) {
+  boxes_.upload(boxes);
+}
 
 void Renderer::set_quads(std::span<const TranslucentQuad> quads) {
   ColoredGeometry g;
@@ -54,11 +60,17 @@ void Renderer::clear_ray_path() {
   has_ray_path_ = false;
 }
 
-void Renderer::set_heatmap(const MetricImage& image) { heatmap_.upload(image); }
+void Renderer::set_heatmap(const MetricImage& image) {
+  heatmap_.upload(image);
+}
 
-void Renderer::set_colormap(ColorMap map) { heatmap_.set_lut(colormap_lut(map)); }
+void Renderer::set_colormap(ColorMap map) {
+  heatmap_.set_lut(colormap_lut(map));
+}
 
-void Renderer::set_colormap_lut(std::span<const glm::vec3> lut) { heatmap_.set_lut(lut); }
+void Renderer::set_colormap_lut(std::span<const glm::vec3> lut) {
+  heatmap_.set_lut(lut);
+}
 
 Aabb Renderer::content_bounds() const {
   Aabb b = mesh_.bounds();
@@ -182,7 +194,9 @@ void Renderer::render(const RenderView& view, int width, int height) {
   check_gl_errors("end of frame");
 }
 
-Rgba8Image Renderer::read_pixels() const { return target_.read_pixels(); }
+Rgba8Image Renderer::read_pixels() const {
+  return target_.read_pixels();
+}
 
 void Renderer::present(int window_width, int window_height) const {
   target_.blit_to_default(window_width, window_height);

@@ -43,8 +43,8 @@ SaveResult write_screenshot_png(const std::filesystem::path& path, const Rgba8Im
     rgb[i * 3 + 2] = image.pixels[i * 4 + 2];
   }
   PngSink sink{f};
-  const int encoded = stbi_write_png_to_func(write_chunk, &sink, image.width, image.height, 3, rgb.data(),
-                                             image.width * 3);
+  const int encoded =
+      stbi_write_png_to_func(write_chunk, &sink, image.width, image.height, 3, rgb.data(), image.width * 3);
   const bool closed = std::fclose(f) == 0;
   if (!encoded || sink.failed || !closed) {
     std::error_code ignored;
