@@ -1,0 +1,121 @@
+// Micro-benchmarks behind `accelviz calibrate` (see calibrate.h).
+//
+// Dead-code elimination is defeated by folding every result (hit flag and
+// entry distance) into a checksum that is written to a volatile sink after
+// each loop; the index pattern (a stride coprime to the array size) keeps the
+// hardware prefetcher honest without making the loop memory-bound.
+#include "core/analysis/calibrate.h"
+
+#include "core/geometry/triangle.h"
+#include "core/math/aabb.h"
+#include "core/math/ray.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <vector>
+
+namespace accelviz {
+
+namespace {
+
+volatile double g_sink = 0;  // results of the timed loops end here
+
+struct Rng {
+  std::uint64_t s;
+  double next() {
+    std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return static_cast<double>((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+  }
+  glm::vec3 point() { return {float(next()), float(next()), float(next())}; }
+};
+
+double median_of(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/// Median ns per call of `test(ray_index, item_index)` -> (hit, t).
+template <typename Test>
+double time_tests(const CalibrateOptions& o, double& hit_fraction, Test&& test) {
+  std::vector<double> ns;
+  const std::size_t n = o.items, stride = 7919;  // prime, coprime to the power-of-two sizes
+  for (int r = 0; r < std::max(1, o.repeat); ++r) {
+    double sum = 0;
+    std::size_t hits = 0, item = 0;
+    const auto t0 = std::chrono::steady_clock::now();
+    for (std::size_t k = 0; k < o.tests; ++k) {
+      float t = 0;
+      const bool h = test(k % n, item, t);
+      hits += h;
+      sum += h ? t : 0.0f;
+      item += stride;
+      if (item >= n) item -= n;
+    }
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    g_sink = g_sink + sum + static_cast<double>(hits);
+    ns.push_back(s * 1e9 / static_cast<double>(std::max<std::size_t>(1, o.tests)));
+    hit_fraction = static_cast<double>(hits) / static_cast<double>(std::max<std::size_t>(1, o.tests));
+  }
+  return median_of(ns);
+}
+
+}  // namespace
+
+Calibration calibrate(const CalibrateOptions& opts) {
+  CalibrateOptions o = opts;
+  o.items = std::max<std::size_t>(o.items, 1);
+  Rng rng{o.seed};
+  // Rays from points in the unit cube towards other points in it; boxes and
+  // triangles of a size that gives a mix of hits and misses (a test that
+  // always misses early would flatter the fast path).
+  std::vector<Ray> rays(o.items);
+  for (Ray& r : rays) {
+    const glm::vec3 a = rng.point(), b = rng.point();
+    glm::vec3 d = b - a;
+    if (glm::length(d) < 1e-3f) d = {1, 0, 0};
+    r = Ray(a, d);
+  }
+  std::vector<Aabb> boxes(o.items);
+  for (Aabb& b : boxes) {
+    const glm::vec3 c = rng.point(), h(0.05f + 0.2f * float(rng.next()));
+    b = Aabb{c - h, c + h};
+  }
+  std::vector<Triangle> tris(o.items);
+  for (Triangle& t : tris) {
+    const glm::vec3 c = rng.point();
+    const float s = 0.3f;
+    t = {c + s * (rng.point() - 0.5f), c + s * (rng.point() - 0.5f), c + s * (rng.point() - 0.5f)};
+  }
+  std::vector<WatertightRay> wrs(o.items);
+  for (std::size_t i = 0; i < o.items; ++i) wrs[i] = WatertightRay(rays[i].direction);
+
+  Calibration c;
+  c.ns_box = time_tests(o, c.box_hit_fraction, [&](std::size_t ri, std::size_t bi, float& t) {
+    SlabInterval iv;
+    const bool h = intersect_slab(boxes[bi], rays[ri], iv);
+    t = iv.t_entry;
+    return h;
+  });
+  // The watertight test's per-ray shear is precomputed once per ray in a
+  // traversal, so it is precomputed here too and not charged to the test.
+  c.ns_triangle_watertight = time_tests(o, c.triangle_hit_fraction, [&](std::size_t ri, std::size_t ti, float& t) {
+    Hit hit;
+    const bool h = intersect_watertight(rays[ri], wrs[ri], tris[ti], rays[ri].tmin, rays[ri].tmax, hit);
+    t = hit.t;
+    return h;
+  });
+  double fast_hits = 0;
+  c.ns_triangle_fast = time_tests(o, fast_hits, [&](std::size_t ri, std::size_t ti, float& t) {
+    Hit hit;
+    const bool h = intersect_moller_trumbore(rays[ri], tris[ti], rays[ri].tmin, rays[ri].tmax, hit);
+    t = hit.t;
+    return h;
+  });
+  return c;
+}
+
+}  // namespace accelviz

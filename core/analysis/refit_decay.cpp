@@ -1,0 +1,110 @@
+// Refit decay experiment (see refit_decay.h).
+#include "core/analysis/refit_decay.h"
+
+#include "core/query/batch.h"
+#include "core/util/parallel.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+namespace accelviz {
+
+namespace {
+
+std::uint64_t mix(std::uint64_t z) {
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+double unit(std::uint64_t h) { return static_cast<double>(h >> 11) * 0x1.0p-53; }
+
+/// Motion of the vertex at rest position p: a unit direction and a phase, from its bits.
+glm::vec3 displace(const glm::vec3& p, float amplitude, double time, std::uint64_t seed) {
+  std::uint32_t bits[3];
+  std::memcpy(bits, &p, sizeof bits);
+  std::uint64_t h = mix(seed ^ 0x9E3779B97F4A7C15ull);
+  for (std::uint32_t b : bits) h = mix(h ^ b);
+  const double z = 2.0 * unit(mix(h + 1)) - 1.0, phi = 6.283185307179586 * unit(mix(h + 2));
+  const double phase = unit(mix(h + 3));
+  const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+  const double s = amplitude * std::sin(6.283185307179586 * (time + phase));
+  return p + glm::vec3(static_cast<float>(s * r * std::cos(phi)), static_cast<float>(s * r * std::sin(phi)),
+                       static_cast<float>(s * z));
+}
+
+void count(const Accelerator& accel, std::span<const Ray> rays, unsigned threads, double& nodes, double& prims) {
+  nodes = prims = 0;
+  if (rays.empty()) return;
+  std::vector<Hit> hits(rays.size());
+  std::vector<RayStats> stats(rays.size());
+  trace_closest(accel, rays, hits, QueryOptions{}, threads, stats);
+  for (const RayStats& s : stats) {
+    nodes += s.nodes_visited;
+    prims += s.prim_tests;
+  }
+  nodes /= static_cast<double>(rays.size());
+  prims /= static_cast<double>(rays.size());
+}
+
+}  // namespace
+
+std::vector<Triangle> animate_vertices(std::span<const Triangle> rest, float amplitude, double time,
+                                       std::uint64_t seed) {
+  std::vector<Triangle> out(rest.begin(), rest.end());
+  for (Triangle& t : out) {
+    t.v0 = displace(t.v0, amplitude, time, seed);
+    t.v1 = displace(t.v1, amplitude, time, seed);
+    t.v2 = displace(t.v2, amplitude, time, seed);
+  }
+  return out;
+}
+
+RefitDecayResult run_refit_decay(std::span<const Triangle> rest, std::span<const Ray> rays,
+                                 const RefitDecayOptions& opts, const FrameSource& source) {
+  if (opts.frames < 1) throw std::invalid_argument("refit decay: frames must be at least 1");
+  if (!(opts.rebuild_ratio >= 0) || !(opts.amplitude >= 0))
+    throw std::invalid_argument("refit decay: amplitude and rebuild ratio must not be negative");
+  Aabb box = Aabb::empty();
+  for (const Triangle& t : rest) box.extend(t.bounds());
+  const float amplitude = rest.empty() ? 0.0f : opts.amplitude * glm::length(box.extent());
+  const unsigned threads = resolve_threads(opts.threads);
+  BvhOptions bo = opts.bvh;
+  bo.compute_epo = false;
+
+  // Frame k's triangles must outlive the tree built over them (Bvh keeps a copy
+  // in leaf order, but the source vector is kept anyway for the next refit).
+  std::vector<Triangle> current(rest.begin(), rest.end());
+  auto tree = std::make_unique<Bvh>(current, bo);
+  int refits = 0;
+  RefitDecayResult result;
+  for (int k = 1; k <= opts.frames; ++k) {
+    current = source ? source(k) : animate_vertices(rest, amplitude, k * opts.frame_step, opts.seed);
+    if (current.size() != rest.size()) throw std::invalid_argument("refit decay: frame changed the triangle count");
+    RefitFrame f;
+    f.frame = k;
+    const auto t0 = std::chrono::steady_clock::now();
+    tree->refit(current);
+    f.refit_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    f.refits_since_build = ++refits;
+    f.sah_refit = tree->build_stats().sah_cost;
+    auto fresh = std::make_unique<Bvh>(current, bo);
+    f.rebuild_ms = fresh->build_stats().build_ms;
+    f.sah_fresh = fresh->build_stats().sah_cost;
+    f.ratio = f.sah_fresh > 0 ? f.sah_refit / f.sah_fresh : 1.0;
+    count(*tree, rays, threads, f.nodes_per_ray_refit, f.prims_per_ray_refit);
+    count(*fresh, rays, threads, f.nodes_per_ray_fresh, f.prims_per_ray_fresh);
+    if (opts.rebuild_ratio > 0 && f.ratio > opts.rebuild_ratio) {
+      tree = std::move(fresh);  // the next frame refits the fresh tree
+      refits = 0;
+      f.rebuilt = true;
+      ++result.rebuilds;
+    }
+    result.frames.push_back(f);
+  }
+  return result;
+}
+
+}  // namespace accelviz

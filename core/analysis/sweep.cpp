@@ -1,0 +1,410 @@
+// Sweep expansion, measurement and the Pareto front (see sweep.h).
+#include "core/analysis/sweep.h"
+
+#include "core/query/batch.h"
+#include "core/util/parallel.h"
+
+#include <algorithm>
+#include <array>
+#include <tuple>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace accelviz {
+
+namespace {
+
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+[[noreturn]] void bad_value(const std::string& name, const std::string& value, const std::string& why) {
+  throw std::invalid_argument("sweep parameter " + name + ": bad value '" + value + "' (" + why + ")");
+}
+
+int parse_int(const std::string& name, const std::string& v, int lo, int hi) {
+  int out = 0;
+  const auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), out);
+  if (ec != std::errc() || p != v.data() + v.size())
+    bad_value(name, v, "expected an integer " + std::to_string(lo) + ".." + std::to_string(hi));
+  if (out < lo || out > hi) bad_value(name, v, "expected " + std::to_string(lo) + ".." + std::to_string(hi));
+  return out;
+}
+
+float parse_positive(const std::string& name, const std::string& v) {
+  // from_chars for float is in GCC 12's libstdc++; strtof would accept "1x".
+  float out = 0;
+  const auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), out);
+  if (ec != std::errc() || p != v.data() + v.size() || !std::isfinite(out) || out <= 0)
+    bad_value(name, v, "expected a positive number");
+  return out;
+}
+
+bool parse_on_off(const std::string& name, const std::string& v) {
+  if (v == "on") return true;
+  if (v == "off") return false;
+  bad_value(name, v, "expected on or off");
+}
+
+std::string joined(const std::vector<std::string>& v) {
+  std::string s;
+  for (const std::string& x : v) s += (s.empty() ? "" : ", ") + x;
+  return s;
+}
+
+std::uint64_t splitmix64(std::uint64_t& state) {
+  std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+double unit(std::uint64_t& state) { return static_cast<double>(splitmix64(state) >> 11) * 0x1.0p-53; }
+
+}  // namespace
+
+std::string setting_label(const SweepSetting& setting) {
+  std::string s;
+  for (const auto& [k, v] : setting) s += (s.empty() ? "" : " ") + k + "=" + v;
+  return s.empty() ? "default" : s;
+}
+
+const std::vector<std::string>& sweep_param_names(std::string_view structure) {
+  static const std::map<std::string, std::vector<std::string>, std::less<>> names{
+      {"bvh", {"buckets", "splitter", "leaf", "ctrav", "cisect", "triangle"}},
+      {"kdtree", {"depth", "ctrav", "cisect", "leaf", "mailbox", "triangle"}},
+      {"grid", {"lambda", "res", "triangle"}},
+      {"octree", {"depth", "leaf", "triangle"}},
+      {"voxels", {"level", "triangle"}},
+  };
+  static const std::vector<std::string> only_triangle{"triangle"};
+  const auto it = names.find(structure);
+  return it == names.end() ? only_triangle : it->second;
+}
+
+SweepParam parse_sweep_param(std::string_view text) {
+  const std::size_t eq = text.find('=');
+  if (eq == std::string_view::npos || eq == 0)
+    throw std::invalid_argument("sweep parameter '" + std::string(text) + "': expected NAME=V1,V2,...");
+  SweepParam p;
+  p.name = std::string(text.substr(0, eq));
+  std::string rest(text.substr(eq + 1));
+  std::stringstream ss(rest);
+  std::string v;
+  while (std::getline(ss, v, ',')) {
+    if (v.empty()) throw std::invalid_argument("sweep parameter " + p.name + ": empty value in '" + rest + "'");
+    p.values.push_back(v);
+  }
+  if (p.values.empty() || rest.back() == ',')
+    throw std::invalid_argument("sweep parameter " + p.name + ": no values (expected " + p.name + "=V1,V2,...)");
+  return p;
+}
+
+void apply_sweep_setting(std::string_view structure, const SweepSetting& setting, StructureOptions& o,
+                         QueryOptions& q) {
+  const std::vector<std::string>& valid = sweep_param_names(structure);
+  for (const auto& [name, v] : setting) {
+    if (std::find(valid.begin(), valid.end(), name) == valid.end())
+      throw std::invalid_argument("unknown sweep parameter '" + name + "' for " + std::string(structure) +
+                                  " (valid: " + joined(valid) + ")");
+    if (name == "triangle") {
+      if (v == "watertight") q.triangle_test = TriangleTest::watertight;
+      else if (v == "fast") q.triangle_test = TriangleTest::moller_trumbore;
+      else bad_value(name, v, "expected watertight or fast");
+    } else if (structure == "bvh") {
+      if (name == "buckets") {
+        if (v == "exact") {
+          o.bvh.splitter = BvhSplitter::exact_sah;
+        } else {
+          o.bvh.buckets = parse_int(name, v, 2, 256);
+          o.bvh.splitter = BvhSplitter::binned_sah;
+        }
+      } else if (name == "splitter") {
+        if (v == "median") o.bvh.splitter = BvhSplitter::median;
+        else if (v == "binned") o.bvh.splitter = BvhSplitter::binned_sah;
+        else if (v == "exact") o.bvh.splitter = BvhSplitter::exact_sah;
+        else bad_value(name, v, "expected median, binned or exact");
+      } else if (name == "leaf") {
+        o.bvh.max_leaf_size = parse_int(name, v, 1, 255);
+        o.bvh.leaf_size_cap = std::max(o.bvh.leaf_size_cap, o.bvh.max_leaf_size);
+      } else if (name == "ctrav") {
+        o.bvh.cost_traversal = parse_positive(name, v);
+      } else if (name == "cisect") {
+        o.bvh.cost_intersect = parse_positive(name, v);
+      }
+    } else if (structure == "kdtree") {
+      if (name == "depth") o.kdtree.max_depth = parse_int(name, v, 0, 64);
+      else if (name == "ctrav") o.kdtree.cost_traversal = parse_positive(name, v);
+      else if (name == "cisect") o.kdtree.cost_intersect = parse_positive(name, v);
+      else if (name == "leaf") o.kdtree.max_leaf_size = parse_int(name, v, 1, 1 << 20);
+      else if (name == "mailbox") o.kdtree.mailboxing = parse_on_off(name, v);
+    } else if (structure == "grid") {
+      if (name == "lambda") {
+        o.grid.lambda = parse_positive(name, v);
+        o.grid.resolution = {0, 0, 0};
+      } else if (name == "res") {
+        std::array<int, 3> r{};
+        std::stringstream ss(v);
+        std::string part;
+        int k = 0;
+        while (std::getline(ss, part, 'x')) {
+          if (k == 3) bad_value(name, v, "expected NXxNYxNZ");
+          r[k++] = parse_int(name, part, 1, 4096);
+        }
+        if (k != 3) bad_value(name, v, "expected NXxNYxNZ, e.g. 16x16x16");
+        o.grid.resolution = r;
+      }
+    } else if (structure == "octree") {
+      if (name == "depth") o.octree.max_depth = parse_int(name, v, 0, 16);
+      else if (name == "leaf") o.octree.max_leaf_size = parse_int(name, v, 1, 1 << 20);
+    } else if (structure == "voxels") {
+      if (name == "level") o.voxels.level = parse_int(name, v, 0, 10);
+    }
+  }
+  if (structure == "bvh") validate(o.bvh);
+}
+
+std::vector<SweepSetting> expand_sweep(std::string_view structure, std::span<const SweepParam> params) {
+  std::set<std::string> seen;
+  for (const SweepParam& p : params) {
+    if (!seen.insert(p.name).second) throw std::invalid_argument("sweep parameter " + p.name + " given twice");
+    if (p.values.empty()) throw std::invalid_argument("sweep parameter " + p.name + ": no values");
+    // Check every value on its own, so the message names the first bad one.
+    for (const std::string& v : p.values) {
+      StructureOptions o;
+      QueryOptions q;
+      apply_sweep_setting(structure, {{p.name, v}}, o, q);
+    }
+  }
+  std::vector<SweepSetting> out{SweepSetting{}};
+  for (const SweepParam& p : params) {
+    std::vector<SweepSetting> next;
+    for (const SweepSetting& s : out)
+      for (const std::string& v : p.values) {
+        SweepSetting t = s;
+        t.emplace_back(p.name, v);
+        next.push_back(std::move(t));
+      }
+    out = std::move(next);
+  }
+  return out;
+}
+
+// ---- shared-edge probes ------------------------------------------------------------
+
+std::vector<EdgeProbe> shared_edge_probes(std::span<const Triangle> triangles, std::size_t max_probes,
+                                          std::uint64_t seed) {
+  // Edges keyed by their two end positions (exact floats, ordered), so
+  // welded meshes match across triangles without an index buffer.
+  using Key = std::array<float, 6>;
+  auto key = [](glm::vec3 a, glm::vec3 b) {
+    if (std::tie(b.x, b.y, b.z) < std::tie(a.x, a.y, a.z)) std::swap(a, b);
+    return Key{a.x, a.y, a.z, b.x, b.y, b.z};
+  };
+  std::map<Key, std::vector<std::uint32_t>> edges;
+  for (std::uint32_t i = 0; i < triangles.size(); ++i) {
+    const Triangle& t = triangles[i];
+    if (t.area() <= 0.0f) continue;
+    edges[key(t.v0, t.v1)].push_back(i);
+    edges[key(t.v1, t.v2)].push_back(i);
+    edges[key(t.v2, t.v0)].push_back(i);
+  }
+  std::vector<std::pair<Key, std::array<std::uint32_t, 2>>> shared;
+  for (const auto& [k, tris] : edges)
+    if (tris.size() == 2 && tris[0] != tris[1]) shared.push_back({k, {tris[0], tris[1]}});
+  if (shared.empty() || max_probes == 0) return {};
+
+  Aabb box = Aabb::empty();
+  for (const Triangle& t : triangles) box.extend(t.bounds());
+  const float diag = glm::length(box.extent());
+  const std::size_t n = std::min(max_probes, shared.size());
+  std::vector<EdgeProbe> out;
+  out.reserve(n);
+  std::uint64_t state = seed;
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto& [e, tris] = shared[k * shared.size() / n];
+    const glm::vec3 a(e[0], e[1], e[2]), b(e[3], e[4], e[5]);
+    const glm::vec3 target = a + 0.5f * (b - a);
+    // A uniform direction on the sphere; the origin sits outside the scene
+    // box so the ray crosses the surface where it hits the edge.
+    const double z = 2.0 * unit(state) - 1.0, phi = 6.283185307179586 * unit(state);
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const glm::vec3 dir(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
+                        static_cast<float>(z));
+    EdgeProbe p;
+    p.ray = Ray(target - dir * (2.0f * diag), dir);
+    p.tri_a = tris[0];
+    p.tri_b = tris[1];
+    out.push_back(p);
+  }
+  return out;
+}
+
+EdgeLeaks count_edge_leaks(std::span<const Triangle> triangles, std::span<const EdgeProbe> probes, TriangleTest test) {
+  EdgeLeaks r;
+  r.probes = probes.size();
+  for (const EdgeProbe& p : probes) {
+    const WatertightRay wr(p.ray.direction);
+    Hit ha, hb;
+    const bool a = intersect_triangle(test, p.ray, wr, triangles[p.tri_a], p.ray.tmin, p.ray.tmax, ha);
+    const bool b = intersect_triangle(test, p.ray, wr, triangles[p.tri_b], p.ray.tmin, p.ray.tmax, hb);
+    r.misses += !a && !b;
+    r.double_hits += a && b;
+  }
+  return r;
+}
+
+// ---- measuring ---------------------------------------------------------------------
+
+SweepResult measure_sweep_setting(std::span<const Triangle> triangles, std::span<const Ray> rays,
+                                  std::span<const EdgeProbe> probes, const SweepConfig& config,
+                                  const SweepSetting& setting) {
+  SweepResult r;
+  r.setting = setting;
+  StructureOptions so = config.base;
+  QueryOptions q = config.query;
+  apply_sweep_setting(config.structure, setting, so, q);
+  so.threads = config.threads;
+  so.bvh.threads = config.threads;
+  r.triangle_test = q.triangle_test == TriangleTest::watertight ? "watertight" : "fast";
+  const int repeat = std::max(1, config.repeat);
+  const unsigned threads = resolve_threads(config.threads);
+
+  std::unique_ptr<Accelerator> accel;
+  for (int k = 0; k < repeat; ++k) {
+    accel.reset();  // never two copies in memory
+    accel = build_accelerator(config.structure, triangles, so);
+    r.build_ms_runs.push_back(accel->build_stats().build_ms);
+  }
+  r.build_ms = median_of(r.build_ms_runs);
+  const BuildStats& bs = accel->build_stats();
+  r.memory_bytes = bs.memory_bytes;
+  r.nodes = bs.node_count;
+  r.leaves = bs.leaf_count;
+  r.max_depth = bs.max_depth;
+  r.sah_cost = bs.sah_cost;
+  if (const auto it = bs.extra.find("epo"); it != bs.extra.end()) r.epo = it->second;
+
+  std::vector<Hit> hits(rays.size());
+  if (!rays.empty()) {
+    for (int k = 0; k < repeat; ++k) {
+      const auto t0 = std::chrono::steady_clock::now();
+      trace_closest(*accel, rays, hits, q, threads);
+      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      r.rays_per_s_runs.push_back(s > 0 ? static_cast<double>(rays.size()) / s : 0.0);
+    }
+    r.rays_per_s = median_of(r.rays_per_s_runs);
+    // Counting pass, outside the timings.
+    std::vector<RayStats> stats(rays.size());
+    trace_closest(*accel, rays, hits, q, threads, stats);
+    double nodes = 0, prims = 0, hit_count = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      nodes += stats[i].nodes_visited;
+      prims += stats[i].prim_tests;
+      hit_count += hits[i].valid();
+    }
+    const double n = static_cast<double>(rays.size());
+    r.nodes_per_ray = nodes / n;
+    r.prims_per_ray = prims / n;
+    r.hit_fraction = hit_count / n;
+  }
+  if (!probes.empty()) r.edges = count_edge_leaks(triangles, probes, q.triangle_test);
+  return r;
+}
+
+std::vector<SweepResult> run_sweep(std::span<const Triangle> triangles, std::span<const Ray> rays,
+                                   std::span<const EdgeProbe> probes, const SweepConfig& config,
+                                   std::span<const SweepSetting> settings, const SweepProgress& progress) {
+  std::vector<SweepResult> out;
+  out.reserve(settings.size());
+  for (std::size_t i = 0; i < settings.size(); ++i) {
+    if (progress && !progress(i, settings.size(), setting_label(settings[i]))) throw BuildCancelled();
+    out.push_back(measure_sweep_setting(triangles, rays, probes, config, settings[i]));
+  }
+  return out;
+}
+
+// ---- analysis ------------------------------------------------------------------------
+
+std::vector<std::size_t> pareto_front(std::span<const Point2> points) {
+  std::vector<std::size_t> front;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Point2& p = points[i];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
+    bool dominated = false;
+    for (std::size_t j = 0; j < points.size() && !dominated; ++j) {
+      const Point2& o = points[j];
+      if (j == i || !std::isfinite(o.x) || !std::isfinite(o.y)) continue;
+      dominated = o.x <= p.x && o.y <= p.y && (o.x < p.x || o.y < p.y);
+    }
+    if (!dominated) front.push_back(i);
+  }
+  std::sort(front.begin(), front.end(), [&](std::size_t a, std::size_t b) {
+    return std::tie(points[a].x, points[a].y, a) < std::tie(points[b].x, points[b].y, b);
+  });
+  return front;
+}
+
+std::size_t best_for_budget(std::span<const SweepResult> results, double rays) {
+  if (results.empty()) throw std::invalid_argument("best_for_budget: no results");
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < results.size(); ++i)
+    if (results[i].total_ms(rays) < results[best].total_ms(rays)) best = i;
+  return best;
+}
+
+std::string sweep_csv(std::span<const SweepResult> results, double ray_budget) {
+  std::ostringstream os;
+  os.precision(10);
+  std::vector<std::string> params;
+  if (!results.empty())
+    for (const auto& [k, v] : results.front().setting) params.push_back(k);
+  for (const std::string& p : params) os << p << ',';
+  os << "label,triangle_test,build_ms,memory_bytes,nodes,leaves,max_depth,sah_cost,epo,nodes_per_ray,"
+        "prims_per_ray,hit_fraction,rays_per_s,ray_budget,trace_ms_budget,total_ms_budget,edge_probes,"
+        "edge_misses,edge_double_hits\n";
+  for (const SweepResult& r : results) {
+    for (const auto& [k, v] : r.setting) os << v << ',';
+    os << '"' << setting_label(r.setting) << "\"," << r.triangle_test << ',' << r.build_ms << ',' << r.memory_bytes
+       << ',' << r.nodes << ',' << r.leaves << ',' << r.max_depth << ',' << r.sah_cost << ',';
+    if (r.epo >= 0) os << r.epo;
+    os << ',' << r.nodes_per_ray << ',' << r.prims_per_ray << ',' << r.hit_fraction << ',' << r.rays_per_s << ','
+       << ray_budget << ',' << r.trace_ms(ray_budget) << ',' << r.total_ms(ray_budget) << ',' << r.edges.probes << ','
+       << r.edges.misses << ',' << r.edges.double_hits << '\n';
+  }
+  return os.str();
+}
+
+}  // namespace accelviz
+
+namespace accelviz {
+
+std::vector<Ray> sweep_ray_set(const Scene& scene, const Camera& camera, int width, int height, RayKind kind,
+                               std::uint64_t seed, unsigned threads, bool* synthetic_light) {
+  if (synthetic_light) *synthetic_light = false;
+  std::vector<Ray> primary = primary_rays(camera, width, height);
+  if (kind == RayKind::primary) return primary;
+  BvhOptions opts;
+  opts.compute_epo = false;
+  opts.threads = threads;
+  const Bvh bvh(scene.triangles, opts);
+  std::vector<Hit> hits(primary.size());
+  trace_closest(bvh, primary, hits, QueryOptions{}, resolve_threads(threads));
+  if (kind == RayKind::diffuse) return diffuse_rays(scene.triangles, primary, hits, seed);
+  std::vector<Light> lights = scene.lights;
+  if (lights.empty()) {
+    lights.push_back(synthetic_bench_light(scene.bounds()));
+    if (synthetic_light) *synthetic_light = true;
+  }
+  return shadow_rays(scene.triangles, primary, hits, lights);
+}
+
+}  // namespace accelviz

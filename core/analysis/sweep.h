@@ -1,0 +1,154 @@
+#pragma once
+// Parameter sweeps: what accuracy costs in time. For every setting of a
+// cartesian product of structure options, build the structure R times and
+// trace a fixed ray set R times (medians), plus one counting pass, and relate
+// build time to trace time for a ray budget N:
+//   total(N) = build_ms + N / rays_per_s.
+// The Pareto front of (build time, trace time) shows which settings are ever
+// worth using; the budget picks one of them.
+#include "core/accel/factory.h"
+#include "core/query/ray_sets.h"
+#include "core/scene/scene.h"
+
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace accelviz {
+
+/// One swept parameter: "buckets=2,4,exact" → {"buckets", {"2", "4", "exact"}}.
+struct SweepParam {
+  std::string name;
+  std::vector<std::string> values;
+};
+
+/// One point of the product: (parameter, value) pairs in the order given.
+using SweepSetting = std::vector<std::pair<std::string, std::string>>;
+
+/// "buckets=16 leaf=4" (space-separated pairs), for tables and chart labels.
+std::string setting_label(const SweepSetting& setting);
+
+/// Parameters a structure accepts (every structure also accepts "triangle").
+const std::vector<std::string>& sweep_param_names(std::string_view structure);
+
+/// Parses "NAME=V1,V2,...". Throws std::invalid_argument on a missing '=' or an empty value.
+SweepParam parse_sweep_param(std::string_view text);
+
+/// The cartesian product of `params` (first parameter varies slowest), after
+/// checking every name and value for `structure` on a copy of the options.
+/// Throws std::invalid_argument naming the unknown parameter or bad value,
+/// and for a parameter given twice or an empty list.
+std::vector<SweepSetting> expand_sweep(std::string_view structure, std::span<const SweepParam> params);
+
+/// Writes one setting into the structure and query options. Throws
+/// std::invalid_argument for an unknown name or a bad value (same messages).
+void apply_sweep_setting(std::string_view structure, const SweepSetting& setting, StructureOptions& options,
+                         QueryOptions& query);
+
+// ---- shared-edge probes (triangle-test accuracy) ---------------------------------
+
+/// A ray aimed at the midpoint of an edge that exactly two triangles share
+/// (same vertex positions), from outside the scene along a seeded direction.
+/// On a closed surface such a ray must hit one of the two triangles; a test
+/// that misses both lets it leak through the mesh.
+struct EdgeProbe {
+  Ray ray;
+  std::uint32_t tri_a = 0, tri_b = 0;
+};
+
+/// Up to `max_probes` probes over the shared edges (evenly sampled in edge
+/// order), directions from `seed`. Deterministic.
+std::vector<EdgeProbe> shared_edge_probes(std::span<const Triangle> triangles, std::size_t max_probes,
+                                          std::uint64_t seed);
+
+struct EdgeLeaks {
+  std::uint64_t probes = 0;
+  std::uint64_t misses = 0;       ///< rays that miss both triangles of the shared edge (a leak)
+  std::uint64_t double_hits = 0;  ///< rays that hit both triangles
+};
+
+/// Tests every probe against its two triangles with `test`.
+EdgeLeaks count_edge_leaks(std::span<const Triangle> triangles, std::span<const EdgeProbe> probes, TriangleTest test);
+
+// ---- measuring ---------------------------------------------------------------------
+
+struct SweepConfig {
+  std::string structure = "bvh";
+  StructureOptions base;      ///< options before each setting is applied
+  QueryOptions query;         ///< before each setting is applied
+  int repeat = 3;             ///< builds and timed passes per setting (medians)
+  unsigned threads = 0;       ///< build and trace threads (0: all hardware threads)
+  double ray_budget = 1e6;    ///< N of total(N)
+};
+
+struct SweepResult {
+  SweepSetting setting;
+  std::vector<double> build_ms_runs;
+  double build_ms = 0;          ///< median of the builder's own figure
+  std::uint64_t memory_bytes = 0;
+  std::uint64_t nodes = 0, leaves = 0;
+  std::uint32_t max_depth = 0;
+  double sah_cost = 0;          ///< 0 where the structure reports none
+  double epo = -1;              ///< < 0: not available (BVH only)
+  std::vector<double> rays_per_s_runs;
+  double rays_per_s = 0;        ///< median of the timed closest-hit passes, no counters
+  double nodes_per_ray = 0;     ///< counting pass: mean nodes visited
+  double prims_per_ray = 0;     ///< counting pass: mean triangle tests
+  double hit_fraction = 0;
+  EdgeLeaks edges;              ///< with the setting's triangle test (probes == 0 when not measured)
+  std::string triangle_test;    ///< "watertight" or "fast"
+
+  /// Trace time of `rays` rays at the measured rate, in ms.
+  double trace_ms(double rays) const { return rays_per_s > 0 ? rays / rays_per_s * 1e3 : 0.0; }
+  /// build_ms + trace_ms(rays).
+  double total_ms(double rays) const { return build_ms + trace_ms(rays); }
+};
+
+/// Called before each setting with its index and the count; false cancels (BuildCancelled).
+using SweepProgress = std::function<bool(std::size_t index, std::size_t count, const std::string& label)>;
+
+/// Measures one setting over `rays` (and `probes` when non-empty).
+SweepResult measure_sweep_setting(std::span<const Triangle> triangles, std::span<const Ray> rays,
+                                  std::span<const EdgeProbe> probes, const SweepConfig& config,
+                                  const SweepSetting& setting);
+
+/// Every setting in order.
+std::vector<SweepResult> run_sweep(std::span<const Triangle> triangles, std::span<const Ray> rays,
+                                   std::span<const EdgeProbe> probes, const SweepConfig& config,
+                                   std::span<const SweepSetting> settings, const SweepProgress& progress = {});
+
+// ---- analysis ------------------------------------------------------------------------
+
+struct Point2 {
+  double x = 0, y = 0;
+};
+
+/// Indices of the points no other point dominates when minimising both
+/// coordinates (q dominates p when q.x <= p.x, q.y <= p.y and one is strictly
+/// smaller), sorted by x then y. Equal points are all kept. Non-finite points
+/// are never on the front.
+std::vector<std::size_t> pareto_front(std::span<const Point2> points);
+
+/// Index of the result with the smallest total_ms(rays); results must not be empty.
+std::size_t best_for_budget(std::span<const SweepResult> results, double rays);
+
+/// CSV with a header row: the swept parameters as columns, then the figures.
+std::string sweep_csv(std::span<const SweepResult> results, double ray_budget);
+
+}  // namespace accelviz
+
+namespace accelviz {
+
+/// The ray set a sweep traces, made as the benchmark makes it: primary rays
+/// of `camera` (W×H); for diffuse and shadow, one closest-hit pass of a
+/// default BVH finds the primary hits they start from (shadow rays aim at the
+/// scene's lights, or at synthetic_bench_light when it has none, reported in
+/// `synthetic_light`).
+std::vector<Ray> sweep_ray_set(const Scene& scene, const Camera& camera, int width, int height, RayKind kind,
+                               std::uint64_t seed, unsigned threads, bool* synthetic_light = nullptr);
+
+}  // namespace accelviz
