@@ -1,0 +1,247 @@
+#include "core/analysis/verify.h"
+
+#include "core/query/camera.h"
+#include "core/util/parallel.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+
+namespace accelviz {
+
+VerifyCounts& VerifyCounts::operator+=(const VerifyCounts& o) {
+  rays += o.rays;
+  mismatched_prim += o.mismatched_prim;
+  t_beyond_tolerance += o.t_beyond_tolerance;
+  anyhit_disagree += o.anyhit_disagree;
+  near_ties += o.near_ties;
+  build_ms += o.build_ms;
+  return *this;
+}
+
+std::vector<VerifyStructure> parse_verify_structures(const std::string& list, unsigned threads) {
+  std::vector<std::string> names;
+  std::stringstream ss(list);
+  for (std::string item; std::getline(ss, item, ',');)
+    if (!item.empty()) names.push_back(item);
+  if (names.empty()) throw std::invalid_argument("--structure: empty list");
+  std::vector<VerifyStructure> out;
+  auto add = [&](const std::string& label, const std::string& factory, BvhSplitter splitter = BvhSplitter::binned_sah) {
+    for (const VerifyStructure& s : out)
+      if (s.label == label) return;
+    VerifyStructure s{label, factory, {}};
+    s.options.threads = threads;
+    s.options.bvh.splitter = splitter;
+    out.push_back(std::move(s));
+  };
+  auto add_bvh = [&](const std::string& which) {
+    if (which == "bvh" || which == "bvh-binned") add("bvh-binned", "bvh", BvhSplitter::binned_sah);
+    if (which == "bvh" || which == "bvh-exact") add("bvh-exact", "bvh", BvhSplitter::exact_sah);
+    if (which == "bvh" || which == "bvh-median") add("bvh-median", "bvh", BvhSplitter::median);
+  };
+  for (const std::string& n : names) {
+    if (n == "all") {
+      add("brute", "brute");
+      add_bvh("bvh");
+      add("kdtree", "kdtree");
+      add("grid", "grid");
+      add("octree", "octree");
+      if (kHaveEmbree) add("embree", "embree");
+    } else if (n == "bvh" || n == "bvh-binned" || n == "bvh-exact" || n == "bvh-median") {
+      add_bvh(n);
+    } else if (n == "brute" || n == "brute-bbox" || n == "kdtree" || n == "grid" || n == "octree" || n == "embree") {
+      if (n == "embree" && !kHaveEmbree) throw std::invalid_argument("--structure embree: this build has no Embree backend");
+      add(n, n);
+    } else if (n == "voxels") {
+      throw std::invalid_argument("--structure voxels: voxel hits are voxels, not triangles; it cannot be verified against triangles");
+    } else {
+      throw std::invalid_argument("--structure: unknown '" + n +
+                                  "' (all, brute, brute-bbox, bvh, bvh-binned, bvh-exact, bvh-median, kdtree, grid, octree" +
+                                  (kHaveEmbree ? ", embree)" : ")"));
+    }
+  }
+  return out;
+}
+
+namespace {
+
+// splitmix64: one independent stream per ray index, so the rays do not
+// depend on the order they are generated in.
+struct Rng {
+  std::uint64_t s;
+  std::uint64_t next_u64() {
+    std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  }
+  double uniform() { return static_cast<double>(next_u64() >> 11) * (1.0 / 9007199254740992.0); }
+  float range(float a, float b) { return a + (b - a) * static_cast<float>(uniform()); }
+  std::size_t below(std::size_t n) { return static_cast<std::size_t>(next_u64() % n); }
+  glm::vec3 in_box(const glm::vec3& lo, const glm::vec3& hi) {
+    return {range(lo.x, hi.x), range(lo.y, hi.y), range(lo.z, hi.z)};
+  }
+  glm::vec3 unit() {
+    for (;;) {
+      const glm::vec3 v(range(-1, 1), range(-1, 1), range(-1, 1));
+      const float l = glm::length(v);
+      if (l > 0.05f && l <= 1.0f) return v / l;
+    }
+  }
+};
+
+Aabb scene_bounds(std::span<const Triangle> tris) {
+  Aabb b;
+  for (const Triangle& t : tris) b.extend(t.bounds());
+  if (b.is_empty()) b = Aabb{glm::vec3(-1.0f), glm::vec3(1.0f)};
+  return b;
+}
+
+}  // namespace
+
+std::vector<Ray> verify_rays(std::span<const Triangle> triangles, std::size_t count, std::uint64_t seed) {
+  std::vector<Ray> rays;
+  rays.reserve(count);
+  const Aabb b = scene_bounds(triangles);
+  const glm::vec3 ext = glm::max(b.hi - b.lo, glm::vec3(1e-6f));
+  const float radius = glm::length(ext);
+  const glm::vec3 centre = (b.lo + b.hi) * 0.5f;
+  const glm::vec3 wide_lo = b.lo - 0.5f * ext, wide_hi = b.hi + 0.5f * ext;
+  const Camera cam = frame_bounds(b, 1.0f);
+  const bool have_tris = !triangles.empty();
+
+  auto outside_point = [&](Rng& r) { return centre + r.unit() * (radius * r.range(0.6f, 1.5f)); };
+  auto vertex = [&](const Triangle& t, std::size_t i) { return i == 0 ? t.v0 : i == 1 ? t.v1 : t.v2; };
+
+  for (std::size_t i = 0; i < count; ++i) {
+    Rng r{seed * 0x2545F4914F6CDD1Dull + i};
+    const double kind = r.uniform();
+    glm::vec3 o, d;
+    if (kind < 0.40 || !have_tris) {
+      // Random: half from inside/around the bounds in any direction, half
+      // from outside aimed into the bounds.
+      if (r.uniform() < 0.5) {
+        o = r.in_box(wide_lo, wide_hi);
+        d = r.unit();
+      } else {
+        o = outside_point(r);
+        d = r.in_box(b.lo, b.hi) - o;
+      }
+    } else if (kind < 0.85) {
+      const Triangle& t = triangles[r.below(triangles.size())];
+      const double sub = r.uniform();
+      if (sub < 0.25) {
+        // Aimed exactly at a vertex: shared by the neighbours of a closed mesh.
+        o = outside_point(r);
+        d = vertex(t, r.below(3)) - o;
+      } else if (sub < 0.45) {
+        // Aimed at a point on an edge (rounded to float: on the edge up to rounding).
+        const std::size_t e = r.below(3);
+        const glm::vec3 a = vertex(t, e), c = vertex(t, (e + 1) % 3);
+        const float s = r.uniform() < 0.2 ? 0.5f : static_cast<float>(r.uniform());
+        o = r.uniform() < 0.5 ? outside_point(r) : r.in_box(wide_lo, wide_hi);
+        d = (a + s * (c - a)) - o;
+      } else if (sub < 0.65) {
+        // Axis-aligned through a vertex or a random point, with +0/-0 in the
+        // other components (1/±0 = ±inf in the slab tests).
+        const int axis = static_cast<int>(r.below(3));
+        const glm::vec3 target = r.uniform() < 0.5 ? vertex(t, r.below(3)) : r.in_box(b.lo, b.hi);
+        const float sign = r.uniform() < 0.5 ? 1.0f : -1.0f;
+        d = glm::vec3(r.uniform() < 0.5 ? 0.0f : -0.0f, r.uniform() < 0.5 ? 0.0f : -0.0f,
+                      r.uniform() < 0.5 ? 0.0f : -0.0f);
+        d[axis] = sign;
+        o = target;
+        o[axis] = sign > 0 ? wide_lo[axis] : wide_hi[axis];
+      } else if (sub < 0.85) {
+        // Grazing: in the triangle's plane, through a point inside it.
+        const float u = static_cast<float>(r.uniform()), v = static_cast<float>(r.uniform()) * (1.0f - u);
+        const glm::vec3 p = t.v0 + u * (t.v1 - t.v0) + v * (t.v2 - t.v0);
+        const float w = r.range(-1.0f, 1.0f);
+        d = (t.v1 - t.v0) + w * (t.v2 - t.v0);
+        o = p - d * r.range(0.5f, 4.0f);
+      } else {
+        // Origin on a face or mid-plane of the bounds (root splits, cell and
+        // node boundaries), direction random or axis-aligned along that plane.
+        o = r.in_box(b.lo, b.hi);
+        const int axis = static_cast<int>(r.below(3));
+        const int which = static_cast<int>(r.below(3));
+        o[axis] = which == 0 ? b.lo[axis] : which == 1 ? b.hi[axis] : centre[axis];
+        d = r.unit();
+        if (r.uniform() < 0.3) d[axis] = 0.0f;  // in the plane
+      }
+    } else {
+      o = cam.position;
+      const Ray cr = camera_ray(cam, static_cast<float>(r.uniform()), static_cast<float>(r.uniform()), 1.0f);
+      o = cr.origin;
+      d = cr.direction;
+    }
+    if (!(glm::length(d) > 0.0f) || !std::isfinite(d.x + d.y + d.z)) d = glm::vec3(0.0f, 0.0f, 1.0f);
+    rays.emplace_back(o, d);
+  }
+  return rays;
+}
+
+VerifyResult verify_structures(std::span<const Triangle> triangles, std::span<const Ray> rays,
+                               const std::vector<VerifyStructure>& structures, unsigned threads) {
+  using Clock = std::chrono::steady_clock;
+  const auto t_start = Clock::now();
+  VerifyResult res;
+  res.rays = rays.size();
+
+  // Reference once: the brute force in double dominates the cost.
+  const ReferenceTracer ref_tracer(triangles);
+  std::vector<ReferenceHit> ref(rays.size());
+  const auto t_ref = Clock::now();
+  parallel_for(rays.size(), threads, 64, [&](std::size_t b, std::size_t e, unsigned) {
+    for (std::size_t i = b; i < e; ++i) ref[i] = ref_tracer.closest_hit(rays[i]);
+  });
+  res.reference_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_ref).count();
+  for (const ReferenceHit& h : ref) res.reference_hits += h.valid();
+
+  const QueryOptions q;  // watertight, ordered: the product's defaults
+  std::mutex mutex;
+  for (const VerifyStructure& s : structures) {
+    const std::unique_ptr<Accelerator> accel = build_accelerator(s.factory_name, triangles, s.options);
+    const unsigned nt = resolve_threads(threads);
+    std::vector<VerifyCounts> per_thread(nt);
+    parallel_for(rays.size(), threads, 256, [&](std::size_t b, std::size_t e, unsigned ti) {
+      VerifyCounts& c = per_thread[ti];
+      for (std::size_t i = b; i < e; ++i) {
+        const Hit h = accel->closest_hit(rays[i], q);
+        const Verdict vc = classify_closest(triangles, rays[i], ref[i], h);
+        const Verdict va = classify_any(ref[i], accel->any_hit(rays[i], q));
+        ++c.rays;
+        c.mismatched_prim += vc == Verdict::mismatched_prim;
+        c.t_beyond_tolerance += vc == Verdict::t_beyond_tolerance;
+        c.near_ties += (vc == Verdict::near_tie) + (va == Verdict::near_tie);
+        c.anyhit_disagree += va == Verdict::mismatched_prim;
+        if (vc == Verdict::mismatched_prim || vc == Verdict::t_beyond_tolerance || va == Verdict::mismatched_prim) {
+          const std::lock_guard<std::mutex> lock(mutex);
+          if (res.examples.size() < 10) {
+            std::ostringstream os;
+            os.precision(9);
+            const Ray& ray = rays[i];
+            os << s.label << " ray " << i << " o=(" << ray.origin.x << "," << ray.origin.y << "," << ray.origin.z
+               << ") d=(" << ray.direction.x << "," << ray.direction.y << "," << ray.direction.z << "): closest "
+               << to_string(vc) << " got prim " << (h.valid() ? static_cast<long long>(h.prim) : -1LL) << " t "
+               << h.t << ", reference prim " << (ref[i].valid() ? static_cast<long long>(ref[i].prim) : -1LL)
+               << " t " << ref[i].t << "; any " << to_string(va);
+            res.examples.push_back(os.str());
+          }
+        }
+      }
+    });
+    VerifyCounts sum;
+    for (const VerifyCounts& c : per_thread) sum += c;
+    sum.build_ms = accel->build_stats().build_ms;
+    res.per_structure.emplace_back(s.label, sum);
+    res.total += sum;
+  }
+  res.total_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_start).count();
+  return res;
+}
+
+}  // namespace accelviz
