@@ -1,0 +1,159 @@
+// The double-precision reference and the classifier behind `accelviz verify`:
+// hand-made rays whose answers are known exactly.
+#include <gtest/gtest.h>
+
+#include "core/accel/brute_force.h"
+#include "core/accel/reference.h"
+#include "core/analysis/verify.h"
+
+using namespace accelviz;
+
+namespace {
+
+// Unit square in z = 0 as two triangles sharing the diagonal (0,0)-(1,1).
+std::vector<Triangle> square() {
+  return {{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}}, {{0, 0, 0}, {1, 1, 0}, {0, 1, 0}}};
+}
+
+}  // namespace
+
+TEST(Reference, HitsInteriorAtExactT) {
+  const auto tris = square();
+  const ReferenceTracer ref(tris);
+  const ReferenceHit h = ref.closest_hit(Ray({0.75f, 0.25f, 2.0f}, {0, 0, -1}));
+  ASSERT_TRUE(h.valid());
+  EXPECT_EQ(h.prim, 0u);
+  EXPECT_EQ(h.t, 2.0);
+  EXPECT_FALSE(h.closest_near_edge);
+  EXPECT_TRUE(h.robust_hit);
+  EXPECT_TRUE(ref.any_hit(Ray({0.75f, 0.25f, 2.0f}, {0, 0, -1})));
+}
+
+TEST(Reference, SharedDiagonalIsHitAndNearEdge) {
+  const auto tris = square();
+  const ReferenceHit h = ReferenceTracer(tris).closest_hit(Ray({0.5f, 0.5f, 1.0f}, {0, 0, -1}));
+  ASSERT_TRUE(h.valid());
+  EXPECT_EQ(h.t, 1.0);
+  EXPECT_TRUE(h.closest_near_edge);
+}
+
+TEST(Reference, MissOutsideAndBeyondTmax) {
+  const auto tris = square();
+  const ReferenceTracer ref(tris);
+  EXPECT_FALSE(ref.closest_hit(Ray({2.0f, 0.5f, 1.0f}, {0, 0, -1})).valid());
+  EXPECT_FALSE(ref.closest_hit(Ray({0.5f, 0.25f, 1.0f}, {0, 0, -1}, 0.0f, 0.5f)).valid());
+  EXPECT_FALSE(ref.any_hit(Ray({0.5f, 0.25f, 1.0f}, {0, 0, -1}, 0.0f, 0.5f)));
+}
+
+TEST(Reference, RayInThePlaneIsANearMissNotAHit) {
+  const auto tris = square();
+  const ReferenceHit h = ReferenceTracer(tris).closest_hit(Ray({-1.0f, 0.5f, 0.0f}, {1, 0, 0}));
+  EXPECT_FALSE(h.valid());
+  EXPECT_TRUE(h.near_hit);
+  EXPECT_FALSE(h.robust_hit);
+}
+
+TEST(Reference, ClosestOfTwoParallelTriangles) {
+  std::vector<Triangle> tris = {{{0, 0, 1}, {1, 0, 1}, {0, 1, 1}}, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}};
+  const ReferenceHit h = ReferenceTracer(tris).closest_hit(Ray({0.2f, 0.2f, -1.0f}, {0, 0, 1}));
+  ASSERT_TRUE(h.valid());
+  EXPECT_EQ(h.prim, 1u);
+  EXPECT_EQ(h.t, 1.0);
+}
+
+TEST(Classifier, SamePrimSameTIsMatchOtherTIsBeyondTolerance) {
+  const auto tris = square();
+  const Ray ray({0.75f, 0.25f, 2.0f}, {0, 0, -1});
+  const ReferenceHit ref = ReferenceTracer(tris).closest_hit(ray);
+  Hit got;
+  got.prim = 0;
+  got.t = 2.0f;
+  EXPECT_EQ(classify_closest(tris, ray, ref, got), Verdict::match);
+  got.t = 2.1f;
+  EXPECT_EQ(classify_closest(tris, ray, ref, got), Verdict::t_beyond_tolerance);
+}
+
+TEST(Classifier, NeighbourOnSharedEdgeIsNearTie) {
+  const auto tris = square();
+  const Ray ray({0.5f, 0.5f, 1.0f}, {0, 0, -1});
+  const ReferenceHit ref = ReferenceTracer(tris).closest_hit(ray);
+  Hit got;
+  got.prim = ref.prim == 0 ? 1 : 0;
+  got.t = 1.0f;
+  EXPECT_EQ(classify_closest(tris, ray, ref, got), Verdict::near_tie);
+}
+
+TEST(Classifier, WrongPrimAtOtherTIsMismatch) {
+  std::vector<Triangle> tris = {{{0, 0, 1}, {1, 0, 1}, {0, 1, 1}}, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}};
+  const Ray ray({0.2f, 0.2f, -1.0f}, {0, 0, 1});
+  const ReferenceHit ref = ReferenceTracer(tris).closest_hit(ray);
+  Hit got;
+  got.prim = 0;  // the farther one: a structure that skipped the closer hit
+  got.t = 2.0f;
+  EXPECT_EQ(classify_closest(tris, ray, ref, got), Verdict::mismatched_prim);
+  EXPECT_EQ(classify_closest(tris, ray, ref, Hit{}), Verdict::mismatched_prim);  // a plain miss
+}
+
+TEST(Classifier, HitWhereReferenceMissesClearlyIsMismatch) {
+  const auto tris = square();
+  const Ray ray({3.0f, 3.0f, 1.0f}, {0, 0, -1});
+  const ReferenceHit ref = ReferenceTracer(tris).closest_hit(ray);
+  Hit got;
+  got.prim = 0;
+  got.t = 1.0f;
+  EXPECT_EQ(classify_closest(tris, ray, ref, got), Verdict::mismatched_prim);
+}
+
+TEST(Classifier, AnyHit) {
+  ReferenceHit miss;
+  EXPECT_EQ(classify_any(miss, false), Verdict::match);
+  EXPECT_EQ(classify_any(miss, true), Verdict::mismatched_prim);
+  ReferenceHit robust;
+  robust.prim = 0;
+  robust.t = 1.0;
+  robust.robust_hit = robust.near_hit = true;
+  EXPECT_EQ(classify_any(robust, true), Verdict::match);
+  EXPECT_EQ(classify_any(robust, false), Verdict::mismatched_prim);
+  ReferenceHit edge_only = robust;
+  edge_only.robust_hit = false;
+  EXPECT_EQ(classify_any(edge_only, false), Verdict::near_tie);
+}
+
+TEST(Reference, AgreesWithFloatBruteForceOnRandomRays) {
+  std::vector<Triangle> tris;
+  for (int i = 0; i < 200; ++i) {
+    const float x = static_cast<float>(i % 20) * 0.1f, y = static_cast<float>(i / 20) * 0.1f;
+    tris.push_back({{x, y, 0.01f * static_cast<float>(i % 7)}, {x + 0.1f, y, 0.0f}, {x, y + 0.1f, 0.02f}});
+  }
+  const std::vector<Ray> rays = verify_rays(tris, 5000, 7);
+  const ReferenceTracer ref(tris);
+  const BruteForce brute(tris);
+  int hits = 0;
+  for (const Ray& r : rays) {
+    const ReferenceHit rh = ref.closest_hit(r);
+    hits += rh.valid();
+    const Verdict v = classify_closest(tris, r, rh, brute.closest_hit(r, {}));
+    EXPECT_TRUE(v == Verdict::match || v == Verdict::near_tie) << to_string(v);
+  }
+  EXPECT_GT(hits, 500);
+}
+
+TEST(Verify, StructureListParsing) {
+  const auto all = parse_verify_structures("all", 1);
+  ASSERT_GE(all.size(), 7u);
+  EXPECT_EQ(all[0].label, "brute");
+  EXPECT_EQ(parse_verify_structures("bvh", 1).size(), 3u);
+  EXPECT_EQ(parse_verify_structures("kdtree,grid,kdtree", 1).size(), 2u);
+  EXPECT_THROW(parse_verify_structures("voxels", 1), std::invalid_argument);
+  EXPECT_THROW(parse_verify_structures("nope", 1), std::invalid_argument);
+}
+
+TEST(Verify, RaysAreDeterministic) {
+  const auto tris = square();
+  const auto a = verify_rays(tris, 1000, 3), b = verify_rays(tris, 1000, 3);
+  ASSERT_EQ(a.size(), 1000u);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].origin, b[i].origin);
+    EXPECT_EQ(a[i].direction, b[i].direction);
+  }
+}
