@@ -52,8 +52,7 @@ double time_tests(const CalibrateOptions& o, double& hit_fraction, Test&& test) 
       const bool h = test(k % n, item, t);
       hits += h;
       sum += h ? t : 0.0f;
-      item += stride;
-      if (item >= n) item -= n;
+      item = (item + stride) % n;
     }
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     g_sink = g_sink + sum + static_cast<double>(hits);

@@ -1,0 +1,177 @@
+// accelviz refit SCENE --frames F --amplitude A [--rebuild-ratio R] --out DIR:
+// refit decay of the BVH under smooth deterministic vertex motion, frame by
+// frame against a fresh build (core/analysis/refit_decay.h), written as
+// refit.csv, refit.json and charts.
+#include "app/cli_common.h"
+
+#include "core/analysis/chart.h"
+#include "core/analysis/refit_decay.h"
+#include "core/query/camera.h"
+#include "core/query/ray_sets.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace accelviz::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RefitCliOptions {
+  std::string scene;
+  int frames = 30;
+  float amplitude = 0.02f;
+  double frame_step = 0.05;
+  double rebuild_ratio = 0;
+  std::string size = "320x240";
+  unsigned threads = 0;
+  std::uint64_t seed = 1;
+  std::string out;
+  bool force = false;
+  StructureCli structure_opts;
+};
+
+bool is_refit_file(const fs::path& p) {
+  const std::string n = p.filename().string();
+  return n == "refit.csv" || n == "refit.json" || (n.rfind("refit-", 0) == 0 && p.extension() == ".png");
+}
+
+int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
+  const ImageSize size = parse_size(o.size);
+  if (!(o.amplitude >= 0)) throw UsageError("--amplitude must not be negative");
+  if (!(o.rebuild_ratio == 0 || o.rebuild_ratio >= 1)) throw UsageError("--rebuild-ratio must be 0 (never) or >= 1");
+  std::error_code ec;
+  const fs::path dir(o.out);
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) throw std::runtime_error(o.out + ": exists and is not a directory");
+  if (fs::is_directory(dir, ec)) {
+    for (const auto& e : fs::directory_iterator(dir, ec))
+      if (is_refit_file(e.path())) {
+        if (!o.force) throw std::runtime_error(o.out + ": already holds refit files (use --force to overwrite)");
+        fs::remove(e.path(), ec);
+      }
+  } else if (!fs::create_directories(dir, ec) || ec) {
+    throw std::runtime_error(o.out + ": cannot create directory");
+  }
+
+  Progress progress(global.quiet);
+  progress.begin("loading " + o.scene);
+  const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
+  progress.end(std::to_string(scene.triangles.size()) + " triangles");
+  // The camera frames the rest pose; the motion is small against the scene, so it stays framed.
+  const std::vector<Ray> rays = primary_rays(camera_for("", scene, size), size.width, size.height);
+
+  RefitDecayOptions opts;
+  opts.frames = o.frames;
+  opts.amplitude = o.amplitude;
+  opts.frame_step = o.frame_step;
+  opts.rebuild_ratio = o.rebuild_ratio;
+  opts.seed = o.seed;
+  opts.threads = o.threads;
+  opts.bvh = o.structure_opts.to_options(o.threads, false).bvh;
+  progress.begin("refitting " + std::to_string(o.frames) + " frames");
+  const RefitDecayResult r = run_refit_decay(scene.triangles, rays, opts);
+  progress.end(std::to_string(r.rebuilds) + " rebuilds");
+
+  // ---- files ----
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "frame,refits_since_build,refit_ms,rebuild_ms,sah_refit,sah_fresh,ratio,nodes_per_ray_refit,"
+         "prims_per_ray_refit,nodes_per_ray_fresh,prims_per_ray_fresh,rebuilt\n";
+  nlohmann::json frames = nlohmann::json::array();
+  for (const RefitFrame& f : r.frames) {
+    csv << f.frame << ',' << f.refits_since_build << ',' << f.refit_ms << ',' << f.rebuild_ms << ',' << f.sah_refit
+        << ',' << f.sah_fresh << ',' << f.ratio << ',' << f.nodes_per_ray_refit << ',' << f.prims_per_ray_refit << ','
+        << f.nodes_per_ray_fresh << ',' << f.prims_per_ray_fresh << ',' << (f.rebuilt ? 1 : 0) << '\n';
+    frames.push_back({{"frame", f.frame},
+                      {"refits_since_build", f.refits_since_build},
+                      {"refit_ms", f.refit_ms},
+                      {"rebuild_ms", f.rebuild_ms},
+                      {"sah_refit", f.sah_refit},
+                      {"sah_fresh", f.sah_fresh},
+                      {"ratio", f.ratio},
+                      {"nodes_per_ray_refit", f.nodes_per_ray_refit},
+                      {"prims_per_ray_refit", f.prims_per_ray_refit},
+                      {"nodes_per_ray_fresh", f.nodes_per_ray_fresh},
+                      {"prims_per_ray_fresh", f.prims_per_ray_fresh},
+                      {"rebuilt", f.rebuilt}});
+  }
+  std::ofstream(dir / "refit.csv") << csv.str();
+  const nlohmann::json j = {{"scene", o.scene},
+                            {"triangles", scene.triangles.size()},
+                            {"frames", o.frames},
+                            {"amplitude_relative_to_diagonal", o.amplitude},
+                            {"frame_step_periods", o.frame_step},
+                            {"rebuild_ratio", o.rebuild_ratio},
+                            {"rays", rays.size()},
+                            {"seed", o.seed},
+                            {"rebuilds", r.rebuilds},
+                            {"per_frame", frames}};
+  std::ofstream(dir / "refit.json") << j.dump(2) << "\n";
+
+  ChartSeries refit{"refitted", {}, {}, {}, {214, 39, 40}, true, true, 2};
+  ChartSeries fresh{"fresh build", {}, {}, {}, {31, 119, 180}, true, true, 2};
+  ChartSeries nodes_refit = refit, nodes_fresh = fresh, ms_refit{"refit ms", {}, {}, {}, {214, 39, 40}, true, true, 2},
+              ms_build{"rebuild ms", {}, {}, {}, {31, 119, 180}, true, true, 2};
+  for (const RefitFrame& f : r.frames) {
+    const double x = f.frame;
+    refit.x.push_back(x), refit.y.push_back(f.sah_refit), refit.labels.push_back(f.rebuilt ? "rebuild" : "");
+    fresh.x.push_back(x), fresh.y.push_back(f.sah_fresh);
+    nodes_refit.x.push_back(x), nodes_refit.y.push_back(f.nodes_per_ray_refit);
+    nodes_fresh.x.push_back(x), nodes_fresh.y.push_back(f.nodes_per_ray_fresh);
+    ms_refit.x.push_back(x), ms_refit.y.push_back(f.refit_ms);
+    ms_build.x.push_back(x), ms_build.y.push_back(f.rebuild_ms);
+  }
+  ChartOptions c;
+  c.x_label = "frame";
+  c.title = "sah cost: refit vs fresh build";
+  c.y_label = "sah cost";
+  write_png((dir / "refit-sah.png").string(), draw_chart(c, {refit, fresh}), true);
+  c.title = "nodes visited per ray";
+  c.y_label = "nodes/ray";
+  write_png((dir / "refit-nodes.png").string(), draw_chart(c, {nodes_refit, nodes_fresh}), true);
+  c.title = "refit vs rebuild time";
+  c.y_label = "ms";
+  write_png((dir / "refit-ms.png").string(), draw_chart(c, {ms_refit, ms_build}), true);
+
+  // ---- text ----
+  std::printf("scene %s: %zu triangles; %d frames, amplitude %g of the diagonal; %zu primary rays\n", o.scene.c_str(),
+              scene.triangles.size(), o.frames, o.amplitude, rays.size());
+  std::printf("%6s %8s %10s %10s %10s %10s %8s %12s %12s %8s\n", "frame", "refits", "refit ms", "build ms", "SAH refit",
+              "SAH fresh", "ratio", "nodes refit", "nodes fresh", "rebuilt");
+  for (const RefitFrame& f : r.frames)
+    std::printf("%6d %8d %10.3f %10.3f %10.3f %10.3f %8.3f %12.2f %12.2f %8s\n", f.frame, f.refits_since_build,
+                f.refit_ms, f.rebuild_ms, f.sah_refit, f.sah_fresh, f.ratio, f.nodes_per_ray_refit,
+                f.nodes_per_ray_fresh, f.rebuilt ? "yes" : "");
+  std::printf("rebuilds: %d; wrote %s\n", r.rebuilds, absolute_path(o.out).c_str());
+  return 0;
+}
+
+Command add_refit_command(CLI::App& parent, const GlobalOptions& global) {
+  auto o = std::make_shared<RefitCliOptions>();
+  CLI::App* sub = parent.add_subcommand(
+      "refit", "Refit decay: BVH quality under smooth vertex motion, refitted frame by frame against fresh builds");
+  sub->add_option("SCENE", o->scene, "Scene file (.gltf, .glb, .obj) or builtin:NAME[?key=value&...]")->required();
+  sub->add_option("--frames", o->frames, "Frames after the rest pose")->check(CLI::Range(1, 100000))->capture_default_str();
+  sub->add_option("--amplitude", o->amplitude, "Vertex motion amplitude, relative to the scene diagonal")
+      ->capture_default_str();
+  sub->add_option("--frame-step", o->frame_step, "Time advance per frame, in motion periods")->capture_default_str();
+  sub->add_option("--rebuild-ratio", o->rebuild_ratio,
+                  "Rebuild when refit SAH / fresh SAH exceeds this (0: never)")
+      ->capture_default_str();
+  sub->add_option("--size", o->size, "Primary rays for the traversal figures: WxH")->check(size_validator())->capture_default_str();
+  sub->add_option("--threads,-j", o->threads, "Build and trace threads (0: all)")->capture_default_str();
+  sub->add_option("--seed", o->seed, "Seed of the motion")->capture_default_str();
+  sub->add_option("--out,-o", o->out, "Output directory (created if missing)")->required();
+  sub->add_flag("--force,-f", o->force, "Overwrite the refit files of an earlier run in DIR");
+  o->structure_opts.add_to(sub);
+  return {sub, [o, &global] { return run_refit(*o, global); }};
+}
+
+const CommandRegistration reg{add_refit_command};
+
+}  // namespace
+
+}  // namespace accelviz::cli

@@ -1,0 +1,395 @@
+// accelviz sweep SCENE --param NAME=V1,V2 ... --out DIR: what accuracy costs
+// in time. Thin over core/analysis/sweep.h: parse, load, make the ray set,
+// run the sweep, then write sweep.csv, sweep.json and the charts, and print
+// the Pareto-optimal settings and the best setting for a few ray budgets.
+#include "app/cli_common.h"
+
+#include "core/analysis/chart.h"
+#include "core/analysis/sweep.h"
+#include "core/query/camera.h"
+#include "core/util/parallel.h"
+
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <thread>
+
+namespace accelviz::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct SweepCliOptions {
+  std::string scene;
+  std::string structure = "bvh";
+  std::vector<std::string> params;
+  std::string rays = "primary";
+  std::string size = "640x480";
+  int repeat = 3;
+  unsigned threads = 0;
+  double ray_budget = 1e6;
+  std::string camera;
+  std::uint64_t seed = 1;
+  int edge_probes = 20000;
+  std::string out;
+  bool force = false;
+};
+
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("model name", 0) == 0) {
+      const std::size_t c = line.find(':');
+      if (c != std::string::npos) return line.substr(line.find_first_not_of(' ', c + 1));
+    }
+  return "unknown";
+}
+
+std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+/// This process's command line, arguments joined by spaces (for the record in sweep.json).
+std::string command_line() {
+  std::ifstream in("/proc/self/cmdline", std::ios::binary);
+  std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  while (!all.empty() && all.back() == '\0') all.pop_back();
+  for (char& c : all)
+    if (c == '\0') c = ' ';
+  return all;
+}
+
+double load_average() {
+  std::ifstream in("/proc/loadavg");
+  double l = -1;
+  in >> l;
+  return l;
+}
+
+/// Files a sweep writes: sweep.csv, sweep.json, sweep-*.png.
+bool is_sweep_file(const fs::path& p) {
+  const std::string n = p.filename().string();
+  return n == "sweep.csv" || n == "sweep.json" || (n.rfind("sweep-", 0) == 0 && p.extension() == ".png");
+}
+
+void prepare_out_dir(const std::string& dir, bool force) {
+  std::error_code ec;
+  const fs::path p(dir);
+  if (fs::exists(p, ec) && !fs::is_directory(p, ec)) throw std::runtime_error(dir + ": exists and is not a directory");
+  if (fs::is_directory(p, ec)) {
+    for (const auto& e : fs::directory_iterator(p, ec))
+      if (is_sweep_file(e.path())) {
+        if (!force) throw std::runtime_error(dir + ": already holds sweep files (use --force to overwrite)");
+        fs::remove(e.path(), ec);  // stale charts of an earlier sweep would mislead
+      }
+    return;
+  }
+  if (!fs::create_directories(p, ec) || ec) throw std::runtime_error(dir + ": cannot create directory");
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  if (!out) throw std::runtime_error(path.string() + ": cannot write");
+}
+
+const glm::u8vec3 kPalette[] = {{31, 119, 180}, {255, 127, 14}, {44, 160, 44}, {214, 39, 40}, {148, 103, 189},
+                                {140, 86, 75},  {227, 119, 194}, {127, 127, 127}, {188, 189, 34}, {23, 190, 207}};
+
+struct Figure {
+  const char* key;
+  const char* title;
+  double (*get)(const SweepResult&, double budget);
+};
+
+const Figure kFigures[] = {
+    {"sah_cost", "sah cost", [](const SweepResult& r, double) { return r.sah_cost; }},
+    {"rays_per_s", "rays/s", [](const SweepResult& r, double) { return r.rays_per_s; }},
+    {"nodes_per_ray", "nodes visited per ray", [](const SweepResult& r, double) { return r.nodes_per_ray; }},
+    {"build_ms", "build ms", [](const SweepResult& r, double) { return r.build_ms; }},
+    {"total_ms", "total ms for the ray budget", [](const SweepResult& r, double b) { return r.total_ms(b); }},
+};
+
+/// (a) build time against trace time for the budget, Pareto front joined and labelled.
+RgbImage pareto_chart(const std::vector<SweepResult>& results, const std::vector<std::size_t>& front,
+                      double budget, const std::string& scene) {
+  ChartSeries all{"settings", {}, {}, {}, kPalette[0], false, true, 3};
+  ChartSeries pf{"pareto front", {}, {}, {}, kPalette[3], true, true, 4};
+  for (const SweepResult& r : results) {
+    all.x.push_back(r.build_ms);
+    all.y.push_back(r.trace_ms(budget));
+  }
+  for (std::size_t i : front) {
+    pf.x.push_back(results[i].build_ms);
+    pf.y.push_back(results[i].trace_ms(budget));
+    pf.labels.push_back(setting_label(results[i].setting));
+  }
+  // Label the dominated points too when there are few, so every dot is identifiable.
+  if (results.size() <= 16)
+    for (std::size_t i = 0; i < results.size(); ++i)
+      all.labels.push_back(std::find(front.begin(), front.end(), i) == front.end() ? setting_label(results[i].setting)
+                                                                                   : "");
+  ChartOptions o;
+  o.width = 800;
+  o.height = 520;
+  o.title = "build vs trace: " + scene;
+  o.x_label = "build ms";
+  o.y_label = "trace ms for " + format_tick(budget) + " rays";
+  o.y_from_zero = false;
+  return draw_chart(o, {all, pf});
+}
+
+/// (b) one figure against parameter `p`: x = its values, one series per
+/// combination of the other parameters.
+RgbImage figure_chart(const std::vector<SweepResult>& results, const std::vector<SweepParam>& params, std::size_t p,
+                      const Figure& fig, double budget) {
+  std::map<std::string, ChartSeries> by_rest;
+  std::vector<std::string> order;
+  for (const SweepResult& r : results) {
+    SweepSetting rest;
+    std::size_t xi = 0;
+    for (std::size_t k = 0; k < r.setting.size(); ++k) {
+      if (k == p) {
+        const auto& vals = params[p].values;
+        xi = static_cast<std::size_t>(std::find(vals.begin(), vals.end(), r.setting[k].second) - vals.begin());
+      } else {
+        rest.push_back(r.setting[k]);
+      }
+    }
+    const std::string name = rest.empty() ? "" : setting_label(rest);
+    auto [it, inserted] = by_rest.try_emplace(name);
+    if (inserted) {
+      it->second.name = name;
+      it->second.color = kPalette[order.size() % std::size(kPalette)];
+      order.push_back(name);
+    }
+    it->second.x.push_back(static_cast<double>(xi));
+    it->second.y.push_back(fig.get(r, budget));
+  }
+  std::vector<ChartSeries> series;
+  for (const std::string& n : order) series.push_back(by_rest[n]);
+  ChartOptions o;
+  o.title = std::string(fig.title) + " vs " + params[p].name;
+  o.x_label = params[p].name;
+  o.y_label = fig.key == std::string("total_ms") ? std::string("total ms, ") + format_tick(budget) + " rays" : fig.title;
+  o.x_categories = params[p].values;
+  return draw_chart(o, series);
+}
+
+nlohmann::json result_json(const SweepResult& r, double budget) {
+  nlohmann::json s = nlohmann::json::object();
+  for (const auto& [k, v] : r.setting) s[k] = v;
+  nlohmann::json j = {
+      {"setting", s},
+      {"label", setting_label(r.setting)},
+      {"triangle_test", r.triangle_test},
+      {"build_ms", r.build_ms},
+      {"build_ms_runs", r.build_ms_runs},
+      {"memory_bytes", r.memory_bytes},
+      {"nodes", r.nodes},
+      {"leaves", r.leaves},
+      {"max_depth", r.max_depth},
+      {"sah_cost", r.sah_cost},
+      {"epo", r.epo >= 0 ? nlohmann::json(r.epo) : nlohmann::json(nullptr)},
+      {"rays_per_s", r.rays_per_s},
+      {"rays_per_s_runs", r.rays_per_s_runs},
+      {"nodes_per_ray", r.nodes_per_ray},
+      {"prims_per_ray", r.prims_per_ray},
+      {"hit_fraction", r.hit_fraction},
+      {"trace_ms_budget", r.trace_ms(budget)},
+      {"total_ms_budget", r.total_ms(budget)},
+      {"total_ms_1e6", r.total_ms(1e6)},
+      {"total_ms_1e9", r.total_ms(1e9)},
+  };
+  if (r.edges.probes > 0)
+    j["edges"] = {{"probes", r.edges.probes}, {"misses", r.edges.misses}, {"double_hits", r.edges.double_hits}};
+  return j;
+}
+
+int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
+  // ---- everything that can be a usage error, before any long work ----
+  if (o.params.empty()) throw UsageError("sweep: give at least one --param NAME=V1,V2,...");
+  if (!(o.ray_budget > 0) || !std::isfinite(o.ray_budget)) throw UsageError("--ray-budget must be positive");
+  std::vector<SweepParam> params;
+  std::vector<SweepSetting> settings;
+  try {
+    for (const std::string& p : o.params) params.push_back(parse_sweep_param(p));
+    settings = expand_sweep(o.structure, params);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  const ImageSize size = parse_size(o.size);
+  const RayKind kind = *parse_ray_kind(o.rays);
+  prepare_out_dir(o.out, o.force);
+  const unsigned threads = resolve_threads(o.threads);
+  Progress progress(global.quiet);
+
+  progress.begin("loading " + o.scene);
+  const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
+  progress.end(std::to_string(scene.triangles.size()) + " triangles");
+
+  progress.begin(std::string("making ") + o.rays + " rays");
+  const Camera camera = camera_for(o.camera, scene, size);
+  bool synthetic_light = false;
+  const std::vector<Ray> rays =
+      sweep_ray_set(scene, camera, size.width, size.height, kind, o.seed, o.threads, &synthetic_light);
+  progress.end(std::to_string(rays.size()) + " rays");
+
+  // Shared-edge probes only when the triangle test is swept: they need an edge map of the whole mesh.
+  std::vector<EdgeProbe> probes;
+  bool sweeps_triangle = false;
+  for (const SweepParam& p : params) sweeps_triangle |= p.name == "triangle";
+  if (sweeps_triangle && o.edge_probes > 0) {
+    progress.begin("shared-edge probes");
+    probes = shared_edge_probes(scene.triangles, static_cast<std::size_t>(o.edge_probes), o.seed);
+    progress.end(std::to_string(probes.size()) + " probes");
+  }
+
+  SweepConfig config;
+  config.structure = o.structure;
+  config.base.bvh.threads = o.threads;
+  config.base.threads = o.threads;
+  config.repeat = o.repeat;
+  config.threads = o.threads;
+  config.ray_budget = o.ray_budget;
+  std::vector<SweepResult> results;
+  for (std::size_t i = 0; i < settings.size(); ++i) {
+    progress.begin("setting " + std::to_string(i + 1) + "/" + std::to_string(settings.size()) + ": " +
+                   setting_label(settings[i]));
+    results.push_back(measure_sweep_setting(scene.triangles, rays, probes, config, settings[i]));
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "build %.1f ms, %.3g rays/s", results.back().build_ms, results.back().rays_per_s);
+    progress.end(buf);
+  }
+
+  // ---- analysis ----
+  std::vector<Point2> pts;
+  for (const SweepResult& r : results) pts.push_back({r.build_ms, r.trace_ms(o.ray_budget)});
+  const std::vector<std::size_t> front = pareto_front(pts);
+  const double budgets[] = {1e6, 1e9, o.ray_budget};
+
+  // ---- files ----
+  const fs::path dir(o.out);
+  write_text(dir / "sweep.csv", sweep_csv(results, o.ray_budget));
+  nlohmann::json j;
+  const std::string cmdline = command_line();
+  j["machine"] = {{"cpu_model", cpu_model()},
+                  {"hardware_threads", std::thread::hardware_concurrency()},
+                  {"threads_used", threads},
+                  {"load_average_1min", load_average()},
+                  {"date", utc_now()},
+                  {"command_line", cmdline}};
+  j["scene"] = o.scene;
+  j["triangles"] = scene.triangles.size();
+  j["structure"] = o.structure;
+  j["rays"] = {{"kind", o.rays}, {"count", rays.size()}, {"size", {size.width, size.height}}, {"seed", o.seed}};
+  if (kind == RayKind::shadow) j["rays"]["synthetic_light"] = synthetic_light;
+  j["repeat"] = o.repeat;
+  j["ray_budget"] = o.ray_budget;
+  j["params"] = nlohmann::json::object();
+  for (const SweepParam& p : params) j["params"][p.name] = p.values;
+  j["results"] = nlohmann::json::array();
+  for (const SweepResult& r : results) j["results"].push_back(result_json(r, o.ray_budget));
+  j["pareto_front"] = nlohmann::json::array();
+  for (std::size_t i : front) j["pareto_front"].push_back(setting_label(results[i].setting));
+  j["best_for_budget"] = nlohmann::json::array();
+  for (double b : budgets) {
+    const SweepResult& r = results[best_for_budget(results, b)];
+    j["best_for_budget"].push_back({{"rays", b}, {"setting", setting_label(r.setting)}, {"total_ms", r.total_ms(b)}});
+  }
+  write_text(dir / "sweep.json", j.dump(2) + "\n");
+
+  std::vector<std::string> charts;
+  auto chart = [&](const std::string& name, const RgbImage& img) {
+    write_png((dir / name).string(), img, true);
+    charts.push_back(name);
+  };
+  chart("sweep-pareto.png", pareto_chart(results, front, o.ray_budget, o.scene));
+  for (std::size_t p = 0; p < params.size(); ++p)
+    for (const Figure& f : kFigures) {
+      if (f.key == std::string("sah_cost") && o.structure != "bvh" && o.structure != "kdtree" && o.structure != "octree")
+        continue;  // grids and voxels report no SAH cost
+      chart("sweep-" + std::string(f.key) + "-vs-" + params[p].name + ".png",
+            figure_chart(results, params, p, f, o.ray_budget));
+    }
+
+  // ---- text ----
+  std::printf("scene %s: %zu triangles; %s, %zu %s rays; %u threads; medians of %d; ray budget %g\n", o.scene.c_str(),
+              scene.triangles.size(), o.structure.c_str(), rays.size(), o.rays.c_str(), threads, o.repeat,
+              o.ray_budget);
+  std::printf("%-32s %10s %10s %8s %10s %10s %12s %12s", "setting", "build ms", "memory", "SAH", "nodes/ray",
+              "prims/ray", "Mrays/s", "total ms");
+  if (!probes.empty()) std::printf(" %12s", "edge leaks");
+  std::printf("\n");
+  for (const SweepResult& r : results) {
+    std::printf("%-32s %10.2f %10s %8.3f %10.2f %10.2f %12.3f %12.2f", setting_label(r.setting).c_str(), r.build_ms,
+                format_bytes(r.memory_bytes).c_str(), r.sah_cost, r.nodes_per_ray, r.prims_per_ray, r.rays_per_s / 1e6,
+                r.total_ms(o.ray_budget));
+    if (!probes.empty())
+      std::printf(" %5llu/%llu", static_cast<unsigned long long>(r.edges.misses),
+                  static_cast<unsigned long long>(r.edges.probes));
+    std::printf("\n");
+  }
+  std::printf("\nPareto-optimal (build ms, trace ms for %g rays):\n", o.ray_budget);
+  for (std::size_t i : front)
+    std::printf("  %-32s build %.2f ms, trace %.2f ms\n", setting_label(results[i].setting).c_str(),
+                results[i].build_ms, results[i].trace_ms(o.ray_budget));
+  for (double b : {1e6, 1e9}) {
+    const SweepResult& r = results[best_for_budget(results, b)];
+    std::printf("best for %g rays: %s (total %.1f ms)\n", b, setting_label(r.setting).c_str(), r.total_ms(b));
+  }
+  std::printf("wrote %s: sweep.csv, sweep.json and %zu charts\n", absolute_path(o.out).c_str(), charts.size());
+  return 0;
+}
+
+Command add_sweep_command(CLI::App& parent, const GlobalOptions& global) {
+  auto o = std::make_shared<SweepCliOptions>();
+  CLI::App* sub = parent.add_subcommand(
+      "sweep", "Sweep structure parameters: build time, memory, SAH, rays/s and total time for a ray budget per "
+               "setting, the Pareto front, CSV/JSON and charts");
+  sub->add_option("SCENE", o->scene, "Scene file (.gltf, .glb, .obj) or builtin:NAME[?key=value&...]")->required();
+  sub->add_option("--structure,-s", o->structure, "Structure to sweep: bvh, kdtree, grid, octree, voxels")
+      ->check(CLI::IsMember({"bvh", "kdtree", "grid", "octree", "voxels"}))
+      ->capture_default_str();
+  sub->add_option("--param,-p", o->params,
+                  "NAME=V1,V2,... (repeatable; the cartesian product is swept). bvh: buckets (2..256 or exact), "
+                  "splitter (median,binned,exact), leaf, ctrav, cisect; kdtree: depth, ctrav, cisect, leaf, "
+                  "mailbox (on,off); grid: lambda, res (NXxNYxNZ); octree: depth, leaf; voxels: level; all: "
+                  "triangle (watertight,fast)")
+      ->required();
+  sub->add_option("--rays", o->rays, "Ray set: primary, diffuse or shadow")
+      ->check(CLI::IsMember({"primary", "diffuse", "shadow"}))
+      ->capture_default_str();
+  sub->add_option("--size", o->size, "Primary rays: one per pixel of a WxH image")->check(size_validator())->capture_default_str();
+  sub->add_option("--repeat,-n", o->repeat, "Builds and timed passes per setting (medians)")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  sub->add_option("--threads,-j", o->threads, "Build and trace threads (0: all hardware threads)")->capture_default_str();
+  sub->add_option("--ray-budget", o->ray_budget, "Rays N of total time = build + N / (rays/s)")->capture_default_str();
+  sub->add_option("--camera", o->camera, "View: ex,ey,ez,tx,ty,tz[,fovdeg] or gltf:N");
+  sub->add_option("--seed", o->seed, "Seed of diffuse directions and edge probes")->capture_default_str();
+  sub->add_option("--edge-probes", o->edge_probes,
+                  "When triangle is swept: rays aimed at shared-edge midpoints, to count leaks")
+      ->check(CLI::Range(0, 10000000))
+      ->capture_default_str();
+  sub->add_option("--out,-o", o->out, "Output directory (created if missing)")->required();
+  sub->add_flag("--force,-f", o->force, "Overwrite the sweep files of an earlier run in DIR");
+  return {sub, [o, &global] { return run_sweep_command(*o, global); }};
+}
+
+const CommandRegistration reg{add_sweep_command};
+
+}  // namespace
+
+}  // namespace accelviz::cli
