@@ -233,12 +233,30 @@ std::vector<EdgeProbe> shared_edge_probes(std::span<const Triangle> triangles, s
     const auto& [e, tris] = shared[k * shared.size() / n];
     const glm::vec3 a(e[0], e[1], e[2]), b(e[3], e[4], e[5]);
     const glm::vec3 target = a + 0.5f * (b - a);
-    // A uniform direction on the sphere; the origin sits outside the scene
-    // box so the ray crosses the surface where it hits the edge.
-    const double z = 2.0 * unit(state) - 1.0, phi = 6.283185307179586 * unit(state);
-    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-    const glm::vec3 dir(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
-                        static_cast<float>(z));
+    // A uniform direction on the sphere, redrawn until the two triangles'
+    // third vertices project to opposite sides of the edge as seen along it:
+    // only then must a ray through the edge hit one of them (seen edge-on, as
+    // a silhouette fold, it may rightly miss both). The origin sits outside
+    // the scene box.
+    auto third = [&](std::uint32_t t) {
+      const Triangle& tri = triangles[t];
+      for (const glm::vec3& v : {tri.v0, tri.v1, tri.v2})
+        if (v != a && v != b) return v;
+      return tri.v0;
+    };
+    const glm::vec3 ca = third(tris[0]), cb = third(tris[1]);
+    glm::vec3 dir(0.0f);
+    bool found = false;
+    for (int attempt = 0; attempt < 32 && !found; ++attempt) {
+      const double z = 2.0 * unit(state) - 1.0, phi = 6.283185307179586 * unit(state);
+      const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+      dir = glm::vec3(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
+                      static_cast<float>(z));
+      const glm::vec3 e = b - a;
+      const float sa = glm::dot(glm::cross(e, ca - a), dir), sb = glm::dot(glm::cross(e, cb - a), dir);
+      found = (sa > 0 && sb < 0) || (sa < 0 && sb > 0);
+    }
+    if (!found) continue;
     EdgeProbe p;
     p.ray = Ray(target - dir * (2.0f * diag), dir);
     p.tri_a = tris[0];

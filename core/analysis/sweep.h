@@ -52,7 +52,9 @@ void apply_sweep_setting(std::string_view structure, const SweepSetting& setting
 // ---- shared-edge probes (triangle-test accuracy) ---------------------------------
 
 /// A ray aimed at the midpoint of an edge that exactly two triangles share
-/// (same vertex positions), from outside the scene along a seeded direction.
+/// (same vertex positions), from outside the scene along a seeded direction
+/// from which the two triangles lie on opposite sides of the edge (so the
+/// edge is crossed, not seen as a silhouette fold).
 /// On a closed surface such a ray must hit one of the two triangles; a test
 /// that misses both lets it leak through the mesh.
 struct EdgeProbe {
@@ -61,7 +63,8 @@ struct EdgeProbe {
 };
 
 /// Up to `max_probes` probes over the shared edges (evenly sampled in edge
-/// order), directions from `seed`. Deterministic.
+/// order; an edge without a crossing direction in 32 draws is skipped),
+/// directions from `seed`. Deterministic.
 std::vector<EdgeProbe> shared_edge_probes(std::span<const Triangle> triangles, std::size_t max_probes,
                                           std::uint64_t seed);
 
