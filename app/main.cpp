@@ -1,8 +1,14 @@
 // accelviz: entry point. Parses the command line and dispatches to one
-// subcommand per cmd_*.cpp. Every failure ends here as one line on stderr:
-// exit 1 for a runtime problem (bad file, failed build), 2 for a usage error.
+// subcommand per cmd_*.cpp, or, without a subcommand, opens the window
+// (app/gui/) on a scene, or runs a script in it; with no display it renders
+// the demo heatmap headless instead. Every failure ends here as one line on
+// stderr: exit 1 for a runtime problem (bad file, failed build, failed
+// script), 2 for a usage error.
 #include "app/cli_common.h"
 #include "core/scene/load.h"
+#ifdef ACCELVIZ_HAVE_UI
+#include "app/gui/gui.h"
+#endif
 
 #include <CLI/CLI.hpp>
 
@@ -33,7 +39,8 @@ int main(int argc, char** argv) {
   using namespace accelviz;
   CLI::App app{
       "accelviz: a lab for ray-tracing acceleration structures.\n"
-      "Without a subcommand it renders the demo scene's heatmap to a PNG in the current directory."};
+      "Without a subcommand it opens the interactive window on SCENE (default: the demo scene); without a\n"
+      "display it renders the demo scene's heatmap to a PNG in the current directory instead."};
   app.set_version_flag("--version", "accelviz 0.1.0");
   app.require_subcommand(0, 1);
   app.footer("\nSCENE is a .gltf/.glb/.obj file or builtin:NAME[?key=value&...].\n" + builtin_list() +
@@ -42,6 +49,13 @@ int main(int argc, char** argv) {
 
   cli::GlobalOptions global;
   app.add_flag("-q,--quiet", global.quiet, "No progress messages on stderr");
+  std::string scene_arg, script_arg;
+  bool no_settings = false;
+  app.add_option("SCENE", scene_arg, "Scene to open in the window (.gltf, .glb, .obj or builtin:NAME[?...])");
+  app.add_option("--script", script_arg,
+                 "Run the commands in FILE in the window, then quit (implies --no-settings; see docs/gui.md)");
+  app.add_flag("--no-settings", no_settings,
+               "Neither read nor write settings or window layout (also: ACCELVIZ_NO_SETTINGS=1)");
 
   std::vector<cli::Command> commands = {
       cli::add_info_command(app, global),  cli::add_render_command(app, global), cli::add_bench_command(app, global),
@@ -60,6 +74,28 @@ int main(int argc, char** argv) {
   try {
     for (const cli::Command& c : commands)
       if (c.app->parsed()) return c.run();
+    const bool want_window = !scene_arg.empty() || !script_arg.empty();
+#ifdef ACCELVIZ_HAVE_UI
+    if (display_available()) {
+      GuiOptions g;
+      if (!scene_arg.empty()) g.scene = scene_arg;
+      if (!script_arg.empty()) g.script = script_arg;
+      g.use_settings = !no_settings;
+      g.quiet = global.quiet;
+      try {
+        return run_gui(g);
+      } catch (const NoWindow& e) {
+        if (want_window) throw std::runtime_error(std::string("cannot open a window: ") + e.what());
+        if (!global.quiet) std::fprintf(stderr, "accelviz: cannot open a window (%s)\n", one_line(e.what()).c_str());
+      }
+    } else if (want_window) {
+      throw std::runtime_error(
+          "no display (DISPLAY and WAYLAND_DISPLAY are unset): the window needs one; `accelviz render` draws "
+          "pictures without a window");
+    }
+#else
+    if (want_window) throw std::runtime_error("this build has no window (configure with ACCELVIZ_BUILD_UI=ON)");
+#endif
     return cli::run_demo(global);
   } catch (const cli::UsageError& e) {
     std::fprintf(stderr, "accelviz: %s\n", one_line(e.what()).c_str());

@@ -1,0 +1,496 @@
+// The GUI main loop: one GLFW window, the renderer drawing the 3D view into
+// its framebuffer, Dear ImGui panels on top, the app state polled once per
+// frame. Builds and heatmaps run on worker threads, so a frame never waits
+// for them; scripts are run between frames through the same calls as the
+// mouse and keyboard.
+#include "app/gui/gui.h"
+
+#include "app/gui/scene_view.h"
+#include "core/scene/load.h"
+#include "ui/app/app_state.h"
+#include "ui/app/script.h"
+#include "ui/app/settings.h"
+#include "ui/gl/glfw_context.h"
+#include "ui/imgui/imgui_context.h"
+#include "ui/panels/panels.h"
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <vector>
+
+namespace accelviz {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Dropped file names arrive in a GLFW callback; they are queued here and
+// opened by the main loop (one window, so one queue).
+std::vector<std::string>* g_dropped = nullptr;
+
+void on_drop(GLFWwindow* /*window*/, int count, const char** paths) {
+  if (!g_dropped) return;
+  for (int i = 0; i < count; ++i) g_dropped->emplace_back(paths[i]);
+}
+
+RgbImage to_rgb(const Rgba8Image& frame) {
+  RgbImage out(frame.width, frame.height);
+  for (std::size_t i = 0, n = static_cast<std::size_t>(frame.width) * frame.height; i < n; ++i)
+    for (int c = 0; c < 3; ++c) out.pixels[3 * i + c] = frame.pixels[4 * i + c];
+  return out;
+}
+
+class Gui final : public ScriptHost {
+ public:
+  explicit Gui(const GuiOptions& options, AppSettings settings, std::optional<ScriptRunner> script,
+               std::string settings_error);
+  ~Gui() override;
+  int run();
+  Status execute(const ScriptCommand& command) override;
+  /// The script opens its own scene first: load nothing before it.
+  void skip_initial_open() { skip_initial_open_ = true; }
+
+ private:
+  void handle_input(int fbw, int fbh, int ww, int wh);
+  void draw_panels(const panels::PanelLayout& layout);
+  void take_screenshot();
+  SavedScreenshot write_frame(const std::optional<std::filesystem::path>& explicit_path);
+  void report_errors();
+  void save_settings_now();
+  std::string redraw_key(int fbw, int fbh) const;
+
+  GuiOptions options_;
+  std::filesystem::path config_dir_;
+  AppState app_;
+  // GL objects die before the window that owns their context.
+  std::unique_ptr<GlfwContext> window_;
+  std::unique_ptr<ImGuiContextGuard> imgui_;
+  std::unique_ptr<SceneView> view_;
+  std::optional<ScriptRunner> script_;
+  std::vector<std::string> dropped_;
+
+  std::string path_field_;
+  std::string last_screenshot_;
+  std::string last_title_;
+  std::string last_redraw_key_;
+  bool show_help_ = false;
+  bool press_in_view_ = false;
+  bool quit_ = false;
+  int exit_code_ = 0;
+  bool size_pending_ = false;
+  int size_frames_ = 0;
+  std::string initial_scene_;
+  bool fallback_tried_ = false;
+  bool skip_initial_open_ = false;
+  Clock::time_point start_ = Clock::now();
+};
+
+Gui::Gui(const GuiOptions& options, AppSettings settings, std::optional<ScriptRunner> script,
+         std::string settings_error)
+    : options_(options), config_dir_(config_dir()), app_(std::move(settings)), script_(std::move(script)) {
+  WindowOptions wo;
+  wo.width = app_.settings().window_width;
+  wo.height = app_.settings().window_height;
+  wo.title = "accelviz";
+  wo.vsync = true;
+  try {
+    window_ = std::make_unique<GlfwContext>(wo);
+  } catch (const std::exception& e) {
+    throw NoWindow(e.what());
+  }
+  g_dropped = &dropped_;
+  glfwSetDropCallback(window_->window(), on_drop);
+  imgui_ = std::make_unique<ImGuiContextGuard>(
+      window_->window(),
+      options_.use_settings ? std::optional<std::filesystem::path>(imgui_ini_file(config_dir_)) : std::nullopt);
+  view_ = std::make_unique<SceneView>();
+  if (!settings_error.empty()) app_.set_error(settings_error);
+}
+
+Gui::~Gui() {
+  g_dropped = nullptr;
+  // Renderer and ImGui objects need the window's context current when they die.
+  if (window_) window_->make_current();
+  view_.reset();
+  imgui_.reset();
+}
+
+void Gui::report_errors() {
+  for (const std::string& e : app_.take_new_errors()) std::fprintf(stderr, "accelviz: %s\n", e.c_str());
+}
+
+void Gui::save_settings_now() {
+  if (!options_.use_settings) return;
+  int w = 0, h = 0;
+  glfwGetWindowSize(window_->window(), &w, &h);
+  if (w >= 100 && h >= 100) {
+    app_.settings().window_width = w;
+    app_.settings().window_height = h;
+  }
+  if (const std::string e = save_settings(settings_file(config_dir_), app_.settings()); !e.empty()) app_.set_error(e);
+}
+
+std::string Gui::redraw_key(int fbw, int fbh) const {
+  const Camera c = app_.camera();
+  std::string key = std::to_string(fbw) + "x" + std::to_string(fbh);
+  for (float f : {c.position.x, c.position.y, c.position.z, c.forward.x, c.forward.y, c.forward.z, c.up.x, c.up.y,
+                  c.up.z, c.yfov})
+    (key += ',') += std::to_string(f);
+  for (const auto& [k, v] : option_values(app_.config())) (((key += k) += '=') += v) += ';';
+  return key;
+}
+
+void Gui::handle_input(int fbw, int fbh, int ww, int wh) {
+  ImGuiIO& io = ImGui::GetIO();
+  // ImGui works in window coordinates; the view and its rays in framebuffer
+  // pixels (more of them on HiDPI displays).
+  const float sx = ww > 0 ? static_cast<float>(fbw) / static_cast<float>(ww) : 1.0f;
+  const float sy = wh > 0 ? static_cast<float>(fbh) / static_cast<float>(wh) : 1.0f;
+  const int px = static_cast<int>(std::floor(io.MousePos.x * sx));
+  const int py = static_cast<int>(std::floor(io.MousePos.y * sy));
+  const bool over_view = ImGui::IsMousePosValid() && px >= 0 && py >= 0 && px < fbw && py < fbh;
+  ViewCamera& cam = app_.view_camera();
+
+  if (ImGui::IsMouseClicked(ImGuiMouseButton_Left)) press_in_view_ = !io.WantCaptureMouse && over_view;
+  if (!io.WantCaptureMouse) {
+    const ImVec2 d = io.MouseDelta;
+    const bool moved = d.x != 0.0f || d.y != 0.0f;
+    if (press_in_view_ && ImGui::IsMouseDragging(ImGuiMouseButton_Left) && moved) {
+      cam.unfix();
+      if (io.KeyShift)
+        cam.orbit.pan(d.x * sx, d.y * sy, fbh);
+      else
+        cam.orbit.orbit(d.x, d.y);
+    }
+    if ((ImGui::IsMouseDragging(ImGuiMouseButton_Right) || ImGui::IsMouseDragging(ImGuiMouseButton_Middle)) && moved) {
+      cam.unfix();
+      cam.orbit.pan(d.x * sx, d.y * sy, fbh);
+    }
+    if (io.MouseWheel != 0.0f && over_view) {
+      cam.unfix();
+      cam.orbit.zoom(io.MouseWheel);
+    }
+    if (ImGui::IsMouseDoubleClicked(ImGuiMouseButton_Left) && over_view) {
+      if (const auto p = app_.pick(px, py)) {
+        cam.unfix();
+        cam.orbit.set_pivot(*p);
+      }
+    } else if (ImGui::IsMouseReleased(ImGuiMouseButton_Left) && press_in_view_ && over_view &&
+               io.MouseDragMaxDistanceSqr[ImGuiMouseButton_Left] < io.MouseDragThreshold * io.MouseDragThreshold) {
+      if (const std::string e = app_.cast_ray(px, py); !e.empty()) app_.set_error(e);
+    }
+    // The heatmap pixel under the mouse, while nothing is being dragged.
+    const auto& frame = app_.heatmap();
+    if (over_view && frame && app_.config().view.heatmap != HeatmapDisplay::off && !ImGui::IsAnyMouseDown() &&
+        frame->image.width > 0) {
+      const int fx = std::min(frame->image.width - 1, px * frame->image.width / fbw);
+      const int fy = std::min(frame->image.height - 1, py * frame->image.height / fbh);
+      panels::pixel_tooltip(fx, fy, frame->at(fx, fy), frame->image.metric, frame->complete);
+    }
+  }
+
+  // Ctrl+Q quits even while a text field has the keyboard.
+  if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_Q, false)) quit_ = true;
+  if (!io.WantCaptureKeyboard && !io.KeyCtrl) {
+    if (ImGui::IsKeyPressed(GLFW_KEY_F, false)) app_.frame_selection();
+    if (ImGui::IsKeyPressed(GLFW_KEY_R, false) || ImGui::IsKeyPressed(GLFW_KEY_HOME, false)) app_.reset_camera();
+    if (ImGui::IsKeyPressed(GLFW_KEY_F12, false)) take_screenshot();
+    if (ImGui::IsKeyPressed(GLFW_KEY_H, false) || ImGui::IsKeyPressed(GLFW_KEY_F1, false)) show_help_ = !show_help_;
+    if (app_.inspection()) {
+      if (ImGui::IsKeyPressed(GLFW_KEY_LEFT) && app_.replay_step() > 0) app_.set_replay_step(app_.replay_step() - 1);
+      if (ImGui::IsKeyPressed(GLFW_KEY_RIGHT)) app_.set_replay_step(app_.replay_step() + 1);
+    }
+  }
+}
+
+void Gui::draw_panels(const panels::PanelLayout& layout) {
+  const panels::SceneAction sa = panels::scene_panel(path_field_, app_.settings().recent, app_.scene(),
+                                                     app_.scene_spec(), app_.view_camera().scene_camera, layout);
+  if (sa.open) app_.open_scene(*sa.open);
+  if (sa.camera) app_.use_scene_camera(*sa.camera);
+  if (sa.reset_view) app_.reset_camera();
+
+  const BuildWorker::Status st = app_.build_status();
+  panels::BuildProgress bp;
+  bp.busy = st.busy;
+  bp.fraction = st.fraction;
+  bp.stage = st.stage;
+  if (app_.current()) bp.shown = describe_structure(app_.current()->choice);
+  bool cancel = false;
+  panels::structure_panel(app_.config().structure, bp, cancel, layout);
+  if (cancel) app_.cancel_build();
+
+  panels::stats_panel(app_.current().get(), app_.heatmap().get(), layout);
+
+  panels::ViewInfo vi;
+  if (const BuiltStructure* b = app_.current().get()) {
+    vi.node_kind = b->nodes.kind();
+    vi.max_depth = b->nodes.max_depth();
+    vi.node_count = b->nodes.size();
+  }
+  vi.boxes_drawn = view_->boxes_drawn();
+  vi.boxes_truncated = view_->boxes_truncated();
+  const glm::vec2 range = view_->heatmap_range(app_);
+  vi.range_min = range.x;
+  vi.range_max = range.y;
+  panels::view_panel(app_.config().view, vi, layout);
+
+  const auto& insp = app_.inspection();
+  if (const auto step = panels::ray_panel(insp ? &*insp : nullptr, app_.replay_step(),
+                                          app_.current() ? &app_.current()->nodes : nullptr, layout))
+    app_.set_replay_step(*step);
+
+  if (panels::screenshot_panel(app_.settings().screenshot_dir, default_screenshot_dir().string(), last_screenshot_,
+                               layout))
+    take_screenshot();
+  panels::help_panel(show_help_, layout);
+  panels::status_bar(app_.message(), app_.error(), bp, app_.heatmap_busy(), layout);
+}
+
+SavedScreenshot Gui::write_frame(const std::optional<std::filesystem::path>& explicit_path) {
+  // Draw the current state now, so the file is exactly what the view shows
+  // after this frame's changes (uploads included).
+  const int w = window_->width(), h = window_->height();
+  view_->sync(app_);
+  view_->draw(app_, w, h);
+  const RgbImage frame = to_rgb(view_->renderer().read_pixels());
+  const glm::vec2 range = view_->heatmap_range(app_);
+  const ScreenshotInfo info = app_.screenshot_info(range.x, range.y);
+  if (explicit_path) return save_screenshot_as(*explicit_path, frame, info);
+  const std::filesystem::path dir = app_.settings().screenshot_dir.empty()
+                                        ? default_screenshot_dir()
+                                        : std::filesystem::path(app_.settings().screenshot_dir);
+  return save_screenshot(dir, frame, info, std::time(nullptr));
+}
+
+void Gui::take_screenshot() {
+  const SavedScreenshot r = write_frame(std::nullopt);
+  if (r.ok) {
+    last_screenshot_ = r.png.string();
+    app_.set_message("screenshot written: " + r.png.string() + " (+ .json)");
+    if (!options_.quiet) std::printf("%s\n", r.png.string().c_str());
+  } else {
+    app_.set_error("screenshot: " + r.error);
+  }
+}
+
+ScriptHost::Status Gui::execute(const ScriptCommand& c) {
+  using K = ScriptCommand::Kind;
+  auto fail_if = [](const std::string& error) {
+    if (!error.empty()) throw std::runtime_error(error);
+  };
+  switch (c.kind) {
+    case K::open:
+      path_field_ = c.arg;
+      app_.open_scene(c.arg);
+      return Status::done;
+    case K::structure: fail_if(app_.set_option("structure", c.arg)); return Status::done;
+    case K::set: fail_if(app_.set_option(c.arg, c.value)); return Status::done;
+    case K::camera: app_.set_camera_spec(c.arg); return Status::done;
+    case K::size: {
+      int w = 0, h = 0;
+      glfwGetWindowSize(window_->window(), &w, &h);
+      if (w == c.x && h == c.y) {
+        size_pending_ = false;
+        return Status::done;
+      }
+      if (!size_pending_) {
+        glfwSetWindowSize(window_->window(), c.x, c.y);
+        size_pending_ = true;
+        size_frames_ = 0;
+      } else if (++size_frames_ > 600) {
+        size_pending_ = false;
+        throw std::runtime_error("the window stayed " + std::to_string(w) + "x" + std::to_string(h));
+      }
+      return Status::again;
+    }
+    case K::wait: return app_.settled() ? Status::done : Status::again;
+    case K::click: fail_if(app_.cast_ray(c.x, c.y)); return Status::done;
+    case K::step: {
+      const auto& insp = app_.inspection();
+      if (!insp) throw std::runtime_error("no ray cast yet (use click first)");
+      const std::size_t n = insp->trace.steps.size();
+      const std::size_t cur = app_.replay_step();
+      if (c.arg == "next") app_.set_replay_step(cur + 1);
+      else if (c.arg == "prev") app_.set_replay_step(cur > 0 ? cur - 1 : 0);
+      else if (c.arg == "first") app_.set_replay_step(0);
+      else if (c.arg == "last") app_.set_replay_step(n > 0 ? n - 1 : 0);
+      else {
+        const std::size_t k = std::stoul(c.arg);
+        if (k >= n) throw std::runtime_error("step " + c.arg + ": the trace has " + std::to_string(n) + " steps");
+        app_.set_replay_step(k);
+      }
+      return Status::done;
+    }
+    case K::screenshot: {
+      const SavedScreenshot r = write_frame(std::filesystem::path(c.arg));
+      if (!r.ok) throw std::runtime_error(r.error);
+      last_screenshot_ = r.png.string();
+      if (!options_.quiet) std::printf("%s\n", r.png.string().c_str());
+      return Status::done;
+    }
+    case K::dump_ray: {
+      const auto& insp = app_.inspection();
+      if (!insp) throw std::runtime_error("no ray cast yet (use click first)");
+      fail_if(write_file_atomic(c.arg, inspection_json(*insp, app_.replay_step()).dump(2) + "\n"));
+      return Status::done;
+    }
+    case K::dump_stats: fail_if(write_file_atomic(c.arg, app_.stats_json().dump(2) + "\n")); return Status::done;
+    case K::quit: quit_ = true; return Status::done;
+  }
+  return Status::done;
+}
+
+int Gui::run() {
+  // What to show first: the file given, else (with settings) the last
+  // scene, else the demo. A script that starts with `open` loads nothing
+  // before it.
+  initial_scene_ = options_.scene ? *options_.scene
+                   : (options_.use_settings && !app_.settings().last_scene.empty()) ? app_.settings().last_scene
+                                                                                     : std::string(kDemoScene);
+  if (!skip_initial_open_) {
+    path_field_ = initial_scene_;
+    app_.open_scene(initial_scene_);
+  }
+
+  GLFWwindow* win = window_->window();
+  while (!quit_ && !glfwWindowShouldClose(win)) {
+    // Idle (nothing building, tracing or scripted): sleep until input
+    // arrives; otherwise keep frames coming so results show up promptly.
+    const bool busy = script_ || app_.build_status().busy || app_.heatmap_busy();
+    if (busy)
+      glfwPollEvents();
+    else
+      glfwWaitEventsTimeout(0.25);
+
+    const int fbw = window_->width(), fbh = window_->height();
+    int ww = 0, wh = 0;
+    glfwGetWindowSize(win, &ww, &wh);
+    if (fbw <= 0 || fbh <= 0) continue;  // minimised
+
+    for (const std::string& path : dropped_) {
+      path_field_ = path;
+      app_.open_scene(path);
+    }
+    dropped_.clear();
+
+    imgui_->new_frame();
+    const ImGuiIO& io = ImGui::GetIO();
+    const panels::PanelLayout layout{imgui_->scale(), io.DisplaySize.x, io.DisplaySize.y};
+    handle_input(fbw, fbh, ww, wh);
+
+    const AppState::FrameUpdate u = app_.update(fbw, fbh);
+    if (u.scene_changed) save_settings_now();
+    // A last scene that no longer opens falls back to the demo once.
+    if (!app_.current() && !app_.error().empty() && !fallback_tried_ && !script_ &&
+        initial_scene_ != kDemoScene && !app_.build_status().busy) {
+      fallback_tried_ = true;
+      app_.open_scene(kDemoScene);
+    }
+
+    if (script_) {
+      const double now = std::chrono::duration<double>(Clock::now() - start_).count();
+      try {
+        const ScriptRunner::State s = script_->advance(*this, now);
+        if (s == ScriptRunner::State::failed) {
+          std::fprintf(stderr, "accelviz: %s\n", script_->error().c_str());
+          exit_code_ = 1;
+          quit_ = true;
+        } else if (s == ScriptRunner::State::finished) {
+          quit_ = true;
+        }
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "accelviz: script: %s\n", e.what());
+        exit_code_ = 1;
+        quit_ = true;
+      }
+    }
+
+    draw_panels(layout);
+    report_errors();
+
+    const std::string title = app_.scene_spec().empty() ? "accelviz" : "accelviz - " + app_.scene_spec();
+    if (title != last_title_) {
+      glfwSetWindowTitle(win, title.c_str());
+      last_title_ = title;
+    }
+
+    try {
+      const bool uploaded = view_->sync(app_);
+      const std::string key = redraw_key(fbw, fbh);
+      if (uploaded || key != last_redraw_key_) {
+        view_->draw(app_, fbw, fbh);
+        last_redraw_key_ = key;
+      }
+    } catch (const std::exception& e) {
+      // A GL or shader failure is reported, not fatal: the panels stay usable.
+      app_.set_error(e.what());
+      report_errors();
+      last_redraw_key_.clear();
+    }
+    view_->renderer().present(fbw, fbh);
+    imgui_->render();
+    window_->swap_buffers();
+    if (options_.use_settings)
+      if (const std::string e = imgui_->save_layout(); !e.empty()) app_.set_error(e);
+  }
+  save_settings_now();
+  if (options_.use_settings)
+    if (const std::string e = imgui_->save_layout(true); !e.empty()) std::fprintf(stderr, "accelviz: %s\n", e.c_str());
+  report_errors();
+  return exit_code_;
+}
+
+}  // namespace
+
+bool display_available() {
+  const char* x = std::getenv("DISPLAY");
+  const char* w = std::getenv("WAYLAND_DISPLAY");
+  return (x && *x) || (w && *w);
+}
+
+bool settings_disabled_by_environment() {
+  const char* v = std::getenv("ACCELVIZ_NO_SETTINGS");
+  return v && *v && std::string_view(v) != "0";
+}
+
+int run_gui(const GuiOptions& options) {
+  GuiOptions o = options;
+  if (o.script || settings_disabled_by_environment()) o.use_settings = false;
+
+  // Parse the script before opening a window: a bad line fails at once.
+  std::optional<ScriptRunner> runner;
+  std::vector<ScriptCommand> commands;
+  if (o.script) {
+    try {
+      commands = load_script(*o.script);
+    } catch (const ScriptError& e) {
+      std::fprintf(stderr, "accelviz: %s\n", e.what());
+      return 1;
+    }
+  }
+  const bool script_opens_first = !commands.empty() && commands.front().kind == ScriptCommand::Kind::open;
+  if (o.script) runner.emplace(std::move(commands), *o.script);
+
+  AppSettings settings;
+  std::string settings_error;
+  if (o.use_settings) {
+    LoadedSettings loaded = load_settings(settings_file(config_dir()));
+    settings = std::move(loaded.settings);
+    settings_error = std::move(loaded.error);
+  }
+  Gui gui(o, std::move(settings), std::move(runner), settings_error);
+  if (script_opens_first && !o.scene) gui.skip_initial_open();
+  return gui.run();
+}
+
+}  // namespace accelviz

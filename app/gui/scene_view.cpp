@@ -1,0 +1,139 @@
+#include "app/gui/scene_view.h"
+
+#include "ui/render/box_selection.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace accelviz {
+
+bool SceneView::sync(const AppState& app) {
+  bool changed = false;
+  const BuiltStructure* built = app.current().get();
+  const void* scene = built ? static_cast<const void*>(built->scene.get()) : nullptr;
+  if (scene != scene_) {
+    renderer_.set_triangles(built ? std::span<const Triangle>(built->scene->scene.triangles)
+                                  : std::span<const Triangle>());
+    scene_ = scene;
+    changed = true;
+  }
+  if (app.heatmap() && app.heatmap().get() != heatmap_frame_) {
+    heatmap_frame_ = app.heatmap().get();
+    renderer_.set_heatmap(app.heatmap()->image);
+    has_heatmap_ = true;
+    changed = true;
+  }
+  if (const int map = static_cast<int>(app.config().view.colormap); map != colormap_) {
+    renderer_.set_colormap(app.config().view.colormap);
+    colormap_ = map;
+    changed = true;
+  }
+  const std::string box_key_before = box_key_, ray_key_before = ray_key_;
+  upload_boxes(app);
+  upload_ray(app);
+  return changed || box_key_ != box_key_before || ray_key_ != ray_key_before;
+}
+
+void SceneView::upload_boxes(const AppState& app) {
+  const ViewSettings& v = app.config().view;
+  const BuiltStructure* built = app.current().get();
+  // Everything the selection and its colours depend on.
+  const std::string key = std::to_string(reinterpret_cast<std::uintptr_t>(built)) + "/" +
+                          std::to_string(static_cast<int>(v.box_mode)) + "/" + std::to_string(v.box_depth) + "/" +
+                          std::to_string(v.box_depth_last) + "/" + std::to_string(v.box_node) + "/" +
+                          std::to_string(static_cast<int>(v.box_color)) + "/" +
+                          std::to_string(static_cast<int>(v.colormap));
+  if (key == box_key_) return;
+  box_key_ = key;
+  boxes_drawn_ = 0;
+  boxes_truncated_ = false;
+  if (!built || built->nodes.empty()) {
+    renderer_.set_boxes({});
+    return;
+  }
+  NodeSelection sel;
+  sel.mode = v.box_mode;
+  sel.depth = static_cast<std::uint32_t>(v.box_depth);
+  sel.depth_last = static_cast<std::uint32_t>(std::max(v.box_depth, v.box_depth_last));
+  sel.node = static_cast<std::uint32_t>(v.box_node);
+  const StructureNodes::Selection s = built->nodes.select(sel, kMaxBoxes);
+  boxes_drawn_ = s.boxes.size();
+  boxes_truncated_ = s.truncated;
+
+  std::vector<ColoredBox> boxes;
+  boxes.reserve(s.boxes.size());
+  float max_share = 0.0f;
+  for (const NodeBox& b : s.boxes) max_share = std::max(max_share, b.sah_share);
+  for (const NodeBox& b : s.boxes) {
+    ColoredBox c;
+    c.box = b.bounds;
+    if (v.box_color == BoxColorBy::depth) {
+      c.color = glm::vec4(qualitative_color(b.depth), 1.0f);
+    } else {
+      // Shares span orders of magnitude (the root's area against a leaf's):
+      // a square root keeps the small ones distinguishable.
+      const float t = max_share > 0.0f ? std::sqrt(b.sah_share / max_share) : 0.0f;
+      c.color = glm::vec4(colormap(v.colormap, t), 1.0f);
+    }
+    boxes.push_back(c);
+  }
+  renderer_.set_boxes(boxes);
+}
+
+void SceneView::upload_ray(const AppState& app) {
+  const auto& insp = app.inspection();
+  const BuiltStructure* built = app.current().get();
+  const std::string key = std::to_string(app.inspection_version()) + "/" + std::to_string(app.replay_step()) + "/" +
+                          std::to_string(reinterpret_cast<std::uintptr_t>(built));
+  if (key == ray_key_) return;
+  ray_key_ = key;
+  if (!insp || !built) {
+    renderer_.clear_ray_path();
+    return;
+  }
+  RayPath path = make_ray_path(insp->ray, insp->hit, built->scene->scene.bounds());
+  const ReplayState r = replay_upto(insp->trace, app.replay_step());
+  for (std::uint32_t id : r.entered)
+    if (const auto b = built->nodes.box(id)) path.visited.push_back(*b);
+  // The node of the current step goes last, so it gets the "last visit"
+  // colour even when that step is a miss or a cull.
+  if (r.current_node && (r.entered.empty() || r.entered.back() != *r.current_node))
+    if (const auto b = built->nodes.box(*r.current_node)) path.visited.push_back(*b);
+  // Voxel "primitives" are voxels, not triangles: nothing to highlight.
+  if (built->nodes.kind() != "voxels") {
+    const std::size_t n = built->scene->scene.triangles.size();
+    for (std::uint32_t p : r.tested)
+      if (p < n) path.highlighted.push_back(p);
+  }
+  renderer_.set_ray_path(path);
+}
+
+glm::vec2 SceneView::heatmap_range(const AppState& app) const { return renderer_.heatmap_range(render_view(app).heatmap); }
+
+RenderView SceneView::render_view(const AppState& app) const {
+  const ViewSettings& v = app.config().view;
+  RenderView r;
+  r.camera = app.camera();
+  r.msaa_samples = v.msaa;
+  r.show_mesh = v.show_mesh;
+  r.show_wireframe = v.show_wireframe;
+  r.show_boxes = v.show_boxes;
+  r.boxes_through_mesh = v.boxes_through_mesh;
+  r.show_ray_path = v.show_ray_path && app.inspection().has_value();
+  r.show_quads = false;
+  HeatmapView& h = r.heatmap;
+  h.mode = !has_heatmap_ ? HeatmapMode::off
+           : v.heatmap == HeatmapDisplay::full_screen ? HeatmapMode::full_screen
+           : v.heatmap == HeatmapDisplay::blend       ? HeatmapMode::blend
+                                                      : HeatmapMode::off;
+  h.opacity = v.opacity;
+  h.auto_scale = v.auto_scale;
+  h.range_min = v.scale_min;
+  h.range_max = v.scale_max;
+  h.show_legend = v.show_legend;
+  return r;
+}
+
+void SceneView::draw(const AppState& app, int width, int height) { renderer_.render(render_view(app), width, height); }
+
+}  // namespace accelviz

@@ -1,0 +1,53 @@
+#pragma once
+// The 3D view: keeps the renderer's uploads (triangles, node boxes, heatmap,
+// colour map, ray path) in step with the AppState and maps the user's view
+// settings onto a RenderView. Needs the window's GL context current.
+#include "ui/app/app_state.h"
+#include "ui/render/renderer.h"
+
+#include <cstdint>
+#include <string>
+
+namespace accelviz {
+
+class SceneView {
+ public:
+  SceneView() = default;
+
+  /// Uploads what changed since the last call (idempotent: call it as often
+  /// as needed, e.g. again right before a screenshot). Returns true when
+  /// the picture may have changed (something was uploaded).
+  bool sync(const AppState& app);
+  /// The RenderView for the app's current settings.
+  RenderView render_view(const AppState& app) const;
+  /// Draws the view into the renderer's frame (width × height pixels).
+  void draw(const AppState& app, int width, int height);
+
+  Renderer& renderer() { return renderer_; }
+  /// The heatmap range the legend shows under the current settings.
+  glm::vec2 heatmap_range(const AppState& app) const;
+  /// Whether a heatmap image has been uploaded.
+  bool has_heatmap() const { return has_heatmap_; }
+
+  std::uint64_t boxes_drawn() const { return boxes_drawn_; }
+  bool boxes_truncated() const { return boxes_truncated_; }
+
+  /// Most boxes drawn at once (llvmpipe draws ~1e5 instanced boxes per frame comfortably).
+  static constexpr std::size_t kMaxBoxes = 200000;
+
+ private:
+  void upload_boxes(const AppState& app);
+  void upload_ray(const AppState& app);
+
+  Renderer renderer_;
+  const void* scene_ = nullptr;  ///< identity of the uploaded scene
+  const void* heatmap_frame_ = nullptr;  ///< identity of the uploaded heatmap level
+  std::string box_key_;
+  std::string ray_key_;
+  int colormap_ = -1;
+  bool has_heatmap_ = false;
+  std::uint64_t boxes_drawn_ = 0;
+  bool boxes_truncated_ = false;
+};
+
+}  // namespace accelviz
