@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# accelviz sweep end to end: a tiny sweep writes CSV, JSON and PNG charts that
+# parse; every requested setting is there; a DIR with sweep files is refused
+# without --force; unknown parameters and values are usage errors naming them.
+set -euo pipefail
+bin="$1"
+tmp="$(mktemp -d)"
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+out="$tmp/s1"
+"$bin" -q sweep 'builtin:teapot?size=800' --param buckets=2,8,exact --param triangle=watertight,fast \
+  --size 32x24 --repeat 1 --threads 1 --edge-probes 300 --out "$out" > "$tmp/stdout.txt"
+grep -q "Pareto-optimal" "$tmp/stdout.txt" || fail "no Pareto list on stdout"
+grep -q "best for 1e+06 rays" "$tmp/stdout.txt" || fail "no best setting for 1e6 rays"
+grep -q "best for 1e+09 rays" "$tmp/stdout.txt" || fail "no best setting for 1e9 rays"
+for f in sweep.csv sweep.json sweep-pareto.png sweep-sah_cost-vs-buckets.png sweep-rays_per_s-vs-buckets.png \
+         sweep-nodes_per_ray-vs-triangle.png sweep-build_ms-vs-buckets.png sweep-total_ms-vs-triangle.png; do
+  [ -s "$out/$f" ] || fail "missing $f"
+done
+
+python3 - "$out" <<'PY'
+import csv, json, struct, sys, zlib, glob, os
+out = sys.argv[1]
+rows = list(csv.DictReader(open(os.path.join(out, "sweep.csv"))))
+assert len(rows) == 6, len(rows)
+want = {(b, t) for b in ("2", "8", "exact") for t in ("watertight", "fast")}
+assert {(r["buckets"], r["triangle"]) for r in rows} == want, rows
+for r in rows:
+    assert float(r["build_ms"]) > 0 and float(r["rays_per_s"]) > 0 and float(r["sah_cost"]) > 0, r
+    assert int(r["edge_probes"]) == 300, r
+    assert int(r["edge_misses"]) <= int(r["edge_probes"]), r
+j = json.load(open(os.path.join(out, "sweep.json")))
+for k in ("cpu_model", "hardware_threads", "threads_used", "date", "command_line"):
+    assert k in j["machine"], k
+assert j["machine"]["threads_used"] == 1
+assert "sweep" in j["machine"]["command_line"]
+assert len(j["results"]) == 6 and len(j["pareto_front"]) >= 1
+assert {b["rays"] for b in j["best_for_budget"]} >= {1e6, 1e9}, j["best_for_budget"]
+for png in glob.glob(os.path.join(out, "*.png")):
+    data = open(png, "rb").read()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", png
+    w, h = struct.unpack(">II", data[16:24])
+    assert w > 100 and h > 100, (png, w, h)
+    # Decompress the IDAT stream to be sure the file is whole.
+    pos, idat = 8, b""
+    while pos < len(data):
+        n = struct.unpack(">I", data[pos:pos + 4])[0]
+        if data[pos + 4:pos + 8] == b"IDAT":
+            idat += data[pos + 8:pos + 8 + n]
+        pos += 12 + n
+    assert len(zlib.decompress(idat)) == h * (1 + 3 * w), png
+PY
+
+# A directory that holds sweep files is refused without --force, accepted with it.
+if "$bin" -q sweep 'builtin:soup?size=200' --param leaf=1,4 --size 8x8 --repeat 1 --out "$out" 2> "$tmp/err.txt"; then
+  fail "overwrote a sweep directory without --force"
+fi
+grep -q "force" "$tmp/err.txt" || fail "refusal does not mention --force: $(cat "$tmp/err.txt")"
+"$bin" -q sweep 'builtin:soup?size=200' --param leaf=1,4 --size 8x8 --repeat 1 --out "$out" --force > /dev/null
+[ "$(wc -l < "$out/sweep.csv")" -eq 3 ] || fail "--force run did not replace sweep.csv"
+[ ! -e "$out/sweep-sah_cost-vs-buckets.png" ] || fail "stale chart of the first sweep left behind"
+
+# Usage errors (exit 2) name the parameter or value.
+set +e
+"$bin" -q sweep 'builtin:soup?size=200' --param bukets=2 --out "$tmp/s2" 2> "$tmp/err.txt"; rc=$?
+set -e
+[ "$rc" -eq 2 ] || fail "unknown parameter: exit $rc"
+grep -q "bukets" "$tmp/err.txt" || fail "unknown parameter not named: $(cat "$tmp/err.txt")"
+set +e
+"$bin" -q sweep 'builtin:soup?size=200' --structure grid --param res=4x4 --out "$tmp/s2" 2> "$tmp/err.txt"; rc=$?
+set -e
+[ "$rc" -eq 2 ] || fail "bad value: exit $rc"
+grep -q "4x4" "$tmp/err.txt" || fail "bad value not named: $(cat "$tmp/err.txt")"
+[ ! -e "$tmp/s2" ] || fail "a usage error created the output directory"
+echo "sweep: ok"
