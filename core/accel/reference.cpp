@@ -93,7 +93,10 @@ ReferenceHit ReferenceTracer::closest_hit(const Ray& ray) const {
     const ReferenceTriangleHit h = intersect_reference(ray, tris_[i], ray.tmin, ray.tmax);
     if (h.hit) {
       best.near_hit = true;
-      best.robust_hit = best.robust_hit || !h.near_edge;
+      // A hit at t within rounding of tmin or tmax (origin on the surface,
+      // a shadow ray ending on it) is a rounding decision too.
+      const bool t_inside = h.t - h.t_tolerance > ray.tmin && h.t + h.t_tolerance < ray.tmax;
+      best.robust_hit = best.robust_hit || (!h.near_edge && t_inside);
       if (h.t < best.t) {
         best.prim = static_cast<std::uint32_t>(i);
         best.t = h.t;
