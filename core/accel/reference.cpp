@@ -153,7 +153,10 @@ Verdict classify_closest(std::span<const Triangle> triangles, const Ray& ray, co
   if (ref.valid() && same_t(mine.t, ref.t, std::max(ref.t_tolerance, mine.t_tolerance))) return Verdict::near_tie;
   if (!ref.valid()) return mine.near_miss ? Verdict::near_tie : Verdict::mismatched_prim;
   if (got.t < ref.t) return mine.near_miss ? Verdict::near_tie : Verdict::mismatched_prim;
-  return ref.closest_near_edge ? Verdict::near_tie : Verdict::mismatched_prim;
+  // Skipping the reference's closer hit is a rounding decision when that hit
+  // was on an edge, or at tmin (the origin lies on that surface).
+  const bool closest_at_tmin = ref.t - ref.t_tolerance <= ray.tmin;
+  return ref.closest_near_edge || closest_at_tmin ? Verdict::near_tie : Verdict::mismatched_prim;
 }
 
 Verdict classify_any(const ReferenceHit& ref, bool got) {
