@@ -295,7 +295,12 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       return Status::done;
     case K::structure: fail_if(app_.set_option("structure", c.arg)); return Status::done;
     case K::set: fail_if(app_.set_option(c.arg, c.value)); return Status::done;
-    case K::camera: app_.set_camera_spec(c.arg); return Status::done;
+    case K::camera:
+      // After `open`, the camera applies to the new scene: wait for it
+      // (its arrival resets the view to the scene's default).
+      if (app_.loading_scene()) return Status::again;
+      app_.set_camera_spec(c.arg);
+      return Status::done;
     case K::size: {
       int w = 0, h = 0;
       glfwGetWindowSize(window_->window(), &w, &h);

@@ -327,13 +327,11 @@ const Entry* find_entry(std::string_view key) {
 }  // namespace
 
 std::string format_number(double v) {
-  char buf[32];
-  // %.9g round-trips a float; try shorter forms first so "1" stays "1".
-  for (int precision = 1; precision <= 9; ++precision) {
-    std::snprintf(buf, sizeof buf, "%.*g", precision, v);
-    if (static_cast<float>(std::strtod(buf, nullptr)) == static_cast<float>(v)) break;
-  }
-  return buf;
+  // Options are floats: the shortest text that reads back to the same
+  // float, fixed or scientific, whichever is shorter ("40", "0.25", "1e-07").
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, static_cast<float>(v));
+  return std::string(buf, r.ptr);
 }
 
 const std::vector<OptionInfo>& option_table() {

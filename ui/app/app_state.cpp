@@ -18,6 +18,7 @@ AppState::AppState(AppSettings settings, BuildWorker::LoadFn load, BuildWorker::
 void AppState::open_scene(const std::string& spec) {
   wanted_scene_ = spec;
   reload_ = true;
+  scene_loading_ = true;
   set_message("loading " + spec);
 }
 
@@ -41,6 +42,7 @@ void AppState::cancel_build() {
     wanted_scene_.clear();
   }
   reload_ = false;
+  scene_loading_ = false;
   set_message("build cancelled");
 }
 
@@ -89,6 +91,7 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
   if (!wanted_scene_.empty() &&
       (reload_ || wanted_scene_ != requested_scene_ || !requested_ || !same_build(*requested_, wanted))) {
     request_id_ = builds_.request({wanted_scene_, wanted, reload_});
+    if (scene_loading_) scene_request_id_ = request_id_;
     requested_scene_ = wanted_scene_;
     requested_ = wanted;
     reload_ = false;
@@ -96,6 +99,8 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
 
   // 2. Finished builds: only the latest request counts.
   for (BuildOutcome& o : builds_.take_outcomes()) {
+    // A later request made while the scene loads carries the scene too.
+    if (o.id >= scene_request_id_ && o.result != BuildOutcome::Result::cancelled) scene_loading_ = false;
     if (o.id != request_id_) continue;
     if (o.result == BuildOutcome::Result::built) {
       const bool new_scene = !current_ || current_->scene != o.built->scene;

@@ -58,6 +58,8 @@ class AppState {
   std::string scene_spec() const { return current_ ? current_->scene->spec : std::string(); }
   /// The scene asked for last (shown in the path field while it loads).
   const std::string& wanted_scene() const { return wanted_scene_; }
+  /// open_scene() was called and its outcome (shown or failed) is not in yet.
+  bool loading_scene() const { return scene_loading_; }
   const std::shared_ptr<const HeatmapFrame>& heatmap() const { return heatmap_; }
   BuildWorker::Status build_status() const { return builds_.status(); }
   bool heatmap_busy() const { return heatmaps_.busy(); }
@@ -129,6 +131,8 @@ class AppState {
 
   std::string wanted_scene_;
   bool reload_ = false;
+  bool scene_loading_ = false;
+  std::uint64_t scene_request_id_ = 0;  ///< the build request that loads the wanted scene
   std::string requested_scene_;              ///< of the last build request
   std::optional<StructureChoice> requested_; ///< of the last build request
   std::uint64_t request_id_ = 0;

@@ -25,7 +25,7 @@ struct OrbitCamera {
   float distance = 5.0f;  ///< eye to pivot, > 0
   float yaw = 0.0f;       ///< about +Y; 0 puts the eye on +Z of the pivot
   float pitch = 0.0f;     ///< elevation of the eye above the pivot, |pitch| <= kMaxPitch
-  float yfov = 0.7853982f;
+  float yfov = Camera{}.yfov;  ///< 0.8 rad, as `accelviz render`'s default framing
 
   /// pivot + distance · (cos p sin y, sin p, cos p cos y).
   glm::vec3 eye() const;

@@ -53,11 +53,14 @@ SavedScreenshot write_pair(const ScreenshotPaths& paths, const RgbImage& frame, 
   r.json = paths.json;
   *name_taken = false;
   std::error_code ec;
-  if (fs::exists(paths.json, ec)) {
-    *name_taken = true;
-    r.error = paths.json.string() + ": exists (not overwritten)";
-    return r;
-  }
+  // Both names are checked before anything is written, so a refused pair
+  // leaves no half behind; the exclusive creates below catch a late race.
+  for (const fs::path& p : {paths.png, paths.json})
+    if (fs::exists(p, ec)) {
+      *name_taken = true;
+      r.error = p.string() + ": exists (not overwritten)";
+      return r;
+    }
   try {
     write_png(paths.png.string(), add_caption(frame, screenshot_caption(info.config)), /*overwrite=*/false);
   } catch (const std::exception& e) {

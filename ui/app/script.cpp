@@ -145,7 +145,7 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
         c.arg = std::string(key);
         c.value = std::string(value);
         const std::string error = apply_option(scratch, c.arg, c.value);
-        if (!error.empty()) fail("set " + error);
+        if (!error.empty()) fail(error.rfind("unknown option", 0) == 0 ? "set: " + error : "set " + error);
         break;
       }
       case ScriptCommand::Kind::camera: {

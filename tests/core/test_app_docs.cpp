@@ -1,0 +1,59 @@
+// docs/gui.md documents what the code defines: every shortcut of the Help
+// panel (ui/app/shortcuts.h), every option key and every script command.
+#include <gtest/gtest.h>
+
+#include "ui/app/app_config.h"
+#include "ui/app/script.h"
+#include "ui/app/shortcuts.h"
+
+#include <fstream>
+#include <sstream>
+
+using namespace accelviz;
+
+namespace {
+
+std::string gui_docs() {
+  std::ifstream in(std::string(ACCELVIZ_SOURCE_DIR) + "/docs/gui.md");
+  EXPECT_TRUE(in) << "docs/gui.md missing";
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+}  // namespace
+
+TEST(AppShortcuts, DocsListEveryShortcut) {
+  const std::string docs = gui_docs();
+  for (const Shortcut& s : shortcuts()) {
+    EXPECT_NE(docs.find("| " + std::string(s.keys) + " |"), std::string::npos)
+        << "docs/gui.md has no table row for '" << s.keys << "'";
+    EXPECT_FALSE(s.action.empty());
+  }
+}
+
+TEST(AppDocs, EveryOptionKeyAndDefaultIsDocumented) {
+  const std::string all = gui_docs();
+  const auto section = all.find("### Options");
+  ASSERT_NE(section, std::string::npos) << "docs/gui.md has no Options section";
+  const std::string docs = all.substr(section);
+  const AppConfig defaults;
+  for (const OptionInfo& o : option_table()) {
+    const std::string row = "| `" + std::string(o.key) + "` |";
+    const auto at = docs.find(row);
+    ASSERT_NE(at, std::string::npos) << "docs/gui.md has no row for option " << o.key;
+    const std::string line = docs.substr(at, docs.find('\n', at) - at);
+    EXPECT_NE(line.find("| `" + option_value(defaults, o.key) + "` |"), std::string::npos)
+        << "the documented default of " << o.key << " is not " << option_value(defaults, o.key) << ": " << line;
+  }
+}
+
+TEST(AppDocs, EveryScriptCommandIsDocumented) {
+  const std::string docs = gui_docs();
+  for (auto k : {ScriptCommand::Kind::open, ScriptCommand::Kind::structure, ScriptCommand::Kind::set,
+                 ScriptCommand::Kind::camera, ScriptCommand::Kind::size, ScriptCommand::Kind::wait,
+                 ScriptCommand::Kind::click, ScriptCommand::Kind::step, ScriptCommand::Kind::screenshot,
+                 ScriptCommand::Kind::dump_ray, ScriptCommand::Kind::dump_stats, ScriptCommand::Kind::quit})
+    EXPECT_NE(docs.find("| `" + std::string(command_name(k))), std::string::npos)
+        << "docs/gui.md has no row for script command " << command_name(k);
+}

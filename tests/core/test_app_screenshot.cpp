@@ -1,0 +1,203 @@
+// Screenshot files: unique time-stamped names that never overwrite, the
+// caption strip, and the JSON side-car with what reproduces the picture.
+#include <gtest/gtest.h>
+
+#include "core/query/camera.h"
+#include "ui/app/screenshot_files.h"
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+using namespace accelviz;
+namespace fs = std::filesystem;
+
+namespace {
+
+class TempDir {
+ public:
+  TempDir() {
+    std::string tmpl = (fs::temp_directory_path() / "accelviz-shots-XXXXXX").string();
+    path_ = mkdtemp(tmpl.data());
+  }
+  ~TempDir() { fs::remove_all(path_); }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+RgbImage test_frame(int w, int h) {
+  RgbImage img(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      img.set(x, y, glm::u8vec3(static_cast<std::uint8_t>(x * 3), static_cast<std::uint8_t>(y * 5), 77));
+  return img;
+}
+
+ScreenshotInfo test_info() {
+  ScreenshotInfo info;
+  info.scene = "builtin:teapot?size=2000";
+  info.triangles = 2256;
+  info.camera_spec = "6,4,8,0,1.2,0,40";
+  info.camera = look_at({6, 4, 8}, {0, 1.2f, 0}, 40.0f * 3.14159265f / 180.0f);
+  info.width = 64;
+  info.height = 48;
+  EXPECT_EQ(apply_option(info.config, "heatmap", "blend"), "");
+  EXPECT_EQ(apply_option(info.config, "metric", "prims"), "");
+  EXPECT_EQ(apply_option(info.config, "colormap", "inferno"), "");
+  EXPECT_EQ(apply_option(info.config, "buckets", "8"), "");
+  info.scale_min = 0.0f;
+  info.scale_max = 39.0f;
+  info.ray_pixel = std::make_pair(32, 24);
+  return info;
+}
+
+}  // namespace
+
+TEST(AppScreenshot, NamesAreTimeStampedAndSkipTakenStems) {
+  TempDir dir;
+  const std::time_t t = 1700000000;
+  const std::string stamp = screenshot_timestamp(t);
+  ASSERT_EQ(stamp.size(), 15u);  // YYYYmmdd-HHMMSS
+  EXPECT_EQ(stamp[8], '-');
+  ScreenshotPaths p = unique_screenshot_paths(dir.path(), stamp);
+  EXPECT_EQ(p.png, dir.path() / ("accelviz-" + stamp + ".png"));
+  EXPECT_EQ(p.json, dir.path() / ("accelviz-" + stamp + ".json"));
+  std::ofstream(p.png) << "x";
+  EXPECT_EQ(unique_screenshot_paths(dir.path(), stamp).png, dir.path() / ("accelviz-" + stamp + "-2.png"));
+  // A side-car alone also takes the stem: the pair stays together.
+  std::ofstream(dir.path() / ("accelviz-" + stamp + "-2.json")) << "{}";
+  EXPECT_EQ(unique_screenshot_paths(dir.path(), stamp).png, dir.path() / ("accelviz-" + stamp + "-3.png"));
+}
+
+TEST(AppScreenshot, SavingTwiceInTheSameSecondNeverOverwrites) {
+  TempDir dir;
+  const fs::path folder = dir.path() / "created" / "on demand";
+  const std::time_t t = 1700000000;
+  const SavedScreenshot a = save_screenshot(folder, test_frame(64, 48), test_info(), t);
+  ASSERT_TRUE(a.ok) << a.error;
+  const std::string first_png = read(a.png), first_json = read(a.json);
+  const SavedScreenshot b = save_screenshot(folder, test_frame(64, 48), test_info(), t);
+  ASSERT_TRUE(b.ok) << b.error;
+  EXPECT_NE(a.png, b.png);
+  EXPECT_NE(a.json, b.json);
+  EXPECT_EQ(read(a.png), first_png) << "the first picture is untouched";
+  EXPECT_EQ(read(a.json), first_json);
+  EXPECT_EQ(b.png.stem().string(), a.png.stem().string() + "-2");
+}
+
+TEST(AppScreenshot, ExplicitPathRefusesExistingFiles) {
+  TempDir dir;
+  const fs::path png = dir.path() / "figure.png";
+  const SavedScreenshot a = save_screenshot_as(png, test_frame(64, 48), test_info());
+  ASSERT_TRUE(a.ok) << a.error;
+  EXPECT_EQ(a.json, dir.path() / "figure.json");
+  const std::string before = read(png);
+  const SavedScreenshot b = save_screenshot_as(png, test_frame(32, 32), test_info());
+  EXPECT_FALSE(b.ok);
+  EXPECT_EQ(b.error, png.string() + ": exists (not overwritten)");
+  EXPECT_EQ(read(png), before);
+  // The side-car is checked too, before anything is written.
+  fs::remove(png);
+  const SavedScreenshot c = save_screenshot_as(png, test_frame(64, 48), test_info());
+  EXPECT_FALSE(c.ok);
+  EXPECT_EQ(c.error, (dir.path() / "figure.json").string() + ": exists (not overwritten)");
+  EXPECT_FALSE(fs::exists(png));
+  EXPECT_FALSE(save_screenshot_as(dir.path() / "no" / "such" / "dir.png", test_frame(8, 8), test_info()).ok);
+}
+
+TEST(AppScreenshot, CaptionStripUnderTheFrame) {
+  const RgbImage frame = test_frame(200, 40);
+  const RgbImage out = add_caption(frame, "BVH (Buckets=8) heatmap nodes");
+  ASSERT_EQ(out.width, 200);
+  ASSERT_GT(out.height, 40);
+  for (int y = 0; y < 40; ++y)
+    for (int x = 0; x < 200; ++x) ASSERT_EQ(out.at(x, y), frame.at(x, y));
+  // Text pixels (bright) and background pixels (dark) in the strip.
+  int bright = 0, dark = 0;
+  for (int y = 40; y < out.height; ++y)
+    for (int x = 0; x < 200; ++x) (out.at(x, y).x > 150 ? bright : dark)++;
+  EXPECT_GT(bright, 50);
+  EXPECT_GT(dark, bright);
+  // Upper-case letters (absent from the font) are lower-cased, not dropped.
+  EXPECT_EQ(add_caption(frame, "BVH").pixels, add_caption(frame, "bvh").pixels);
+}
+
+TEST(AppScreenshot, SideCarSaysHowToReproduceThePicture) {
+  const ScreenshotInfo info = test_info();
+  const nlohmann::json j = screenshot_sidecar(info, "/x/accelviz-1.png");
+  EXPECT_EQ(j["png"], "/x/accelviz-1.png");
+  EXPECT_EQ(j["scene"], "builtin:teapot?size=2000");
+  EXPECT_EQ(j["triangles"], 2256);
+  EXPECT_EQ(j["size"]["width"], 64);
+  EXPECT_EQ(j["camera"]["spec"], "6,4,8,0,1.2,0,40");
+  EXPECT_NEAR(j["camera"]["yfov_deg"].get<double>(), 40.0, 1e-4);
+  EXPECT_EQ(j["structure"]["name"], "bvh");
+  EXPECT_EQ(j["structure"]["options"]["buckets"], "8");
+  EXPECT_EQ(j["query"]["triangle_test"], "watertight");
+  EXPECT_EQ(j["heatmap"]["display"], "blend");
+  EXPECT_EQ(j["heatmap"]["metric"], "prims");
+  EXPECT_EQ(j["heatmap"]["colormap"], "inferno");
+  EXPECT_EQ(j["heatmap"]["scale"], "auto");
+  EXPECT_EQ(j["heatmap"]["range"][1], 39.0);
+  EXPECT_EQ(j["options"].size(), option_table().size());
+  EXPECT_EQ(j["ray_pixel"][0], 32);
+  EXPECT_EQ(j["caption"], screenshot_caption(info.config));
+
+  const std::string cmd = j["reproduce"]["render_heatmap"];
+  for (const char* part : {"accelviz render 'builtin:teapot?size=2000'", "--structure bvh", "--camera 6,4,8,0,1.2,0,40",
+                           "--size 64x48", "--metric prims", "--colormap inferno", "--buckets 8",
+                           "--out accelviz-1-heatmap.png"})
+    EXPECT_NE(cmd.find(part), std::string::npos) << part << " not in " << cmd;
+  EXPECT_EQ(cmd.find("--max"), std::string::npos) << "auto scale: no --max";
+  const std::string raster = j["reproduce"]["render_raster"];
+  for (const char* part : {"--view raster", "--depth 3", "--blend 0.6", "--ray-pixel 32,24"})
+    EXPECT_NE(raster.find(part), std::string::npos) << part << " not in " << raster;
+
+  const auto& script = j["reproduce"]["script"];
+  EXPECT_EQ(script.front(), "open builtin:teapot?size=2000");
+  EXPECT_NE(std::find(script.begin(), script.end(), "set buckets 8"), script.end());
+  EXPECT_NE(std::find(script.begin(), script.end(), "camera 6,4,8,0,1.2,0,40"), script.end());
+  EXPECT_NE(std::find(script.begin(), script.end(), "click 32 24"), script.end());
+  EXPECT_EQ(script.back(), "quit");
+  EXPECT_TRUE(j["reproduce"]["notes"].empty());
+}
+
+TEST(AppScreenshot, SideCarNotesWhatTheCommandLineCannotSay) {
+  ScreenshotInfo info = test_info();
+  ASSERT_EQ(apply_option(info.config, "structure", "kdtree"), "");
+  ASSERT_EQ(apply_option(info.config, "kd-leaf", "6"), "");
+  ASSERT_EQ(apply_option(info.config, "scale", "2,30"), "");
+  info.camera_spec = "";
+  const nlohmann::json j = screenshot_sidecar(info, "shot.png");
+  const std::string cmd = j["reproduce"]["render_heatmap"];
+  EXPECT_NE(cmd.find("--structure kdtree"), std::string::npos);
+  EXPECT_NE(cmd.find("--max 30"), std::string::npos);
+  EXPECT_EQ(cmd.find("--camera"), std::string::npos) << "the default view needs no --camera";
+  std::string notes = j["reproduce"]["notes"].dump();
+  EXPECT_NE(notes.find("kd-leaf=6"), std::string::npos) << notes;
+  EXPECT_NE(notes.find("starts at 2"), std::string::npos) << notes;
+}
+
+TEST(AppScreenshot, DefaultFolderFollowsXdgPictures) {
+  const char* old_pics = std::getenv("XDG_PICTURES_DIR");
+  const std::string saved_pics = old_pics ? old_pics : "";
+  const char* old_home = std::getenv("HOME");
+  const std::string saved_home = old_home ? old_home : "";
+  setenv("XDG_PICTURES_DIR", "/pics", 1);
+  EXPECT_EQ(default_screenshot_dir(), fs::path("/pics/accelviz"));
+  unsetenv("XDG_PICTURES_DIR");
+  setenv("HOME", "/home/u", 1);
+  EXPECT_EQ(default_screenshot_dir(), fs::path("/home/u/Pictures/accelviz"));
+  if (old_pics) setenv("XDG_PICTURES_DIR", saved_pics.c_str(), 1);
+  if (old_home) setenv("HOME", saved_home.c_str(), 1);
+}

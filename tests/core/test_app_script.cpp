@@ -1,0 +1,172 @@
+// The --script language: parsing (every command, comments, errors naming the
+// file and line) and the runner's sequencing over a host that may need more
+// frames, fails, or never finishes.
+#include <gtest/gtest.h>
+
+#include "ui/app/script.h"
+
+#include <functional>
+
+using namespace accelviz;
+using K = ScriptCommand::Kind;
+
+namespace {
+
+std::string parse_error(const std::string& text) {
+  try {
+    parse_script(text, "s.txt");
+  } catch (const ScriptError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+// A host that records commands and answers from a function.
+struct FakeHost : ScriptHost {
+  std::vector<std::string> log;
+  std::function<Status(const ScriptCommand&)> answer = [](const ScriptCommand&) { return Status::done; };
+  Status execute(const ScriptCommand& c) override {
+    log.push_back(std::string(command_name(c.kind)) + (c.arg.empty() ? "" : " " + c.arg));
+    return answer(c);
+  }
+};
+
+}  // namespace
+
+TEST(AppScript, ParsesEveryCommand) {
+  const auto cmds = parse_script(
+      "# a comment\n"
+      "\n"
+      "open builtin:teapot?size=2000\n"
+      "  structure kdtree  \n"
+      "set buckets 32\n"
+      "set scale 0,40\n"
+      "camera 6,4,8,0,1.2,0,40\n"
+      "camera gltf:0\n"
+      "size 640 480\n"
+      "wait\n"
+      "click 320 240\n"
+      "step 3\n"
+      "step next\n"
+      "screenshot out dir/shot one.png\n"
+      "dump-ray ray.json\n"
+      "dump-stats stats.json\n"
+      "quit\r\n",
+      "s.txt");
+  ASSERT_EQ(cmds.size(), 15u);
+  EXPECT_EQ(cmds[0].kind, K::open);
+  EXPECT_EQ(cmds[0].arg, "builtin:teapot?size=2000");
+  EXPECT_EQ(cmds[0].line, 3);
+  EXPECT_EQ(cmds[1].kind, K::structure);
+  EXPECT_EQ(cmds[1].arg, "kdtree");
+  EXPECT_EQ(cmds[2].kind, K::set);
+  EXPECT_EQ(cmds[2].arg, "buckets");
+  EXPECT_EQ(cmds[2].value, "32");
+  EXPECT_EQ(cmds[3].value, "0,40");
+  EXPECT_EQ(cmds[4].kind, K::camera);
+  EXPECT_EQ(cmds[5].arg, "gltf:0");
+  EXPECT_EQ(cmds[6].kind, K::size);
+  EXPECT_EQ(cmds[6].x, 640);
+  EXPECT_EQ(cmds[6].y, 480);
+  EXPECT_EQ(cmds[7].kind, K::wait);
+  EXPECT_EQ(cmds[8].kind, K::click);
+  EXPECT_EQ(cmds[8].x, 320);
+  EXPECT_EQ(cmds[9].arg, "3");
+  EXPECT_EQ(cmds[10].arg, "next");
+  EXPECT_EQ(cmds[11].kind, K::screenshot);
+  EXPECT_EQ(cmds[11].arg, "out dir/shot one.png") << "paths keep their spaces";
+  EXPECT_EQ(cmds[12].kind, K::dump_ray);
+  EXPECT_EQ(cmds[13].kind, K::dump_stats);
+  EXPECT_EQ(cmds[14].kind, K::quit);
+  EXPECT_EQ(cmds[14].line, 17);
+}
+
+TEST(AppScript, ErrorsNameFileAndLine) {
+  struct Case {
+    const char* text;
+    const char* expected;
+  };
+  for (const Case& c : {
+           Case{"wait\nfrobnicate\n", "s.txt:2: unknown command 'frobnicate'"},
+           Case{"open\n", "s.txt:1: open: expected a scene"},
+           Case{"\n\nset buckets\n", "s.txt:3: set buckets: expected a value"},
+           Case{"set bukets 4\n", "s.txt:1: set: unknown option 'bukets'"},
+           Case{"set buckets 1\n", "s.txt:1: set buckets: expected an integer in 2..256, got '1'"},
+           Case{"set leaf 8\nset leaf-cap 4\n", "s.txt:2: set leaf-cap: expected an integer in 8..255"},
+           Case{"structure octopus\n", "s.txt:1: structure: expected one of"},
+           Case{"size 640\n", "s.txt:1: size: expected W H"},
+           Case{"size 10 10\n", "s.txt:1: size: W and H must lie in 64..8192"},
+           Case{"click 1 2 3\n", "s.txt:1: click: expected X Y"},
+           Case{"click -1 2\n", "s.txt:1: click: X and Y must be >= 0"},
+           Case{"step sideways\n", "s.txt:1: step: expected N"},
+           Case{"camera 1,2,3\n", "s.txt:1: camera: expected 6 or 7 numbers"},
+           Case{"camera 1,2,3,1,2,3\n", "s.txt:1: camera: eye and target are the same point"},
+           Case{"camera 0,0,5,0,0,0,180\n", "s.txt:1: camera: fov must lie strictly between 0 and 180"},
+           Case{"camera gltf:x\n", "s.txt:1: camera: expected gltf:N"},
+           Case{"wait now\n", "s.txt:1: wait: takes no argument"},
+           Case{"quit please\n", "s.txt:1: quit: takes no argument"},
+       }) {
+    const std::string e = parse_error(c.text);
+    EXPECT_EQ(e.rfind(c.expected, 0), 0u) << "script: " << c.text << "\ngot: " << e;
+  }
+  // Later lines are not checked against earlier ones' configuration only
+  // when they come first: the cap is fine before the leaf grows.
+  EXPECT_EQ(parse_error("set leaf-cap 32\nset leaf 8\n"), "(no error)");
+}
+
+TEST(AppScript, MissingFileIsAnError) {
+  try {
+    load_script("/nonexistent/dir/script.txt");
+    FAIL() << "no error";
+  } catch (const ScriptError& e) {
+    EXPECT_STREQ(e.what(), "/nonexistent/dir/script.txt:0: cannot be read");
+  }
+}
+
+TEST(AppScript, RunnerRetriesCommandsThatNeedMoreFrames) {
+  const auto cmds = parse_script("open a.glb\nwait\nclick 1 1\nquit\nclick 2 2\n", "s.txt");
+  ScriptRunner runner(cmds, "s.txt");
+  FakeHost host;
+  int waits = 0;
+  host.answer = [&](const ScriptCommand& c) {
+    if (c.kind == K::wait && ++waits < 3) return ScriptHost::Status::again;
+    return ScriptHost::Status::done;
+  };
+  EXPECT_EQ(runner.advance(host, 0.0), ScriptRunner::State::running);
+  EXPECT_EQ(host.log, (std::vector<std::string>{"open a.glb", "wait"}));
+  EXPECT_EQ(runner.advance(host, 1.0), ScriptRunner::State::running);
+  EXPECT_EQ(runner.advance(host, 2.0), ScriptRunner::State::finished);
+  // quit ends the script: the command after it never runs.
+  EXPECT_EQ(host.log, (std::vector<std::string>{"open a.glb", "wait", "wait", "wait", "click", "quit"}));
+  EXPECT_EQ(runner.advance(host, 3.0), ScriptRunner::State::finished);
+}
+
+TEST(AppScript, EndOfFileFinishes) {
+  ScriptRunner runner(parse_script("wait\n", "s.txt"), "s.txt");
+  FakeHost host;
+  EXPECT_EQ(runner.advance(host, 0.0), ScriptRunner::State::finished);
+  ScriptRunner empty({}, "e.txt");
+  EXPECT_EQ(empty.advance(host, 0.0), ScriptRunner::State::finished);
+}
+
+TEST(AppScript, AFailingCommandNamesItsLine) {
+  ScriptRunner runner(parse_script("wait\n\nclick 5 5\nquit\n", "s.txt"), "s.txt");
+  FakeHost host;
+  host.answer = [](const ScriptCommand& c) -> ScriptHost::Status {
+    if (c.kind == K::click) throw std::runtime_error("pixel 5,5 is outside\nthe view");
+    return ScriptHost::Status::done;
+  };
+  EXPECT_EQ(runner.advance(host, 0.0), ScriptRunner::State::failed);
+  EXPECT_EQ(runner.error(), "s.txt:3: click: pixel 5,5 is outside the view");
+  EXPECT_EQ(host.log.back(), "click");
+}
+
+TEST(AppScript, ACommandThatNeverCompletesTimesOut) {
+  ScriptRunner runner(parse_script("wait\n", "s.txt"), "s.txt", /*timeout_s=*/10.0);
+  FakeHost host;
+  host.answer = [](const ScriptCommand&) { return ScriptHost::Status::again; };
+  EXPECT_EQ(runner.advance(host, 100.0), ScriptRunner::State::running);
+  EXPECT_EQ(runner.advance(host, 109.0), ScriptRunner::State::running);
+  EXPECT_EQ(runner.advance(host, 110.5), ScriptRunner::State::failed);
+  EXPECT_EQ(runner.error(), "s.txt:1: wait: not complete after 10 s");
+}

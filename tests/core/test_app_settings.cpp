@@ -1,0 +1,182 @@
+// Settings on disk: round trip, atomic replacement, the XDG location, and
+// unusable files reported in one line and replaced by defaults.
+#include <gtest/gtest.h>
+
+#include "ui/app/settings.h"
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+using namespace accelviz;
+namespace fs = std::filesystem;
+
+namespace {
+
+class TempDir {
+ public:
+  TempDir() {
+    std::string tmpl = (fs::temp_directory_path() / "accelviz-settings-XXXXXX").string();
+    path_ = mkdtemp(tmpl.data());
+  }
+  ~TempDir() { fs::remove_all(path_); }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void write(const fs::path& p, const std::string& text) {
+  std::ofstream(p, std::ios::binary) << text;
+}
+
+// Restores an environment variable on scope exit.
+class EnvGuard {
+ public:
+  explicit EnvGuard(const char* name) : name_(name) {
+    if (const char* v = std::getenv(name)) old_ = v;
+  }
+  ~EnvGuard() {
+    if (old_)
+      setenv(name_, old_->c_str(), 1);
+    else
+      unsetenv(name_);
+  }
+
+ private:
+  const char* name_;
+  std::optional<std::string> old_;
+};
+
+}  // namespace
+
+TEST(AppSettings, RoundTrip) {
+  TempDir dir;
+  AppSettings s;
+  s.last_scene = "/data/bunny.glb";
+  s.recent = {"/data/bunny.glb", "builtin:teapot?size=5000"};
+  s.screenshot_dir = "/tmp/shots";
+  s.window_width = 1600;
+  s.window_height = 900;
+  ASSERT_EQ(apply_option(s.config, "structure", "octree"), "");
+  ASSERT_EQ(apply_option(s.config, "octree-depth", "7"), "");
+  ASSERT_EQ(apply_option(s.config, "buckets", "64"), "");
+  ASSERT_EQ(apply_option(s.config, "heatmap", "blend"), "");
+  ASSERT_EQ(apply_option(s.config, "scale", "1,30"), "");
+  ASSERT_EQ(apply_option(s.config, "wireframe", "on"), "");
+  const fs::path file = settings_file(dir.path() / "accelviz");
+  ASSERT_EQ(save_settings(file, s), "");
+
+  const LoadedSettings loaded = load_settings(file);
+  EXPECT_EQ(loaded.error, "");
+  EXPECT_EQ(loaded.settings.last_scene, s.last_scene);
+  EXPECT_EQ(loaded.settings.recent, s.recent);
+  EXPECT_EQ(loaded.settings.screenshot_dir, s.screenshot_dir);
+  EXPECT_EQ(loaded.settings.window_width, 1600);
+  EXPECT_EQ(loaded.settings.window_height, 900);
+  EXPECT_EQ(option_values(loaded.settings.config), option_values(s.config));
+}
+
+TEST(AppSettings, MissingFileGivesDefaultsSilently) {
+  TempDir dir;
+  const LoadedSettings loaded = load_settings(dir.path() / "none" / "settings.json");
+  EXPECT_EQ(loaded.error, "");
+  EXPECT_EQ(option_values(loaded.settings.config), option_values(AppConfig{}));
+  EXPECT_TRUE(loaded.settings.recent.empty());
+}
+
+TEST(AppSettings, CorruptedFileIsReportedAndReplacedByDefaults) {
+  TempDir dir;
+  const fs::path file = dir.path() / "settings.json";
+  struct Case {
+    const char* text;
+    const char* problem;
+  };
+  for (const Case& c : {
+           Case{"{\"version\": 1, \"options\": {\"buckets\": ", "parse error"},
+           Case{"", "parse error"},
+           Case{"[1, 2]", "not a JSON object"},
+           Case{"{\"version\": 7}", "unsupported version 7"},
+           Case{"{\"recent\": \"x\"}", "recent: expected an array of strings"},
+           Case{"{\"last_scene\": 3}", "last_scene: expected a string"},
+           Case{"{\"window\": {\"width\": 5}}", "window.width: expected an integer in 100..16384"},
+           Case{"{\"options\": {\"buckets\": \"1\"}}", "options.buckets: expected an integer in 2..256, got '1'"},
+           Case{"{\"options\": {\"buckets\": 16}}", "options.buckets: expected a string"},
+           Case{"{\"options\": {\"wobble\": \"on\"}}", "options: unknown option 'wobble'"},
+       }) {
+    write(file, c.text);
+    const LoadedSettings loaded = load_settings(file);
+    EXPECT_EQ(loaded.error.rfind(file.string() + ": ", 0), 0u) << loaded.error;
+    EXPECT_NE(loaded.error.find(c.problem), std::string::npos) << c.text << " -> " << loaded.error;
+    EXPECT_NE(loaded.error.find("(using defaults)"), std::string::npos);
+    EXPECT_EQ(loaded.error.find('\n'), std::string::npos) << "one line";
+    EXPECT_EQ(option_values(loaded.settings.config), option_values(AppConfig{})) << c.text;
+    EXPECT_EQ(loaded.settings.last_scene, "");
+  }
+  // Saving afterwards replaces the bad file with a readable one.
+  ASSERT_EQ(save_settings(file, load_settings(file).settings), "");
+  EXPECT_EQ(load_settings(file).error, "");
+}
+
+TEST(AppSettings, AtomicWriteReplacesWholeFilesAndLeavesNoTemporary) {
+  TempDir dir;
+  const fs::path file = dir.path() / "sub" / "dir" / "f.txt";
+  ASSERT_EQ(write_file_atomic(file, "first version, rather long\n"), "");
+  EXPECT_EQ(read(file), "first version, rather long\n");
+  ASSERT_EQ(write_file_atomic(file, "second\n"), "");
+  EXPECT_EQ(read(file), "second\n") << "replaced, not overwritten in place (no tail of the old text)";
+  ASSERT_EQ(write_file_atomic(file, ""), "");
+  EXPECT_EQ(read(file), "");
+  std::size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(file.parent_path())) ++entries;
+  EXPECT_EQ(entries, 1u) << "no temporary file left next to it";
+}
+
+TEST(AppSettings, AtomicWriteFailureIsOneLineAndKeepsTheOldFile) {
+  TempDir dir;
+  // A directory where the file should be: rename() cannot replace it.
+  const fs::path target = dir.path() / "taken";
+  fs::create_directories(target / "inside");
+  const std::string e = write_file_atomic(target, "text");
+  EXPECT_EQ(e.rfind(target.string() + ": ", 0), 0u) << e;
+  EXPECT_TRUE(fs::is_directory(target / "inside"));
+  std::size_t entries = 0;
+  for ([[maybe_unused]] const auto& x : fs::directory_iterator(dir.path())) ++entries;
+  EXPECT_EQ(entries, 1u) << "the temporary file was removed";
+  // A parent that is a file cannot become a folder.
+  write(dir.path() / "plain", "x");
+  EXPECT_NE(write_file_atomic(dir.path() / "plain" / "f.txt", "text"), "");
+}
+
+TEST(AppSettings, ConfigDirFollowsXdg) {
+  EnvGuard xdg("XDG_CONFIG_HOME"), home("HOME");
+  setenv("XDG_CONFIG_HOME", "/cfg/here", 1);
+  EXPECT_EQ(config_dir(), fs::path("/cfg/here/accelviz"));
+  setenv("XDG_CONFIG_HOME", "relative/path", 1);  // invalid per the spec: ignored
+  setenv("HOME", "/home/someone", 1);
+  EXPECT_EQ(config_dir(), fs::path("/home/someone/.config/accelviz"));
+  unsetenv("XDG_CONFIG_HOME");
+  EXPECT_EQ(config_dir(), fs::path("/home/someone/.config/accelviz"));
+  EXPECT_EQ(settings_file(config_dir()).filename(), "settings.json");
+  EXPECT_EQ(imgui_ini_file(config_dir()).filename(), "imgui.ini");
+}
+
+TEST(AppSettings, RecentFilesMostRecentFirstWithoutDuplicates) {
+  AppSettings s;
+  for (int i = 0; i < 15; ++i) add_recent(s, "scene" + std::to_string(i));
+  ASSERT_EQ(s.recent.size(), AppSettings::kMaxRecent);
+  EXPECT_EQ(s.recent.front(), "scene14");
+  add_recent(s, "scene10");
+  EXPECT_EQ(s.recent.front(), "scene10");
+  EXPECT_EQ(std::count(s.recent.begin(), s.recent.end(), "scene10"), 1);
+  add_recent(s, "");
+  EXPECT_EQ(s.recent.front(), "scene10");
+}

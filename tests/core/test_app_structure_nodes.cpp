@@ -1,0 +1,154 @@
+// Node tables for the box overlay and the ray replay: they mirror each
+// structure's own arrays, selections pick what they say, and the ids a
+// traversal reports map to boxes the ray really passes through.
+#include <gtest/gtest.h>
+
+#include "core/accel/factory.h"
+#include "core/query/camera.h"
+#include "core/scene/load.h"
+#include "ui/app/structure_nodes.h"
+
+#include <cmath>
+
+using namespace accelviz;
+
+namespace {
+
+const Scene& teapot() {
+  static const Scene s = load_scene("builtin:teapot?size=800");
+  return s;
+}
+
+bool inside(const Aabb& outer, const Aabb& inner, float tol) {
+  for (int a = 0; a < 3; ++a)
+    if (inner.lo[a] < outer.lo[a] - tol || inner.hi[a] > outer.hi[a] + tol) return false;
+  return true;
+}
+
+bool same_box(const Aabb& a, const Aabb& b) { return a.lo == b.lo && a.hi == b.hi; }
+
+}  // namespace
+
+TEST(AppStructureNodes, TreesMirrorTheirNodeArrays) {
+  for (const char* name : {"bvh", "kdtree", "octree", "voxels"}) {
+    SCOPED_TRACE(name);
+    const auto accel = build_accelerator(name, teapot().triangles, StructureOptions{});
+    const StructureNodes t = StructureNodes::of(*accel);
+    EXPECT_EQ(t.kind(), name);
+    ASSERT_FALSE(t.empty());
+    const BuildStats& b = accel->build_stats();
+    if (std::string(name) != "voxels") {
+      EXPECT_EQ(t.size(), b.node_count);
+      EXPECT_EQ(t.max_depth(), b.max_depth);
+    }
+    // Leaves mode finds every leaf the build reports (voxels: full blocks).
+    const auto leaves = t.select({BoxMode::leaves, 0, 0, 0}, 1u << 30);
+    EXPECT_EQ(leaves.matched, b.leaf_count);
+    double share = 0.0;
+    std::uint64_t roots = 0;
+    for (std::uint32_t i = 0; i < t.size(); ++i) {
+      const StructureNode* n = t.node(i);
+      ASSERT_NE(n, nullptr);
+      share += n->sah_share;
+      if (n->parent == 0xFFFFFFFFu) {
+        ++roots;
+        continue;
+      }
+      const StructureNode* p = t.node(n->parent);
+      ASSERT_NE(p, nullptr);
+      EXPECT_EQ(n->depth, p->depth + 1);
+      EXPECT_TRUE(inside(p->bounds, n->bounds, 1e-5f)) << "node " << i << " pokes out of its parent";
+    }
+    EXPECT_EQ(roots, 1u);
+    EXPECT_NEAR(share, 1.0, 1e-4);
+  }
+}
+
+TEST(AppStructureNodes, SelectionsPickWhatTheySay) {
+  const auto accel = build_accelerator("bvh", teapot().triangles, StructureOptions{});
+  const auto& bvh = dynamic_cast<const Bvh&>(*accel);
+  const StructureNodes t = StructureNodes::of(*accel);
+  for (std::uint32_t i = 0; i < bvh.nodes().size(); ++i) EXPECT_TRUE(same_box(*t.box(i), bvh.nodes()[i].bounds));
+  EXPECT_FALSE(t.box(static_cast<std::uint32_t>(bvh.nodes().size())).has_value());
+
+  const auto d3 = t.select({BoxMode::depth, 3, 0, 0}, 1u << 30);
+  ASSERT_FALSE(d3.boxes.empty());
+  for (const NodeBox& b : d3.boxes) EXPECT_EQ(b.depth, 3u);
+  std::uint64_t at3 = 0;
+  for (std::uint32_t i = 0; i < t.size(); ++i) at3 += t.node(i)->depth == 3;
+  EXPECT_EQ(d3.matched, at3);
+
+  const auto range = t.select({BoxMode::depth_range, 2, 4, 0}, 1u << 30);
+  for (const NodeBox& b : range.boxes) EXPECT_TRUE(b.depth >= 2 && b.depth <= 4);
+
+  const auto all = t.select({BoxMode::subtree, 0, 0, 0}, 1u << 30);
+  EXPECT_EQ(all.matched, t.size()) << "the root's subtree is everything";
+  EXPECT_EQ(all.boxes.front().id, 0u) << "parent before children";
+  const auto some = t.select({BoxMode::subtree, 0, 0, 5}, 1u << 30);
+  for (const NodeBox& b : some.boxes) EXPECT_TRUE(inside(*t.box(5), b.bounds, 0.0f));
+
+  const auto cut = t.select({BoxMode::leaves, 0, 0, 0}, 10);
+  EXPECT_EQ(cut.boxes.size(), 10u);
+  EXPECT_TRUE(cut.truncated);
+  EXPECT_GT(cut.matched, 10u);
+}
+
+TEST(AppStructureNodes, GridCellsAreTheGridsOwn) {
+  const auto accel = build_accelerator("grid", teapot().triangles, StructureOptions{});
+  const auto& grid = dynamic_cast<const Grid&>(*accel);
+  const StructureNodes t = StructureNodes::of(*accel);
+  EXPECT_EQ(t.kind(), "grid");
+  const auto r = grid.resolution();
+  EXPECT_EQ(t.size(), static_cast<std::uint64_t>(r[0]) * r[1] * r[2]);
+  for (int z = 0; z < r[2]; z += 3)
+    for (int y = 0; y < r[1]; y += 2)
+      for (int x = 0; x < r[0]; ++x) {
+        const std::uint32_t id = static_cast<std::uint32_t>(x + r[0] * (y + r[1] * z));
+        EXPECT_TRUE(same_box(*t.box(id), grid.cell_box(x, y, z)));
+      }
+  const auto root = t.select({BoxMode::depth, 0, 0, 0}, 100);
+  ASSERT_EQ(root.boxes.size(), 1u);
+  EXPECT_TRUE(same_box(root.boxes[0].bounds, grid.bounds()));
+  const auto cells = t.select({BoxMode::leaves, 0, 0, 0}, 1u << 30);
+  EXPECT_EQ(cells.matched, static_cast<std::uint64_t>(grid.build_stats().node_count -
+                                                        grid.build_stats().extra.at("empty_cells")));
+}
+
+TEST(AppStructureNodes, EnteredNodesContainTheRaySegmentTheyReport) {
+  const Scene& s = teapot();
+  const Camera cam = camera_from_spec("", s, 1.0f);
+  for (const char* name : {"bvh", "kdtree", "octree", "grid", "voxels"}) {
+    SCOPED_TRACE(name);
+    const auto accel = build_accelerator(name, s.triangles, StructureOptions{});
+    const StructureNodes t = StructureNodes::of(*accel);
+    std::size_t checked = 0;
+    for (int y = 2; y < 32; y += 5)
+      for (int x = 2; x < 32; x += 5) {
+        const Ray ray = primary_ray(cam, x, y, 32, 32);
+        VisitTrace trace;
+        RayStats stats;
+        accel->closest_hit(ray, {}, &stats, &trace);
+        for (const VisitStep& st : trace.steps) {
+          if (st.kind != VisitStep::Kind::node_entered) continue;
+          const auto box = t.box(st.id);
+          ASSERT_TRUE(box.has_value()) << "id " << st.id;
+          const float tm = 0.5f * (std::max(st.t_entry, ray.tmin) + st.t_exit);
+          if (!std::isfinite(tm)) continue;
+          const glm::vec3 p = ray.at(tm);
+          const float tol = 1e-3f * glm::length(box->extent()) + 1e-4f;
+          EXPECT_TRUE(inside(*box, Aabb::of_point(p), tol)) << "node " << st.id << " at t " << tm;
+          ++checked;
+        }
+      }
+    EXPECT_GT(checked, 0u);
+  }
+}
+
+TEST(AppStructureNodes, StructuresWithoutNodesHaveNone) {
+  const auto accel = build_accelerator("brute", teapot().triangles, StructureOptions{});
+  const StructureNodes t = StructureNodes::of(*accel);
+  EXPECT_TRUE(t.empty());
+  EXPECT_EQ(t.kind(), "");
+  EXPECT_TRUE(t.select({BoxMode::depth, 0, 0, 0}, 10).boxes.empty());
+  EXPECT_FALSE(t.box(0).has_value());
+}

@@ -1,0 +1,353 @@
+// Scripted runs of the real app: `accelviz --script FILE` opens its window
+// on a private Xvfb server (llvmpipe), runs the commands through its main
+// loop, and the test checks what it wrote: screenshots pixel by pixel, the
+// picked ray against a brute-force trace computed here, the stats of each
+// structure, and that bad input is reported while the app carries on.
+#include <gtest/gtest.h>
+
+#include "core/accel/brute_force.h"
+#include "core/analysis/heatmap.h"
+#include "core/query/camera.h"
+#include "core/scene/load.h"
+
+#include <nlohmann/json.hpp>
+
+#include <csignal>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <fcntl.h>
+#include <poll.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using namespace accelviz;
+
+namespace {
+
+// Xvfb for this process, on the display number it picks itself (-displayfd).
+class PrivateXServer : public ::testing::Environment {
+ public:
+  void SetUp() override {
+    int fds[2];
+    ASSERT_EQ(pipe(fds), 0);
+    pid_ = fork();
+    ASSERT_GE(pid_, 0);
+    if (pid_ == 0) {
+      close(fds[0]);
+      const int devnull = open("/dev/null", O_WRONLY);
+      dup2(devnull, STDOUT_FILENO);
+      dup2(devnull, STDERR_FILENO);
+      const std::string fd = std::to_string(fds[1]);
+      // -noreset: the server must survive each run's window closing.
+      execl(ACCELVIZ_XVFB, "Xvfb", "-displayfd", fd.c_str(), "-screen", "0", "1280x800x24", "-nolisten", "tcp",
+            "-noreset", static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    close(fds[1]);
+    std::string number;
+    pollfd p{fds[0], POLLIN, 0};
+    while (poll(&p, 1, 20000) > 0) {
+      char c = 0;
+      if (read(fds[0], &c, 1) != 1 || c == '\n') break;
+      number += c;
+    }
+    close(fds[0]);
+    ASSERT_FALSE(number.empty()) << "Xvfb (" << ACCELVIZ_XVFB << ") did not start";
+    setenv("DISPLAY", (":" + number).c_str(), 1);
+    unsetenv("WAYLAND_DISPLAY");
+    // The window's GL comes from Mesa's libGL: llvmpipe, two rasteriser
+    // threads (the CI machines have two cores).
+    setenv("LIBGL_ALWAYS_SOFTWARE", "1", 1);
+    setenv("GALLIUM_DRIVER", "llvmpipe", 1);
+    setenv("LP_NUM_THREADS", "2", 1);
+  }
+  void TearDown() override {
+    if (pid_ > 0) {
+      kill(pid_, SIGTERM);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+
+ private:
+  pid_t pid_ = -1;
+};
+
+[[maybe_unused]] ::testing::Environment* const x_server = ::testing::AddGlobalTestEnvironment(new PrivateXServer);
+
+constexpr const char* kTeapot = "builtin:teapot?size=2000";
+// Eye, target, fov: the teapot's body fills the middle of a 640×480 view.
+constexpr const char* kCamera = "6,4,8,0,1.2,0,40";
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+nlohmann::json read_json(const fs::path& p) {
+  const std::string text = read_text(p);
+  if (text.empty()) ADD_FAILURE() << p << " is missing or empty";
+  return nlohmann::json::parse(text.empty() ? "null" : text);
+}
+
+struct RunResult {
+  int code = -1;
+  std::string out;
+  std::string err;
+};
+
+class GuiScript : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string tmpl = (fs::temp_directory_path() / "accelviz-gui-XXXXXX").string();
+    dir_ = mkdtemp(tmpl.data());
+    // Where settings and default screenshots would go: both must stay empty.
+    setenv("XDG_CONFIG_HOME", (dir_ / "config").c_str(), 1);
+    setenv("XDG_PICTURES_DIR", (dir_ / "pictures").c_str(), 1);
+  }
+  void TearDown() override {
+    EXPECT_FALSE(fs::exists(dir_ / "config")) << "a scripted run wrote settings";
+    if (!HasFailure()) fs::remove_all(dir_);
+  }
+
+  fs::path path(const std::string& name) const { return dir_ / name; }
+
+  /// Writes the script and runs `accelviz --script` on it (plus `args`).
+  RunResult run(const std::string& script, const std::string& args = "") {
+    const fs::path file = dir_ / "script.txt";
+    std::ofstream(file) << script;
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string cmd = std::string("'") + ACCELVIZ_BIN + "' --script '" + file.string() + "' " + args + " > '" +
+                            out.string() + "' 2> '" + err.string() + "'";
+    const int status = std::system(cmd.c_str());
+    RunResult r;
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = read_text(out);
+    r.err = read_text(err);
+    return r;
+  }
+
+  fs::path dir_;
+};
+
+// Colour distance (sum over channels).
+int distance(glm::u8vec3 a, glm::u8vec3 b) {
+  return std::abs(a.x - b.x) + std::abs(a.y - b.y) + std::abs(a.z - b.z);
+}
+
+std::size_t distinct_colours(const RgbImage& img) {
+  std::set<std::uint32_t> colours;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      const glm::u8vec3 c = img.at(x, y);
+      colours.insert(c.x << 16 | c.y << 8 | c.z);
+    }
+  return colours.size();
+}
+
+// Pixels of the region within `tol` of colour `c`.
+int count_near(const RgbImage& img, int x0, int y0, int x1, int y1, glm::u8vec3 c, int tol) {
+  int n = 0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) n += distance(img.at(x, y), c) <= tol;
+  return n;
+}
+
+}  // namespace
+
+TEST_F(GuiScript, ScreenshotShowsTheMeshAndTheLegend) {
+  const RunResult r = run(std::string("open ") + kTeapot + "\n" +
+                    "size 640 480\n"
+                    "camera " + kCamera + "\n"
+                    "set boxes off\n"
+                    "wait\n"
+                    "screenshot " + path("mesh.png").string() + "\n"
+                    "set heatmap blend\n"
+                    "set opacity 0.8\n"
+                    "wait\n"
+                    "screenshot " + path("heatmap.png").string() + "\n"
+                    "quit\n");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find(path("mesh.png").string()), std::string::npos) << "the path written is printed";
+
+  const RgbImage mesh = read_png(path("mesh.png").string());
+  const RgbImage heat = read_png(path("heatmap.png").string());
+  // The 3D view is 640×480; the caption strip is added below it.
+  ASSERT_EQ(mesh.width, 640);
+  ASSERT_GT(mesh.height, 480);
+  ASSERT_EQ(heat.width, 640);
+
+  // Not blank, and the teapot stands out from the background.
+  EXPECT_GT(distinct_colours(mesh), 50u);
+  const glm::u8vec3 background = mesh.at(4, 4);
+  EXPECT_EQ(distance(background, mesh.at(635, 475)), 0) << "corners show the background";
+  EXPECT_GT(distance(mesh.at(320, 240), background), 60) << "the teapot is at the centre";
+  int on_mesh = 0;
+  for (int y = 0; y < 480; ++y)
+    for (int x = 0; x < 640; ++x) on_mesh += distance(mesh.at(x, y), background) > 30;
+  EXPECT_GT(on_mesh, 640 * 480 / 20);
+  EXPECT_LT(on_mesh, 640 * 480 * 9 / 10);
+
+  // The legend at the right edge: the top of viridis (yellow) and its
+  // bottom (dark purple) appear there with the heatmap on, not without.
+  const glm::u8vec3 top = to_rgb8(colormap(ColorMap::viridis, 1.0f));
+  const glm::u8vec3 bottom = to_rgb8(colormap(ColorMap::viridis, 0.0f));
+  EXPECT_GT(count_near(heat, 512, 0, 640, 480, top, 12), 40);
+  EXPECT_GT(count_near(heat, 512, 0, 640, 480, bottom, 12), 40);
+  EXPECT_EQ(count_near(mesh, 512, 0, 640, 480, top, 12), 0);
+  // The heatmap changes the teapot's colours.
+  EXPECT_GT(distance(heat.at(320, 240), mesh.at(320, 240)), 30);
+
+  // The caption under the picture and the side-car next to it.
+  int caption_text = 0;
+  for (int y = 481; y < heat.height; ++y)
+    for (int x = 0; x < 640; ++x) caption_text += heat.at(x, y).x > 150;
+  EXPECT_GT(caption_text, 100);
+  const nlohmann::json side = read_json(path("heatmap.json"));
+  EXPECT_EQ(side["scene"], kTeapot);
+  EXPECT_EQ(side["camera"]["spec"], kCamera);
+  EXPECT_EQ(side["heatmap"]["display"], "blend");
+  EXPECT_EQ(side["structure"]["name"], "bvh");
+  EXPECT_EQ(side["size"]["width"], 640);
+  EXPECT_FALSE(fs::exists(dir_ / "pictures")) << "explicit paths only";
+}
+
+TEST_F(GuiScript, ClickCastsThePixelRayAndReplaysItsTraversal) {
+  const RunResult r = run(std::string("open ") + kTeapot + "\n" +
+                    "size 640 480\n"
+                    "camera " + kCamera + "\n"
+                    "wait\n"
+                    "click 320 240\n"
+                    "dump-ray " + path("ray-dump.json").string() + "\n"
+                    "step 0\n"
+                    "step next\n"
+                    "dump-ray " + path("ray-dump1.json").string() + "\n"
+                    "screenshot " + path("ray.png").string() + "\n"
+                    "quit\n");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = read_json(path("ray-dump.json"));
+  ASSERT_EQ(j["size"], nlohmann::json::array({640, 480}));
+  ASSERT_FALSE(j["hit"].is_null()) << "the centre pixel hits the teapot";
+
+  // The same pixel's ray, traced here by brute force.
+  const Scene scene = load_scene(kTeapot);
+  const Camera cam = camera_from_spec(kCamera, scene, 640.0f / 480.0f);
+  const Ray ray = primary_ray(cam, 320, 240, 640, 480);
+  const Hit expected = BruteForce(scene.triangles).closest_hit(ray, {});
+  ASSERT_TRUE(expected.valid());
+  EXPECT_EQ(j["hit"]["prim"].get<std::uint32_t>(), expected.prim);
+  EXPECT_NEAR(j["hit"]["t"].get<float>(), expected.t, 1e-5f * expected.t);
+  EXPECT_NEAR(j["ray"]["direction"][0].get<float>(), ray.direction.x, 1e-6f);
+  EXPECT_NEAR(j["ray"]["origin"][2].get<float>(), ray.origin.z, 1e-5f);
+
+  // The traversal: entered nodes, primitive tests, the hit among them.
+  const auto& steps = j["steps"];
+  ASSERT_FALSE(steps.empty());
+  int entered = 0, hit_steps = 0;
+  for (const auto& s : steps) {
+    entered += s["kind"] == "entered";
+    hit_steps += s["kind"] == "prim-hit" && s["id"] == expected.prim;
+  }
+  EXPECT_GT(entered, 0);
+  EXPECT_EQ(entered, j["entered_nodes"].get<int>());
+  EXPECT_GE(hit_steps, 1);
+  EXPECT_EQ(j["replay_step"].get<std::size_t>(), steps.size() - 1) << "a new ray shows its whole traversal";
+  EXPECT_EQ(read_json(path("ray-dump1.json"))["replay_step"], 1) << "step 0, then next";
+  // The scene has a light: one shadow ray towards it.
+  EXPECT_EQ(j["shadows"].size(), scene.lights.size());
+  EXPECT_TRUE(fs::exists(path("ray.png")));
+  // Stepping replays the same ray; it does not cast a new one.
+  const nlohmann::json stepped = read_json(path("ray-dump1.json"));
+  EXPECT_EQ(stepped["ray"], j["ray"]);
+  EXPECT_EQ(stepped["hit"], j["hit"]);
+}
+
+TEST_F(GuiScript, SwitchingStructuresRebuildsAndTheHeatmapFollows) {
+  std::string script = std::string("open ") + kTeapot + "\nsize 640 480\ncamera " + kCamera + "\nset heatmap full\n";
+  for (const char* s : {"bvh", "kdtree", "grid"})
+    script += std::string("structure ") + s + "\nwait\ndump-stats " + path(std::string(s) + "-stats.json").string() +
+              "\nscreenshot " + path(std::string(s) + ".png").string() + "\n";
+  const RunResult r = run(script + "quit\n");
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::set<std::uint64_t> node_counts;
+  std::vector<RgbImage> shots;
+  for (const char* s : {"bvh", "kdtree", "grid"}) {
+    SCOPED_TRACE(s);
+    const nlohmann::json j = read_json(path(std::string(s) + "-stats.json"));
+    EXPECT_EQ(j["structure"], s);
+    EXPECT_EQ(j["scene"], kTeapot);
+    EXPECT_EQ(j["building"], false);
+    EXPECT_EQ(j["error"], "");
+    ASSERT_FALSE(j["build"].is_null());
+    EXPECT_GT(j["build"]["nodes"].get<std::uint64_t>(), 0u);
+    node_counts.insert(j["build"]["nodes"].get<std::uint64_t>());
+    // The view's figures come from a complete heatmap of this structure.
+    ASSERT_FALSE(j["view"].is_null());
+    EXPECT_EQ(j["view"]["structure"], s);
+    EXPECT_EQ(j["view"]["complete"], true);
+    EXPECT_EQ(j["view"]["rays"], 640 * 480);
+    EXPECT_GT(j["view"]["mean_nodes"].get<double>(), 0.0);
+    EXPECT_GT(j["view"]["max_prims"].get<double>(), 0.0);
+    EXPECT_GT(j["view"]["rays_per_s"].get<double>(), 0.0);
+    shots.push_back(read_png(path(std::string(s) + ".png").string()));
+    EXPECT_GT(distinct_colours(shots.back()), 20u) << "the heatmap is drawn";
+  }
+  EXPECT_EQ(node_counts.size(), 3u) << "three different structures were built";
+  EXPECT_NE(shots[0].pixels, shots[1].pixels);
+  EXPECT_NE(shots[1].pixels, shots[2].pixels);
+}
+
+TEST_F(GuiScript, ABadScenePathIsReportedAndTheAppKeepsRunning) {
+  const std::string missing = path("no-such-model.glb").string();
+  const RunResult r = run(std::string("open ") + kTeapot + "\nsize 640 480\nwait\n" + "open " + missing + "\nwait\n" +
+                    "dump-stats " + path("after-error.json").string() + "\n" +
+                    "structure octree\nwait\n" +
+                    "dump-stats " + path("after-octree.json").string() + "\n" +
+                    "screenshot " + path("still-running.png").string() + "\nquit\n");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json e = read_json(path("after-error.json"));
+  const std::string error = e["error"];
+  EXPECT_NE(error.find("no-such-model.glb"), std::string::npos) << error;
+  EXPECT_EQ(error.find('\n'), std::string::npos);
+  EXPECT_EQ(e["scene"], kTeapot) << "the scene shown stays";
+  EXPECT_NE(r.err.find("no-such-model.glb"), std::string::npos) << "also reported on stderr";
+  const nlohmann::json o = read_json(path("after-octree.json"));
+  EXPECT_EQ(o["structure"], "octree");
+  EXPECT_EQ(o["scene"], kTeapot);
+  EXPECT_GT(distinct_colours(read_png(path("still-running.png").string())), 20u);
+}
+
+TEST_F(GuiScript, ScriptErrorsNameTheLineAndExitWithOne) {
+  // A bad line is found before anything runs.
+  RunResult r = run("wait\n# comment\nset bukets 4\nquit\n");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find((dir_ / "script.txt").string() + ":3: set: unknown option 'bukets'"), std::string::npos)
+      << r.err;
+  // A command that fails while running.
+  r = run(std::string("open ") + kTeapot + "\nsize 640 480\nwait\nclick 9000 10\nquit\n");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find(":4: click: pixel 9000,10 is outside the 640x480 view"), std::string::npos) << r.err;
+  // A screenshot never overwrites.
+  std::ofstream(path("taken.png")) << "mine";
+  r = run(std::string("open ") + kTeapot + "\nwait\nscreenshot " + path("taken.png").string() + "\nquit\n");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find(":3: screenshot: " + path("taken.png").string() + ": exists (not overwritten)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(read_text(path("taken.png")), "mine");
+}
+
+TEST_F(GuiScript, SceneArgumentOpensBeforeTheScript) {
+  const RunResult r = run("wait\ndump-stats " + path("s.json").string() + "\nquit\n", "'builtin:teapot?size=300'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = read_json(path("s.json"));
+  EXPECT_EQ(j["scene"], "builtin:teapot?size=300");
+  EXPECT_EQ(j["structure"], "bvh");
+  EXPECT_EQ(j["camera"], "") << "the default view";
+}
