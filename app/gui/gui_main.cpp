@@ -42,6 +42,20 @@ void on_drop(GLFWwindow* /*window*/, int count, const char** paths) {
   for (int i = 0; i < count; ++i) g_dropped->emplace_back(paths[i]);
 }
 
+// Key presses as events. ImGui 1.86 keeps only key *state* (io.KeysDown),
+// so a press and release that arrive in the same poll (a quick tap during
+// a slow frame) would never be seen as pressed; GLFW's callback sees every
+// one. ImGui's backend chains to this callback (installed before it).
+struct KeyPress {
+  int key;
+  int mods;
+};
+std::vector<KeyPress>* g_keys = nullptr;
+
+void on_key(GLFWwindow* /*window*/, int key, int /*scancode*/, int action, int mods) {
+  if (g_keys && (action == GLFW_PRESS || action == GLFW_REPEAT)) g_keys->push_back({key, mods | (action == GLFW_REPEAT ? 0x10000 : 0)});
+}
+
 RgbImage to_rgb(const Rgba8Image& frame) {
   RgbImage out(frame.width, frame.height);
   for (std::size_t i = 0, n = static_cast<std::size_t>(frame.width) * frame.height; i < n; ++i)
@@ -77,6 +91,7 @@ class Gui final : public ScriptHost {
   std::unique_ptr<SceneView> view_;
   std::optional<ScriptRunner> script_;
   std::vector<std::string> dropped_;
+  std::vector<KeyPress> keys_;
 
   std::string path_field_;
   std::string last_screenshot_;
@@ -108,7 +123,9 @@ Gui::Gui(const GuiOptions& options, AppSettings settings, std::optional<ScriptRu
     throw NoWindow(e.what());
   }
   g_dropped = &dropped_;
+  g_keys = &keys_;
   glfwSetDropCallback(window_->window(), on_drop);
+  glfwSetKeyCallback(window_->window(), on_key);  // before ImGui's, which chains to it
   imgui_ = std::make_unique<ImGuiContextGuard>(
       window_->window(),
       options_.use_settings ? std::optional<std::filesystem::path>(imgui_ini_file(config_dir_)) : std::nullopt);
@@ -118,6 +135,7 @@ Gui::Gui(const GuiOptions& options, AppSettings settings, std::optional<ScriptRu
 
 Gui::~Gui() {
   g_dropped = nullptr;
+  g_keys = nullptr;
   // Renderer and ImGui objects need the window's context current when they die.
   if (window_) window_->make_current();
   view_.reset();
@@ -198,16 +216,27 @@ void Gui::handle_input(int fbw, int fbh, int ww, int wh) {
     }
   }
 
-  // Ctrl+Q quits even while a text field has the keyboard.
-  if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_Q, false)) quit_ = true;
-  if (!io.WantCaptureKeyboard && !io.KeyCtrl) {
-    if (ImGui::IsKeyPressed(GLFW_KEY_F, false)) app_.frame_selection();
-    if (ImGui::IsKeyPressed(GLFW_KEY_R, false) || ImGui::IsKeyPressed(GLFW_KEY_HOME, false)) app_.reset_camera();
-    if (ImGui::IsKeyPressed(GLFW_KEY_F12, false)) take_screenshot();
-    if (ImGui::IsKeyPressed(GLFW_KEY_H, false) || ImGui::IsKeyPressed(GLFW_KEY_F1, false)) show_help_ = !show_help_;
-    if (app_.inspection()) {
-      if (ImGui::IsKeyPressed(GLFW_KEY_LEFT) && app_.replay_step() > 0) app_.set_replay_step(app_.replay_step() - 1);
-      if (ImGui::IsKeyPressed(GLFW_KEY_RIGHT)) app_.set_replay_step(app_.replay_step() + 1);
+  std::vector<KeyPress> keys;
+  keys.swap(keys_);
+  for (const KeyPress& k : keys) {
+    const bool repeat = (k.mods & 0x10000) != 0;
+    const bool ctrl = (k.mods & GLFW_MOD_CONTROL) != 0;
+    // Ctrl+Q quits even while a text field has the keyboard.
+    if (ctrl && k.key == GLFW_KEY_Q) quit_ = true;
+    if (io.WantCaptureKeyboard || ctrl) continue;
+    switch (k.key) {
+      case GLFW_KEY_LEFT:
+        if (app_.inspection() && app_.replay_step() > 0) app_.set_replay_step(app_.replay_step() - 1);
+        break;
+      case GLFW_KEY_RIGHT:
+        if (app_.inspection()) app_.set_replay_step(app_.replay_step() + 1);
+        break;
+      default:
+        if (repeat) break;  // only the arrows repeat
+        if (k.key == GLFW_KEY_F) app_.frame_selection();
+        if (k.key == GLFW_KEY_R || k.key == GLFW_KEY_HOME) app_.reset_camera();
+        if (k.key == GLFW_KEY_F12) take_screenshot();
+        if (k.key == GLFW_KEY_H || k.key == GLFW_KEY_F1) show_help_ = !show_help_;
     }
   }
 }

@@ -21,7 +21,9 @@ ImGuiContextGuard::ImGuiContextGuard(GLFWwindow* window, std::optional<std::file
   ImGui::CreateContext();
   ImGuiIO& io = ImGui::GetIO();
   io.IniFilename = nullptr;  // the app persists the layout itself (see header)
-  io.ConfigFlags |= ImGuiConfigFlags_NavEnableKeyboard;
+  // No keyboard navigation: with it, any focused panel would claim the
+  // keyboard (WantCaptureKeyboard) and the view shortcuts would stop working
+  // after a click on a panel.
   if (ini_) {
     std::ifstream in(*ini_, std::ios::binary);
     if (in) {

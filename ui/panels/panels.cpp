@@ -18,9 +18,11 @@
 namespace accelviz::panels {
 namespace {
 
-// First-use placement in a 1280×800 window: scene and structure on the left,
-// stats and view on the right, ray inspector at the bottom left. ImGui's
-// saved layout replaces this afterwards.
+// First-use placement in a 1280×800 window: scene, structure and screenshot
+// on the left, stats and view on the right but clear of the heatmap legend
+// (the renderer draws it along the right edge), the ray inspector at the
+// bottom in between, all clear of the status line. ImGui's saved layout replaces
+// this afterwards.
 void place(const PanelLayout& l, float x, float y, float w, float h) {
   const float s = l.scale;
   const float px = x >= 0.0f ? x * s : l.width + x * s;
@@ -97,7 +99,7 @@ bool slider_int(const char* label, int& v, int lo, int hi, const char* help = nu
 SceneAction scene_panel(std::string& path_field, const std::vector<std::string>& recent, const Scene* scene,
                         const std::string& shown_spec, int active_camera, const PanelLayout& layout) {
   SceneAction a;
-  place(layout, 8, 8, 340, 300);
+  place(layout, 8, 8, 340, 260);
   if (!ImGui::Begin("Scene")) {
     ImGui::End();
     return a;
@@ -156,7 +158,7 @@ SceneAction scene_panel(std::string& path_field, const std::vector<std::string>&
 bool structure_panel(StructureChoice& choice, const BuildProgress& progress, bool& cancel, const PanelLayout& layout) {
   cancel = false;
   bool changed = false;
-  place(layout, 8, 316, 340, 380);
+  place(layout, 8, 276, 340, 400);
   if (!ImGui::Begin("Structure")) {
     ImGui::End();
     return false;
@@ -267,7 +269,7 @@ bool structure_panel(StructureChoice& choice, const BuildProgress& progress, boo
 // ---- Stats ---------------------------------------------------------------------------------
 
 void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const PanelLayout& layout) {
-  place(layout, -328, 8, 320, 360);
+  place(layout, -438, 8, 320, 340);
   if (!ImGui::Begin("Stats")) {
     ImGui::End();
     return;
@@ -316,7 +318,7 @@ void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const Pa
 
 bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout) {
   bool changed = false;
-  place(layout, -328, 376, 320, 420);
+  place(layout, -438, 356, 320, 404);
   if (!ImGui::Begin("View")) {
     ImGui::End();
     return false;
@@ -426,8 +428,8 @@ std::optional<std::size_t> ray_panel(const RayInspection* ray, std::size_t step,
                                      const PanelLayout& layout) {
   std::optional<std::size_t> moved;
   // Along the bottom edge, between the left and right columns.
-  ImGui::SetNextWindowSize(ImVec2(560 * layout.scale, 300 * layout.scale), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowPos(ImVec2(356 * layout.scale, layout.height - 308 * layout.scale), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(486 * layout.scale, 260 * layout.scale), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowPos(ImVec2(356 * layout.scale, layout.height - 300 * layout.scale), ImGuiCond_FirstUseEver);
   if (!ImGui::Begin("Ray")) {
     ImGui::End();
     return moved;
@@ -530,7 +532,7 @@ std::optional<std::size_t> ray_panel(const RayInspection* ray, std::size_t step,
 
 bool screenshot_panel(std::string& folder, const std::string& default_folder, const std::string& last_written,
                       const PanelLayout& layout) {
-  place(layout, 8, 704, 340, 88);
+  place(layout, 8, 684, 340, 76);
   bool pressed = false;
   if (ImGui::Begin("Screenshot")) {
     ImGui::SetNextItemWidth(-1.0f);
