@@ -13,7 +13,9 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
+#include <filesystem>
 #include <new>
 #include <string>
 #include <vector>
@@ -24,6 +26,17 @@ namespace {
 std::string one_line(std::string s) {
   std::replace(s.begin(), s.end(), '\n', ' ');
   return s;
+}
+
+/// Whether a lone argument names a scene rather than a mistyped subcommand:
+/// a built-in spec, a scene file extension, or a file that exists.
+bool looks_like_scene(const std::string& arg) {
+  if (arg.rfind("builtin:", 0) == 0) return true;
+  std::string ext = std::filesystem::path(arg).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (ext == ".gltf" || ext == ".glb" || ext == ".obj") return true;
+  std::error_code ec;
+  return std::filesystem::is_regular_file(arg, ec);
 }
 
 std::string builtin_list() {
@@ -74,6 +87,12 @@ int main(int argc, char** argv) {
   try {
     for (const cli::Command& c : commands)
       if (c.app->parsed()) return c.run();
+    if (!scene_arg.empty() && !looks_like_scene(scene_arg)) {
+      std::string names;
+      for (const cli::Command& c : commands) names += (names.empty() ? "" : ", ") + c.app->get_name();
+      throw cli::UsageError("'" + scene_arg + "' is neither a subcommand (" + names +
+                            ") nor a scene (.gltf/.glb/.obj file or builtin:NAME)");
+    }
     const bool want_window = !scene_arg.empty() || !script_arg.empty();
 #ifdef ACCELVIZ_HAVE_UI
     if (display_available()) {
