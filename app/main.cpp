@@ -66,7 +66,8 @@ int main(int argc, char** argv) {
   bool no_settings = false;
   app.add_option("SCENE", scene_arg, "Scene to open in the window (.gltf, .glb, .obj or builtin:NAME[?...])");
   app.add_option("--script", script_arg,
-                 "Run the commands in FILE in the window, then quit (implies --no-settings; see docs/gui.md)");
+                 "Run the commands in FILE in the window, then quit (implies --no-settings; see docs/gui.md)")
+      ->option_text("FILE");
   app.add_flag("--no-settings", no_settings,
                "Neither read nor write settings or window layout (also: ACCELVIZ_NO_SETTINGS=1)");
 

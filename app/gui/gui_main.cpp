@@ -106,6 +106,7 @@ class Gui final : public ScriptHost {
   std::string initial_scene_;
   bool fallback_tried_ = false;
   bool skip_initial_open_ = false;
+  bool was_busy_ = true;
   Clock::time_point start_ = Clock::now();
 };
 
@@ -400,11 +401,13 @@ int Gui::run() {
   while (!quit_ && !glfwWindowShouldClose(win)) {
     // Idle (nothing building, tracing or scripted): sleep until input
     // arrives; otherwise keep frames coming so results show up promptly.
+    // One more frame after the workers go quiet picks up their last result.
     const bool busy = script_ || app_.build_status().busy || app_.heatmap_busy();
-    if (busy)
+    if (busy || was_busy_)
       glfwPollEvents();
     else
       glfwWaitEventsTimeout(0.25);
+    was_busy_ = busy;
 
     const int fbw = window_->width(), fbh = window_->height();
     int ww = 0, wh = 0;
