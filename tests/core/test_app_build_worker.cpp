@@ -9,6 +9,7 @@
 #include "core/query/camera.h"
 #include "ui/app/app_state.h"
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
@@ -90,7 +91,8 @@ bool pump(AppState& app, Pred pred) {
   return false;
 }
 
-BuildWorker::LoadFn fake_loader(int* loads = nullptr) {
+// `loads` counts loads; the loader runs on the worker thread, hence atomic.
+BuildWorker::LoadFn fake_loader(std::atomic<int>* loads = nullptr) {
   return [loads](const std::string& spec) {
     if (loads) ++*loads;
     if (spec.find("missing") != std::string::npos) throw SceneError(spec + ": no such file");
@@ -190,7 +192,7 @@ TEST(AppBuildWorker, TheShownStructureStaysUntilItsSuccessorIsReady) {
 
 TEST(AppBuildWorker, FailuresKeepWhatIsShown) {
   GatedBuilder gate;
-  int loads = 0;
+  std::atomic<int> loads = 0;
   AppSettings settings;
   settings.config.structure.options.bvh.buckets = 4;
   AppState app(settings, fake_loader(&loads), gate.fn());
@@ -210,7 +212,7 @@ TEST(AppBuildWorker, FailuresKeepWhatIsShown) {
 
   // A build that throws: error shown, old structure kept, and the next
   // change builds over the scene that is shown (no reload).
-  const int loads_before = loads;
+  const int loads_before = loads.load();
   app.config().structure.name = "fail";
   app.config().structure.options.bvh.buckets = 6;
   gate.open(6);
@@ -246,7 +248,7 @@ TEST(AppBuildWorker, CancelKeepsTheShownStructureAndItsOptions) {
 }
 
 TEST(AppBuildWorker, ReopeningTheSameSceneReloadsIt) {
-  int loads = 0;
+  std::atomic<int> loads = 0;
   AppState app(AppSettings{}, fake_loader(&loads));
   app.open_scene("scene");
   ASSERT_TRUE(pump(app, [&] { return app.current() != nullptr && app.settled(); }));

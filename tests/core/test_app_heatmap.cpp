@@ -8,6 +8,7 @@
 #include "core/scene/load.h"
 #include "ui/app/heatmap_worker.h"
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <thread>
@@ -113,7 +114,7 @@ TEST(AppHeatmap, PixelFiguresMatchASingleRay) {
 
 TEST(AppHeatmap, StopsWhenToldTo) {
   const auto built = teapot_bvh();
-  int calls = 0;
+  std::atomic<int> calls = 0;  // keep_going is asked from every tracing thread
   std::vector<int> strides;
   const bool done = trace_progressive(
       request_for(built, 64, 64, HeatMetric::nodes), 1, [&] { return ++calls < 12; },

@@ -70,8 +70,10 @@ struct HeatmapFrame {
 };
 
 /// Traces request `r` level by level, synchronously, calling `publish`
-/// after each level; stops early (returning false) when `keep_going`
-/// returns false. The worker's engine, exposed for tests.
+/// after each level (on the calling thread); stops early (returning false)
+/// when `keep_going` returns false. `keep_going` is asked once per image
+/// row, from all tracing threads at once, so it must be thread-safe. The
+/// worker's engine, exposed for tests.
 bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::function<bool()>& keep_going,
                        const std::function<void(std::shared_ptr<const HeatmapFrame>)>& publish);
 
