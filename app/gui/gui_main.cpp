@@ -53,7 +53,8 @@ struct KeyPress {
 std::vector<KeyPress>* g_keys = nullptr;
 
 void on_key(GLFWwindow* /*window*/, int key, int /*scancode*/, int action, int mods) {
-  if (g_keys && (action == GLFW_PRESS || action == GLFW_REPEAT)) g_keys->push_back({key, mods | (action == GLFW_REPEAT ? 0x10000 : 0)});
+  if (g_keys && (action == GLFW_PRESS || action == GLFW_REPEAT))
+    g_keys->push_back({key, mods | (action == GLFW_REPEAT ? 0x10000 : 0)});
 }
 
 RgbImage to_rgb(const Rgba8Image& frame) {
@@ -323,8 +324,12 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       path_field_ = c.arg;
       app_.open_scene(c.arg);
       return Status::done;
-    case K::structure: fail_if(app_.set_option("structure", c.arg)); return Status::done;
-    case K::set: fail_if(app_.set_option(c.arg, c.value)); return Status::done;
+    case K::structure:
+      fail_if(app_.set_option("structure", c.arg));
+      return Status::done;
+    case K::set:
+      fail_if(app_.set_option(c.arg, c.value));
+      return Status::done;
     case K::camera:
       // After `open`, the camera applies to the new scene: wait for it
       // (its arrival resets the view to the scene's default).
@@ -348,17 +353,24 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       }
       return Status::again;
     }
-    case K::wait: return app_.settled() ? Status::done : Status::again;
-    case K::click: fail_if(app_.cast_ray(c.x, c.y)); return Status::done;
+    case K::wait:
+      return app_.settled() ? Status::done : Status::again;
+    case K::click:
+      fail_if(app_.cast_ray(c.x, c.y));
+      return Status::done;
     case K::step: {
       const auto& insp = app_.inspection();
       if (!insp) throw std::runtime_error("no ray cast yet (use click first)");
       const std::size_t n = insp->trace.steps.size();
       const std::size_t cur = app_.replay_step();
-      if (c.arg == "next") app_.set_replay_step(cur + 1);
-      else if (c.arg == "prev") app_.set_replay_step(cur > 0 ? cur - 1 : 0);
-      else if (c.arg == "first") app_.set_replay_step(0);
-      else if (c.arg == "last") app_.set_replay_step(n > 0 ? n - 1 : 0);
+      if (c.arg == "next")
+        app_.set_replay_step(cur + 1);
+      else if (c.arg == "prev")
+        app_.set_replay_step(cur > 0 ? cur - 1 : 0);
+      else if (c.arg == "first")
+        app_.set_replay_step(0);
+      else if (c.arg == "last")
+        app_.set_replay_step(n > 0 ? n - 1 : 0);
       else {
         const std::size_t k = std::stoul(c.arg);
         if (k >= n) throw std::runtime_error("step " + c.arg + ": the trace has " + std::to_string(n) + " steps");
@@ -379,8 +391,12 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       fail_if(write_file_atomic(c.arg, inspection_json(*insp, app_.replay_step()).dump(2) + "\n"));
       return Status::done;
     }
-    case K::dump_stats: fail_if(write_file_atomic(c.arg, app_.stats_json().dump(2) + "\n")); return Status::done;
-    case K::quit: quit_ = true; return Status::done;
+    case K::dump_stats:
+      fail_if(write_file_atomic(c.arg, app_.stats_json().dump(2) + "\n"));
+      return Status::done;
+    case K::quit:
+      quit_ = true;
+      return Status::done;
   }
   return Status::done;
 }
@@ -389,9 +405,9 @@ int Gui::run() {
   // What to show first: the file given, else (with settings) the last
   // scene, else the demo. A script that starts with `open` loads nothing
   // before it.
-  initial_scene_ = options_.scene ? *options_.scene
+  initial_scene_ = options_.scene                                                   ? *options_.scene
                    : (options_.use_settings && !app_.settings().last_scene.empty()) ? app_.settings().last_scene
-                                                                                     : std::string(kDemoScene);
+                                                                                    : std::string(kDemoScene);
   if (!skip_initial_open_) {
     path_field_ = initial_scene_;
     app_.open_scene(initial_scene_);
@@ -428,8 +444,8 @@ int Gui::run() {
     const AppState::FrameUpdate u = app_.update(fbw, fbh);
     if (u.scene_changed) save_settings_now();
     // A last scene that no longer opens falls back to the demo once.
-    if (!app_.current() && !app_.error().empty() && !fallback_tried_ && !script_ &&
-        initial_scene_ != kDemoScene && !app_.build_status().busy) {
+    if (!app_.current() && !app_.error().empty() && !fallback_tried_ && !script_ && initial_scene_ != kDemoScene &&
+        !app_.build_status().busy) {
       fallback_tried_ = true;
       app_.open_scene(kDemoScene);
     }

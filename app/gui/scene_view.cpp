@@ -38,11 +38,10 @@ void SceneView::upload_boxes(const AppState& app) {
   const ViewSettings& v = app.config().view;
   const BuiltStructure* built = app.current().get();
   // Everything the selection and its colours depend on.
-  const std::string key = std::to_string(reinterpret_cast<std::uintptr_t>(built)) + "/" +
-                          std::to_string(static_cast<int>(v.box_mode)) + "/" + std::to_string(v.box_depth) + "/" +
-                          std::to_string(v.box_depth_last) + "/" + std::to_string(v.box_node) + "/" +
-                          std::to_string(static_cast<int>(v.box_color)) + "/" +
-                          std::to_string(static_cast<int>(v.colormap));
+  const std::string key =
+      std::to_string(reinterpret_cast<std::uintptr_t>(built)) + "/" + std::to_string(static_cast<int>(v.box_mode)) +
+      "/" + std::to_string(v.box_depth) + "/" + std::to_string(v.box_depth_last) + "/" + std::to_string(v.box_node) +
+      "/" + std::to_string(static_cast<int>(v.box_color)) + "/" + std::to_string(static_cast<int>(v.colormap));
   if (key == box_key_) return;
   box_key_ = key;
   boxes_drawn_ = 0;
@@ -108,7 +107,9 @@ void SceneView::upload_ray(const AppState& app) {
   renderer_.set_ray_path(path);
 }
 
-glm::vec2 SceneView::heatmap_range(const AppState& app) const { return renderer_.heatmap_range(render_view(app).heatmap); }
+glm::vec2 SceneView::heatmap_range(const AppState& app) const {
+  return renderer_.heatmap_range(render_view(app).heatmap);
+}
 
 RenderView SceneView::render_view(const AppState& app) const {
   const ViewSettings& v = app.config().view;
@@ -122,7 +123,7 @@ RenderView SceneView::render_view(const AppState& app) const {
   r.show_ray_path = v.show_ray_path && app.inspection().has_value();
   r.show_quads = false;
   HeatmapView& h = r.heatmap;
-  h.mode = !has_heatmap_ ? HeatmapMode::off
+  h.mode = !has_heatmap_                              ? HeatmapMode::off
            : v.heatmap == HeatmapDisplay::full_screen ? HeatmapMode::full_screen
            : v.heatmap == HeatmapDisplay::blend       ? HeatmapMode::blend
                                                       : HeatmapMode::off;
@@ -134,6 +135,8 @@ RenderView SceneView::render_view(const AppState& app) const {
   return r;
 }
 
-void SceneView::draw(const AppState& app, int width, int height) { renderer_.render(render_view(app), width, height); }
+void SceneView::draw(const AppState& app, int width, int height) {
+  renderer_.render(render_view(app), width, height);
+}
 
 }  // namespace accelviz

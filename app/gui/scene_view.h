@@ -40,7 +40,7 @@ class SceneView {
   void upload_ray(const AppState& app);
 
   Renderer renderer_;
-  const void* scene_ = nullptr;  ///< identity of the uploaded scene
+  const void* scene_ = nullptr;          ///< identity of the uploaded scene
   const void* heatmap_frame_ = nullptr;  ///< identity of the uploaded heatmap level
   std::string box_key_;
   std::string ray_key_;

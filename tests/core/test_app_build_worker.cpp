@@ -59,8 +59,12 @@ class GatedBuilder {
     cv_.notify_all();
   }
   // Waits (bounded) until the build with this label has started / been cancelled.
-  bool wait_started(int label) { return wait_for([&] { return contains(started_, label); }); }
-  bool wait_cancelled(int label) { return wait_for([&] { return contains(cancelled_, label); }); }
+  bool wait_started(int label) {
+    return wait_for([&] { return contains(started_, label); });
+  }
+  bool wait_cancelled(int label) {
+    return wait_for([&] { return contains(cancelled_, label); });
+  }
   std::vector<int> started() {
     std::lock_guard lock(m_);
     return started_;

@@ -13,17 +13,52 @@ namespace {
 
 // A second valid value for every key, different from its default.
 const std::map<std::string, std::string> kOtherValues = {
-    {"structure", "kdtree"}, {"splitter", "exact"}, {"buckets", "32"}, {"leaf", "2"}, {"leaf-cap", "8"},
-    {"ctrav", "1.5"}, {"cisect", "0.25"}, {"threads", "3"}, {"epo", "off"}, {"kd-ctrav", "2"},
-    {"kd-cisect", "3"}, {"kd-max-depth", "20"}, {"kd-leaf", "4"}, {"kd-empty-bonus", "0.5"},
-    {"kd-perfect-splits", "off"}, {"kd-mailboxing", "off"}, {"grid-res", "4,5,6"}, {"grid-lambda", "2"},
-    {"grid-exact", "off"}, {"grid-mailboxing", "off"}, {"octree-depth", "6"}, {"octree-leaf", "3"},
-    {"octree-mailboxing", "off"}, {"octree-cost-termination", "off"}, {"voxel-level", "5"},
-    {"embree-quality", "high"}, {"embree-robust", "on"}, {"triangle-test", "fast"}, {"ordered", "off"},
-    {"mesh", "off"}, {"wireframe", "on"}, {"boxes", "off"}, {"box-mode", "subtree"}, {"box-depth", "7"},
-    {"box-depth-last", "9"}, {"box-node", "12"}, {"box-color", "sah"}, {"boxes-through-mesh", "on"},
-    {"heatmap", "blend"}, {"metric", "prims"}, {"colormap", "turbo"}, {"opacity", "0.3"}, {"scale", "2,40"},
-    {"legend", "off"}, {"ray-path", "off"}, {"msaa", "1"},
+    {"structure", "kdtree"},
+    {"splitter", "exact"},
+    {"buckets", "32"},
+    {"leaf", "2"},
+    {"leaf-cap", "8"},
+    {"ctrav", "1.5"},
+    {"cisect", "0.25"},
+    {"threads", "3"},
+    {"epo", "off"},
+    {"kd-ctrav", "2"},
+    {"kd-cisect", "3"},
+    {"kd-max-depth", "20"},
+    {"kd-leaf", "4"},
+    {"kd-empty-bonus", "0.5"},
+    {"kd-perfect-splits", "off"},
+    {"kd-mailboxing", "off"},
+    {"grid-res", "4,5,6"},
+    {"grid-lambda", "2"},
+    {"grid-exact", "off"},
+    {"grid-mailboxing", "off"},
+    {"octree-depth", "6"},
+    {"octree-leaf", "3"},
+    {"octree-mailboxing", "off"},
+    {"octree-cost-termination", "off"},
+    {"voxel-level", "5"},
+    {"embree-quality", "high"},
+    {"embree-robust", "on"},
+    {"triangle-test", "fast"},
+    {"ordered", "off"},
+    {"mesh", "off"},
+    {"wireframe", "on"},
+    {"boxes", "off"},
+    {"box-mode", "subtree"},
+    {"box-depth", "7"},
+    {"box-depth-last", "9"},
+    {"box-node", "12"},
+    {"box-color", "sah"},
+    {"boxes-through-mesh", "on"},
+    {"heatmap", "blend"},
+    {"metric", "prims"},
+    {"colormap", "turbo"},
+    {"opacity", "0.3"},
+    {"scale", "2,40"},
+    {"legend", "off"},
+    {"ray-path", "off"},
+    {"msaa", "1"},
 };
 
 }  // namespace
@@ -64,12 +99,17 @@ TEST(AppConfig, ErrorsNameTheOptionAndChangeNothing) {
     const char* key;
     const char* value;
   };
-  for (const Bad& b : {Bad{"buckets", "1"}, Bad{"buckets", "300"}, Bad{"buckets", "16x"}, Bad{"leaf", "0"},
-                       Bad{"ctrav", "0"}, Bad{"ctrav", "-1"}, Bad{"ctrav", "nan"}, Bad{"cisect", "inf"},
-                       Bad{"splitter", "sah"}, Bad{"structure", "octopus"}, Bad{"grid-res", "1,2"},
-                       Bad{"grid-res", "0,4,4"}, Bad{"grid-res", "a,b,c"}, Bad{"scale", "5,1"}, Bad{"scale", "x"},
-                       Bad{"opacity", "1.5"}, Bad{"mesh", "maybe"}, Bad{"msaa", "3"}, Bad{"voxel-level", "11"},
-                       Bad{"octree-depth", "17"}, Bad{"metric", "time"}, Bad{"colormap", "diverging"}}) {
+  for (const Bad& b : {Bad{"buckets", "1"},      Bad{"buckets", "300"},
+                       Bad{"buckets", "16x"},    Bad{"leaf", "0"},
+                       Bad{"ctrav", "0"},        Bad{"ctrav", "-1"},
+                       Bad{"ctrav", "nan"},      Bad{"cisect", "inf"},
+                       Bad{"splitter", "sah"},   Bad{"structure", "octopus"},
+                       Bad{"grid-res", "1,2"},   Bad{"grid-res", "0,4,4"},
+                       Bad{"grid-res", "a,b,c"}, Bad{"scale", "5,1"},
+                       Bad{"scale", "x"},        Bad{"opacity", "1.5"},
+                       Bad{"mesh", "maybe"},     Bad{"msaa", "3"},
+                       Bad{"voxel-level", "11"}, Bad{"octree-depth", "17"},
+                       Bad{"metric", "time"},    Bad{"colormap", "diverging"}}) {
     const std::string e = apply_option(c, b.key, b.value);
     EXPECT_EQ(e.rfind(std::string(b.key) + ": ", 0), 0u) << b.key << "=" << b.value << " gave '" << e << "'";
     EXPECT_NE(e.find(b.value), std::string::npos) << e;
@@ -131,8 +171,7 @@ TEST(AppConfig, DescriptionsAndCaption) {
   c.structure.name = "brute";
   EXPECT_EQ(describe_structure(c.structure), "brute");
   c.structure.name = "grid";
-  EXPECT_EQ(describe_structure(c.structure),
-            "grid (grid-res=0,0,0, grid-lambda=3, grid-exact=on, grid-mailboxing=on)");
+  EXPECT_EQ(describe_structure(c.structure), "grid (grid-res=0,0,0, grid-lambda=3, grid-exact=on, grid-mailboxing=on)");
   ASSERT_EQ(apply_option(c, "heatmap", "blend"), "");
   ASSERT_EQ(apply_option(c, "metric", "cost"), "");
   ASSERT_EQ(apply_option(c, "colormap", "inferno"), "");

@@ -40,7 +40,9 @@ HeatmapRequest request_for(const std::shared_ptr<const BuiltStructure>& b, int w
   return r;
 }
 
-bool same_value(float a, float b) { return (std::isnan(a) && std::isnan(b)) || a == b; }
+bool same_value(float a, float b) {
+  return (std::isnan(a) && std::isnan(b)) || a == b;
+}
 
 }  // namespace
 
@@ -51,7 +53,8 @@ TEST(AppHeatmap, LevelsRefineToExactlyWhatRenderComputes) {
   for (HeatMetric m : {HeatMetric::nodes, HeatMetric::depth}) {
     std::vector<std::shared_ptr<const HeatmapFrame>> frames;
     const HeatmapRequest r = request_for(built, w, h, m);
-    ASSERT_TRUE(trace_progressive(r, 7, [] { return true; }, [&](auto f) { frames.push_back(f); }));
+    ASSERT_TRUE(trace_progressive(
+        r, 7, [] { return true; }, [&](auto f) { frames.push_back(f); }));
     ASSERT_EQ(frames.size(), 4u);
     EXPECT_EQ(frames[0]->stride, 8);
     EXPECT_EQ(frames[3]->stride, 1);
@@ -95,7 +98,8 @@ TEST(AppHeatmap, PixelFiguresMatchASingleRay) {
   const auto built = teapot_bvh();
   const HeatmapRequest r = request_for(built, 40, 30, HeatMetric::prims);
   std::shared_ptr<const HeatmapFrame> last;
-  trace_progressive(r, 1, [] { return true; }, [&](auto f) { last = f; });
+  trace_progressive(
+      r, 1, [] { return true; }, [&](auto f) { last = f; });
   ASSERT_TRUE(last && last->complete);
   std::uint32_t max_nodes = 0;
   for (int y = 0; y < 30; y += 7)

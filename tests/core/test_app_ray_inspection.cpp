@@ -64,8 +64,10 @@ TEST(AppRayInspection, PixelRayHitsWhatBruteForceHits) {
 TEST(AppRayInspection, ShadowRaysGoToEachLightOnTheLitSide) {
   Scene s;
   // A floor at y = 0 (facing up) and a roof at y = 2 over part of it.
-  s.triangles = {{{-10, 0, -10}, {10, 0, 10}, {10, 0, -10}}, {{-10, 0, -10}, {-10, 0, 10}, {10, 0, 10}},
-                 {{-1, 2, -1}, {1, 2, 1}, {1, 2, -1}},       {{-1, 2, -1}, {-1, 2, 1}, {1, 2, 1}}};
+  s.triangles = {{{-10, 0, -10}, {10, 0, 10}, {10, 0, -10}},
+                 {{-10, 0, -10}, {-10, 0, 10}, {10, 0, 10}},
+                 {{-1, 2, -1}, {1, 2, 1}, {1, 2, -1}},
+                 {{-1, 2, -1}, {-1, 2, 1}, {1, 2, 1}}};
   Light above;
   above.name = "above";
   above.position = {0, 5, 0};
@@ -104,8 +106,9 @@ TEST(AppRayInspection, ShadowRaysGoToEachLightOnTheLitSide) {
 TEST(AppRayInspection, ReplayWalksTheTraceInOrder) {
   VisitTrace t;
   using Kd = VisitStep::Kind;
-  t.steps = {{Kd::node_entered, 0, 1, 9}, {Kd::node_missed, 2, 2, 3},  {Kd::node_entered, 1, 1, 5},
-             {Kd::prim_miss, 7, kInfinity, kInfinity}, {Kd::prim_hit, 4, 3, kInfinity}, {Kd::prim_miss, 7, kInfinity, kInfinity},
+  t.steps = {{Kd::node_entered, 0, 1, 9},     {Kd::node_missed, 2, 2, 3},
+             {Kd::node_entered, 1, 1, 5},     {Kd::prim_miss, 7, kInfinity, kInfinity},
+             {Kd::prim_hit, 4, 3, kInfinity}, {Kd::prim_miss, 7, kInfinity, kInfinity},
              {Kd::node_culled, 5, 6, 8}};
   ReplayState s = replay_upto(t, 0);
   EXPECT_EQ(s.entered, std::vector<std::uint32_t>{0});

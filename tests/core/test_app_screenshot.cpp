@@ -154,9 +154,9 @@ TEST(AppScreenshot, SideCarSaysHowToReproduceThePicture) {
   EXPECT_EQ(j["caption"], screenshot_caption(info.config));
 
   const std::string cmd = j["reproduce"]["render_heatmap"];
-  for (const char* part : {"accelviz render 'builtin:teapot?size=2000'", "--structure bvh", "--camera 6,4,8,0,1.2,0,40",
-                           "--size 64x48", "--metric prims", "--colormap inferno", "--buckets 8",
-                           "--out accelviz-1-heatmap.png"})
+  for (const char* part :
+       {"accelviz render 'builtin:teapot?size=2000'", "--structure bvh", "--camera 6,4,8,0,1.2,0,40", "--size 64x48",
+        "--metric prims", "--colormap inferno", "--buckets 8", "--out accelviz-1-heatmap.png"})
     EXPECT_NE(cmd.find(part), std::string::npos) << part << " not in " << cmd;
   EXPECT_EQ(cmd.find("--max"), std::string::npos) << "auto scale: no --max";
   const std::string raster = j["reproduce"]["render_raster"];

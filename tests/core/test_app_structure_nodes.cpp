@@ -25,7 +25,9 @@ bool inside(const Aabb& outer, const Aabb& inner, float tol) {
   return true;
 }
 
-bool same_box(const Aabb& a, const Aabb& b) { return a.lo == b.lo && a.hi == b.hi; }
+bool same_box(const Aabb& a, const Aabb& b) {
+  return a.lo == b.lo && a.hi == b.hi;
+}
 
 }  // namespace
 
@@ -110,8 +112,8 @@ TEST(AppStructureNodes, GridCellsAreTheGridsOwn) {
   ASSERT_EQ(root.boxes.size(), 1u);
   EXPECT_TRUE(same_box(root.boxes[0].bounds, grid.bounds()));
   const auto cells = t.select({BoxMode::leaves, 0, 0, 0}, 1u << 30);
-  EXPECT_EQ(cells.matched, static_cast<std::uint64_t>(grid.build_stats().node_count -
-                                                        grid.build_stats().extra.at("empty_cells")));
+  EXPECT_EQ(cells.matched,
+            static_cast<std::uint64_t>(grid.build_stats().node_count - grid.build_stats().extra.at("empty_cells")));
 }
 
 TEST(AppStructureNodes, EnteredNodesContainTheRaySegmentTheyReport) {

@@ -170,16 +170,22 @@ int count_near(const RgbImage& img, int x0, int y0, int x1, int y1, glm::u8vec3 
 
 TEST_F(GuiScript, ScreenshotShowsTheMeshAndTheLegend) {
   const RunResult r = run(std::string("open ") + kTeapot + "\n" +
-                    "size 640 480\n"
-                    "camera " + kCamera + "\n"
-                    "set boxes off\n"
-                    "wait\n"
-                    "screenshot " + path("mesh.png").string() + "\n"
-                    "set heatmap blend\n"
-                    "set opacity 0.8\n"
-                    "wait\n"
-                    "screenshot " + path("heatmap.png").string() + "\n"
-                    "quit\n");
+                          "size 640 480\n"
+                          "camera " +
+                          kCamera +
+                          "\n"
+                          "set boxes off\n"
+                          "wait\n"
+                          "screenshot " +
+                          path("mesh.png").string() +
+                          "\n"
+                          "set heatmap blend\n"
+                          "set opacity 0.8\n"
+                          "wait\n"
+                          "screenshot " +
+                          path("heatmap.png").string() +
+                          "\n"
+                          "quit\n");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find(path("mesh.png").string()), std::string::npos) << "the path written is printed";
 
@@ -227,16 +233,24 @@ TEST_F(GuiScript, ScreenshotShowsTheMeshAndTheLegend) {
 
 TEST_F(GuiScript, ClickCastsThePixelRayAndReplaysItsTraversal) {
   const RunResult r = run(std::string("open ") + kTeapot + "\n" +
-                    "size 640 480\n"
-                    "camera " + kCamera + "\n"
-                    "wait\n"
-                    "click 320 240\n"
-                    "dump-ray " + path("ray-dump.json").string() + "\n"
-                    "step 0\n"
-                    "step next\n"
-                    "dump-ray " + path("ray-dump1.json").string() + "\n"
-                    "screenshot " + path("ray.png").string() + "\n"
-                    "quit\n");
+                          "size 640 480\n"
+                          "camera " +
+                          kCamera +
+                          "\n"
+                          "wait\n"
+                          "click 320 240\n"
+                          "dump-ray " +
+                          path("ray-dump.json").string() +
+                          "\n"
+                          "step 0\n"
+                          "step next\n"
+                          "dump-ray " +
+                          path("ray-dump1.json").string() +
+                          "\n"
+                          "screenshot " +
+                          path("ray.png").string() +
+                          "\n"
+                          "quit\n");
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json j = read_json(path("ray-dump.json"));
   ASSERT_EQ(j["size"], nlohmann::json::array({640, 480}));
@@ -312,11 +326,10 @@ TEST_F(GuiScript, SwitchingStructuresRebuildsAndTheHeatmapFollows) {
 
 TEST_F(GuiScript, ABadScenePathIsReportedAndTheAppKeepsRunning) {
   const std::string missing = path("no-such-model.glb").string();
-  const RunResult r = run(std::string("open ") + kTeapot + "\nsize 640 480\nwait\n" + "open " + missing + "\nwait\n" +
-                    "dump-stats " + path("after-error.json").string() + "\n" +
-                    "structure octree\nwait\n" +
-                    "dump-stats " + path("after-octree.json").string() + "\n" +
-                    "screenshot " + path("still-running.png").string() + "\nquit\n");
+  const RunResult r =
+      run(std::string("open ") + kTeapot + "\nsize 640 480\nwait\n" + "open " + missing + "\nwait\n" + "dump-stats " +
+          path("after-error.json").string() + "\n" + "structure octree\nwait\n" + "dump-stats " +
+          path("after-octree.json").string() + "\n" + "screenshot " + path("still-running.png").string() + "\nquit\n");
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json e = read_json(path("after-error.json"));
   const std::string error = e["error"];

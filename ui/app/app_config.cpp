@@ -46,7 +46,9 @@ std::string quoted(std::string_view v) {
   return q;
 }
 
-const char* on_off(bool b) { return b ? "on" : "off"; }
+const char* on_off(bool b) {
+  return b ? "on" : "off";
+}
 
 // ---- the table ----------------------------------------------------------------
 
@@ -67,8 +69,7 @@ Entry int_option(std::string_view key, std::string_view values, std::string_view
           [field, lo, hi](AppConfig& c, std::string_view v) -> std::string {
             const auto x = to_int(v);
             if (!x || *x < lo || *x > hi)
-              return "expected an integer in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " +
-                     quoted(v);
+              return "expected an integer in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " + quoted(v);
             field(c) = static_cast<int>(*x);
             return {};
           }};
@@ -158,8 +159,8 @@ const std::vector<Entry>& entries() {
                    BvhOptions& b = c.structure.options.bvh;
                    const auto x = to_int(v);
                    if (!x || *x < b.max_leaf_size || *x > 255)
-                     return "expected an integer in " + std::to_string(b.max_leaf_size) + "..255 (at least leaf), got " +
-                            quoted(v);
+                     return "expected an integer in " + std::to_string(b.max_leaf_size) +
+                            "..255 (at least leaf), got " + quoted(v);
                    b.leaf_size_cap = static_cast<int>(*x);
                    return {};
                  }});
@@ -167,11 +168,11 @@ const std::vector<Entry>& entries() {
                              1e6, true, [](AppConfig& c) -> float& { return c.structure.options.bvh.cost_traversal; }));
     t.push_back(float_option("cisect", "> 0", "BVH SAH cost of a triangle test (C_isect; also the cost metric's)", 0,
                              1e6, true, [](AppConfig& c) -> float& { return c.structure.options.bvh.cost_intersect; }));
-    t.push_back(int_option("threads", "0..256", "build threads (0: all hardware threads)", 0, 256,
-                           [](AppConfig& c) -> int& {
-                             // unsigned in StructureOptions; the range keeps the cast exact.
-                             return reinterpret_cast<int&>(c.structure.options.threads);
-                           }));
+    t.push_back(
+        int_option("threads", "0..256", "build threads (0: all hardware threads)", 0, 256, [](AppConfig& c) -> int& {
+          // unsigned in StructureOptions; the range keeps the cast exact.
+          return reinterpret_cast<int&>(c.structure.options.threads);
+        }));
     t.push_back(bool_option("epo", "BVH: compute the EPO figure after the build",
                             [](AppConfig& c) -> bool& { return c.structure.options.bvh.compute_epo; }));
     // K-D tree (KdTreeOptions).
@@ -247,13 +248,16 @@ const std::vector<Entry>& entries() {
                             [](AppConfig& c) -> bool& { return c.structure.query.ordered; }));
     // View layers.
     t.push_back(bool_option("mesh", "shaded mesh", [](AppConfig& c) -> bool& { return c.view.show_mesh; }));
-    t.push_back(bool_option("wireframe", "triangle edges", [](AppConfig& c) -> bool& { return c.view.show_wireframe; }));
+    t.push_back(
+        bool_option("wireframe", "triangle edges", [](AppConfig& c) -> bool& { return c.view.show_wireframe; }));
     t.push_back(bool_option("boxes", "node boxes", [](AppConfig& c) -> bool& { return c.view.show_boxes; }));
-    t.push_back(enum_option<BoxMode>(
-        "box-mode", "depth|range|leaves|subtree", "which node boxes: one depth, a depth range, leaves, a subtree",
-        {{"depth", BoxMode::depth}, {"range", BoxMode::depth_range}, {"leaves", BoxMode::leaves},
-         {"subtree", BoxMode::subtree}},
-        [](AppConfig& c) -> BoxMode& { return c.view.box_mode; }));
+    t.push_back(enum_option<BoxMode>("box-mode", "depth|range|leaves|subtree",
+                                     "which node boxes: one depth, a depth range, leaves, a subtree",
+                                     {{"depth", BoxMode::depth},
+                                      {"range", BoxMode::depth_range},
+                                      {"leaves", BoxMode::leaves},
+                                      {"subtree", BoxMode::subtree}},
+                                     [](AppConfig& c) -> BoxMode& { return c.view.box_mode; }));
     t.push_back(int_option("box-depth", "0..64", "depth of the boxes (range: first depth)", 0, 64,
                            [](AppConfig& c) -> int& { return c.view.box_depth; }));
     t.push_back(int_option("box-depth-last", "0..64", "range: last depth (inclusive)", 0, 64,

@@ -37,23 +37,23 @@ struct ViewSettings {
 
   bool show_boxes = true;
   BoxMode box_mode = BoxMode::depth;
-  int box_depth = 3;        ///< depth mode: the depth; range mode: the first depth
-  int box_depth_last = 5;   ///< range mode: the last depth (inclusive)
-  int box_node = 0;         ///< subtree mode: its root node (the "selected node")
+  int box_depth = 3;       ///< depth mode: the depth; range mode: the first depth
+  int box_depth_last = 5;  ///< range mode: the last depth (inclusive)
+  int box_node = 0;        ///< subtree mode: its root node (the "selected node")
   BoxColorBy box_color = BoxColorBy::depth;
   bool boxes_through_mesh = false;
 
   HeatmapDisplay heatmap = HeatmapDisplay::off;
   HeatMetric metric = HeatMetric::nodes;
   ColorMap colormap = ColorMap::viridis;
-  float opacity = 0.6f;     ///< blend: heatmap alpha over the mesh
-  bool auto_scale = true;   ///< [0, image max]; else [scale_min, scale_max]
+  float opacity = 0.6f;    ///< blend: heatmap alpha over the mesh
+  bool auto_scale = true;  ///< [0, image max]; else [scale_min, scale_max]
   float scale_min = 0.0f;
   float scale_max = 100.0f;
   bool show_legend = true;
 
   bool show_ray_path = true;
-  int msaa = 4;             ///< samples of the 3D view (1 = off)
+  int msaa = 4;  ///< samples of the 3D view (1 = off)
 };
 
 /// Everything the option table covers.

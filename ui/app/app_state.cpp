@@ -8,7 +8,9 @@
 namespace accelviz {
 namespace {
 
-float aspect_of(int w, int h) { return w > 0 && h > 0 ? static_cast<float>(w) / static_cast<float>(h) : 1.0f; }
+float aspect_of(int w, int h) {
+  return w > 0 && h > 0 ? static_cast<float>(w) / static_cast<float>(h) : 1.0f;
+}
 
 }  // namespace
 
@@ -113,11 +115,11 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
         clear_inspection();
         settings_.last_scene = current_->scene->spec;
         add_recent(settings_, current_->scene->spec);
-        std::string m = "opened " + current_->scene->spec + " (" + std::to_string(scene.triangles.size()) +
-                        " triangles)";
+        std::string m =
+            "opened " + current_->scene->spec + " (" + std::to_string(scene.triangles.size()) + " triangles)";
         if (!scene.report.warnings.empty())
-          m += ", " + std::to_string(scene.report.warnings.size()) + " loader warning(s): " +
-               scene.report.warnings.front();
+          m += ", " + std::to_string(scene.report.warnings.size()) +
+               " loader warning(s): " + scene.report.warnings.front();
         set_message(m);
       } else {
         set_message("built " + describe_structure(current_->choice) + " in " +
@@ -215,8 +217,8 @@ std::optional<glm::vec3> AppState::pick(int x, int y) const {
 std::string AppState::cast_ray(int x, int y) {
   if (!current_) return "no structure yet (use wait after open)";
   if (x < 0 || y < 0 || x >= view_w_ || y >= view_h_)
-    return "pixel " + std::to_string(x) + "," + std::to_string(y) + " is outside the " + std::to_string(view_w_) +
-           "x" + std::to_string(view_h_) + " view";
+    return "pixel " + std::to_string(x) + "," + std::to_string(y) + " is outside the " + std::to_string(view_w_) + "x" +
+           std::to_string(view_h_) + " view";
   inspection_ = inspect_pixel(*current_, camera(), x, y, view_w_, view_h_, config().structure.query);
   inspected_query_ = config().structure.query;
   ++inspection_version_;
@@ -264,15 +266,10 @@ nlohmann::json AppState::stats_json() const {
       options[std::string(key)] = option_value(c, key);
     j["options"] = options;
     const BuildStats& b = current_->accel->build_stats();
-    j["build"] = {{"build_ms", b.build_ms},
-                  {"wall_ms", current_->wall_ms},
-                  {"nodes", b.node_count},
-                  {"leaves", b.leaf_count},
-                  {"max_depth", b.max_depth},
-                  {"avg_leaf_depth", b.avg_leaf_depth},
-                  {"memory_bytes", b.memory_bytes},
-                  {"sah_cost", b.sah_cost},
-                  {"extra", b.extra}};
+    j["build"] = {
+        {"build_ms", b.build_ms},         {"wall_ms", current_->wall_ms}, {"nodes", b.node_count},
+        {"leaves", b.leaf_count},         {"max_depth", b.max_depth},     {"avg_leaf_depth", b.avg_leaf_depth},
+        {"memory_bytes", b.memory_bytes}, {"sah_cost", b.sah_cost},       {"extra", b.extra}};
   }
   if (heatmap_) {
     const HeatmapSummary& s = heatmap_->summary;

@@ -132,9 +132,9 @@ class AppState {
   std::string wanted_scene_;
   bool reload_ = false;
   bool scene_loading_ = false;
-  std::uint64_t scene_request_id_ = 0;  ///< the build request that loads the wanted scene
-  std::string requested_scene_;              ///< of the last build request
-  std::optional<StructureChoice> requested_; ///< of the last build request
+  std::uint64_t scene_request_id_ = 0;        ///< the build request that loads the wanted scene
+  std::string requested_scene_;               ///< of the last build request
+  std::optional<StructureChoice> requested_;  ///< of the last build request
   std::uint64_t request_id_ = 0;
 
   std::shared_ptr<const BuiltStructure> current_;

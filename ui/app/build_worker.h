@@ -43,9 +43,9 @@ struct BuiltStructure {
 };
 
 struct BuildRequest {
-  std::string scene;          ///< scene spec; loaded unless it is the one loaded last (or `reload`)
+  std::string scene;  ///< scene spec; loaded unless it is the one loaded last (or `reload`)
   StructureChoice structure;
-  bool reload = false;        ///< load the scene again even if it is the current one (File > Open of the same file)
+  bool reload = false;  ///< load the scene again even if it is the current one (File > Open of the same file)
 };
 
 struct BuildOutcome {
@@ -53,8 +53,8 @@ struct BuildOutcome {
   std::uint64_t id = 0;
   Result result = Result::failed;
   std::shared_ptr<const BuiltStructure> built;  ///< when built
-  std::string error;                             ///< when failed: one line
-  bool scene_error = false;                      ///< the failure was loading the scene
+  std::string error;                            ///< when failed: one line
+  bool scene_error = false;                     ///< the failure was loading the scene
 };
 
 class BuildWorker {
@@ -80,10 +80,10 @@ class BuildWorker {
   std::vector<BuildOutcome> take_outcomes();
 
   struct Status {
-    bool busy = false;         ///< a job is queued or running
-    std::uint64_t id = 0;      ///< the running (or queued) job
-    double fraction = 0.0;     ///< the builder's progress, 0..1
-    std::string stage;         ///< "loading ...", "building bvh", ...
+    bool busy = false;      ///< a job is queued or running
+    std::uint64_t id = 0;   ///< the running (or queued) job
+    double fraction = 0.0;  ///< the builder's progress, 0..1
+    std::string stage;      ///< "loading ...", "building bvh", ...
   };
   Status status() const;
   /// Nothing queued, nothing running, no outcome waiting to be taken.

@@ -31,7 +31,7 @@ struct HeatmapRequest {
   int height = 0;
   HeatMetric metric = HeatMetric::nodes;
   QueryOptions query;
-  float c_trav = 1.0f;   ///< cost metric weights
+  float c_trav = 1.0f;  ///< cost metric weights
   float c_isect = 1.0f;
   unsigned threads = 0;  ///< 0: all hardware threads
   int coarsest = 8;      ///< first lattice spacing (a power of two >= 1)
@@ -39,11 +39,11 @@ struct HeatmapRequest {
 
 /// What one pixel's ray found (the hover tooltip shows these).
 struct PixelFigures {
-  float value = 0.0f;        ///< the metric (NaN: no value)
-  std::uint32_t nodes = 0;   ///< RayStats::nodes_visited
-  std::uint32_t prims = 0;   ///< RayStats::prim_tests
+  float value = 0.0f;                ///< the metric (NaN: no value)
+  std::uint32_t nodes = 0;           ///< RayStats::nodes_visited
+  std::uint32_t prims = 0;           ///< RayStats::prim_tests
   std::uint32_t prim = 0xFFFFFFFFu;  ///< hit primitive (kInvalidId: miss)
-  float t = 0.0f;            ///< hit distance (inf: miss)
+  float t = 0.0f;                    ///< hit distance (inf: miss)
 };
 
 /// Figures over the pixels traced so far (all of them once complete).
@@ -53,15 +53,15 @@ struct HeatmapSummary {
   double mean_nodes = 0.0, mean_prims = 0.0;
   std::uint32_t max_nodes = 0, max_prims = 0;
   double mean_value = 0.0, max_value = 0.0;  ///< of the metric, over pixels with a value
-  double render_ms = 0.0;    ///< tracing time of all levels so far (instrumented)
+  double render_ms = 0.0;                    ///< tracing time of all levels so far (instrumented)
   double rays_per_s = 0.0;
 };
 
 struct HeatmapFrame {
   std::uint64_t id = 0;
-  int stride = 0;          ///< lattice spacing of this level (1 = every pixel traced)
-  bool complete = false;   ///< stride 1 done
-  MetricImage image;       ///< W×H, block-filled below stride 1
+  int stride = 0;                    ///< lattice spacing of this level (1 = every pixel traced)
+  bool complete = false;             ///< stride 1 done
+  MetricImage image;                 ///< W×H, block-filled below stride 1
   std::vector<PixelFigures> pixels;  ///< W×H, row 0 at the top, block-filled like the image
   HeatmapSummary summary;
   HeatmapRequest request;  ///< what it shows (structure, camera, size, metric)

@@ -22,9 +22,9 @@ struct OrbitCamera {
   static constexpr float kZoomPerStep = 0.85f;  ///< distance factor per wheel step towards the pivot
 
   glm::vec3 pivot{0.0f};
-  float distance = 5.0f;  ///< eye to pivot, > 0
-  float yaw = 0.0f;       ///< about +Y; 0 puts the eye on +Z of the pivot
-  float pitch = 0.0f;     ///< elevation of the eye above the pivot, |pitch| <= kMaxPitch
+  float distance = 5.0f;       ///< eye to pivot, > 0
+  float yaw = 0.0f;            ///< about +Y; 0 puts the eye on +Z of the pivot
+  float pitch = 0.0f;          ///< elevation of the eye above the pivot, |pitch| <= kMaxPitch
   float yfov = Camera{}.yfov;  ///< 0.8 rad, as `accelviz render`'s default framing
 
   /// pivot + distance · (cos p sin y, sin p, cos p cos y).
@@ -55,8 +55,8 @@ struct OrbitCamera {
 struct ViewCamera {
   OrbitCamera orbit;
   std::optional<Camera> fixed;
-  int scene_camera = -1;  ///< index into Scene::cameras while `fixed` is one of them
-  bool is_default = false;  ///< `fixed` is the default view (what `render` shows without --camera)
+  int scene_camera = -1;     ///< index into Scene::cameras while `fixed` is one of them
+  bool is_default = false;   ///< `fixed` is the default view (what `render` shows without --camera)
   std::string command_spec;  ///< `fixed` came from a --camera style spec (script `camera`): that spec
 
   Camera camera() const { return fixed ? *fixed : orbit.camera(); }

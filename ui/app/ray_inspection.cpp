@@ -9,14 +9,19 @@
 namespace accelviz {
 namespace {
 
-nlohmann::json number_or_null(float v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+nlohmann::json number_or_null(float v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
 
-nlohmann::json vec(const glm::vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
+nlohmann::json vec(const glm::vec3& v) {
+  return nlohmann::json::array({v.x, v.y, v.z});
+}
 
 nlohmann::json stats_json(const RayStats& s) {
-  return {{"nodes_visited", s.nodes_visited}, {"box_tests", s.box_tests},   {"prim_tests", s.prim_tests},
-          {"nodes_culled", s.nodes_culled},   {"nodes_missed", s.nodes_missed},
-          {"repeated_prim_tests", s.repeated_prim_tests}, {"empty_cells", s.empty_cells}};
+  return {{"nodes_visited", s.nodes_visited}, {"box_tests", s.box_tests},
+          {"prim_tests", s.prim_tests},       {"nodes_culled", s.nodes_culled},
+          {"nodes_missed", s.nodes_missed},   {"repeated_prim_tests", s.repeated_prim_tests},
+          {"empty_cells", s.empty_cells}};
 }
 
 }  // namespace
@@ -76,11 +81,16 @@ RayInspection inspect_ray(const BuiltStructure& built, const RayInspection& like
 
 const char* step_kind_name(VisitStep::Kind k) {
   switch (k) {
-    case VisitStep::Kind::node_entered: return "entered";
-    case VisitStep::Kind::node_missed: return "missed";
-    case VisitStep::Kind::node_culled: return "culled";
-    case VisitStep::Kind::prim_hit: return "prim-hit";
-    case VisitStep::Kind::prim_miss: return "prim-miss";
+    case VisitStep::Kind::node_entered:
+      return "entered";
+    case VisitStep::Kind::node_missed:
+      return "missed";
+    case VisitStep::Kind::node_culled:
+      return "culled";
+    case VisitStep::Kind::prim_hit:
+      return "prim-hit";
+    case VisitStep::Kind::prim_miss:
+      return "prim-miss";
   }
   return "?";
 }
@@ -121,8 +131,8 @@ nlohmann::json inspection_json(const RayInspection& r, std::size_t replay_step) 
   }
   nlohmann::json hit = nullptr;
   if (r.hit.valid())
-    hit = {{"prim", r.hit.prim}, {"t", r.hit.t},   {"u", r.hit.u},
-           {"v", r.hit.v},       {"point", vec(r.ray.at(r.hit.t))}, {"normal", vec(r.hit.ng)}};
+    hit = {{"prim", r.hit.prim},     {"t", r.hit.t}, {"u", r.hit.u}, {"v", r.hit.v}, {"point", vec(r.ray.at(r.hit.t))},
+           {"normal", vec(r.hit.ng)}};
   nlohmann::json shadows = nlohmann::json::array();
   for (const ShadowRay& s : r.shadows)
     shadows.push_back({{"light", s.light},

@@ -17,17 +17,17 @@
 namespace accelviz {
 
 struct ShadowRay {
-  std::size_t light = 0;   ///< index into Scene::lights
+  std::size_t light = 0;  ///< index into Scene::lights
   std::string light_name;
-  Ray ray;                 ///< from just off the hit towards the light (tmax short of it; inf for directional)
+  Ray ray;  ///< from just off the hit towards the light (tmax short of it; inf for directional)
   bool occluded = false;
   RayStats stats;
 };
 
 struct RayInspection {
-  int x = 0, y = 0;              ///< pixel, row 0 at the top
-  int width = 0, height = 0;     ///< of the view it was cast in
-  std::string structure;         ///< Accelerator::name()
+  int x = 0, y = 0;           ///< pixel, row 0 at the top
+  int width = 0, height = 0;  ///< of the view it was cast in
+  std::string structure;      ///< Accelerator::name()
   Ray ray;
   Hit hit;
   RayStats stats;

@@ -15,7 +15,8 @@ namespace {
 std::string shell_quote(const std::string& s) {
   bool plain = !s.empty();
   for (char c : s)
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || std::string_view("-_./,:=+").find(c) != std::string_view::npos))
+    if (!(std::isalnum(static_cast<unsigned char>(c)) ||
+          std::string_view("-_./,:=+").find(c) != std::string_view::npos))
       plain = false;
   if (plain) return s;
   std::string q = "'";
@@ -38,9 +39,12 @@ std::string write_text_exclusive(const fs::path& path, const std::string& text) 
 
 std::string heatmap_display_name(HeatmapDisplay d) {
   switch (d) {
-    case HeatmapDisplay::off: return "off";
-    case HeatmapDisplay::full_screen: return "full";
-    case HeatmapDisplay::blend: return "blend";
+    case HeatmapDisplay::off:
+      return "off";
+    case HeatmapDisplay::full_screen:
+      return "full";
+    case HeatmapDisplay::blend:
+      return "blend";
   }
   return "off";
 }
@@ -160,11 +164,15 @@ std::string render_command(const ScreenshotInfo& info, bool raster, const std::s
     const ViewSettings& v = c.view;
     if (v.show_boxes) {
       switch (v.box_mode) {
-        case BoxMode::depth: cmd += " --depth " + std::to_string(v.box_depth); break;
+        case BoxMode::depth:
+          cmd += " --depth " + std::to_string(v.box_depth);
+          break;
         case BoxMode::depth_range:
           cmd += " --depth " + std::to_string(v.box_depth) + " --depth-last " + std::to_string(v.box_depth_last);
           break;
-        case BoxMode::leaves: cmd += " --leaves"; break;
+        case BoxMode::leaves:
+          cmd += " --leaves";
+          break;
         case BoxMode::subtree:
           if (notes) notes->push_back("raster: a subtree selection has no command-line option");
           break;
@@ -221,8 +229,7 @@ nlohmann::json screenshot_sidecar(const ScreenshotInfo& info, const fs::path& pn
         {"up", vec(cam.up)},
         {"yfov_deg", cam.yfov * 180.0 / 3.14159265358979}}},
       {"structure", {{"name", c.structure.name}, {"options", structure_options}}},
-      {"query",
-       {{"triangle_test", option_value(c, "triangle-test")}, {"ordered", c.structure.query.ordered}}},
+      {"query", {{"triangle_test", option_value(c, "triangle-test")}, {"ordered", c.structure.query.ordered}}},
       {"heatmap",
        {{"display", heatmap_display_name(c.view.heatmap)},
         {"metric", metric_name(c.view.metric)},

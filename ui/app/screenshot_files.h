@@ -33,14 +33,14 @@ ScreenshotPaths unique_screenshot_paths(const std::filesystem::path& dir, const 
 
 /// What a screenshot shows, for its caption and side-car.
 struct ScreenshotInfo {
-  std::string scene;           ///< scene spec (file path or builtin:...)
+  std::string scene;  ///< scene spec (file path or builtin:...)
   std::uint64_t triangles = 0;
-  std::string camera_spec;     ///< ViewCamera::spec(): "" (scene default), "gltf:N" or "ex,ey,ez,tx,ty,tz,fov"
-  Camera camera;               ///< the camera itself
-  int width = 0;               ///< the 3D view's size in pixels (without the caption strip)
+  std::string camera_spec;  ///< ViewCamera::spec(): "" (scene default), "gltf:N" or "ex,ey,ez,tx,ty,tz,fov"
+  Camera camera;            ///< the camera itself
+  int width = 0;            ///< the 3D view's size in pixels (without the caption strip)
   int height = 0;
-  AppConfig config;            ///< structure, options, view layers
-  float scale_min = 0.0f;      ///< the heatmap range actually drawn
+  AppConfig config;        ///< structure, options, view layers
+  float scale_min = 0.0f;  ///< the heatmap range actually drawn
   float scale_max = 1.0f;
   std::optional<std::pair<int, int>> ray_pixel;  ///< the inspected pixel, when a ray is shown
 };

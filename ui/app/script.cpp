@@ -69,12 +69,18 @@ struct NamedKind {
   ScriptCommand::Kind kind;
 };
 constexpr NamedKind kCommands[] = {
-    {"open", ScriptCommand::Kind::open},         {"structure", ScriptCommand::Kind::structure},
-    {"set", ScriptCommand::Kind::set},           {"camera", ScriptCommand::Kind::camera},
-    {"size", ScriptCommand::Kind::size},         {"wait", ScriptCommand::Kind::wait},
-    {"click", ScriptCommand::Kind::click},       {"step", ScriptCommand::Kind::step},
-    {"screenshot", ScriptCommand::Kind::screenshot}, {"dump-ray", ScriptCommand::Kind::dump_ray},
-    {"dump-stats", ScriptCommand::Kind::dump_stats}, {"quit", ScriptCommand::Kind::quit},
+    {"open", ScriptCommand::Kind::open},
+    {"structure", ScriptCommand::Kind::structure},
+    {"set", ScriptCommand::Kind::set},
+    {"camera", ScriptCommand::Kind::camera},
+    {"size", ScriptCommand::Kind::size},
+    {"wait", ScriptCommand::Kind::wait},
+    {"click", ScriptCommand::Kind::click},
+    {"step", ScriptCommand::Kind::step},
+    {"screenshot", ScriptCommand::Kind::screenshot},
+    {"dump-ray", ScriptCommand::Kind::dump_ray},
+    {"dump-stats", ScriptCommand::Kind::dump_stats},
+    {"quit", ScriptCommand::Kind::quit},
 };
 
 }  // namespace
@@ -104,8 +110,8 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
     auto fail = [&](const std::string& msg) { throw ScriptError(file, line_no, msg); };
     std::string_view rest;
     const std::string_view word = first_word(line, rest);
-    const auto it = std::find_if(std::begin(kCommands), std::end(kCommands),
-                                 [&](const NamedKind& c) { return c.name == word; });
+    const auto it =
+        std::find_if(std::begin(kCommands), std::end(kCommands), [&](const NamedKind& c) { return c.name == word; });
     if (it == std::end(kCommands))
       fail("unknown command '" + std::string(word) +
            "' (valid: open, structure, set, camera, size, wait, click, step, screenshot, dump-ray, dump-stats, quit)");

@@ -14,11 +14,12 @@ namespace accelviz {
 struct ScriptCommand {
   enum class Kind { open, structure, set, camera, size, wait, click, step, screenshot, dump_ray, dump_stats, quit };
   Kind kind = Kind::wait;
-  int line = 0;              ///< 1-based line in the script file
-  std::string text;          ///< the line as written (trimmed), for messages
-  std::string arg;           ///< open: scene; structure: name; set: key; camera: spec; step: N|next|prev|first|last; screenshot/dump-*: path
-  std::string value;         ///< set: value
-  int x = 0, y = 0;          ///< size: width, height; click: pixel
+  int line = 0;       ///< 1-based line in the script file
+  std::string text;   ///< the line as written (trimmed), for messages
+  std::string arg;    ///< open: scene; structure: name; set: key; camera: spec; step: N|next|prev|first|last;
+                      ///< screenshot/dump-*: path
+  std::string value;  ///< set: value
+  int x = 0, y = 0;   ///< size: width, height; click: pixel
 };
 
 /// The command's name as written in scripts ("dump-ray").

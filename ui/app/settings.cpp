@@ -21,7 +21,8 @@ void add_recent(AppSettings& s, const std::string& spec) {
 
 std::filesystem::path config_dir() {
   // The spec says a relative XDG_CONFIG_HOME is invalid and must be ignored.
-  if (const char* xdg = std::getenv("XDG_CONFIG_HOME"); xdg && *xdg == '/') return std::filesystem::path(xdg) / "accelviz";
+  if (const char* xdg = std::getenv("XDG_CONFIG_HOME"); xdg && *xdg == '/')
+    return std::filesystem::path(xdg) / "accelviz";
   const char* home = std::getenv("HOME");
   return std::filesystem::path(home && *home ? home : ".") / ".config" / "accelviz";
 }

@@ -22,10 +22,10 @@ struct AppSettings {
   static constexpr std::size_t kMaxRecent = 10;
 
   AppConfig config;
-  std::string last_scene;            ///< opened when the app starts without a file ("" = the demo scene)
-  std::vector<std::string> recent;   ///< most recent first, no duplicates, at most kMaxRecent
-  std::string screenshot_dir;        ///< "" = default_screenshot_dir()
-  int window_width = 1280;           ///< screen coordinates
+  std::string last_scene;           ///< opened when the app starts without a file ("" = the demo scene)
+  std::vector<std::string> recent;  ///< most recent first, no duplicates, at most kMaxRecent
+  std::string screenshot_dir;       ///< "" = default_screenshot_dir()
+  int window_width = 1280;          ///< screen coordinates
   int window_height = 800;
 };
 
@@ -35,8 +35,12 @@ void add_recent(AppSettings& s, const std::string& spec);
 /// $XDG_CONFIG_HOME/accelviz when XDG_CONFIG_HOME is set and absolute, else
 /// $HOME/.config/accelviz (XDG Base Directory specification).
 std::filesystem::path config_dir();
-inline std::filesystem::path settings_file(const std::filesystem::path& dir) { return dir / "settings.json"; }
-inline std::filesystem::path imgui_ini_file(const std::filesystem::path& dir) { return dir / "imgui.ini"; }
+inline std::filesystem::path settings_file(const std::filesystem::path& dir) {
+  return dir / "settings.json";
+}
+inline std::filesystem::path imgui_ini_file(const std::filesystem::path& dir) {
+  return dir / "imgui.ini";
+}
 
 /// Settings as written to disk: {"version": 1, "last_scene", "recent",
 /// "screenshot_dir", "window": {"width", "height"}, "options": {KEY: VALUE}}

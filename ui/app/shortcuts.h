@@ -27,6 +27,8 @@ inline constexpr Shortcut kShortcuts[] = {
     {"Drop a .gltf/.glb/.obj file", "open it"},
 };
 
-inline std::span<const Shortcut> shortcuts() { return kShortcuts; }
+inline std::span<const Shortcut> shortcuts() {
+  return kShortcuts;
+}
 
 }  // namespace accelviz

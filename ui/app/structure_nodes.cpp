@@ -246,8 +246,7 @@ StructureNodes::Selection StructureNodes::select(const NodeSelection& sel, std::
     double total = 0.0;
     for (std::uint32_t c : g.counts) total += c;
     for (std::uint32_t c = 0; c < g.counts.size(); ++c)
-      if (g.counts[c] > 0)
-        add({*box(c), c, 1, true, total > 0.0 ? static_cast<float>(g.counts[c] / total) : 0.0f});
+      if (g.counts[c] > 0) add({*box(c), c, 1, true, total > 0.0 ? static_cast<float>(g.counts[c] / total) : 0.0f});
     return out;
   }
   auto to_box = [&](std::uint32_t i) {

@@ -23,7 +23,7 @@ struct StructureNode {
   std::uint32_t parent = 0xFFFFFFFFu;  ///< none for the root
   std::uint32_t prims = 0;             ///< leaves: primitives referenced
   bool leaf = false;
-  float sah_share = 0.0f;              ///< this node's part of the SAH cost, all nodes summing to 1
+  float sah_share = 0.0f;  ///< this node's part of the SAH cost, all nodes summing to 1
 };
 
 /// Which nodes to show (ViewSettings' box_* fields).

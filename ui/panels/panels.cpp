@@ -181,7 +181,8 @@ bool structure_panel(StructureChoice& choice, const BuildProgress& progress, boo
       b.splitter = static_cast<BvhSplitter>(splitter);
       changed = true;
     }
-    if (b.splitter == BvhSplitter::binned_sah) changed |= slider_int("Buckets", b.buckets, 2, 256, "binned SAH bucket count");
+    if (b.splitter == BvhSplitter::binned_sah)
+      changed |= slider_int("Buckets", b.buckets, 2, 256, "binned SAH bucket count");
     if (slider_int("Max leaf size", b.max_leaf_size, 1, 255, "nodes with at most this many triangles are leaves")) {
       b.leaf_size_cap = std::max(b.leaf_size_cap, b.max_leaf_size);
       changed = true;
@@ -342,17 +343,21 @@ bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout
   }
   const int max_depth = static_cast<int>(info.max_depth);
   switch (v.box_mode) {
-    case BoxMode::depth: changed |= slider_int("Depth", v.box_depth, 0, std::max(max_depth, 1)); break;
+    case BoxMode::depth:
+      changed |= slider_int("Depth", v.box_depth, 0, std::max(max_depth, 1));
+      break;
     case BoxMode::depth_range:
       changed |= slider_int("First depth", v.box_depth, 0, std::max(max_depth, 1));
       changed |= slider_int("Last depth", v.box_depth_last, 0, std::max(max_depth, 1));
       break;
-    case BoxMode::leaves: break;
+    case BoxMode::leaves:
+      break;
     case BoxMode::subtree: {
       int node = v.box_node;
       if (ImGui::InputInt("Node", &node)) {
-        v.box_node = std::clamp(node, 0, static_cast<int>(std::min<std::uint64_t>(
-                                             info.node_count > 0 ? info.node_count - 1 : 0, 0x7FFFFFFF)));
+        v.box_node = std::clamp(
+            node, 0,
+            static_cast<int>(std::min<std::uint64_t>(info.node_count > 0 ? info.node_count - 1 : 0, 0x7FFFFFFF)));
         changed = true;
       }
       ImGui::TextDisabled("F frames it; the Ray panel's node ids work here");
@@ -520,8 +525,9 @@ std::optional<std::size_t> ray_panel(const RayInspection* ray, std::size_t step,
         }
       }
     // Keep the current step in view while stepping with the buttons/keys.
-    if (moved) ImGui::SetScrollY(static_cast<float>(*moved) * ImGui::GetTextLineHeightWithSpacing() -
-                                 ImGui::GetWindowHeight() * 0.4f);
+    if (moved)
+      ImGui::SetScrollY(static_cast<float>(*moved) * ImGui::GetTextLineHeightWithSpacing() -
+                        ImGui::GetWindowHeight() * 0.4f);
     ImGui::EndTable();
   }
   ImGui::End();
@@ -567,14 +573,15 @@ void help_panel(bool& open, const PanelLayout& layout) {
       }
       ImGui::EndTable();
     }
-    ImGui::TextWrapped("Hovering the view with the heatmap on shows that pixel's figures. Panels keep the mouse "
-                       "and keyboard while they are hovered or focused. Documentation: docs/gui.md.");
+    ImGui::TextWrapped(
+        "Hovering the view with the heatmap on shows that pixel's figures. Panels keep the mouse "
+        "and keyboard while they are hovered or focused. Documentation: docs/gui.md.");
   }
   ImGui::End();
 }
 
-void status_bar(const std::string& message, const std::string& error, const BuildProgress& progress,
-                bool heatmap_busy, const PanelLayout& layout) {
+void status_bar(const std::string& message, const std::string& error, const BuildProgress& progress, bool heatmap_busy,
+                const PanelLayout& layout) {
   const float h = ImGui::GetFrameHeightWithSpacing() + 4.0f * layout.scale;
   ImGui::SetNextWindowPos(ImVec2(0.0f, layout.height - h));
   ImGui::SetNextWindowSize(ImVec2(layout.width, h));

@@ -20,7 +20,7 @@ namespace accelviz::panels {
 
 /// Where panels start on first use (later the user's layout from imgui.ini wins).
 struct PanelLayout {
-  float scale = 1.0f;  ///< HiDPI content scale
+  float scale = 1.0f;                      ///< HiDPI content scale
   float width = 1280.0f, height = 800.0f;  ///< window size in ImGui units
 };
 
@@ -54,7 +54,7 @@ void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const Pa
 
 // ---- View ------------------------------------------------------------------------------
 struct ViewInfo {
-  std::string node_kind;         ///< StructureNodes::kind() ("" when the structure has none)
+  std::string node_kind;  ///< StructureNodes::kind() ("" when the structure has none)
   std::uint32_t max_depth = 0;
   std::uint64_t node_count = 0;
   std::uint64_t boxes_drawn = 0;
@@ -81,8 +81,8 @@ bool screenshot_panel(std::string& folder, const std::string& default_folder, co
 /// Every shortcut (ui/app/shortcuts.h).
 void help_panel(bool& open, const PanelLayout& layout);
 /// One line at the bottom: the error (red) or message, and the build's progress.
-void status_bar(const std::string& message, const std::string& error, const BuildProgress& progress,
-                bool heatmap_busy, const PanelLayout& layout);
+void status_bar(const std::string& message, const std::string& error, const BuildProgress& progress, bool heatmap_busy,
+                const PanelLayout& layout);
 /// The figures of one heatmap pixel, as a tooltip at the mouse.
 void pixel_tooltip(int x, int y, const PixelFigures& p, HeatMetric metric, bool exact);
 
