@@ -6,7 +6,7 @@ namespace accelviz {
 
 const std::vector<std::string>& structure_names() {
   static const std::vector<std::string> names = [] {
-    std::vector<std::string> n = {"brute", "brute-bbox", "bvh", "kdtree", "grid", "octree", "voxels"};
+    std::vector<std::string> n = {"brute", "brute-bbox", "bvh", "kdtree", "grid", "octree", "voxels", "tlas"};
     if (kHaveEmbree) n.push_back("embree");
     return n;
   }();
@@ -21,6 +21,21 @@ std::string structure_names_joined() {
 
 std::unique_ptr<Accelerator> build_accelerator(std::string_view name, std::span<const Triangle> triangles,
                                                const StructureOptions& opts, const ProgressCallback& progress) {
+  const bool unflattened = opts.scene != nullptr && triangles.empty() && opts.scene->triangles.empty() &&
+                           !opts.scene->instances.empty();
+  if (name == "tlas") {
+    TlasOptions to;
+    to.blas = opts.bvh;
+    if (to.blas.threads == 0) to.blas.threads = opts.threads;
+    to.tlas = to.blas;
+    const bool same = opts.scene != nullptr && triangles.data() == opts.scene->triangles.data() &&
+                      triangles.size() == opts.scene->triangles.size() && !triangles.empty();
+    if (same || unflattened) return std::make_unique<Tlas>(*opts.scene, to, progress);
+    return std::make_unique<Tlas>(triangles, to, progress);
+  }
+  if (unflattened)
+    throw std::invalid_argument("structure '" + std::string(name) + "': " + opts.scene->source +
+                                " is instanced and too large to flatten; only 'tlas' can hold it");
   if (name == "brute" || name == "brute-bbox") {
     BruteForceOptions bo = opts.brute;
     bo.bbox_early_out = name == "brute-bbox";

@@ -9,6 +9,7 @@
 #include "core/accel/grid/grid.h"
 #include "core/accel/kdtree/kdtree.h"
 #include "core/accel/octree/octree.h"
+#include "core/accel/tlas/tlas.h"
 #include "core/accel/voxels/voxels.h"
 
 #include <memory>
@@ -29,6 +30,11 @@ struct StructureOptions {
   VoxelOptions voxels;       ///< "voxels" (hits are voxels, not triangles: see voxels.h)
   EmbreeOptions embree;      ///< "embree"
   unsigned threads = 0;      ///< build threads for structures whose own option is 0 (0: all hardware threads)
+  /// "tlas": the scene whose meshes and instances make the two levels (both
+  /// levels use `bvh`'s options). Used when `triangles` is this scene's
+  /// flattened list (or empty: a scene too large to flatten); otherwise
+  /// "tlas" wraps the triangles as one identity instance.
+  const Scene* scene = nullptr;
 };
 
 /// Names build_accelerator accepts, in the order `--help` lists them

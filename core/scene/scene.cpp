@@ -8,6 +8,20 @@ namespace accelviz {
 Aabb Scene::bounds() const {
   Aabb b;
   for (const Triangle& t : triangles) b.extend(t.bounds());
+  if (!triangles.empty() || instances.empty()) return b;
+  // Not flattened (an instanced scene too large for it): the instances'
+  // transformed mesh boxes.
+  std::vector<Aabb> mesh_box(meshes.size());
+  for (std::size_t m = 0; m < meshes.size(); ++m)
+    for (const glm::vec3& p : meshes[m].positions) mesh_box[m].extend(p);
+  for (const Instance& inst : instances) {
+    if (inst.mesh >= meshes.size() || mesh_box[inst.mesh].is_empty()) continue;
+    const Aabb& mb = mesh_box[inst.mesh];
+    for (int i = 0; i < 8; ++i) {
+      const glm::vec3 c((i & 1) ? mb.hi.x : mb.lo.x, (i & 2) ? mb.hi.y : mb.lo.y, (i & 4) ? mb.hi.z : mb.lo.z);
+      b.extend(glm::vec3(inst.transform * glm::vec4(c, 1.0f)));
+    }
+  }
   return b;
 }
 

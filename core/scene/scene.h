@@ -91,6 +91,17 @@ struct Animation {
   std::vector<AnimationChannel> channels;
 };
 
+/// A procedural deformation of one mesh (built-in dynamic scenes; glTF has
+/// no such thing): at time t every vertex sways horizontally by
+/// amplitude * (y / height)^2 * (sin(w), 0, 0.5 cos(w)), w = 2 pi frequency t
+/// + 0.7 x + 0.5 z, so vertices at y <= 0 stay put (waving grass).
+struct MeshDeformer {
+  std::uint32_t mesh = 0;
+  float amplitude = 0.05f;
+  float frequency = 0.5f;  ///< Hz
+  float height = 1.0f;     ///< y at which the sway reaches `amplitude`
+};
+
 /// What the loader dropped, skipped or noticed. Never silent.
 struct LoadReport {
   std::uint64_t dropped_nonfinite = 0;   ///< triangles with a NaN/inf vertex, removed
@@ -109,9 +120,12 @@ struct Scene {
   std::vector<Camera> cameras;
   std::vector<Light> lights;
   std::vector<Animation> animations;
+  std::vector<MeshDeformer> deformers;
   LoadReport report;
 
-  /// Bounds of all world-space triangles (empty box for an empty scene).
+  /// Bounds of all world-space triangles (empty box for an empty scene); for
+  /// an instanced scene left unflattened (triangles empty), the instances'
+  /// transformed mesh boxes.
   Aabb bounds() const;
   /// True when some mesh is referenced by more than one instance.
   bool has_instancing() const;

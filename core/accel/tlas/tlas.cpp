@@ -1,0 +1,370 @@
+// Two-level structure: BLAS per unique mesh, TLAS over instance boxes,
+// traversal in instance space (see tlas.h).
+#include "core/accel/tlas/tlas.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace accelviz {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+bool finite3(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+/// Object-space triangles of a mesh in index order, without the non-finite
+/// ones (Scene::flatten drops the same ones, so kept index k is the k-th
+/// world triangle of every instance).
+std::vector<Triangle> object_triangles(const Mesh& mesh) {
+  std::vector<Triangle> out;
+  out.reserve(mesh.indices.size());
+  for (const glm::uvec3& idx : mesh.indices) {
+    const Triangle t{mesh.positions[idx.x], mesh.positions[idx.y], mesh.positions[idx.z]};
+    if (finite3(t.v0) && finite3(t.v1) && finite3(t.v2)) out.push_back(t);
+  }
+  return out;
+}
+
+/// The world box of an object box under M, padded by a few ulps of its
+/// magnitude: world triangles flattened vertex by vertex round differently
+/// from the box corners, and a ray carried into object space rounds too.
+Aabb transform_box(const Aabb& box, const glm::mat4& m) {
+  Aabb out;
+  if (box.is_empty()) return out;
+  for (int i = 0; i < 8; ++i) {
+    const glm::vec3 c((i & 1) ? box.hi.x : box.lo.x, (i & 2) ? box.hi.y : box.lo.y, (i & 4) ? box.hi.z : box.lo.z);
+    out.extend(glm::vec3(m * glm::vec4(c, 1.0f)));
+  }
+  const glm::vec3 mag = glm::max(glm::abs(out.lo), glm::abs(out.hi));
+  const float pad = 1e-5f * std::max({mag.x, mag.y, mag.z, out.extent().x, out.extent().y, out.extent().z});
+  out.lo -= glm::vec3(pad);
+  out.hi += glm::vec3(pad);
+  return out;
+}
+
+BvhOptions quiet(BvhOptions o) {
+  o.compute_epo = false;
+  return o;
+}
+
+}  // namespace
+
+Tlas::Tlas(const Scene& scene, const TlasOptions& opts, const ProgressCallback& progress) : opts_(opts) {
+  const auto t0 = Clock::now();
+  validate(opts_.blas);
+  validate(opts_.tlas);
+  build_blas_list(scene, progress);
+  // Instances, with the world primitive ids flattening gives (or would give).
+  std::vector<std::uint64_t> kept(blas_.size());
+  for (std::size_t b = 0; b < blas_.size(); ++b) kept[b] = blas_[b]->leaf_triangles().size();
+  std::uint64_t next = 0;
+  instances_.reserve(scene.instances.size());
+  const bool flattened = !scene.triangles.empty();
+  for (const Instance& si : scene.instances) {
+    TlasInstance inst;
+    inst.mesh = si.mesh;
+    const int b = blas_of_mesh(si.mesh);
+    if (b < 0)
+      throw std::invalid_argument("tlas: instance references mesh " + std::to_string(si.mesh) +
+                                  " that is not in the scene");
+    inst.blas = static_cast<std::uint32_t>(b);
+    inst.first_prim = flattened ? si.first_triangle : next;
+    next += kept[inst.blas];
+    set_instance_transform(inst, si.transform);
+    instances_.push_back(inst);
+  }
+  instanced_triangles_ = next;
+  stats_.extra["tlas_ms"] = build_top();
+  stats_.build_ms = ms_since(t0);
+  update_memory_stats();
+  if (progress) progress(1.0);
+}
+
+Tlas::Tlas(std::span<const Triangle> triangles, const TlasOptions& opts, const ProgressCallback& progress)
+    : opts_(opts) {
+  const auto t0 = Clock::now();
+  validate(opts_.blas);
+  validate(opts_.tlas);
+  blas_.push_back(std::make_unique<Bvh>(triangles, quiet(opts_.blas), progress));
+  blas_mesh_.push_back(0);
+  TlasInstance inst;
+  set_instance_transform(inst, glm::mat4(1.0f));
+  instances_.push_back(inst);
+  instanced_triangles_ = triangles.size();
+  stats_.extra["tlas_ms"] = build_top();
+  stats_.build_ms = ms_since(t0);
+  update_memory_stats();
+}
+
+Tlas::~Tlas() = default;
+
+void Tlas::build_blas_list(const Scene& scene, const ProgressCallback& progress) {
+  std::vector<bool> used(scene.meshes.size(), false);
+  for (const Instance& si : scene.instances)
+    if (si.mesh < used.size()) used[si.mesh] = true;
+  std::uint64_t total = 0, done = 0;
+  for (std::size_t m = 0; m < used.size(); ++m)
+    if (used[m]) total += scene.meshes[m].indices.size();
+  for (std::size_t m = 0; m < used.size(); ++m) {
+    if (!used[m]) continue;
+    const std::vector<Triangle> tris = object_triangles(scene.meshes[m]);
+    const double lo = total ? static_cast<double>(done) / static_cast<double>(total) : 0.0;
+    const double span = total ? static_cast<double>(scene.meshes[m].indices.size()) / static_cast<double>(total) : 0.0;
+    ProgressCallback sub;
+    if (progress) sub = [&](double f) { return progress(lo + span * f); };
+    blas_.push_back(std::make_unique<Bvh>(tris, quiet(opts_.blas), sub));
+    blas_mesh_.push_back(static_cast<std::uint32_t>(m));
+    done += scene.meshes[m].indices.size();
+  }
+}
+
+int Tlas::blas_of_mesh(std::uint32_t mesh) const {
+  const auto it = std::find(blas_mesh_.begin(), blas_mesh_.end(), mesh);
+  return it == blas_mesh_.end() ? -1 : static_cast<int>(it - blas_mesh_.begin());
+}
+
+void Tlas::set_instance_transform(TlasInstance& inst, const glm::mat4& to_world) {
+  const float det = glm::determinant(glm::mat3(to_world));
+  bool ok = std::isfinite(det) && det != 0.0f;
+  for (int c = 0; c < 4 && ok; ++c)
+    for (int r = 0; r < 4; ++r) ok = ok && std::isfinite(to_world[c][r]);
+  if (!ok)
+    throw std::invalid_argument("tlas: instance transform is not invertible (determinant " + std::to_string(det) + ")");
+  inst.to_world = to_world;
+  // The inverse in double: nearly singular transforms (a 1e-4 squash) keep
+  // their digits.
+  const glm::dmat4 inv = glm::inverse(glm::dmat4(to_world));
+  inst.to_object = glm::mat4(inv);
+  inst.mirrored = det < 0.0f;
+  inst.normal_to_world = glm::mat3(glm::transpose(glm::dmat3(inv))) * (inst.mirrored ? -1.0f : 1.0f);
+  update_world_bounds(inst);
+}
+
+void Tlas::update_world_bounds(TlasInstance& inst) const {
+  const Bvh& b = *blas_[inst.blas];
+  inst.world_bounds = b.nodes().empty() ? Aabb{} : transform_box(b.nodes()[0].bounds, inst.to_world);
+}
+
+double Tlas::build_top() {
+  const auto t0 = Clock::now();
+  std::vector<Aabb> bounds;
+  std::vector<glm::vec3> centroids;
+  std::vector<std::uint32_t> ids;
+  for (std::uint32_t i = 0; i < instances_.size(); ++i) {
+    if (instances_[i].world_bounds.is_empty()) continue;
+    bounds.push_back(instances_[i].world_bounds);
+    centroids.push_back(instances_[i].world_bounds.center());
+    ids.push_back(i);
+  }
+  BvhTopology topo = build_bvh(bounds, centroids, opts_.tlas);
+  tlas_nodes_ = std::move(topo.nodes);
+  tlas_prims_.resize(topo.prim_indices.size());
+  for (std::size_t k = 0; k < topo.prim_indices.size(); ++k) tlas_prims_[k] = ids[topo.prim_indices[k]];
+  // Figures: both levels together.
+  stats_.node_count = tlas_nodes_.size();
+  stats_.leaf_count = topo.stats.leaf_count;
+  std::uint32_t blas_depth = 0;
+  for (const auto& b : blas_) {
+    stats_.node_count += b->build_stats().node_count;
+    stats_.leaf_count += b->build_stats().leaf_count;
+    blas_depth = std::max(blas_depth, b->build_stats().max_depth);
+  }
+  stats_.max_depth = topo.stats.max_depth + 1 + blas_depth;
+  stats_.avg_leaf_depth = topo.stats.avg_leaf_depth;
+  // Expected cost per ray: TLAS nodes by area, then each instance's BLAS SAH
+  // weighted by the chance of entering its world box (the box stands in for
+  // the BLAS root, whose cost is normalised by its own area).
+  double sah = 0.0, tlas_sah = 0.0;
+  if (!tlas_nodes_.empty()) {
+    const double root = std::max(static_cast<double>(tlas_nodes_[0].bounds.surface_area()), 1e-30);
+    for (const BvhNode& n : tlas_nodes_) {
+      const double p = n.bounds.surface_area() / root;
+      tlas_sah += opts_.tlas.cost_traversal * p;
+      if (!n.is_leaf()) continue;
+      for (std::uint32_t k = n.index; k < n.index + n.count; ++k) {
+        const TlasInstance& inst = instances_[tlas_prims_[k]];
+        sah += inst.world_bounds.surface_area() / root * blas_[inst.blas]->build_stats().sah_cost;
+      }
+    }
+  }
+  stats_.sah_cost = sah + tlas_sah;
+  stats_.extra["tlas_sah"] = tlas_sah;
+  stats_.extra["tlas_nodes"] = static_cast<double>(tlas_nodes_.size());
+  stats_.extra["instances"] = static_cast<double>(instances_.size());
+  stats_.extra["blas"] = static_cast<double>(blas_.size());
+  return ms_since(t0);
+}
+
+void Tlas::update_memory_stats() {
+  std::uint64_t blas_bytes = 0, flat = 0;
+  for (const auto& b : blas_) blas_bytes += b->build_stats().memory_bytes;
+  for (const TlasInstance& inst : instances_) flat += blas_[inst.blas]->build_stats().memory_bytes;
+  const std::uint64_t top = tlas_nodes_.size() * sizeof(BvhNode) + tlas_prims_.size() * sizeof(std::uint32_t) +
+                            instances_.size() * sizeof(TlasInstance);
+  stats_.memory_bytes = blas_bytes + top;
+  stats_.extra["memory_two_level"] = static_cast<double>(stats_.memory_bytes);
+  stats_.extra["memory_flattened_estimate"] = static_cast<double>(flat);
+  stats_.extra["instanced_triangles"] = static_cast<double>(instanced_triangles_);
+  std::uint64_t unique = 0;
+  for (const auto& b : blas_) unique += b->leaf_triangles().size();
+  stats_.extra["unique_triangles"] = static_cast<double>(unique);
+}
+
+namespace {
+
+struct Counters {
+  RayStats* rs;
+  TwoLevelRayStats* ts;
+  VisitTrace* trace;
+  bool any() const { return rs || ts || trace; }
+};
+
+}  // namespace
+
+template <bool AnyHit>
+static Hit traverse_two_level(const Tlas& t, std::span<const BvhNode> nodes, std::span<const std::uint32_t> prims,
+                              const Ray& ray, const QueryOptions& qo, const Counters& c) {
+  Hit best;
+  if (nodes.empty()) return best;
+  float tmax = ray.tmax;
+  std::uint32_t stack[2 * kBvhMaxDepth + 2];
+  int sp = 0;
+  stack[sp++] = 0;
+  const auto instances = t.instances();
+  while (sp > 0) {
+    const std::uint32_t idx = stack[--sp];
+    const BvhNode& node = nodes[idx];
+    SlabInterval iv;
+    const bool hit_box = intersect_slab(node.bounds, ray.origin, ray.inv_dir, ray.tmin, tmax, iv);
+    if (c.rs) ++c.rs->box_tests;
+    if (!hit_box) {
+      if (c.rs) ++c.rs->nodes_missed;
+      if (c.trace) c.trace->steps.push_back({VisitStep::Kind::node_missed, idx, kInfinity, kInfinity});
+      continue;
+    }
+    if (c.rs) ++c.rs->nodes_visited;
+    if (c.ts) ++c.ts->tlas_nodes;
+    if (c.trace) c.trace->steps.push_back({VisitStep::Kind::node_entered, idx, iv.t_entry, iv.t_exit});
+    if (!node.is_leaf()) {
+      // Near child first: order by the ray's sign on the box's longest axis.
+      const glm::vec3 e = node.bounds.extent();
+      const int axis = e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
+      const bool flip = ray.direction[axis] < 0.0f && qo.ordered;
+      stack[sp++] = flip ? node.index : node.index + 1;
+      stack[sp++] = flip ? node.index + 1 : node.index;
+      continue;
+    }
+    for (std::uint32_t k = node.index; k < node.index + node.count; ++k) {
+      const std::uint32_t id = prims[k];
+      const TlasInstance& inst = instances[id];
+      // Into object space: t keeps its meaning (direction not renormalised).
+      const glm::vec3 o(inst.to_object * glm::vec4(ray.origin, 1.0f));
+      const glm::vec3 d(glm::mat3(inst.to_object) * ray.direction);
+      const Ray local(o, d, ray.tmin, tmax);
+      const Bvh& blas = t.blas(inst.blas);
+      RayStats ls;
+      RayStats* lsp = c.any() ? &ls : nullptr;
+      if (c.ts) ++c.ts->instances_visited;
+      if constexpr (AnyHit) {
+        const bool h = blas.any_hit(local, qo, lsp);
+        if (c.rs) *c.rs += ls;
+        if (c.ts) {
+          c.ts->blas_nodes += ls.nodes_visited;
+          c.ts->prim_tests += ls.prim_tests;
+        }
+        if (h) {
+          best.prim = 0;  // any-hit: validity only
+          best.instance = id;
+          return best;
+        }
+      } else {
+        VisitTrace lt;
+        Hit h = blas.closest_hit(local, qo, lsp, c.trace ? &lt : nullptr);
+        if (c.rs) *c.rs += ls;
+        if (c.ts) {
+          c.ts->blas_nodes += ls.nodes_visited;
+          c.ts->prim_tests += ls.prim_tests;
+        }
+        if (c.trace)
+          for (VisitStep s : lt.steps)
+            if (s.kind == VisitStep::Kind::prim_hit || s.kind == VisitStep::Kind::prim_miss) {
+              s.id = static_cast<std::uint32_t>(inst.first_prim + s.id);
+              c.trace->steps.push_back(s);
+            }
+        if (h.valid() && h.t <= tmax) {
+          tmax = h.t;
+          h.prim = static_cast<std::uint32_t>(inst.first_prim + h.prim);
+          h.instance = id;
+          const glm::vec3 n = inst.normal_to_world * h.ng;
+          const float len = glm::length(n);
+          h.ng = len > 0.0f ? n / len : glm::vec3(0.0f);
+          best = h;
+        }
+      }
+    }
+  }
+  return best;
+}
+
+Hit Tlas::closest_hit(const Ray& ray, const QueryOptions& opts, RayStats* stats, VisitTrace* trace) const {
+  return traverse_two_level<false>(*this, tlas_nodes_, tlas_prims_, ray, opts, Counters{stats, nullptr, trace});
+}
+
+bool Tlas::any_hit(const Ray& ray, const QueryOptions& opts, RayStats* stats) const {
+  return traverse_two_level<true>(*this, tlas_nodes_, tlas_prims_, ray, opts, Counters{stats, nullptr, nullptr})
+      .valid();
+}
+
+Hit Tlas::closest_hit_two_level(const Ray& ray, const QueryOptions& opts, TwoLevelRayStats* stats) const {
+  return traverse_two_level<false>(*this, tlas_nodes_, tlas_prims_, ray, opts, Counters{nullptr, stats, nullptr});
+}
+
+TlasUpdateStats Tlas::update_transforms(std::span<const glm::mat4> to_world) {
+  if (to_world.size() != instances_.size())
+    throw std::invalid_argument("tlas: " + std::to_string(to_world.size()) + " transforms for " +
+                                std::to_string(instances_.size()) + " instances");
+  for (std::size_t i = 0; i < instances_.size(); ++i) set_instance_transform(instances_[i], to_world[i]);
+  TlasUpdateStats s;
+  s.tlas_rebuild_ms = build_top();
+  return s;
+}
+
+TlasUpdateStats Tlas::refit_blas(std::size_t b, std::span<const Triangle> tris) {
+  if (b >= blas_.size()) throw std::invalid_argument("tlas: no BLAS " + std::to_string(b));
+  TlasUpdateStats s;
+  const auto t0 = Clock::now();
+  blas_[b]->refit(tris);
+  s.blas_refit_ms = ms_since(t0);
+  for (TlasInstance& inst : instances_)
+    if (inst.blas == b) update_world_bounds(inst);
+  s.tlas_rebuild_ms = build_top();
+  update_memory_stats();
+  return s;
+}
+
+TlasUpdateStats Tlas::rebuild_blas(std::size_t b, std::span<const Triangle> tris) {
+  if (b >= blas_.size()) throw std::invalid_argument("tlas: no BLAS " + std::to_string(b));
+  if (tris.size() != blas_[b]->leaf_triangles().size())
+    throw std::invalid_argument("tlas: rebuild of BLAS " + std::to_string(b) + " with " + std::to_string(tris.size()) +
+                                " triangles, built with " + std::to_string(blas_[b]->leaf_triangles().size()));
+  TlasUpdateStats s;
+  const auto t0 = Clock::now();
+  *blas_[b] = Bvh(tris, quiet(opts_.blas));
+  s.blas_rebuild_ms = ms_since(t0);
+  for (TlasInstance& inst : instances_)
+    if (inst.blas == b) update_world_bounds(inst);
+  s.tlas_rebuild_ms = build_top();
+  update_memory_stats();
+  return s;
+}
+
+}  // namespace accelviz
