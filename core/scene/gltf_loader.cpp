@@ -115,7 +115,16 @@ class JsonPrecheck final : public nlohmann::json_sax<nlohmann::json> {
 
   bool null() override { return value(); }
   bool boolean(bool) override { return value(); }
-  bool number_integer(number_integer_t) override { return value(); }
+  bool number_integer(number_integer_t v) override {
+    // tinygltf silently ignores a negative index, offset, length or count
+    // (keeping its default 0), which would load other bytes than the file
+    // names; reject them here (found by tests/core/test_malformed_files.cpp).
+    if (v < 0 && is_unsigned_key(last_key_)) {
+      error = "invalid glTF: negative " + last_key_ + " (" + std::to_string(v) + ")";
+      return false;
+    }
+    return value();
+  }
   bool number_unsigned(number_unsigned_t) override { return value(); }
   bool number_float(number_float_t, const string_t&) override { return value(); }
   bool binary(binary_t&) override { return value(); }
@@ -137,6 +146,7 @@ class JsonPrecheck final : public nlohmann::json_sax<nlohmann::json> {
   }
   bool key(string_t& k) override {
     if (depth_ == 1) key_ = k;
+    last_key_ = k;
     return true;
   }
   bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& ex) override {
@@ -151,6 +161,19 @@ class JsonPrecheck final : public nlohmann::json_sax<nlohmann::json> {
   }
 
  private:
+  static bool is_unsigned_key(const std::string& k) {
+    static const char* const keys[] = {
+        "byteOffset", "byteLength", "byteStride", "count",    "buffer",    "bufferView", "componentType",
+        "mode",       "indices",    "material",   "mesh",     "camera",    "skin",       "node",
+        "scene",      "children",   "nodes",      "joints",   "sampler",   "source",     "input",
+        "output",     "index",      "texCoord",   "light",    "POSITION",  "NORMAL",     "TANGENT",
+        "TEXCOORD_0", "TEXCOORD_1", "COLOR_0",    "JOINTS_0", "WEIGHTS_0", "target"};
+    for (const char* key : keys)
+      if (k == key) return true;
+    return false;
+  }
+  std::string last_key_;  ///< the most recent key at any depth (the one a scalar or array element belongs to)
+
   bool value() {
     if (depth_ == 0) {
       error = "malformed glTF: the JSON root is not an object";
