@@ -213,7 +213,10 @@ nlohmann::json result_json(const SweepResult& r, double budget) {
       {"total_ms_1e9", r.total_ms(1e9)},
   };
   if (r.edges.probes > 0)
-    j["edges"] = {{"probes", r.edges.probes}, {"misses", r.edges.misses}, {"double_hits", r.edges.double_hits}};
+    j["edges"] = {{"probes", r.edges.probes},
+                  {"misses", r.edges.misses},
+                  {"double_hits", r.edges.double_hits},
+                  {"ray_double_hits", r.ray_double_hits}};
   return j;
 }
 
@@ -330,7 +333,7 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
               o.ray_budget);
   std::printf("%-32s %10s %10s %8s %10s %10s %12s %12s", "setting", "build ms", "memory", "SAH", "nodes/ray",
               "prims/ray", "Mrays/s", "total ms");
-  if (!probes.empty()) std::printf(" %12s", "edge leaks");
+  if (!probes.empty()) std::printf(" %12s %12s", "edge leaks", "rays hit 2x");
   std::printf("\n");
   for (const SweepResult& r : results) {
     std::printf("%-32s %10.2f %10s %8.3f %10.2f %10.2f %12.3f %12.2f", setting_label(r.setting).c_str(), r.build_ms,
@@ -339,6 +342,7 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
     if (!probes.empty())
       std::printf(" %5llu/%llu", static_cast<unsigned long long>(r.edges.misses),
                   static_cast<unsigned long long>(r.edges.probes));
+    if (!probes.empty()) std::printf(" %12llu", static_cast<unsigned long long>(r.ray_double_hits));
     std::printf("\n");
   }
   std::printf("\nPareto-optimal (build ms, trace ms for %g rays):\n", o.ray_budget);

@@ -280,6 +280,50 @@ EdgeLeaks count_edge_leaks(std::span<const Triangle> triangles, std::span<const 
   return r;
 }
 
+std::vector<std::array<std::uint32_t, 3>> shared_edge_neighbours(std::span<const Triangle> triangles) {
+  using Key = std::array<float, 6>;
+  auto key = [](glm::vec3 a, glm::vec3 b) {
+    if (std::tie(b.x, b.y, b.z) < std::tie(a.x, a.y, a.z)) std::swap(a, b);
+    return Key{a.x, a.y, a.z, b.x, b.y, b.z};
+  };
+  std::map<Key, std::vector<std::pair<std::uint32_t, int>>> edges;
+  for (std::uint32_t i = 0; i < triangles.size(); ++i) {
+    const Triangle& t = triangles[i];
+    if (t.area() <= 0.0f) continue;
+    edges[key(t.v0, t.v1)].push_back({i, 0});
+    edges[key(t.v1, t.v2)].push_back({i, 1});
+    edges[key(t.v2, t.v0)].push_back({i, 2});
+  }
+  std::vector<std::array<std::uint32_t, 3>> out(triangles.size(), {kInvalidId, kInvalidId, kInvalidId});
+  for (const auto& [k, v] : edges)
+    if (v.size() == 2 && v[0].first != v[1].first) {
+      out[v[0].first][v[0].second] = v[1].first;
+      out[v[1].first][v[1].second] = v[0].first;
+    }
+  return out;
+}
+
+std::uint64_t count_ray_double_hits(std::span<const Triangle> triangles,
+                                    std::span<const std::array<std::uint32_t, 3>> neighbours,
+                                    std::span<const Ray> rays, std::span<const Hit> hits, TriangleTest test) {
+  std::uint64_t n = 0;
+  for (std::size_t i = 0; i < rays.size() && i < hits.size(); ++i) {
+    const Hit& h = hits[i];
+    if (!h.valid() || h.prim >= neighbours.size()) continue;
+    const WatertightRay wr(rays[i].direction);
+    for (const std::uint32_t o : neighbours[h.prim]) {
+      if (o == kInvalidId) continue;
+      Hit other;
+      if (intersect_triangle(test, rays[i], wr, triangles[o], rays[i].tmin, rays[i].tmax, other) &&
+          std::fabs(other.t - h.t) <= 1e-5f * std::max(1.0f, h.t)) {
+        ++n;
+        break;
+      }
+    }
+  }
+  return n;
+}
+
 // ---- measuring ---------------------------------------------------------------------
 
 SweepResult measure_sweep_setting(std::span<const Triangle> triangles, std::span<const Ray> rays,
@@ -296,10 +340,16 @@ SweepResult measure_sweep_setting(std::span<const Triangle> triangles, std::span
   const int repeat = std::max(1, config.repeat);
   const unsigned threads = resolve_threads(config.threads);
 
+  const auto check = [&] {
+    if (config.keep_going && !config.keep_going()) throw BuildCancelled();
+  };
+  ProgressCallback build_progress;
+  if (config.keep_going) build_progress = [&](double) { return config.keep_going(); };
   std::unique_ptr<Accelerator> accel;
   for (int k = 0; k < repeat; ++k) {
     accel.reset();  // never two copies in memory
-    accel = build_accelerator(config.structure, triangles, so);
+    check();
+    accel = build_accelerator(config.structure, triangles, so, build_progress);
     r.build_ms_runs.push_back(accel->build_stats().build_ms);
   }
   r.build_ms = median_of(r.build_ms_runs);
@@ -314,6 +364,7 @@ SweepResult measure_sweep_setting(std::span<const Triangle> triangles, std::span
   std::vector<Hit> hits(rays.size());
   if (!rays.empty()) {
     for (int k = 0; k < repeat; ++k) {
+      check();
       const auto t0 = std::chrono::steady_clock::now();
       trace_closest(*accel, rays, hits, q, threads);
       const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -321,6 +372,7 @@ SweepResult measure_sweep_setting(std::span<const Triangle> triangles, std::span
     }
     r.rays_per_s = median_of(r.rays_per_s_runs);
     // Counting pass, outside the timings.
+    check();
     std::vector<RayStats> stats(rays.size());
     trace_closest(*accel, rays, hits, q, threads, stats);
     double nodes = 0, prims = 0, hit_count = 0;
@@ -333,6 +385,9 @@ SweepResult measure_sweep_setting(std::span<const Triangle> triangles, std::span
     r.nodes_per_ray = nodes / n;
     r.prims_per_ray = prims / n;
     r.hit_fraction = hit_count / n;
+    if (!probes.empty())
+      r.ray_double_hits =
+          count_ray_double_hits(triangles, shared_edge_neighbours(triangles), rays, hits, q.triangle_test);
   }
   if (!probes.empty()) r.edges = count_edge_leaks(triangles, probes, q.triangle_test);
   return r;
@@ -388,7 +443,7 @@ std::string sweep_csv(std::span<const SweepResult> results, double ray_budget) {
   for (const std::string& p : params) os << p << ',';
   os << "label,triangle_test,build_ms,memory_bytes,nodes,leaves,max_depth,sah_cost,epo,nodes_per_ray,"
         "prims_per_ray,hit_fraction,rays_per_s,ray_budget,trace_ms_budget,total_ms_budget,edge_probes,"
-        "edge_misses,edge_double_hits\n";
+        "edge_misses,edge_double_hits,ray_double_hits\n";
   for (const SweepResult& r : results) {
     for (const auto& [k, v] : r.setting) os << v << ',';
     os << '"' << setting_label(r.setting) << "\"," << r.triangle_test << ',' << r.build_ms << ',' << r.memory_bytes
@@ -396,7 +451,7 @@ std::string sweep_csv(std::span<const SweepResult> results, double ray_budget) {
     if (r.epo >= 0) os << r.epo;
     os << ',' << r.nodes_per_ray << ',' << r.prims_per_ray << ',' << r.hit_fraction << ',' << r.rays_per_s << ','
        << ray_budget << ',' << r.trace_ms(ray_budget) << ',' << r.total_ms(ray_budget) << ',' << r.edges.probes << ','
-       << r.edges.misses << ',' << r.edges.double_hits << '\n';
+       << r.edges.misses << ',' << r.edges.double_hits << ',' << r.ray_double_hits << '\n';
   }
   return os.str();
 }

@@ -10,6 +10,7 @@
 #include "core/query/ray_sets.h"
 #include "core/scene/scene.h"
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <span>
@@ -77,6 +78,19 @@ struct EdgeLeaks {
 /// Tests every probe against its two triangles with `test`.
 EdgeLeaks count_edge_leaks(std::span<const Triangle> triangles, std::span<const EdgeProbe> probes, TriangleTest test);
 
+/// For every triangle, the triangles across its three edges (v0v1, v1v2,
+/// v2v0) where exactly two triangles share that edge's positions; kInvalidId
+/// elsewhere (boundary, non-manifold or degenerate).
+std::vector<std::array<std::uint32_t, 3>> shared_edge_neighbours(std::span<const Triangle> triangles);
+
+/// Of `rays` with closest hits `hits` (as traced with `test`), how many are
+/// also hit by a neighbour of the hit triangle at the same distance (|dt| <=
+/// 1e-5 max(1, t)): the ray went through the shared edge and both sides
+/// reported it.
+std::uint64_t count_ray_double_hits(std::span<const Triangle> triangles,
+                                    std::span<const std::array<std::uint32_t, 3>> neighbours,
+                                    std::span<const Ray> rays, std::span<const Hit> hits, TriangleTest test);
+
 // ---- measuring ---------------------------------------------------------------------
 
 struct SweepConfig {
@@ -86,6 +100,9 @@ struct SweepConfig {
   int repeat = 3;             ///< builds and timed passes per setting (medians)
   unsigned threads = 0;       ///< build and trace threads (0: all hardware threads)
   double ray_budget = 1e6;    ///< N of total(N)
+  /// Asked during builds and between timed passes (any thread); false
+  /// cancels the setting being measured (BuildCancelled). Empty: never.
+  std::function<bool()> keep_going;
 };
 
 struct SweepResult {
@@ -103,6 +120,11 @@ struct SweepResult {
   double prims_per_ray = 0;     ///< counting pass: mean triangle tests
   double hit_fraction = 0;
   EdgeLeaks edges;              ///< with the setting's triangle test (probes == 0 when not measured)
+  /// Main ray set, when edges are measured: rays whose closest hit is also
+  /// hit, at the same distance (relative 1e-5), by a triangle sharing an
+  /// edge with it: the ray struck the shared edge and the test reported it
+  /// on both sides (counted twice by any-hit or counting queries).
+  std::uint64_t ray_double_hits = 0;
   std::string triangle_test;    ///< "watertight" or "fast"
 
   /// Trace time of `rays` rays at the measured rate, in ms.
