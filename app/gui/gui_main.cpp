@@ -9,6 +9,7 @@
 #include "core/scene/load.h"
 #include "ui/app/app_state.h"
 #include "ui/app/script.h"
+#include "ui/app/sweep_worker.h"
 #include "ui/app/settings.h"
 #include "ui/gl/glfw_context.h"
 #include "ui/imgui/imgui_context.h"
@@ -91,6 +92,8 @@ class Gui final : public ScriptHost {
   std::unique_ptr<ImGuiContextGuard> imgui_;
   std::unique_ptr<SceneView> view_;
   std::optional<ScriptRunner> script_;
+  SweepWorker sweeps_;  ///< the Cost of accuracy panel's sweeps
+  panels::AccuracyPanelState accuracy_;
   std::vector<std::string> dropped_;
   std::vector<KeyPress> keys_;
 
@@ -285,6 +288,38 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
     take_screenshot();
   panels::help_panel(show_help_, layout);
   panels::status_bar(app_.message(), app_.error(), bp, app_.heatmap_busy(), layout);
+
+  const std::shared_ptr<const SweepSnapshot> sweep = sweeps_.latest();
+  const panels::AccuracyAction aa =
+      panels::accuracy_panel(accuracy_, sweep.get(), sweeps_.busy(), app_.config().structure.name, layout);
+  if (aa.cancel) sweeps_.cancel();
+  if (aa.run) {
+    accuracy_.error.clear();
+    try {
+      if (!app_.current()) throw std::invalid_argument("no scene shown yet");
+      SweepRequest r;
+      r.scene = app_.current()->scene;
+      r.structure = app_.config().structure.name;
+      r.base = app_.config().structure.options;
+      r.query = app_.config().structure.query;
+      r.params = parse_sweep_params_text(r.structure, accuracy_.params);
+      r.camera = app_.camera();
+      r.width = accuracy_.width;
+      r.height = accuracy_.height;
+      r.repeat = accuracy_.repeat;
+      r.calibrate = accuracy_.calibrate;
+      sweeps_.request(std::move(r));
+    } catch (const std::exception& e) {
+      accuracy_.error = e.what();
+    }
+  }
+  if (aa.apply) {
+    const std::string err = apply_sweep_point(app_.config().structure, aa.apply_structure, *aa.apply);
+    if (err.empty())
+      app_.set_message("applied " + aa.apply_structure + " " + setting_label(*aa.apply) + " from the sweep");
+    else
+      app_.set_error(err);
+  }
 }
 
 SavedScreenshot Gui::write_frame(const std::optional<std::filesystem::path>& explicit_path) {
@@ -418,7 +453,7 @@ int Gui::run() {
     // Idle (nothing building, tracing or scripted): sleep until input
     // arrives; otherwise keep frames coming so results show up promptly.
     // One more frame after the workers go quiet picks up their last result.
-    const bool busy = script_ || app_.build_status().busy || app_.heatmap_busy();
+    const bool busy = script_ || app_.build_status().busy || app_.heatmap_busy() || sweeps_.busy();
     if (busy || was_busy_)
       glfwPollEvents();
     else

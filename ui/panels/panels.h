@@ -10,6 +10,7 @@
 #include "ui/app/ray_inspection.h"
 #include "ui/app/settings.h"
 #include "ui/app/structure_nodes.h"
+#include "ui/app/sweep_worker.h"
 
 #include <cstddef>
 #include <optional>
@@ -85,5 +86,30 @@ void status_bar(const std::string& message, const std::string& error, const Buil
                 const PanelLayout& layout);
 /// The figures of one heatmap pixel, as a tooltip at the mouse.
 void pixel_tooltip(int x, int y, const PixelFigures& p, HeatMetric metric, bool exact);
+
+// ---- Cost of accuracy (accuracy_panel.cpp) -----------------------------------------------
+struct AccuracyPanelState {
+  std::string params;      ///< "buckets=2,4,exact leaf=1,4" (the structure's default when it changes)
+  std::string params_for;  ///< structure `params` was made for
+  int width = 160, height = 120;  ///< primary rays of the current view
+  int repeat = 1;
+  double ray_budget = 1e6;
+  int figure = 0;  ///< SweepFigure of the figure-vs-parameter chart
+  int param = 0;   ///< its parameter
+  bool calibrate = false;
+  bool collapsed_at_start = true;
+  std::string error;  ///< the last request's one-line error (bad parameter)
+};
+struct AccuracyAction {
+  bool run = false;  ///< run the sweep in `params` (restarting one in progress)
+  bool cancel = false;
+  std::optional<SweepSetting> apply;  ///< a clicked point's setting ...
+  std::string apply_structure;        ///< ... for this structure
+};
+/// Parameter field, ray size, Run/Cancel with progress, and the live charts
+/// of `snap` (build vs trace with the Pareto front, total for the ray budget,
+/// figure vs parameter, table, calibrated constants).
+AccuracyAction accuracy_panel(AccuracyPanelState& state, const SweepSnapshot* snap, bool busy,
+                              const std::string& structure, const PanelLayout& layout);
 
 }  // namespace accelviz::panels

@@ -1,0 +1,328 @@
+#include "ui/app/sweep_worker.h"
+
+#include "core/accel/bvh/bvh.h"
+#include "core/analysis/sah.h"
+#include "core/query/batch.h"
+#include "core/query/ray_sets.h"
+#include "core/util/parallel.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+namespace accelviz {
+
+std::vector<SweepParam> parse_sweep_params_text(std::string_view structure, std::string_view text) {
+  std::vector<SweepParam> params;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    while (i < text.size() && (text[i] == ' ' || text[i] == ';' || text[i] == '\t')) ++i;
+    std::size_t j = i;
+    while (j < text.size() && text[j] != ' ' && text[j] != ';' && text[j] != '\t') ++j;
+    if (j > i) params.push_back(parse_sweep_param(text.substr(i, j - i)));
+    i = j;
+  }
+  if (params.empty()) throw std::invalid_argument("sweep: no parameter given (expected NAME=V1,V2,...)");
+  expand_sweep(structure, params);  // checks names, values and duplicates
+  return params;
+}
+
+std::string default_sweep_params_text(std::string_view structure) {
+  if (structure == "bvh") return "buckets=2,4,8,16,32,exact";
+  if (structure == "kdtree") return "depth=8,12,16,20,0";
+  if (structure == "grid") return "lambda=0.25,0.5,1,2,4,8";
+  if (structure == "octree") return "depth=4,6,8,10";
+  if (structure == "voxels") return "level=4,5,6,7,8";
+  return "triangle=watertight,fast";
+}
+
+std::string apply_sweep_point(StructureChoice& choice, std::string_view structure, const SweepSetting& setting) {
+  StructureChoice next = choice;
+  next.name = std::string(structure);
+  try {
+    apply_sweep_setting(structure, setting, next.options, next.query);
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  choice = std::move(next);
+  return {};
+}
+
+std::vector<Point2> build_vs_trace_points(std::span<const SweepResult> results, double rays) {
+  std::vector<Point2> p;
+  p.reserve(results.size());
+  for (const SweepResult& r : results) p.push_back({r.build_ms, r.trace_ms(rays)});
+  return p;
+}
+
+const char* sweep_figure_name(SweepFigure f) {
+  switch (f) {
+    case SweepFigure::sah_cost:
+      return "SAH cost";
+    case SweepFigure::rays_per_s:
+      return "rays/s";
+    case SweepFigure::nodes_per_ray:
+      return "nodes/ray";
+    case SweepFigure::prims_per_ray:
+      return "triangle tests/ray";
+    case SweepFigure::build_ms:
+      return "build ms";
+    case SweepFigure::total_ms:
+      return "total ms (budget)";
+    case SweepFigure::memory:
+      return "memory MiB";
+    case SweepFigure::edge_misses:
+      return "edge misses";
+  }
+  return "?";
+}
+
+double sweep_figure_value(const SweepResult& r, SweepFigure f, double rays) {
+  switch (f) {
+    case SweepFigure::sah_cost:
+      return r.sah_cost;
+    case SweepFigure::rays_per_s:
+      return r.rays_per_s;
+    case SweepFigure::nodes_per_ray:
+      return r.nodes_per_ray;
+    case SweepFigure::prims_per_ray:
+      return r.prims_per_ray;
+    case SweepFigure::build_ms:
+      return r.build_ms;
+    case SweepFigure::total_ms:
+      return r.total_ms(rays);
+    case SweepFigure::memory:
+      return static_cast<double>(r.memory_bytes) / (1024.0 * 1024.0);
+    case SweepFigure::edge_misses:
+      return static_cast<double>(r.edges.misses);
+  }
+  return 0.0;
+}
+
+std::vector<SweepSeries> sweep_series(std::span<const SweepResult> results, std::size_t param) {
+  std::vector<SweepSeries> out;
+  std::map<std::string, std::size_t> by_label;
+  // Value order as first seen (the sweep lists each parameter's values in order).
+  std::vector<std::string> values;
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    const SweepSetting& s = results[i].setting;
+    if (param >= s.size()) continue;
+    SweepSetting others;
+    for (std::size_t k = 0; k < s.size(); ++k)
+      if (k != param) others.push_back(s[k]);
+    const std::string label = others.empty() ? std::string() : setting_label(others);
+    auto [it, fresh] = by_label.emplace(label, out.size());
+    if (fresh) out.push_back({label, {}, {}});
+    const std::string& v = s[param].second;
+    auto vit = std::find(values.begin(), values.end(), v);
+    if (vit == values.end()) vit = values.insert(values.end(), v);
+    SweepSeries& series = out[it->second];
+    series.value_index.push_back(static_cast<int>(vit - values.begin()));
+    series.result.push_back(i);
+  }
+  return out;
+}
+
+namespace {
+
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+CalibratedTree measure_tree(std::span<const Triangle> triangles, std::span<const Ray> rays, float ctrav, float cisect,
+                            double judge_cisect, const QueryOptions& q, unsigned threads, int repeat,
+                            const std::function<bool()>& keep_going) {
+  BvhOptions o;
+  o.cost_traversal = ctrav;
+  o.cost_intersect = cisect;
+  o.compute_epo = false;
+  o.threads = threads;
+  ProgressCallback progress;
+  if (keep_going) progress = [&](double) { return keep_going(); };
+  const Bvh bvh(triangles, o, progress);
+  CalibratedTree t;
+  t.c_trav = ctrav;
+  t.c_isect = cisect;
+  t.build_ms = bvh.build_stats().build_ms;
+  t.nodes = bvh.build_stats().node_count;
+  t.sah_calibrated = bvh_sah_cost(bvh.nodes(), 1.0, judge_cisect);
+  std::vector<Hit> hits(rays.size());
+  std::vector<double> rps;
+  const unsigned n_threads = resolve_threads(threads);
+  for (int k = 0; k < std::max(1, repeat) && !rays.empty(); ++k) {
+    if (keep_going && !keep_going()) throw BuildCancelled();
+    const auto t0 = std::chrono::steady_clock::now();
+    trace_closest(bvh, rays, hits, q, n_threads);
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    rps.push_back(s > 0 ? static_cast<double>(rays.size()) / s : 0.0);
+  }
+  t.rays_per_s = median_of(rps);
+  if (!rays.empty()) {
+    std::vector<RayStats> stats(rays.size());
+    trace_closest(bvh, rays, hits, q, n_threads, stats);
+    for (const RayStats& s : stats) {
+      t.nodes_per_ray += s.nodes_visited;
+      t.prims_per_ray += s.prim_tests;
+    }
+    t.nodes_per_ray /= static_cast<double>(rays.size());
+    t.prims_per_ray /= static_cast<double>(rays.size());
+  }
+  return t;
+}
+
+}  // namespace
+
+CalibrationReport compare_calibrated_bvh(std::span<const Triangle> triangles, std::span<const Ray> rays,
+                                         const Calibration& c, const QueryOptions& query, unsigned threads, int repeat,
+                                         const std::function<bool()>& keep_going) {
+  CalibrationReport r;
+  r.machine = c;
+  r.c_isect = query.triangle_test == TriangleTest::watertight ? c.c_isect_watertight() : c.c_isect_fast();
+  if (!(r.c_isect > 0) || !std::isfinite(r.c_isect))
+    throw std::runtime_error("calibration gave no usable C_isect (box test time 0?)");
+  r.with_default = measure_tree(triangles, rays, 1.0f, 1.0f, r.c_isect, query, threads, repeat, keep_going);
+  r.with_calibrated =
+      measure_tree(triangles, rays, 1.0f, static_cast<float>(r.c_isect), r.c_isect, query, threads, repeat, keep_going);
+  return r;
+}
+
+double SweepSnapshot::fraction() const {
+  const std::size_t steps = settings.size() + (calibration || stage == "calibrating" ? 1 : 0);
+  if (state == State::done) return 1.0;
+  const std::size_t done = results.size() + (calibration ? 1 : 0);
+  return steps ? static_cast<double>(done) / static_cast<double>(steps) : 0.0;
+}
+
+std::shared_ptr<const SweepSnapshot> run_sweep_request(
+    const SweepRequest& r, std::uint64_t id, const std::function<bool()>& keep_going,
+    const std::function<void(std::shared_ptr<const SweepSnapshot>)>& publish) {
+  auto snap = std::make_shared<SweepSnapshot>();
+  snap->id = id;
+  snap->structure = r.structure;
+  snap->params = r.params;
+  auto emit = [&] {
+    auto copy = std::make_shared<const SweepSnapshot>(*snap);
+    if (publish) publish(copy);
+    return copy;
+  };
+  try {
+    if (!r.scene) throw std::runtime_error("no scene loaded");
+    const std::vector<Triangle>& tris = r.scene->scene.triangles;
+    snap->triangles = tris.size();
+    snap->settings = expand_sweep(r.structure, r.params);
+    bool sweeps_triangle = false;
+    for (const SweepParam& p : r.params) sweeps_triangle |= p.name == "triangle";
+    snap->stage = "making rays";
+    emit();
+    const std::vector<Ray> rays = primary_rays(r.camera, std::max(1, r.width), std::max(1, r.height));
+    std::vector<EdgeProbe> probes;
+    if (sweeps_triangle) probes = shared_edge_probes(tris, r.edge_probes, r.seed);
+    snap->rays = rays.size();
+    snap->probes = probes.size();
+    SweepConfig cfg;
+    cfg.structure = r.structure;
+    cfg.base = r.base;
+    cfg.query = r.query;
+    cfg.repeat = r.repeat;
+    cfg.threads = r.threads;
+    cfg.keep_going = keep_going;
+    for (const SweepSetting& s : snap->settings) {
+      if (keep_going && !keep_going()) throw BuildCancelled();
+      snap->stage = r.structure + " " + setting_label(s);
+      emit();
+      snap->results.push_back(measure_sweep_setting(tris, rays, probes, cfg, s));
+    }
+    if (r.calibrate) {
+      snap->stage = "calibrating";
+      emit();
+      const Calibration c = calibrate(r.calibrate_options);
+      if (keep_going && !keep_going()) throw BuildCancelled();
+      snap->calibration = compare_calibrated_bvh(tris, rays, c, r.query, r.threads, r.repeat, keep_going);
+    }
+    snap->state = SweepSnapshot::State::done;
+    snap->stage.clear();
+  } catch (const BuildCancelled&) {
+    snap->state = SweepSnapshot::State::cancelled;
+    snap->stage.clear();
+  } catch (const std::exception& e) {
+    snap->state = SweepSnapshot::State::failed;
+    snap->error = e.what();
+    snap->stage.clear();
+  }
+  return emit();
+}
+
+SweepWorker::SweepWorker() : thread_([this] { run(); }) {}
+
+SweepWorker::~SweepWorker() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+    queued_.reset();
+  }
+  cancel_upto_ = ~std::uint64_t{0};
+  wake_.notify_all();
+  thread_.join();
+}
+
+std::uint64_t SweepWorker::request(SweepRequest r) {
+  std::uint64_t id;
+  {
+    std::lock_guard lock(mutex_);
+    id = next_id_.fetch_add(1);
+    queued_.emplace(id, std::move(r));
+    cancel_upto_ = id - 1;
+  }
+  wake_.notify_all();
+  return id;
+}
+
+void SweepWorker::cancel() {
+  std::lock_guard lock(mutex_);
+  queued_.reset();
+  cancel_upto_ = next_id_.load() - 1;
+}
+
+std::shared_ptr<const SweepSnapshot> SweepWorker::latest() const {
+  std::lock_guard lock(mutex_);
+  return latest_;
+}
+
+bool SweepWorker::busy() const {
+  std::lock_guard lock(mutex_);
+  return running_ || queued_.has_value();
+}
+
+void SweepWorker::run() {
+  for (;;) {
+    std::pair<std::uint64_t, SweepRequest> job;
+    {
+      std::unique_lock lock(mutex_);
+      wake_.wait(lock, [&] { return stop_ || queued_.has_value(); });
+      if (stop_) return;
+      job = std::move(*queued_);
+      queued_.reset();
+      running_ = true;
+    }
+    const std::uint64_t id = job.first;
+    run_sweep_request(
+        job.second, id, [&] { return id > cancel_upto_.load(std::memory_order_relaxed); },
+        [&](std::shared_ptr<const SweepSnapshot> s) {
+          std::lock_guard lock(mutex_);
+          // A superseded job's snapshots never replace a newer job's; its
+          // own final "cancelled" snapshot is shown only if nothing newer is queued.
+          if (id > cancel_upto_.load() || (!queued_ && (!latest_ || latest_->id <= id))) latest_ = std::move(s);
+        });
+    {
+      std::lock_guard lock(mutex_);
+      running_ = false;
+    }
+  }
+}
+
+}  // namespace accelviz
