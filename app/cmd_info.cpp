@@ -1,8 +1,9 @@
 // accelviz info SCENE [--json]: what the loader found, dropped and noticed.
-#include "app/cli_common.h"
-
 #include <cstdio>
 #include <memory>
+
+#include "app/cli_common.h"
+#include "core/scene/effects.h"
 
 namespace accelviz::cli {
 
@@ -11,15 +12,24 @@ namespace {
 struct InfoOptions {
   std::string scene;
   bool json = false;
+  std::vector<std::string> force;  ///< --force-effect NAME (repeatable)
 };
 
-nlohmann::json vec_json(const glm::vec3& v) { return {v.x, v.y, v.z}; }
+nlohmann::json vec_json(const glm::vec3& v) {
+  return {v.x, v.y, v.z};
+}
 
 int run_info(const InfoOptions& o, const GlobalOptions& global) {
   const Scene scene = load_scene_noting_warnings(o.scene, /*quiet=*/true);
   (void)global;
   const Aabb b = scene.bounds();
   const bool empty = b.is_empty();
+  EffectForces forces;
+  for (const std::string& name : o.force)
+    if (!set_force(forces, name))
+      throw UsageError("--force-effect: unknown effect '" + name +
+                       "' (valid: shadow-rays, per-frame-updates, two-level, textures)");
+  const SceneEffects effects = decide_effects(scene, forces);
   if (o.json) {
     nlohmann::json j;
     j["scene"] = o.scene;
@@ -36,6 +46,10 @@ int run_info(const InfoOptions& o, const GlobalOptions& global) {
     j["degenerate"] = scene.report.degenerate;
     j["skipped_primitives"] = scene.report.skipped_primitives;
     j["warnings"] = scene.report.warnings;
+    j["effects"] = nlohmann::json::array();
+    for (const Effect& e : effects.list())
+      j["effects"].push_back({{"name", e.name}, {"on", e.on}, {"forced", e.forced}, {"reason", e.reason}});
+    j["structure"] = effects.structure();
     print_json_line(j);
     return 0;
   }
@@ -62,6 +76,7 @@ int run_info(const InfoOptions& o, const GlobalOptions& global) {
               static_cast<unsigned long long>(scene.report.skipped_primitives));
   std::printf("warnings       %zu\n", scene.report.warnings.size());
   for (const std::string& w : scene.report.warnings) std::printf("  - %s\n", w.c_str());
+  std::printf("effects        (structure: %s)\n%s", effects.structure().c_str(), effects_text(effects).c_str());
   return 0;
 }
 
@@ -69,10 +84,13 @@ int run_info(const InfoOptions& o, const GlobalOptions& global) {
 
 Command add_info_command(CLI::App& parent, const GlobalOptions& global) {
   auto o = std::make_shared<InfoOptions>();
-  CLI::App* sub = parent.add_subcommand("info", "Print what a scene contains: counts, bounds, dropped and "
-                                                "degenerate triangles, loader warnings");
+  CLI::App* sub = parent.add_subcommand("info",
+                                        "Print what a scene contains: counts, bounds, dropped and "
+                                        "degenerate triangles, loader warnings, the effects it calls for");
   sub->add_option("SCENE", o->scene, "Scene file (.gltf, .glb, .obj) or builtin:NAME[?key=value&...]")->required();
   sub->add_flag("--json", o->json, "Print one JSON object instead of text");
+  sub->add_option("--force-effect", o->force,
+                  "Force an effect on (repeatable): shadow-rays, per-frame-updates, two-level, textures");
   return {sub, [o, &global] { return run_info(*o, global); }};
 }
 

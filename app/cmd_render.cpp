@@ -60,7 +60,8 @@ int run_render_raster(const RenderOptions& o, const GlobalOptions& global) {
   progress.end(std::to_string(scene.triangles.size()) + " triangles");
   const Camera camera = camera_for(o.camera, scene, size);
   progress.begin("building " + o.structure);
-  const StructureOptions so = o.structure_opts.to_options(o.threads, /*compute_epo=*/false);
+  StructureOptions so = o.structure_opts.to_options(o.threads, /*compute_epo=*/false);
+  so.scene = &scene;  // "tlas" builds its two levels from the scene's meshes and instances
   const std::unique_ptr<Accelerator> accel = build_accelerator(o.structure, scene.triangles, so, progress.callback());
   progress.end(std::to_string(static_cast<long long>(accel->build_stats().build_ms)) + " ms");
 
@@ -95,7 +96,8 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
   const Camera camera = camera_for(o.camera, scene, size);
 
   progress.begin("building " + o.structure);
-  const StructureOptions so = o.structure_opts.to_options(o.threads, /*compute_epo=*/false);
+  StructureOptions so = o.structure_opts.to_options(o.threads, /*compute_epo=*/false);
+  so.scene = &scene;  // "tlas" builds its two levels from the scene's meshes and instances
   const auto t0 = Clock::now();
   const std::unique_ptr<Accelerator> accel = build_accelerator(o.structure, scene.triangles, so, progress.callback());
   const double build_wall_ms = ms_since(t0);

@@ -46,6 +46,11 @@ CountRange documented_range(const std::string& name, std::int64_t size) {
     return {size, size};
   if (name == "grass") return {size + 1, size + 3};                // 3 per blade, rounded, + 2 ground
   if (name == "forest") return {size - 48 + 2, size + 48 + 2};     // 96 per tree, rounded, + 2 ground
+  if (name == "dynamic") return {size - 12, size + 3};             // 12 per box, rounded down; lawn 3 per blade + 2
+  if (name == "island") {  // size = unique; default copies 4: about 0.1 size + 0.9 size 4 instanced, within 10%
+    const auto n = static_cast<std::int64_t>(3.7 * static_cast<double>(size));
+    return {n - n / 10, n + n / 10};
+  }
   // Grid-quantised scenes (teapot, teapot-stadium, terrain, walls): within 10%
   // for size >= 10,000 (terrain: 2%).
   if (name == "terrain") return {size - size / 50, size + size / 50};
@@ -203,7 +208,7 @@ TEST(BuiltinSpec, ValueParsers) {
 
 TEST(BuiltinSpec, ListingNamesEveryScene) {
   const std::vector<std::string> expected = {"teapot", "teapot-stadium", "grass", "terrain", "soup", "walls",
-                                             "walls-rotated", "forest", "same-centroid", "same-bounds",
+                                             "walls-rotated", "forest", "island", "dynamic", "same-centroid", "same-bounds",
                                              "duplicates", "flat-wall"};
   EXPECT_EQ(all_names(), expected);
   for (const BuiltinSceneInfo& info : builtin_scenes()) {
@@ -311,6 +316,8 @@ TEST_P(EveryScene, GoldenHash) {
       {"walls", 0x71bc978aa0e5e6b5ull},
       {"walls-rotated", 0x5999be285abc8ecdull},
       {"forest", 0xf72b94ca7905172dull},
+      {"island", 0xfadeb096a51b8fdfull},
+      {"dynamic", 0x30df047b654b8c71ull},
       {"same-centroid", 0xea4d7d6f960d8d37ull},
       {"same-bounds", 0x8b2a829be763e3c3ull},
       {"duplicates", 0x16d3fef73e72cf05ull},
@@ -632,6 +639,56 @@ TEST(Degenerate, FlatWallHasZeroDepth) {
   EXPECT_GT(b.extent().x, 0.99f);
   EXPECT_GT(b.extent().y, 0.99f);
   EXPECT_TRUE((Aabb{glm::vec3(0.0f), glm::vec3(1.0f, 1.0f, 0.0f)}.contains(b)));
+}
+
+// ---------------------------------------------------------------------------
+// Island and dynamic
+// ---------------------------------------------------------------------------
+
+TEST(Island, EightSpeciesInstancedCopiesTimes) {
+  const Scene s = make_builtin("island?size=20000&copies=3&seed=2");
+  ASSERT_EQ(s.meshes.size(), 9u);  // ground + 8 species
+  std::vector<int> refs(s.meshes.size(), 0);
+  for (const Instance& inst : s.instances) ++refs[inst.mesh];
+  EXPECT_EQ(refs[0], 1);
+  for (std::size_t m = 1; m < refs.size(); ++m) EXPECT_EQ(refs[m], 3) << m;
+  EXPECT_TRUE(s.has_instancing());
+  std::int64_t unique = 0;
+  for (const Mesh& m : s.meshes) unique += static_cast<std::int64_t>(m.indices.size());
+  EXPECT_NEAR(static_cast<double>(unique), 20000.0, 2000.0);
+}
+
+TEST(Island, LeftUnflattenedAboveTheLimitWithAWarning) {
+  // 9 * 0.9 * 1e5 ... = about 0.9 * 100000 * 600 = 54M instanced triangles: over the 50M limit.
+  const Scene s = make_builtin("island?size=100000&copies=600");
+  EXPECT_TRUE(s.triangles.empty());
+  ASSERT_EQ(s.report.warnings.size(), 1u);
+  EXPECT_NE(s.report.warnings[0].find("not flattened"), std::string::npos);
+  EXPECT_NE(s.report.warnings[0].find("tlas"), std::string::npos);
+  EXPECT_FALSE(s.bounds().is_empty());
+  expect_spec_error("island?size=10000001", "island", {"too large", "10000000", "unique"});
+  expect_spec_error("island?copies=0", "island", {"copies"});
+}
+
+TEST(Dynamic, AnimatedBoxesAndWavingGrass) {
+  const Scene s = make_builtin("dynamic?size=12000&seed=3");
+  ASSERT_EQ(s.animations.size(), 1u);
+  ASSERT_EQ(s.deformers.size(), 1u);
+  EXPECT_EQ(s.meshes[s.deformers[0].mesh].name, "grass");
+  int boxes = 0;
+  for (const Instance& inst : s.instances) boxes += s.meshes[inst.mesh].name == "box";
+  EXPECT_EQ(boxes, 9000 / 12);
+  int kinds[3] = {0, 0, 0};
+  for (const AnimationChannel& c : s.animations[0].channels) {
+    ASSERT_GE(c.node, 0);
+    ASSERT_LT(static_cast<std::size_t>(c.node), s.nodes.size());
+    ++kinds[static_cast<int>(c.interpolation)];
+    const std::size_t per_key = c.interpolation == AnimationChannel::Interpolation::cubic_spline ? 3 : 1;
+    EXPECT_EQ(c.values.size(), per_key * c.times.size());
+  }
+  EXPECT_GT(kinds[0], 0);
+  EXPECT_GT(kinds[1], 0);
+  EXPECT_GT(kinds[2], 0);
 }
 
 // ---------------------------------------------------------------------------

@@ -351,6 +351,21 @@ TlasUpdateStats Tlas::refit_blas(std::size_t b, std::span<const Triangle> tris) 
   return s;
 }
 
+TlasUpdateStats Tlas::replace_blas(std::size_t b, Bvh fresh) {
+  if (b >= blas_.size()) throw std::invalid_argument("tlas: no BLAS " + std::to_string(b));
+  if (fresh.leaf_triangles().size() != blas_[b]->leaf_triangles().size())
+    throw std::invalid_argument("tlas: replacement BLAS " + std::to_string(b) + " has " +
+                                std::to_string(fresh.leaf_triangles().size()) + " triangles, built with " +
+                                std::to_string(blas_[b]->leaf_triangles().size()));
+  *blas_[b] = std::move(fresh);
+  for (TlasInstance& inst : instances_)
+    if (inst.blas == b) update_world_bounds(inst);
+  TlasUpdateStats s;
+  s.tlas_rebuild_ms = build_top();
+  update_memory_stats();
+  return s;
+}
+
 TlasUpdateStats Tlas::rebuild_blas(std::size_t b, std::span<const Triangle> tris) {
   if (b >= blas_.size()) throw std::invalid_argument("tlas: no BLAS " + std::to_string(b));
   if (tris.size() != blas_[b]->leaf_triangles().size())

@@ -105,7 +105,10 @@ class Tlas final : public Accelerator {
   /// (same count and order as built), then rebuilds the TLAS (instance boxes
   /// change). Returns the timings; the BLAS's build_stats().sah_cost is the refit SAH.
   TlasUpdateStats refit_blas(std::size_t blas, std::span<const Triangle> object_triangles);
-  /// Same, but builds BLAS `blas` afresh.
+  /// Replaces BLAS `blas` by FRESH (built elsewhere over the same triangle
+  /// count and order), then rebuilds the TLAS.
+  TlasUpdateStats replace_blas(std::size_t blas, Bvh fresh);
+  /// Same as refit_blas, but builds BLAS `blas` afresh.
   TlasUpdateStats rebuild_blas(std::size_t blas, std::span<const Triangle> object_triangles);
 
  private:

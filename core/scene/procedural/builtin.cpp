@@ -52,6 +52,16 @@ const std::vector<Entry>& registry() {
        {{"angle", 45.0, -360.0, 360.0, "rotation of the plan about +y, degrees"}}, procedural::make_walls},
       {"forest", "one tree mesh instanced many times on a ground square",
        "instanced triangles; 96 per tree (plus 2 for the ground)", true, {}, procedural::make_forest},
+      {"island",
+       "a Moana-like island: a height field and 8 plant species, each instanced `copies` times (left "
+       "unflattened above 50M instanced triangles: tlas only)",
+       "UNIQUE triangles, <= 10000000; about 0.1 size + 0.9 size copies instanced", true,
+       {{"copies", 4.0, 1.0, 100000.0, "instances of each of the 8 plant species"}}, procedural::make_island},
+      {"dynamic",
+       "thousands of animated boxes (glTF-style TRS channels: linear, step, cubic spline) over a lawn of "
+       "waving grass (a deforming mesh)",
+       "triangles; 12 per box for 3/4 of size, the lawn (3 per blade + 2) the rest", true, {},
+       procedural::make_dynamic},
       {"same-centroid", "degenerate: N varied triangles sharing one centroid exactly", "triangles, exactly", true,
        {}, procedural::make_same_centroid},
       {"same-bounds", "degenerate: N distinct triangles with identical bounding boxes", "triangles, exactly",

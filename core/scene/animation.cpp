@@ -1,0 +1,223 @@
+// Animation sampling and the per-frame update of a two-level structure (see animation.h).
+#include "core/scene/animation.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace accelviz {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+glm::quat to_quat(const glm::vec4& v) {
+  return glm::quat(v.w, v.x, v.y, v.z);
+}
+glm::vec4 from_quat(const glm::quat& q) {
+  return glm::vec4(q.x, q.y, q.z, q.w);
+}
+
+glm::mat4 compose(const glm::vec3& t, const glm::quat& r, const glm::vec3& s) {
+  glm::mat4 m = glm::mat4_cast(r);
+  m[0] *= s.x;
+  m[1] *= s.y;
+  m[2] *= s.z;
+  m[3] = glm::vec4(t, 1.0f);
+  return m;
+}
+
+}  // namespace
+
+glm::vec4 sample_channel(const AnimationChannel& c, float t) {
+  using I = AnimationChannel::Interpolation;
+  const std::size_t keys = c.times.size();
+  const std::size_t per_key = c.interpolation == I::cubic_spline ? 3 : 1;
+  if (keys == 0) throw std::invalid_argument("animation channel without keys");
+  if (c.values.size() != keys * per_key)
+    throw std::invalid_argument("animation channel: " + std::to_string(c.values.size()) + " values for " +
+                                std::to_string(keys) + " keys (expected " + std::to_string(keys * per_key) + ")");
+  const bool rotation = c.path == AnimationChannel::Path::rotation;
+  const auto value = [&](std::size_t k) { return c.values[k * per_key + (per_key == 3 ? 1 : 0)]; };
+  if (keys == 1 || t <= c.times.front()) return value(0);
+  if (t >= c.times.back()) return value(keys - 1);
+  // Key interval [k, k+1] holding t.
+  const std::size_t k =
+      static_cast<std::size_t>(std::upper_bound(c.times.begin(), c.times.end(), t) - c.times.begin()) - 1;
+  const float t0 = c.times[k], t1 = c.times[k + 1];
+  const float td = t1 - t0;
+  const float s = td > 0.0f ? (t - t0) / td : 0.0f;
+  switch (c.interpolation) {
+    case I::step:
+      return value(k);
+    case I::linear:
+      if (rotation) return from_quat(glm::slerp(to_quat(value(k)), to_quat(value(k + 1)), s));
+      return value(k) + s * (value(k + 1) - value(k));
+    case I::cubic_spline: {
+      // glTF 2.0 Appendix C: Hermite with tangents scaled by the key interval.
+      const glm::vec4 p0 = value(k), p1 = value(k + 1);
+      const glm::vec4 b0 = c.values[k * 3 + 2];    // out-tangent of k
+      const glm::vec4 a1 = c.values[(k + 1) * 3];  // in-tangent of k+1
+      const float s2 = s * s, s3 = s2 * s;
+      glm::vec4 v =
+          (2 * s3 - 3 * s2 + 1) * p0 + td * (s3 - 2 * s2 + s) * b0 + (-2 * s3 + 3 * s2) * p1 + td * (s3 - s2) * a1;
+      if (rotation) {
+        const float len = glm::length(v);
+        if (len > 0.0f) v /= len;
+      }
+      return v;
+    }
+  }
+  return value(k);
+}
+
+float animation_duration(const Scene& scene) {
+  float d = 0.0f;
+  for (const Animation& a : scene.animations)
+    for (const AnimationChannel& c : a.channels)
+      if (!c.times.empty()) d = std::max(d, c.times.back());
+  return d;
+}
+
+bool scene_animates(const Scene& scene) {
+  if (!scene.deformers.empty()) return true;
+  for (const Animation& a : scene.animations)
+    for (const AnimationChannel& c : a.channels)
+      if (c.node >= 0 && c.path != AnimationChannel::Path::weights && !c.times.empty()) return true;
+  return false;
+}
+
+void apply_animation(const Animation& anim, float t, std::vector<Node>& nodes, std::vector<bool>& changed) {
+  changed.resize(nodes.size(), false);
+  for (const AnimationChannel& c : anim.channels) {
+    if (c.node < 0 || static_cast<std::size_t>(c.node) >= nodes.size()) continue;
+    if (c.path == AnimationChannel::Path::weights) continue;
+    Node& n = nodes[c.node];
+    const glm::vec4 v = sample_channel(c, t);
+    switch (c.path) {
+      case AnimationChannel::Path::translation:
+        n.translation = glm::vec3(v);
+        break;
+      case AnimationChannel::Path::rotation:
+        n.rotation = glm::normalize(to_quat(v));
+        break;
+      case AnimationChannel::Path::scale:
+        n.scale = glm::vec3(v);
+        break;
+      case AnimationChannel::Path::weights:
+        break;
+    }
+    n.local = compose(n.translation, n.rotation, n.scale);
+    n.has_matrix = false;
+    changed[c.node] = true;
+  }
+}
+
+std::vector<glm::mat4> node_world_transforms(std::span<const Node> nodes) {
+  std::vector<glm::mat4> world(nodes.size());
+  std::vector<char> done(nodes.size(), 0);
+  // Iterative: walk up to the first computed ancestor, then down.
+  std::vector<std::size_t> chain;
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    chain.clear();
+    std::size_t j = i;
+    while (!done[j]) {
+      chain.push_back(j);
+      const int p = nodes[j].parent;
+      if (p < 0 || static_cast<std::size_t>(p) >= nodes.size() || chain.size() > nodes.size()) break;
+      j = static_cast<std::size_t>(p);
+    }
+    for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+      const int p = nodes[*it].parent;
+      const bool has_parent = p >= 0 && static_cast<std::size_t>(p) < nodes.size() && done[p];
+      world[*it] = has_parent ? world[p] * nodes[*it].local : nodes[*it].local;
+      done[*it] = 1;
+    }
+  }
+  return world;
+}
+
+std::vector<Triangle> deformed_triangles(const Mesh& mesh, const MeshDeformer& d, float t) {
+  const auto finite3 = [](const glm::vec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+  };
+  const float w0 = 2.0f * 3.14159265358979f * d.frequency * t;
+  std::vector<glm::vec3> moved(mesh.positions.size());
+  for (std::size_t i = 0; i < moved.size(); ++i) {
+    const glm::vec3& p = mesh.positions[i];
+    const float h = d.height > 0.0f ? std::max(0.0f, p.y) / d.height : 0.0f;
+    const float sway = d.amplitude * h * h;
+    const float w = w0 + 0.7f * p.x + 0.5f * p.z;
+    moved[i] = p + glm::vec3(sway * std::sin(w), 0.0f, 0.5f * sway * std::cos(w));
+  }
+  std::vector<Triangle> out;
+  out.reserve(mesh.indices.size());
+  for (const glm::uvec3& idx : mesh.indices) {
+    const glm::vec3 &a = mesh.positions[idx.x], &b = mesh.positions[idx.y], &c = mesh.positions[idx.z];
+    if (!finite3(a) || !finite3(b) || !finite3(c)) continue;  // as the BLAS was built
+    out.push_back({moved[idx.x], moved[idx.y], moved[idx.z]});
+  }
+  return out;
+}
+
+SceneAnimator::SceneAnimator(const Scene& scene, Tlas& tlas, const AnimatorOptions& opts)
+    : scene_(scene), tlas_(tlas), opts_(opts), nodes_(scene.nodes), duration_(animation_duration(scene)) {
+  if (tlas.instances().size() != scene.instances.size())
+    throw std::invalid_argument("animator: the two-level structure has " + std::to_string(tlas.instances().size()) +
+                                " instances, the scene " + std::to_string(scene.instances.size()));
+  transforms_.reserve(scene.instances.size());
+  for (const Instance& inst : scene.instances) transforms_.push_back(inst.transform);
+}
+
+FrameStats SceneAnimator::step(float t) {
+  FrameStats fs;
+  fs.frame = frame_++;
+  if (duration_ > 0.0f) t = std::fmod(std::max(t, 0.0f), duration_);
+  fs.time = t;
+  // Rigid motion: only if a channel drives a node.
+  std::vector<bool> changed;
+  for (const Animation& a : scene_.animations) apply_animation(a, t, nodes_, changed);
+  if (std::find(changed.begin(), changed.end(), true) != changed.end()) {
+    const std::vector<glm::mat4> world = node_world_transforms(nodes_);
+    for (std::size_t i = 0; i < transforms_.size(); ++i) {
+      const std::uint32_t n = scene_.instances[i].node;
+      if (n >= world.size() || world[n] == transforms_[i]) continue;
+      transforms_[i] = world[n];
+      ++fs.moved_instances;
+    }
+    if (fs.moved_instances > 0) {
+      fs.tlas_rebuild_ms += tlas_.update_transforms(transforms_).tlas_rebuild_ms;
+      fs.tlas_rebuilt = true;
+    }
+  }
+  // Deforming meshes: refit, or rebuild past the ratio.
+  for (const MeshDeformer& d : scene_.deformers) {
+    const int b = d.mesh < scene_.meshes.size() ? tlas_.blas_of_mesh(d.mesh) : -1;
+    if (b < 0) continue;
+    const std::vector<Triangle> tris = deformed_triangles(scene_.meshes[d.mesh], d, t);
+    const auto t0 = Clock::now();
+    Bvh fresh(tris, tlas_.blas(b).options());
+    fs.rebuild_ms += ms_since(t0);
+    const TlasUpdateStats us = tlas_.refit_blas(static_cast<std::size_t>(b), tris);
+    ++fs.refits;
+    fs.refit_ms += us.blas_refit_ms;
+    fs.tlas_rebuild_ms += us.tlas_rebuild_ms;
+    fs.tlas_rebuilt = true;
+    const double sah_refit = tlas_.blas(b).build_stats().sah_cost;
+    const double sah_fresh = fresh.build_stats().sah_cost;
+    fs.sah_refit += sah_refit;
+    fs.sah_rebuilt += sah_fresh;
+    if (opts_.rebuild_ratio > 0.0 && sah_refit > opts_.rebuild_ratio * sah_fresh) {
+      fs.tlas_rebuild_ms += tlas_.replace_blas(static_cast<std::size_t>(b), std::move(fresh)).tlas_rebuild_ms;
+      ++fs.rebuilds;
+    }
+  }
+  return fs;
+}
+
+}  // namespace accelviz

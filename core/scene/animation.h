@@ -1,0 +1,89 @@
+#pragma once
+// Playing a scene's motion: sampling glTF TRS channels at a time t (linear,
+// with quaternion slerp for rotations; step; cubic spline with in/out
+// tangents, glTF 2.0 Appendix C), node world transforms, procedural mesh
+// deformation (MeshDeformer), and the per-frame update of a two-level
+// structure: rigid motion touches only instance transforms and the TLAS;
+// a deforming mesh refits its BLAS, or rebuilds it when the refitted tree's
+// SAH exceeds a fresh build's by more than a set ratio (the rule of
+// core/analysis/refit_decay.h, applied per BLAS).
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <span>
+#include <vector>
+
+#include "core/accel/tlas/tlas.h"
+#include "core/scene/scene.h"
+
+namespace accelviz {
+
+/// Value of CHANNEL at time T (clamped to its first and last key). Vec3
+/// paths return xyz (w = 0); rotation returns the unit quaternion as (x, y,
+/// z, w), glTF's order. Throws std::invalid_argument for a channel without
+/// keys or with a value count that does not match its interpolation.
+glm::vec4 sample_channel(const AnimationChannel& channel, float t);
+
+/// Last key time over all channels of all animations (0: nothing animates).
+float animation_duration(const Scene& scene);
+
+/// True when the scene has animation channels or mesh deformers.
+bool scene_animates(const Scene& scene);
+
+/// Sets the TRS of every node a channel of ANIM drives to its value at T and
+/// recomputes those nodes' local matrices (T * R * S). Marks them in
+/// `changed` (resized to nodes.size()). Weight channels are ignored.
+void apply_animation(const Animation& anim, float t, std::vector<Node>& nodes, std::vector<bool>& changed);
+
+/// World (object-to-world) matrix of every node: parent chain of locals.
+std::vector<glm::mat4> node_world_transforms(std::span<const Node> nodes);
+
+/// Object-space triangles of MESH deformed by D at time T, in index order.
+std::vector<Triangle> deformed_triangles(const Mesh& mesh, const MeshDeformer& d, float t);
+
+struct AnimatorOptions {
+  /// Rebuild a deforming BLAS when refit SAH / fresh SAH exceeds this (> 1);
+  /// 0: always refit (the fresh build is still made to report its SAH).
+  double rebuild_ratio = 1.3;
+};
+
+/// What one frame did and cost.
+struct FrameStats {
+  std::uint32_t frame = 0;
+  float time = 0.0f;
+  std::uint32_t moved_instances = 0;  ///< instances whose transform changed this frame
+  std::uint32_t refits = 0;           ///< BLAS refits
+  std::uint32_t rebuilds = 0;         ///< BLAS rebuilds (the ratio rule fired)
+  bool tlas_rebuilt = false;          ///< false when nothing moved
+  double tlas_rebuild_ms = 0.0;
+  double refit_ms = 0.0;
+  double rebuild_ms = 0.0;   ///< fresh BLAS builds (made every frame a mesh deforms, to compare SAH)
+  double sah_refit = 0.0;    ///< refitted deforming BLAS (sum over deforming meshes)
+  double sah_rebuilt = 0.0;  ///< fresh build on the same vertices (sum)
+};
+
+/// Drives a Tlas built from SCENE through time. Only what moves is touched:
+/// a static scene costs nothing per frame (no TLAS rebuild, no refit).
+class SceneAnimator {
+ public:
+  /// SCENE and TLAS must outlive the animator; TLAS must have been built from SCENE.
+  SceneAnimator(const Scene& scene, Tlas& tlas, const AnimatorOptions& opts = {});
+
+  /// Moves everything to time T (seconds, wrapped into the animation's
+  /// duration) and updates the structure.
+  FrameStats step(float t);
+
+  /// Instance transforms as of the last step.
+  std::span<const glm::mat4> instance_transforms() const { return transforms_; }
+
+ private:
+  const Scene& scene_;
+  Tlas& tlas_;
+  AnimatorOptions opts_;
+  std::vector<Node> nodes_;
+  std::vector<glm::mat4> transforms_;
+  std::uint32_t frame_ = 0;
+  float duration_ = 0.0f;
+};
+
+}  // namespace accelviz

@@ -1,0 +1,138 @@
+// Effects by scene (see effects.h).
+#include "core/scene/effects.h"
+
+#include <cstdio>
+#include <string>
+
+#include "core/query/camera.h"
+
+namespace accelviz {
+
+namespace {
+
+std::string count(std::size_t n, const char* what) {
+  return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
+}
+
+void apply_force(Effect& e, bool force) {
+  if (!force || e.on) return;
+  if (!e.forceable) {
+    e.reason += " (asked for, but cannot be forced)";
+    return;
+  }
+  e.on = true;
+  e.forced = true;
+  e.reason = "forced on by the user; the scene alone would not: " + e.reason;
+}
+
+}  // namespace
+
+SceneEffects decide_effects(const Scene& scene, const EffectForces& forces) {
+  SceneEffects fx;
+  fx.shadow_rays.name = "shadow-rays";
+  fx.shadow_rays.on = !scene.lights.empty();
+  fx.shadow_rays.reason = scene.lights.empty()
+                              ? "no lights: nothing casts a shadow"
+                              : count(scene.lights.size(), "light") + ": one any-hit ray per light per hit";
+
+  fx.per_frame_updates.name = "per-frame-updates";
+  std::size_t channels = 0;
+  for (const Animation& a : scene.animations)
+    for (const AnimationChannel& c : a.channels)
+      if (c.node >= 0 && c.path != AnimationChannel::Path::weights && !c.times.empty()) ++channels;
+  fx.per_frame_updates.on = scene_animates(scene);
+  if (fx.per_frame_updates.on) {
+    std::string what;
+    if (channels > 0) what = count(channels, "animation channel") + " (rigid: instance transforms + TLAS)";
+    if (!scene.deformers.empty())
+      what += (what.empty() ? "" : ", ") + count(scene.deformers.size(), "deforming mesh") + " (BLAS refit or rebuild)";
+    fx.per_frame_updates.reason = what;
+  } else {
+    fx.per_frame_updates.reason = "nothing animates: the structure is built once";
+  }
+
+  fx.two_level.name = "two-level";
+  std::vector<std::size_t> refs(scene.meshes.size(), 0);
+  for (const Instance& inst : scene.instances)
+    if (inst.mesh < refs.size()) ++refs[inst.mesh];
+  std::size_t shared = 0;
+  for (std::size_t r : refs) shared += r > 1;
+  fx.two_level.on = scene.has_instancing() || (scene.triangles.empty() && !scene.instances.empty());
+  if (scene.triangles.empty() && !scene.instances.empty())
+    fx.two_level.reason = "instanced and too large to flatten: only the two-level structure holds it";
+  else if (fx.two_level.on)
+    fx.two_level.reason = count(shared, "mesh") + " instanced more than once (" +
+                          count(scene.instances.size(), "instance") + "): one BLAS per unique mesh";
+  else
+    fx.two_level.reason = "no mesh is instanced twice: a single flattened BVH";
+
+  fx.textures.name = "textures";
+  fx.textures.on = false;
+  fx.textures.forceable = false;
+  fx.textures.reason = "no view draws textures or materials: the loader skips image decoding";
+
+  apply_force(fx.shadow_rays, forces.shadow_rays);
+  apply_force(fx.per_frame_updates, forces.per_frame_updates);
+  apply_force(fx.two_level, forces.two_level);
+  apply_force(fx.textures, forces.textures);
+  return fx;
+}
+
+bool set_force(EffectForces& f, const std::string& name) {
+  if (name == "shadow-rays")
+    f.shadow_rays = true;
+  else if (name == "per-frame-updates")
+    f.per_frame_updates = true;
+  else if (name == "two-level")
+    f.two_level = true;
+  else if (name == "textures")
+    f.textures = true;
+  else
+    return false;
+  return true;
+}
+
+std::string effects_text(const SceneEffects& fx) {
+  std::string out;
+  for (const Effect& e : fx.list()) {
+    char line[64];
+    std::snprintf(line, sizeof line, "  %-18s %-3s %-7s ", e.name.c_str(), e.on ? "on" : "off",
+                  e.forced ? "forced" : "");
+    out += line + e.reason + "\n";
+  }
+  return out;
+}
+
+FrameCounters run_frame(const Scene& scene, const SceneEffects& fx, const Accelerator& accel, const Camera& camera,
+                        int width, int height, SceneAnimator* animator, float t) {
+  FrameCounters c;
+  if (fx.per_frame_updates.on && animator != nullptr) {
+    const FrameStats fs = animator->step(t);
+    c.refits = fs.refits;
+    c.rebuilds = fs.rebuilds;
+    c.tlas_rebuilds = fs.tlas_rebuilt ? 1 : 0;
+    c.moved_instances = fs.moved_instances;
+  }
+  const QueryOptions qo;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const Ray ray = primary_ray(camera, x, y, width, height);
+      ++c.primary_rays;
+      const Hit h = accel.closest_hit(ray, qo);
+      if (!h.valid() || !fx.shadow_rays.on) continue;
+      const glm::vec3 p = ray.at(h.t);
+      // Offset along the normal, toward the side the ray came from.
+      const glm::vec3 n = glm::dot(h.ng, ray.direction) < 0.0f ? h.ng : -h.ng;
+      const glm::vec3 o = p + n * (1e-4f * (1.0f + glm::length(p)));
+      for (const Light& l : scene.lights) {
+        const bool directional = l.kind == Light::Kind::directional;
+        const glm::vec3 d = directional ? -l.direction : l.position - o;
+        const Ray shadow(o, d, 0.0f, directional ? kInfinity : 1.0f);
+        ++c.shadow_rays;
+        (void)accel.any_hit(shadow, qo);
+      }
+    }
+  return c;
+}
+
+}  // namespace accelviz

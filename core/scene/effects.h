@@ -1,0 +1,73 @@
+#pragma once
+// Effects by scene: the app inspects the loaded scene and runs only what it
+// calls for, with a one-line reason for each decision:
+//  - shadow-rays: any-hit rays toward the lights, only when the scene has lights;
+//  - per-frame-updates: only when something animates (TRS channels or a
+//    deforming mesh), and then only what moved;
+//  - two-level: the TLAS/BLAS structure only when some mesh is instanced
+//    more than once (otherwise one flattened BVH does the same work);
+//  - textures: never decoded (no view draws them; the glTF loader skips
+//    images), and cannot be forced on.
+// The user can force any forceable effect on. `accelviz info` prints the
+// list; the GUI's Scene panel shows it. run_frame() is the frame loop that
+// honours the decisions and counts what it did, so tests can check them.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/accel/accel.h"
+#include "core/scene/animation.h"
+#include "core/scene/scene.h"
+
+namespace accelviz {
+
+struct Effect {
+  std::string name;  ///< "shadow-rays", "per-frame-updates", "two-level", "textures"
+  bool on = false;
+  bool forced = false;    ///< on because the user asked, not because the scene calls for it
+  bool forceable = true;  ///< false: asking for it changes nothing (see reason)
+  std::string reason;     ///< why on or off, one line
+};
+
+/// User overrides: force an effect on even when the scene does not call for it.
+struct EffectForces {
+  bool shadow_rays = false;
+  bool per_frame_updates = false;
+  bool two_level = false;
+  bool textures = false;  ///< not forceable: recorded in the reason
+};
+
+struct SceneEffects {
+  Effect shadow_rays, per_frame_updates, two_level, textures;
+
+  std::vector<Effect> list() const { return {shadow_rays, per_frame_updates, two_level, textures}; }
+  /// The structure the app should build: "tlas" when two-level is on, else FALLBACK.
+  std::string structure(const std::string& fallback = "bvh") const { return two_level.on ? "tlas" : fallback; }
+};
+
+SceneEffects decide_effects(const Scene& scene, const EffectForces& forces = {});
+
+/// Sets the force named NAME ("shadow-rays", ...); false for an unknown name.
+bool set_force(EffectForces& forces, const std::string& name);
+
+/// "name  on|off  [forced]  reason" lines, for `accelviz info`.
+std::string effects_text(const SceneEffects& effects);
+
+/// What one frame did.
+struct FrameCounters {
+  std::uint64_t primary_rays = 0;
+  std::uint64_t shadow_rays = 0;
+  std::uint64_t refits = 0;
+  std::uint64_t rebuilds = 0;
+  std::uint64_t tlas_rebuilds = 0;
+  std::uint64_t moved_instances = 0;
+};
+
+/// One frame at time T: the animator steps only when per-frame updates are
+/// on (ANIMATOR may be null), WIDTH x HEIGHT primary rays from CAMERA are
+/// traced on ACCEL, and for each primary hit one shadow ray per light when
+/// shadow rays are on.
+FrameCounters run_frame(const Scene& scene, const SceneEffects& effects, const Accelerator& accel, const Camera& camera,
+                        int width, int height, SceneAnimator* animator, float t);
+
+}  // namespace accelviz
