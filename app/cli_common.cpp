@@ -1,7 +1,6 @@
 #include "app/cli_common.h"
 
-#include "core/query/camera.h"
-#include "core/scene/load.h"
+#include <unistd.h>
 
 #include <algorithm>
 #include <charconv>
@@ -9,7 +8,8 @@
 #include <filesystem>
 #include <iostream>
 
-#include <unistd.h>
+#include "core/query/camera.h"
+#include "core/scene/load.h"
 
 namespace accelviz::cli {
 
@@ -42,8 +42,9 @@ CLI::Validator size_validator() {
 }
 
 void StructureCli::add_to(CLI::App* app) {
-  app->add_option("--splitter", splitter, "BVH split strategy: binned (binned SAH), exact (full SAH sweep), median")
-      ->check(CLI::IsMember({"binned", "exact", "median"}))
+  app->add_option("--splitter", splitter,
+                  "BVH split strategy: binned (binned SAH), exact (full SAH sweep), median, lbvh (Morton codes)")
+      ->check(CLI::IsMember({"binned", "exact", "median", "lbvh"}))
       ->capture_default_str()
       ->group("Structure");
   app->add_option("--buckets", buckets, "BVH binned-SAH bucket count")
@@ -77,6 +78,7 @@ StructureOptions StructureCli::to_options(unsigned threads, bool compute_epo) co
   o.threads = threads;
   o.bvh.splitter = splitter == "exact"    ? BvhSplitter::exact_sah
                    : splitter == "median" ? BvhSplitter::median
+                   : splitter == "lbvh"   ? BvhSplitter::lbvh
                                           : BvhSplitter::binned_sah;
   o.bvh.buckets = buckets;
   o.bvh.max_leaf_size = leaf;

@@ -9,17 +9,16 @@
 // on all threads, each the median of `repeat` timed passes without counters;
 // then one instrumented pass for the mean node visits and primitive tests
 // per ray, kept out of the timings.
-#include "app/cli_common.h"
-
-#include "core/query/batch.h"
-#include "core/query/camera.h"
-#include "core/query/ray_sets.h"
-#include "core/util/parallel.h"
-
 #include <cstdio>
 #include <iostream>
 #include <memory>
 #include <optional>
+
+#include "app/cli_common.h"
+#include "core/query/batch.h"
+#include "core/query/camera.h"
+#include "core/query/ray_sets.h"
+#include "core/util/parallel.h"
 
 namespace accelviz::cli {
 
@@ -46,7 +45,7 @@ struct RaySet {
 };
 
 struct QueryFigures {
-  double closest_1t = 0, closest_nt = 0, any_1t = 0, any_nt = 0;  ///< Mrays/s, medians
+  double closest_1t = 0, closest_nt = 0, any_1t = 0, any_nt = 0;   ///< Mrays/s, medians
   double closest_nodes = 0, closest_prims = 0, closest_boxes = 0;  ///< per ray, instrumented pass
   double any_nodes = 0, any_prims = 0, any_boxes = 0;
   double hit_fraction = 0, occluded_fraction = 0;
@@ -55,12 +54,14 @@ struct QueryFigures {
 struct StructureResult {
   std::string name;
   std::vector<double> build_ms;
-  BuildStats stats;  ///< of the last build
+  BuildStats stats;                            ///< of the last build
   std::optional<EmbreeBvhFigures> embree_bvh;  ///< bvh only: Embree's binary rtcBuildBVH on the same input
   std::vector<std::pair<std::string, QueryFigures>> queries;
 };
 
-double mrays(std::size_t n, double ms) { return ms > 0.0 ? static_cast<double>(n) / (ms * 1e3) : 0.0; }
+double mrays(std::size_t n, double ms) {
+  return ms > 0.0 ? static_cast<double>(n) / (ms * 1e3) : 0.0;
+}
 
 template <typename Trace>
 double timed_median(int repeat, std::size_t n, Trace&& trace) {
@@ -125,20 +126,49 @@ QueryFigures measure(const Accelerator& accel, const std::vector<Ray>& rays, con
 
 nlohmann::json query_json(const QueryFigures& f) {
   return {
-      {"closest_mrays_1t", f.closest_1t},       {"closest_mrays_nt", f.closest_nt},
-      {"any_mrays_1t", f.any_1t},               {"any_mrays_nt", f.any_nt},
-      {"closest_nodes_per_ray", f.closest_nodes}, {"closest_prims_per_ray", f.closest_prims},
-      {"closest_boxes_per_ray", f.closest_boxes}, {"any_nodes_per_ray", f.any_nodes},
-      {"any_prims_per_ray", f.any_prims},       {"any_boxes_per_ray", f.any_boxes},
-      {"hit_fraction", f.hit_fraction},         {"occluded_fraction", f.occluded_fraction},
+      {"closest_mrays_1t", f.closest_1t},
+      {"closest_mrays_nt", f.closest_nt},
+      {"any_mrays_1t", f.any_1t},
+      {"any_mrays_nt", f.any_nt},
+      {"closest_nodes_per_ray", f.closest_nodes},
+      {"closest_prims_per_ray", f.closest_prims},
+      {"closest_boxes_per_ray", f.closest_boxes},
+      {"any_nodes_per_ray", f.any_nodes},
+      {"any_prims_per_ray", f.any_prims},
+      {"any_boxes_per_ray", f.any_boxes},
+      {"hit_fraction", f.hit_fraction},
+      {"occluded_fraction", f.occluded_fraction},
   };
 }
 
-double ratio(double ours, double theirs) { return theirs > 0.0 ? ours / theirs : 0.0; }
+double ratio(double ours, double theirs) {
+  return theirs > 0.0 ? ours / theirs : 0.0;
+}
+
+/// Bench-only rows: Embree at a fixed build quality, beside the plain
+/// "embree" row (which follows --embree-quality, medium by default).
+constexpr const char* kEmbreeQualityRows[] = {"embree-low", "embree-medium", "embree-high"};
+
+std::vector<std::string> bench_structure_names() {
+  std::vector<std::string> names = structure_names();
+  if (kHaveEmbree)
+    for (const char* n : kEmbreeQualityRows) names.emplace_back(n);
+  return names;
+}
+
+std::unique_ptr<Accelerator> build_bench_structure(const std::string& name, std::span<const Triangle> tris,
+                                                   const StructureOptions& so, const ProgressCallback& cb) {
+  if (name.starts_with("embree-")) {
+    StructureOptions o = so;
+    o.embree.quality = parse_embree_quality(std::string_view(name).substr(7)).value_or(EmbreeQuality::medium);
+    return build_accelerator("embree", tris, o, cb);
+  }
+  return build_accelerator(name, tris, so, cb);
+}
 
 int run_bench(BenchOptions o, const GlobalOptions& global) {
-  if (o.structures.empty()) o.structures = kHaveEmbree ? std::vector<std::string>{"bvh", "embree"}
-                                                       : std::vector<std::string>{"bvh"};
+  if (o.structures.empty())
+    o.structures = kHaveEmbree ? std::vector<std::string>{"bvh", "embree"} : std::vector<std::string>{"bvh"};
   if (o.repeat < 1) throw UsageError("--repeat must be at least 1");
   const ImageSize size = parse_size(o.size);
   const unsigned all = resolve_threads(o.threads);
@@ -152,8 +182,7 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   const StructureOptions so = o.structure_opts.to_options(o.threads, /*compute_epo=*/!o.no_epo);
 
   // ---- ray sets, from the first structure's primary hits ----
-  const Camera camera =
-      camera_for(o.camera, scene, size);
+  const Camera camera = camera_for(o.camera, scene, size);
   std::vector<RaySet> sets;
   sets.push_back({"primary", primary_rays(camera, size.width, size.height)});
   bool synthetic_light = false;
@@ -164,7 +193,7 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
     progress.begin("primary hits for the secondary rays (" + o.structures.front() + ")");
     StructureOptions quick = so;
     quick.bvh.compute_epo = false;
-    const std::unique_ptr<Accelerator> ref = build_accelerator(o.structures.front(), scene.triangles, quick);
+    const std::unique_ptr<Accelerator> ref = build_bench_structure(o.structures.front(), scene.triangles, quick, {});
     std::vector<Hit> hits(sets[0].rays.size());
     trace_closest(*ref, sets[0].rays, hits, q, all);
     progress.end();
@@ -182,8 +211,9 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   }
   if (o.rays != "all" && o.rays != "primary") sets.erase(sets.begin());
   if (synthetic_light && !global.quiet)
-    std::fprintf(stderr, "accelviz: %s has no lights: shadow rays aim at a synthetic point light at (%g, %g, %g) "
-                         "(benchmark only)\n",
+    std::fprintf(stderr,
+                 "accelviz: %s has no lights: shadow rays aim at a synthetic point light at (%g, %g, %g) "
+                 "(benchmark only)\n",
                  o.scene.c_str(), synthetic_position->x, synthetic_position->y, synthetic_position->z);
 
   // ---- per structure ----
@@ -195,7 +225,7 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
     for (int k = 0; k < o.repeat; ++k) {
       progress.begin("building " + name + " (" + std::to_string(k + 1) + "/" + std::to_string(o.repeat) + ")");
       accel.reset();  // never two copies in memory
-      accel = build_accelerator(name, scene.triangles, so, progress.callback());
+      accel = build_bench_structure(name, scene.triangles, so, progress.callback());
       r.build_ms.push_back(accel->build_stats().build_ms);
       progress.end(std::to_string(static_cast<long long>(r.build_ms.back())) + " ms");
     }
@@ -239,21 +269,24 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
     nlohmann::json s;
     s["name"] = r.name;
     s["build"] = {
-        {"build_ms", median(r.build_ms)},     {"build_ms_runs", r.build_ms},
-        {"nodes", r.stats.node_count},        {"leaves", r.stats.leaf_count},
-        {"max_depth", r.stats.max_depth},     {"avg_leaf_depth", r.stats.avg_leaf_depth},
+        {"build_ms", median(r.build_ms)},       {"build_ms_runs", r.build_ms},
+        {"nodes", r.stats.node_count},          {"leaves", r.stats.leaf_count},
+        {"max_depth", r.stats.max_depth},       {"avg_leaf_depth", r.stats.avg_leaf_depth},
         {"memory_bytes", r.stats.memory_bytes}, {"sah_cost", r.stats.sah_cost},
     };
     for (const auto& [k, v] : r.stats.extra) s["build"][k] = v;
     if (r.embree_bvh) {
       s["embree_binary_bvh"] = {
-          {"sah_cost", r.embree_bvh->sah_cost},     {"build_ms", r.embree_bvh->build_ms},
-          {"nodes", r.embree_bvh->node_count},      {"leaves", r.embree_bvh->leaf_count},
-          {"max_depth", r.embree_bvh->max_depth},   {"sah_ratio_ours_over_embree", ratio(r.stats.sah_cost, r.embree_bvh->sah_cost)},
+          {"sah_cost", r.embree_bvh->sah_cost},
+          {"build_ms", r.embree_bvh->build_ms},
+          {"nodes", r.embree_bvh->node_count},
+          {"leaves", r.embree_bvh->leaf_count},
+          {"max_depth", r.embree_bvh->max_depth},
+          {"sah_ratio_ours_over_embree", ratio(r.stats.sah_cost, r.embree_bvh->sah_cost)},
       };
     }
     // Embree keeps no per-ray counters: its *_per_ray figures are 0 and marked so.
-    s["per_ray_counters"] = r.name != "embree";
+    s["per_ray_counters"] = !r.name.starts_with("embree");
     s["rays"] = nlohmann::json::object();
     for (const auto& [set, f] : r.queries) s["rays"][set] = query_json(f);
     j["structures"].push_back(s);
@@ -289,7 +322,7 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
                 set.name == "shadow" && synthetic_light ? " (to a synthetic light: the scene has none)" : "");
   for (const StructureResult& r : results) {
     std::printf("\n%s\n", r.name.c_str());
-    const bool has_counters = r.name != "embree";  // Embree exposes neither its tree nor per-ray counters
+    const bool has_counters = !r.name.starts_with("embree");  // Embree exposes neither its tree nor per-ray counters
     std::printf("  build %.1f ms", median(r.build_ms));
     if (r.stats.node_count > 0)
       std::printf(", nodes %llu, leaves %llu, depth %u", static_cast<unsigned long long>(r.stats.node_count),
@@ -318,7 +351,8 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
     std::printf("\nratios ours/embree (build and memory: lower is better; Mrays/s: higher is better)\n");
     for (const StructureResult& r : results) {
       if (&r == embree) continue;
-      std::printf("  %s: build %.2f, memory %.2f\n", r.name.c_str(), ratio(median(r.build_ms), median(embree->build_ms)),
+      std::printf("  %s: build %.2f, memory %.2f\n", r.name.c_str(),
+                  ratio(median(r.build_ms), median(embree->build_ms)),
                   ratio(static_cast<double>(r.stats.memory_bytes), static_cast<double>(embree->stats.memory_bytes)));
       for (std::size_t k = 0; k < r.queries.size(); ++k) {
         const QueryFigures& a = r.queries[k].second;
@@ -337,13 +371,17 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
 Command add_bench_command(CLI::App& parent, const GlobalOptions& global) {
   auto o = std::make_shared<BenchOptions>();
   CLI::App* sub = parent.add_subcommand(
-      "bench", "Benchmark structures: build figures and closest/any-hit Mrays/s on primary, diffuse and shadow rays "
-               "(medians of repeated runs), with ratios to Embree when it is among the structures");
+      "bench",
+      "Benchmark structures: build figures and closest/any-hit Mrays/s on primary, diffuse and shadow rays "
+      "(medians of repeated runs), with ratios to Embree when it is among the structures");
   sub->add_option("SCENE", o->scene, "Scene file (.gltf, .glb, .obj) or builtin:NAME[?key=value&...]")->required();
   sub->add_option("--structure,-s", o->structures,
-                  std::string("Comma-separated structures (default: bvh") + (kHaveEmbree ? ",embree" : "") + ")")
+                  std::string("Comma-separated structures (default: bvh") + (kHaveEmbree ? ",embree" : "") + ")" +
+                      (kHaveEmbree ? "; embree-low, embree-medium, embree-high: Embree at that build quality "
+                                     "(ratios are quoted against the plain embree row)"
+                                   : ""))
       ->delimiter(',')
-      ->check(CLI::IsMember(structure_names()));
+      ->check(CLI::IsMember(bench_structure_names()));
   sub->add_option("--rays", o->rays, "Ray sets: primary, diffuse, shadow or all")
       ->check(CLI::IsMember({"primary", "diffuse", "shadow", "all"}))
       ->capture_default_str();
@@ -353,7 +391,8 @@ Command add_bench_command(CLI::App& parent, const GlobalOptions& global) {
   sub->add_option("--repeat,-n", o->repeat, "Runs per figure; the median is reported")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
-  sub->add_option("--threads,-j", o->threads, "Threads of the all-threads figures and of builds (0: all hardware threads)")
+  sub->add_option("--threads,-j", o->threads,
+                  "Threads of the all-threads figures and of builds (0: all hardware threads)")
       ->capture_default_str();
   sub->add_flag("--json", o->json, "Print one JSON document instead of text");
   sub->add_option("--camera", o->camera,

@@ -131,7 +131,8 @@ void apply_sweep_setting(std::string_view structure, const SweepSetting& setting
         if (v == "median") o.bvh.splitter = BvhSplitter::median;
         else if (v == "binned") o.bvh.splitter = BvhSplitter::binned_sah;
         else if (v == "exact") o.bvh.splitter = BvhSplitter::exact_sah;
-        else bad_value(name, v, "expected median, binned or exact");
+        else if (v == "lbvh") o.bvh.splitter = BvhSplitter::lbvh;
+        else bad_value(name, v, "expected median, binned, exact or lbvh");
       } else if (name == "leaf") {
         o.bvh.max_leaf_size = parse_int(name, v, 1, 255);
         o.bvh.leaf_size_cap = std::max(o.bvh.leaf_size_cap, o.bvh.max_leaf_size);

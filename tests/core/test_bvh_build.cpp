@@ -110,6 +110,8 @@ std::vector<BvhOptions> option_sets() {
     BvhOptions m = e;
     m.splitter = BvhSplitter::median;
     v.push_back(m);
+    m.splitter = BvhSplitter::lbvh;
+    v.push_back(m);
   }
   for (BvhOptions& o : v) o.compute_epo = false;
   return v;
@@ -159,12 +161,17 @@ TEST(BvhBuild, StatsMatchTheNodeArray) {
   EXPECT_EQ(st.max_depth, max_depth);
   EXPECT_NEAR(st.avg_leaf_depth, depth_sum / static_cast<double>(leaves), 1e-9);
   // Nodes, indices, the leaf-order triangles, and the 4-wide copy (128-byte
-  // nodes plus the binary id each of its four slots copies).
+  // nodes plus the binary id each of its four slots copies; the leaves'
+  // triangles in 160-byte blocks of four, ceil(count / 4) per leaf, and a
+  // 4-byte first-block index per leaf position).
   const std::size_t wide = static_cast<std::size_t>(st.extra.at("wide_nodes"));
   EXPECT_GT(wide, 0u);
   EXPECT_LT(wide, bvh.nodes().size() / 2);
-  EXPECT_EQ(st.memory_bytes,
-            bvh.nodes().size() * 32 + tris.size() * 4 + tris.size() * sizeof(Triangle) + wide * (128 + 16));
+  std::size_t blocks = 0;
+  for (const BvhNode& n : bvh.nodes())
+    if (n.count > 0) blocks += (n.count + 3) / 4;
+  EXPECT_EQ(st.memory_bytes, bvh.nodes().size() * 32 + tris.size() * 4 + tris.size() * sizeof(Triangle) +
+                                 wide * (128 + 16) + blocks * 160 + tris.size() * 4);
   o.wide_traversal = false;
   const Bvh binary_only(tris, o);
   EXPECT_EQ(binary_only.build_stats().memory_bytes,
@@ -391,7 +398,7 @@ TEST(BvhBuild, NonFiniteCoordinatesDoNotBreakTheBuild) {
 TEST(BvhBuild, ThreadCountDoesNotChangeTheNodeArray) {
   // Large enough that several subtrees go to other threads.
   const auto tris = random_soup(60000, 21, 0.01f);
-  for (BvhSplitter s : {BvhSplitter::binned_sah, BvhSplitter::median, BvhSplitter::exact_sah}) {
+  for (BvhSplitter s : {BvhSplitter::binned_sah, BvhSplitter::median, BvhSplitter::exact_sah, BvhSplitter::lbvh}) {
     BvhOptions o;
     o.splitter = s;
     o.compute_epo = false;

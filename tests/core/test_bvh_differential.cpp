@@ -197,6 +197,8 @@ std::vector<BvhOptions> option_sets() {
     v.push_back(o);
     o.splitter = BvhSplitter::median;
     v.push_back(o);
+    o.splitter = BvhSplitter::lbvh;
+    v.push_back(o);
   }
   // The binary fast path too (the default walks the 4-wide copy).
   for (BvhSplitter s : {BvhSplitter::binned_sah, BvhSplitter::exact_sah, BvhSplitter::median}) {

@@ -136,8 +136,11 @@ const std::vector<Entry>& entries() {
                  }});
     // BVH (BvhOptions, core/accel/bvh/bvh.h).
     t.push_back(enum_option<BvhSplitter>(
-        "splitter", "binned|exact|median", "BVH split: binned SAH (Wald 2007), exact SAH sweep, median",
-        {{"binned", BvhSplitter::binned_sah}, {"exact", BvhSplitter::exact_sah}, {"median", BvhSplitter::median}},
+        "splitter", "binned|exact|median|lbvh", "BVH split: binned SAH (Wald 2007), exact SAH sweep, median, LBVH",
+        {{"binned", BvhSplitter::binned_sah},
+         {"exact", BvhSplitter::exact_sah},
+         {"median", BvhSplitter::median},
+         {"lbvh", BvhSplitter::lbvh}},
         [](AppConfig& c) -> BvhSplitter& { return c.structure.options.bvh.splitter; }));
     t.push_back(int_option("buckets", "2..256", "BVH binned SAH buckets", 2, 256,
                            [](AppConfig& c) -> int& { return c.structure.options.bvh.buckets; }));

@@ -177,7 +177,7 @@ bool structure_panel(StructureChoice& choice, const BuildProgress& progress, boo
   if (choice.name == "bvh") {
     BvhOptions& b = o.bvh;
     int splitter = static_cast<int>(b.splitter);
-    if (combo("Splitter", splitter, {"binned SAH", "exact SAH", "median"})) {
+    if (combo("Splitter", splitter, {"binned SAH", "exact SAH", "median", "LBVH (Morton)"})) {
       b.splitter = static_cast<BvhSplitter>(splitter);
       changed = true;
     }

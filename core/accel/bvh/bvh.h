@@ -31,9 +31,10 @@ enum class BvhSplitter {
   binned_sah,  ///< SAH evaluated at bucket boundaries on all three axes (Wald 2007)
   exact_sah,   ///< SAH evaluated between every pair of neighbours in sorted order on each axis (full sweep)
   median,      ///< equal counts on the axis of largest centroid extent (no SAH)
+  lbvh,        ///< Morton-code order cut at the highest differing bit (Karras 2012; no SAH, fastest build)
 };
 
-/// Short name of a splitter ("binned", "exact", "median").
+/// Short name of a splitter ("binned", "exact", "median", "lbvh").
 const char* to_string(BvhSplitter s);
 
 struct BvhOptions {

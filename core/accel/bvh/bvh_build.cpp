@@ -36,6 +36,7 @@ const char* to_string(BvhSplitter s) {
     case BvhSplitter::binned_sah: return "binned";
     case BvhSplitter::exact_sah: return "exact";
     case BvhSplitter::median: return "median";
+    case BvhSplitter::lbvh: return "lbvh";
   }
   return "?";
 }
@@ -43,7 +44,7 @@ const char* to_string(BvhSplitter s) {
 void validate(const BvhOptions& o) {
   const auto fail = [](const std::string& msg) { throw std::invalid_argument("BvhOptions: " + msg); };
   if (o.splitter != BvhSplitter::binned_sah && o.splitter != BvhSplitter::exact_sah &&
-      o.splitter != BvhSplitter::median)
+      o.splitter != BvhSplitter::median && o.splitter != BvhSplitter::lbvh)
     fail("unknown splitter");
   if (o.buckets < 2 || o.buckets > 256) fail("buckets must be in 2..256, got " + std::to_string(o.buckets));
   if (o.max_leaf_size < 1 || o.max_leaf_size > 255)
@@ -265,10 +266,15 @@ BvhTopology build_bvh(std::span<const Aabb> bounds, std::span<const glm::vec3> c
       root_centroids.extend(centroids[i]);
     }
     // 2.-3. Recursive build.
-    const SplitParams params{opts.buckets, opts.max_leaf_size, opts.leaf_size_cap, opts.cost_traversal,
-                             opts.cost_intersect};
+    SplitParams params{opts.buckets, opts.max_leaf_size, opts.leaf_size_cap, opts.cost_traversal,
+                       opts.cost_intersect};
+    if (opts.splitter == BvhSplitter::lbvh) {
+      params.morton = morton_frame(root_centroids);
+      lbvh_sort(prims, params.morton, resolve_threads(opts.threads));
+    }
     const SplitFn split = opts.splitter == BvhSplitter::binned_sah  ? split_binned_sah
                           : opts.splitter == BvhSplitter::exact_sah ? split_exact_sah
+                          : opts.splitter == BvhSplitter::lbvh      ? split_lbvh
                                                                     : split_median;
     Builder builder(params, split, prims, resolve_threads(opts.threads), progress);
     topo.nodes.reserve(2 * n / static_cast<std::size_t>(opts.max_leaf_size) + 1);

@@ -93,6 +93,15 @@ WideBvh collapse_to_wide(std::span<const BvhNode> binary) {
   return wide;
 }
 
+void build_tri4_blocks(WideBvh& wide, std::span<const BvhNode> binary, std::span<const Triangle> leaf_tris) {
+  wide.tri_blocks.clear();
+  wide.tri_blocks.reserve(leaf_tris.size() / 2 + 1);
+  wide.leaf_block.assign(leaf_tris.size(), 0);
+  for (const BvhNode& n : binary)
+    if (n.count > 0) wide.leaf_block[n.index] = append_tri4_blocks(leaf_tris, n.index, n.count, wide.tri_blocks);
+  wide.tri_blocks.shrink_to_fit();
+}
+
 void refit_wide(WideBvh& wide, std::span<const BvhNode> binary) {
   for (std::size_t w = 0; w < wide.nodes.size(); ++w)
     for (int s = 0; s < 4; ++s)

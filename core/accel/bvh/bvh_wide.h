@@ -14,11 +14,12 @@
 // and refitted: the statistics/trace path traverses it, and every wide slot
 // records the binary node it copies, so a refit updates both. Leaves are the
 // binary tree's leaves (the same primitive ranges).
-#include "core/accel/bvh/bvh.h"
-
 #include <cstdint>
 #include <span>
 #include <vector>
+
+#include "core/accel/bvh/bvh.h"
+#include "core/accel/bvh/bvh_tri4.h"
 
 namespace accelviz::bvh_detail {
 
@@ -37,7 +38,16 @@ inline constexpr std::uint32_t kWideEmpty = 0xFFFFFFFFu;
 struct WideBvh {
   std::vector<WideNode> nodes;        ///< root at 0; empty when the binary tree is
   std::vector<std::uint32_t> source;  ///< 4 per wide node: the binary node each slot copies (kWideEmpty if unused)
+  /// The leaves' triangles as blocks of four (bvh_tri4.h), for the watertight
+  /// fast path: a leaf starting at leaf position p has its
+  /// ceil(count / 4) blocks from tri_blocks[leaf_block[p]] on.
+  std::vector<TriBlock4> tri_blocks;
+  std::vector<std::uint32_t> leaf_block;  ///< indexed by a leaf's first position; other entries unused
 };
+
+/// Fills wide.tri_blocks and wide.leaf_block from the binary leaves and the
+/// leaf-order triangles.
+void build_tri4_blocks(WideBvh& wide, std::span<const BvhNode> binary, std::span<const Triangle> leaf_tris);
 
 /// Collapses a binary node array: each wide node takes a binary inner node's
 /// children and keeps opening the child with the largest surface area until

@@ -1,0 +1,163 @@
+#pragma once
+// Four triangles per SIMD test: the leaves of the 4-wide BVH keep their
+// triangles as blocks of four in structure-of-arrays order (Embree's
+// "triangle4" idea), and the watertight test (Woop et al. 2013) runs on the
+// four lanes at once with SSE2.
+//
+// Exactness: each lane performs the float operations of
+// core/geometry/triangle.cpp's intersect_watertight in the same order (SSE2
+// add/sub/mul/div are IEEE like their scalar forms; no FMA), so a lane's
+// U, V, W, det, T and t are bit for bit the scalar ones. Lanes that take one
+// of the scalar test's special paths (an edge function of zero, overflow,
+// tiny values) are answered by the scalar function itself. The tmax-dependent
+// acceptance (scaled interval compare, t <= tmax) is then redone per hit lane
+// in slot order against the closest hit so far, exactly as the scalar loop
+// over the leaf would, so the traversal's answers do not change.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "core/accel/bvh/bvh_triangle.h"
+
+#if defined(__SSE2__) && !defined(ACCELVIZ_NO_SIMD)
+#include <emmintrin.h>
+#define ACCELVIZ_BVH_TRI4_SSE2 1
+#endif
+
+namespace accelviz::bvh_detail {
+
+/// 160 bytes: rows v[3·vertex + axis][lane], and the leaf-order position of
+/// each lane's triangle (kTri4Empty: padding lane).
+struct alignas(16) TriBlock4 {
+  float v[9][4];
+  std::uint32_t pos[4];
+};
+static_assert(sizeof(TriBlock4) == 160);
+
+inline constexpr std::uint32_t kTri4Empty = 0xFFFFFFFFu;
+
+/// Blocks for leaf triangles [first, first + count) of `tris` (leaf order),
+/// appended to `out`; returns the index of the first block.
+inline std::uint32_t append_tri4_blocks(std::span<const Triangle> tris, std::uint32_t first, std::uint32_t count,
+                                        std::vector<TriBlock4>& out) {
+  const auto start = static_cast<std::uint32_t>(out.size());
+  for (std::uint32_t b = 0; b < count; b += 4) {
+    TriBlock4 blk{};
+    for (std::uint32_t l = 0; l < 4; ++l) {
+      const bool used = b + l < count;
+      // Padding lanes repeat the block's first triangle (finite values) and are masked out.
+      const Triangle& t = tris[first + b + (used ? l : 0)];
+      const glm::vec3* vs[3] = {&t.v0, &t.v1, &t.v2};
+      for (int k = 0; k < 3; ++k)
+        for (int a = 0; a < 3; ++a) blk.v[3 * k + a][l] = (&vs[k]->x)[a];
+      blk.pos[l] = used ? first + b + l : kTri4Empty;
+    }
+    out.push_back(blk);
+  }
+  return start;
+}
+
+/// Copies the triangles at the blocks' positions again (after a refit).
+inline void refit_tri4_blocks(std::span<const Triangle> tris, std::vector<TriBlock4>& blocks) {
+  for (TriBlock4& blk : blocks)
+    for (std::uint32_t l = 0; l < 4; ++l) {
+      const std::uint32_t p = blk.pos[l] != kTri4Empty ? blk.pos[l] : blk.pos[0];
+      const Triangle& t = tris[p];
+      const glm::vec3* vs[3] = {&t.v0, &t.v1, &t.v2};
+      for (int k = 0; k < 3; ++k)
+        for (int a = 0; a < 3; ++a) blk.v[3 * k + a][l] = (&vs[k]->x)[a];
+    }
+}
+
+#ifdef ACCELVIZ_BVH_TRI4_SSE2
+
+/// Per-ray constants of the four-lane test.
+struct Tri4Ray {
+  __m128 ox, oy, oz, sx, sy, sz;
+  int kx, ky, kz;
+  explicit Tri4Ray(const InlineWatertightRay& r)
+      : ox(_mm_set1_ps(r.ox)),
+        oy(_mm_set1_ps(r.oy)),
+        oz(_mm_set1_ps(r.oz)),
+        sx(_mm_set1_ps(r.wr.sx)),
+        sy(_mm_set1_ps(r.wr.sy)),
+        sz(_mm_set1_ps(r.wr.sz)),
+        kx(r.wr.kx),
+        ky(r.wr.ky),
+        kz(r.wr.kz) {}
+};
+
+/// The tmax-independent part of the watertight test on four lanes.
+struct Tri4Result {
+  alignas(16) float T[4], det[4], t[4], u[4], v[4];
+  int candidate = 0;  ///< lanes inside, det != 0, and t >= tmin with t finite (tmax not yet applied)
+  int special = 0;    ///< lanes the scalar function must answer
+};
+
+[[gnu::always_inline]] inline __m128 finite_mask(__m128 x) {
+  // x - x is 0 for finite x, NaN for inf/NaN; (0 == 0) true, NaN compares false.
+  return _mm_cmpeq_ps(_mm_sub_ps(x, x), _mm_setzero_ps());
+}
+
+[[gnu::always_inline]] inline void intersect_tri4(const TriBlock4& b, const Tri4Ray& r, float tmin, Tri4Result& out) {
+  const __m128 zero = _mm_setzero_ps();
+  const __m128 Ax = _mm_sub_ps(_mm_load_ps(b.v[0 + r.kx]), r.ox), Ay = _mm_sub_ps(_mm_load_ps(b.v[0 + r.ky]), r.oy),
+               Az = _mm_sub_ps(_mm_load_ps(b.v[0 + r.kz]), r.oz);
+  const __m128 Bx = _mm_sub_ps(_mm_load_ps(b.v[3 + r.kx]), r.ox), By = _mm_sub_ps(_mm_load_ps(b.v[3 + r.ky]), r.oy),
+               Bz = _mm_sub_ps(_mm_load_ps(b.v[3 + r.kz]), r.oz);
+  const __m128 Cx = _mm_sub_ps(_mm_load_ps(b.v[6 + r.kx]), r.ox), Cy = _mm_sub_ps(_mm_load_ps(b.v[6 + r.ky]), r.oy),
+               Cz = _mm_sub_ps(_mm_load_ps(b.v[6 + r.kz]), r.oz);
+  const __m128 ax = _mm_sub_ps(Ax, _mm_mul_ps(r.sx, Az)), ay = _mm_sub_ps(Ay, _mm_mul_ps(r.sy, Az));
+  const __m128 bx = _mm_sub_ps(Bx, _mm_mul_ps(r.sx, Bz)), by = _mm_sub_ps(By, _mm_mul_ps(r.sy, Bz));
+  const __m128 cx = _mm_sub_ps(Cx, _mm_mul_ps(r.sx, Cz)), cy = _mm_sub_ps(Cy, _mm_mul_ps(r.sy, Cz));
+  const __m128 U = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
+  const __m128 V = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
+  const __m128 W = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
+  const __m128 det = _mm_add_ps(_mm_add_ps(U, V), W);
+  // Special: a zero edge function, or U + V + W not finite (as triangle.cpp's checks, in its order).
+  __m128 special = _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(U, zero), _mm_cmpeq_ps(V, zero)), _mm_cmpeq_ps(W, zero));
+  special = _mm_or_ps(special, _mm_andnot_ps(finite_mask(det), _mm_castsi128_ps(_mm_set1_epi32(-1))));
+  const __m128 any_neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(U, zero), _mm_cmplt_ps(V, zero)), _mm_cmplt_ps(W, zero));
+  const __m128 any_pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(U, zero), _mm_cmpgt_ps(V, zero)), _mm_cmpgt_ps(W, zero));
+  __m128 ok = _mm_andnot_ps(_mm_and_ps(any_neg, any_pos), _mm_cmpneq_ps(det, zero));
+  // |det| < 1e-30: special (only for lanes still in the game, as the scalar order has it).
+  const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF));
+  const __m128 low = _mm_set1_ps(1e-30f);
+  const __m128 tiny_det = _mm_and_ps(ok, _mm_cmplt_ps(_mm_and_ps(det, abs_mask), low));
+  const __m128 az = _mm_mul_ps(r.sz, Az), bz = _mm_mul_ps(r.sz, Bz), cz = _mm_mul_ps(r.sz, Cz);
+  const __m128 T = _mm_add_ps(_mm_add_ps(_mm_mul_ps(U, az), _mm_mul_ps(V, bz)), _mm_mul_ps(W, cz));
+  const __m128 absT = _mm_and_ps(T, abs_mask);
+  const __m128 bad_T = _mm_or_ps(_mm_andnot_ps(finite_mask(T), _mm_castsi128_ps(_mm_set1_epi32(-1))),
+                                 _mm_and_ps(_mm_cmplt_ps(absT, low), _mm_cmpneq_ps(T, zero)));
+  const __m128 special_late = _mm_andnot_ps(tiny_det, _mm_and_ps(ok, bad_T));
+  const __m128 late = _mm_or_ps(tiny_det, special_late);
+  ok = _mm_andnot_ps(late, ok);
+  // tmin side of the scaled compare: det > 0: T >= tmin·det; det < 0: T <= tmin·det.
+  const __m128 tmin_det = _mm_mul_ps(_mm_set1_ps(tmin), det);
+  const __m128 pos = _mm_cmpgt_ps(det, zero);
+  const __m128 tmin_ok =
+      _mm_or_ps(_mm_and_ps(pos, _mm_cmpge_ps(T, tmin_det)), _mm_andnot_ps(pos, _mm_cmple_ps(T, tmin_det)));
+  ok = _mm_and_ps(ok, tmin_ok);
+  const __m128 rcp = _mm_div_ps(_mm_set1_ps(1.0f), det);
+  const __m128 t = _mm_mul_ps(T, rcp);
+  ok = _mm_and_ps(ok, _mm_cmpge_ps(t, _mm_set1_ps(tmin)));
+  _mm_store_ps(out.T, T);
+  _mm_store_ps(out.det, det);
+  _mm_store_ps(out.t, t);
+  _mm_store_ps(out.u, _mm_mul_ps(V, rcp));
+  _mm_store_ps(out.v, _mm_mul_ps(W, rcp));
+  const int sp = _mm_movemask_ps(special);
+  out.special = sp | (_mm_movemask_ps(late) & ~sp);
+  out.candidate = _mm_movemask_ps(ok) & ~sp;
+}
+
+/// The scalar test's tmax-dependent acceptance of candidate lane l.
+[[gnu::always_inline]] inline bool tri4_accept(const Tri4Result& r, int l, float tmax) {
+  const float det = r.det[l], T = r.T[l];
+  if (det > 0.0f ? T > tmax * det : T < tmax * det) return false;
+  return r.t[l] <= tmax;
+}
+
+#endif  // ACCELVIZ_BVH_TRI4_SSE2
+
+}  // namespace accelviz::bvh_detail

@@ -1,0 +1,111 @@
+// The BVH's inline ray/triangle tests (core/accel/bvh/bvh_triangle.h) against
+// the out-of-line ones of core/geometry/triangle.cpp: the same hit/miss and
+// bit for bit the same t, u, v, on random input and on the cases that take
+// the special paths (rays through shared edges and vertices, axis-aligned
+// rays, huge and tiny coordinates, degenerate triangles, t at the interval
+// ends).
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "core/accel/bvh/bvh_triangle.h"
+
+using namespace accelviz;
+
+namespace {
+
+float uniform(std::mt19937& rng) {
+  return static_cast<float>(rng() >> 8) * (1.0f / 16777216.0f);
+}
+
+bool same_bits(float a, float b) {
+  return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+struct Counts {
+  int hits = 0, misses = 0;
+};
+
+void expect_same(const Ray& ray, const Triangle& tri, float tmin, float tmax, Counts& c) {
+  const WatertightRay wr(ray.direction);
+  const bvh_detail::InlineWatertightRay iwr(ray);
+  Hit a, b;
+  const bool ha = intersect_watertight(ray, wr, tri, tmin, tmax, a);
+  const bool hb = bvh_detail::intersect_watertight_inline(ray, iwr, tri, tmin, tmax, b);
+  ASSERT_EQ(ha, hb);
+  if (ha) {
+    ++c.hits;
+    ASSERT_TRUE(same_bits(a.t, b.t) && same_bits(a.u, b.u) && same_bits(a.v, b.v))
+        << a.t << " " << b.t << " " << a.u << " " << b.u;
+  } else {
+    ++c.misses;
+  }
+  Hit m, n;
+  const bool hm = intersect_moller_trumbore(ray, tri, tmin, tmax, m);
+  const bool hn = bvh_detail::intersect_moller_trumbore_inline(ray, tri, tmin, tmax, n);
+  ASSERT_EQ(hm, hn);
+  if (hm) {
+    ASSERT_TRUE(same_bits(m.t, n.t) && same_bits(m.u, n.u) && same_bits(m.v, n.v));
+  }
+}
+
+glm::vec3 rand_vec(std::mt19937& rng, float scale) {
+  return scale * glm::vec3(2 * uniform(rng) - 1, 2 * uniform(rng) - 1, 2 * uniform(rng) - 1);
+}
+
+}  // namespace
+
+TEST(BvhInlineTriangle, RandomRaysAndTrianglesAgreeBitForBit) {
+  std::mt19937 rng(7);
+  Counts c;
+  for (int i = 0; i < 200000; ++i) {
+    const Triangle tri{rand_vec(rng, 1), rand_vec(rng, 1), rand_vec(rng, 1)};
+    // Aim at a random point of the triangle's plane region half the time.
+    const glm::vec3 o = rand_vec(rng, 3);
+    const float u = uniform(rng) * 1.4f - 0.2f, v = uniform(rng) * 1.4f - 0.2f;
+    const glm::vec3 target = tri.v0 + u * (tri.v1 - tri.v0) + v * (tri.v2 - tri.v0);
+    const glm::vec3 d = (i & 1) ? target - o : rand_vec(rng, 1);
+    const Ray ray(o, d);
+    expect_same(ray, tri, 0.0f, kInfinity, c);
+    expect_same(ray, tri, 0.5f * uniform(rng), 0.5f + uniform(rng), c);
+  }
+  EXPECT_GT(c.hits, 30000);
+  EXPECT_GT(c.misses, 100000);
+}
+
+TEST(BvhInlineTriangle, SpecialPathsAgree) {
+  std::mt19937 rng(11);
+  Counts c;
+  const float scales[] = {1e-20f, 1e-12f, 1e-6f, 1.0f, 1e6f, 1e18f, 1e25f};
+  for (float s : scales) {
+    for (int i = 0; i < 2000; ++i) {
+      // A shared edge between two triangles, and a ray through its midpoint
+      // or through a shared vertex: edge functions round to exactly zero.
+      const glm::vec3 a = rand_vec(rng, s), b = rand_vec(rng, s), p = rand_vec(rng, s), q = rand_vec(rng, s);
+      const Triangle t1{a, b, p}, t2{b, a, q};
+      const glm::vec3 through = (i % 3 == 0) ? a : 0.5f * (a + b);
+      const glm::vec3 o = through + rand_vec(rng, s);
+      const Ray ray(o, through - o);
+      expect_same(ray, t1, 0.0f, kInfinity, c);
+      expect_same(ray, t2, 0.0f, kInfinity, c);
+      // Axis-aligned rays (zero direction components) and degenerate triangles.
+      glm::vec3 d(0.0f);
+      d[i % 3] = (i & 4) ? -1.0f : 1.0f;
+      const Ray axis(o, d);
+      expect_same(axis, t1, 0.0f, kInfinity, c);
+      expect_same(ray, Triangle{a, a, b}, 0.0f, kInfinity, c);
+      expect_same(ray, Triangle{a, b, 0.5f * (a + b)}, 0.0f, kInfinity, c);
+    }
+  }
+  // t exactly at the interval ends.
+  const Triangle wall{{-1, -1, 2}, {1, -1, 2}, {0, 1, 2}};
+  const Ray r({0, 0, 0}, {0, 0, 1});
+  expect_same(r, wall, 2.0f, 2.0f, c);
+  expect_same(r, wall, 0.0f, 2.0f, c);
+  expect_same(r, wall, 2.0f, kInfinity, c);
+  expect_same(r, wall, 0.0f, std::nextafter(2.0f, 0.0f), c);
+  EXPECT_GT(c.hits, 1000);
+  EXPECT_GT(c.misses, 1000);
+}
