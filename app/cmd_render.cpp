@@ -3,6 +3,7 @@
 // Also the no-subcommand demo, which renders the demo scene the same way.
 #include "app/cli_common.h"
 #include "app/render_raster.h"
+#include "app/render_compare.h"
 
 #include "core/analysis/heatmap.h"
 #include "core/query/camera.h"
@@ -12,6 +13,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 namespace accelviz::cli {
 
@@ -30,6 +32,9 @@ struct RenderOptions {
   unsigned threads = 0;
   std::string triangle_test = "watertight";
   bool force = false;
+  std::string order = "front-to-back";  ///< child order: front-to-back, back-to-front, unordered
+  bool xray = false;                     ///< count the full traversal as if no hit ended it
+  std::optional<std::string> compare;    ///< B's differences from A (render --compare)
   StructureCli structure_opts;
   std::string view = "heatmap";
   RasterOptions raster;
@@ -109,6 +114,9 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
   ho.height = size.height;
   ho.threads = o.threads;
   ho.query.triangle_test = parse_triangle_test(o.triangle_test);
+  ho.query.ordered = o.order != "unordered";
+  ho.query.back_to_front = o.order == "back-to-front";
+  ho.query.xray = o.xray;
   ho.c_trav = o.structure_opts.ctrav;
   ho.c_isect = o.structure_opts.cisect;
   progress.begin("rendering " + o.metric);
@@ -149,6 +157,13 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
 }
 
 int run_render(const RenderOptions& o, const GlobalOptions& global) {
+  if (o.compare) {
+    if (o.view != "heatmap") throw UsageError("--compare needs --view heatmap");
+    CompareJob job{o.scene, o.camera, o.size, o.metric, o.colormap, o.legend, o.max, o.threads, o.out, o.force, {}, {}};
+    job.a = CompareSide{o.structure, o.structure_opts, o.triangle_test, o.order, o.xray};
+    job.b = parse_compare_spec(*o.compare, job.a);
+    return run_render_compare(job, global);
+  }
   check_output_path(o.out, o.force);  // before any long work
   if (o.view == "raster") return run_render_raster(o, global);
   if (o.raster.box_depth >= 0 || o.raster.leaves || !o.ray_pixel.empty() || o.raster.blend > 0.0f ||
@@ -225,6 +240,17 @@ Command add_render_command(CLI::App& parent, const GlobalOptions& global) {
       ->check(CLI::IsMember({"watertight", "fast"}))
       ->capture_default_str();
   sub->add_flag("--force,-f", o->force, "Overwrite an existing output file");
+  sub->add_option("--order", o->order,
+                  "Child order of the traversal (BVH): front-to-back, back-to-front (the worst order), unordered")
+      ->check(CLI::IsMember({"front-to-back", "back-to-front", "unordered"}))
+      ->capture_default_str();
+  sub->add_flag("--xray", o->xray,
+                "Count the full traversal as if no hit ended it (BVH: no culling behind the closest hit)");
+  sub->add_option("--compare", o->compare,
+                  "A/B: render A (these options) and B (A with these changes, e.g. 'structure=bvh buckets=4' or "
+                  "'order=unordered'; keys: structure splitter buckets leaf leaf-cap ctrav cisect embree-quality "
+                  "triangle-test order xray) and write OUT-a.png, OUT-b.png (one locked colour scale) and "
+                  "OUT-diff.png (B - A, diverging colours)");
   sub->add_option("--view", o->view,
                   "heatmap: the per-pixel metric image traced on the CPU; raster: the overlay view drawn by the "
                   "OpenGL renderer headless (mesh, node boxes, a ray path, heatmap blend)")

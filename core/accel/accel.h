@@ -29,6 +29,7 @@ struct RayStats {
   std::uint32_t nodes_missed = 0;    ///< children whose box the ray missed
   std::uint32_t repeated_prim_tests = 0;  ///< tests of a primitive already tested by this ray
   std::uint32_t empty_cells = 0;     ///< empty cells/voxels stepped (grids)
+  std::uint32_t leaves_skipped = 0;  ///< any-hit (BVH): leaves the ray crosses that the early exit never reached
 
   RayStats& operator+=(const RayStats& o) {
     nodes_visited += o.nodes_visited;
@@ -38,6 +39,7 @@ struct RayStats {
     nodes_missed += o.nodes_missed;
     repeated_prim_tests += o.repeated_prim_tests;
     empty_cells += o.empty_cells;
+    leaves_skipped += o.leaves_skipped;
     return *this;
   }
 };
@@ -87,6 +89,14 @@ struct BuildCancelled : std::exception {
 struct QueryOptions {
   TriangleTest triangle_test = TriangleTest::watertight;
   bool ordered = true;  ///< front-to-back child order (false: fixed order, to show what ordering buys)
+  /// BVH, with `ordered`: the farther child first (back-to-front), the worst
+  /// order, to show what ordering buys. Same hit, more work.
+  bool back_to_front = false;
+  /// BVH closest hit: "x-ray" counting. No box is culled and no primitive test
+  /// is shortened by the closest hit so far, so the counters show the full
+  /// traversal as if no hit ended it (the cost hidden behind the first
+  /// surface). Same hit. Either flag takes the instrumented path.
+  bool xray = false;
 };
 
 class Accelerator {

@@ -9,7 +9,6 @@
 #include "core/accel/bvh/bvh.h"
 
 #include "core/accel/bvh/bvh_slab.h"
-#include "core/accel/bvh/bvh_triangle.h"
 #include "core/accel/bvh/bvh_wide.h"
 
 #include "core/analysis/epo.h"
@@ -42,10 +41,7 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
   stats_.memory_bytes += leaf_tris_.size() * sizeof(Triangle);
   if (opts_.wide_traversal && !nodes_.empty()) {
     wide_ = std::make_unique<bvh_detail::WideBvh>(bvh_detail::collapse_to_wide(nodes_));
-    bvh_detail::build_tri4_blocks(*wide_, nodes_, leaf_tris_);
-    stats_.memory_bytes += wide_->nodes.size() * sizeof(bvh_detail::WideNode) + wide_->source.size() * sizeof(std::uint32_t) +
-                           wide_->tri_blocks.size() * sizeof(bvh_detail::TriBlock4) +
-                           wide_->leaf_block.size() * sizeof(std::uint32_t);
+    stats_.memory_bytes += wide_->nodes.size() * sizeof(bvh_detail::WideNode) + wide_->source.size() * sizeof(std::uint32_t);
     stats_.extra["wide_nodes"] = static_cast<double>(wide_->nodes.size());
   }
   stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -86,10 +82,7 @@ void Bvh::refit(std::span<const Triangle> moved) {
     }
     n.bounds = b;
   }
-  if (wide_) {
-    bvh_detail::refit_wide(*wide_, nodes_);
-    bvh_detail::refit_tri4_blocks(leaf_tris_, wide_->tri_blocks);
-  }
+  if (wide_) bvh_detail::refit_wide(*wide_, nodes_);
   stats_.extra["refit_ms"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   update_quality_stats();
 }
@@ -111,6 +104,8 @@ struct BvhView {
 struct Collector {
   RayStats* stats;
   VisitTrace* trace;
+  bool back_to_front = false;  ///< QueryOptions::back_to_front (Collect path only)
+  bool xray = false;           ///< QueryOptions::xray (Collect path only)
 
   void entered(std::uint32_t node, float t0, float t1) const {
     ++stats->nodes_visited;
@@ -130,16 +125,34 @@ struct Collector {
   }
 };
 
-using bvh_detail::InlineWatertightRay;
-
-/// The inline twins of triangle.cpp's tests (bvh_triangle.h): same results.
 template <TriangleTest Test>
-[[gnu::always_inline]] inline bool test_triangle(const Ray& ray, const InlineWatertightRay& wr, const Triangle& tri,
-                                                 float tmin, float tmax, Hit& h) {
+inline bool test_triangle(const Ray& ray, const WatertightRay& wr, const Triangle& tri, float tmin, float tmax,
+                          Hit& h) {
   if constexpr (Test == TriangleTest::watertight)
-    return bvh_detail::intersect_watertight_inline(ray, wr, tri, tmin, tmax, h);
+    return intersect_watertight(ray, wr, tri, tmin, tmax, h);
   else
-    return bvh_detail::intersect_moller_trumbore_inline(ray, tri, tmin, tmax, h);
+    return intersect_moller_trumbore(ray, tri, tmin, tmax, h);
+}
+
+/// Leaves of the subtree at `node` whose boxes (and their ancestors' boxes
+/// below `node`) the ray crosses in [tmin, tmax]: what a full traversal of
+/// that subtree would enter. `node` itself was already tested when pushed.
+std::uint32_t leaves_crossed(const BvhView& bvh, const SlabRay& sr, float tmin, float tmax, std::uint32_t node) {
+  std::uint32_t stack[kBvhMaxDepth + 1];
+  unsigned sp = 0;
+  std::uint32_t leaves = 0;
+  stack[sp++] = node;
+  while (sp > 0) {
+    const BvhNode& n = bvh.nodes[stack[--sp]];
+    if (n.count > 0) {
+      ++leaves;
+      continue;
+    }
+    float t0, t1;
+    for (std::uint32_t ch = n.index; ch < n.index + 2; ++ch)
+      if (slab_test(bvh.nodes[ch], sr, tmin, tmax, t0, t1)) stack[sp++] = ch;
+  }
+  return leaves;
 }
 
 /// Stack-based traversal (children tested at the parent; the far child is
@@ -177,7 +190,7 @@ Hit traverse(const BvhView& bvh, const Ray& ray, const Collector& c) {
   }
   if constexpr (Collect) c.entered(0, r0, r1);
   // Set up after the root test: most rays of a typical view miss the scene box.
-  const InlineWatertightRay wr = Test == TriangleTest::watertight ? InlineWatertightRay(ray) : InlineWatertightRay();
+  const WatertightRay wr = Test == TriangleTest::watertight ? WatertightRay(ray.direction) : WatertightRay();
 
   std::uint32_t node = 0;
   for (;;) {
@@ -192,10 +205,11 @@ Hit traverse(const BvhView& bvh, const Ray& ray, const Collector& c) {
       const float a0 = te[0], a1 = tx[0], b0 = te[1], b1 = tx[1];
       if constexpr (Collect) {
         c.stats->box_tests += 2;
+        const float cull_t = c.xray ? ray.tmax : closest;
         if (!h0) c.missed(i0, a0, a1);
-        else if (a0 > closest) { c.culled(i0, a0, a1); h0 = false; }
+        else if (a0 > cull_t) { c.culled(i0, a0, a1); h0 = false; }
         if (!h1) c.missed(i1, b0, b1);
-        else if (b0 > closest) { c.culled(i1, b0, b1); h1 = false; }
+        else if (b0 > cull_t) { c.culled(i1, b0, b1); h1 = false; }
       }
       if constexpr (!Collect) {
         // Fast path with one data-dependent branch (any child hit?) instead
@@ -213,7 +227,7 @@ Hit traverse(const BvhView& bvh, const Ray& ray, const Collector& c) {
         }
       } else if (h0 && h1) {
         // Which child is nearer is a coin flip per node: selects, not a swap.
-        const bool second_first = Ordered && b0 < a0;
+        const bool second_first = Ordered && (c.back_to_front ? a0 < b0 : b0 < a0);
         const std::uint32_t near = i0 + (second_first ? 1u : 0u);
         const std::uint32_t far = i1 - (second_first ? 1u : 0u);
         stack[sp] = {far, second_first ? a0 : b0};
@@ -235,7 +249,9 @@ Hit traverse(const BvhView& bvh, const Ray& ray, const Collector& c) {
     } else {
       for (std::uint32_t k = n.index, end = n.index + n.count; k < end; ++k) {
         Hit h;
-        const bool hit = test_triangle<Test>(ray, wr, bvh.tris[k], tmin, closest, h);
+        // X-ray: every primitive is tested over the whole segment.
+        const float prim_tmax = Collect && !AnyHit && c.xray ? ray.tmax : closest;
+        const bool hit = test_triangle<Test>(ray, wr, bvh.tris[k], tmin, prim_tmax, h);
         if constexpr (Collect) {
           ++c.stats->prim_tests;
           c.prim(bvh.prim_ids[k], hit, h.t);
@@ -244,6 +260,11 @@ Hit traverse(const BvhView& bvh, const Ray& ray, const Collector& c) {
           if (hit) {
             best = h;
             best.prim = k;
+            if constexpr (Collect) {
+              // Leaves the early exit never reached: those below the pending stack entries that the ray crosses.
+              for (unsigned i = 0; i < sp; ++i)
+                c.stats->leaves_skipped += leaves_crossed(bvh, sr, tmin, ray.tmax, stack[i].node);
+            }
             return best;
           }
         } else if (hit && h.t < best.t) {  // first found wins ties, as in BruteForce
@@ -258,7 +279,7 @@ Hit traverse(const BvhView& bvh, const Ray& ray, const Collector& c) {
       if (sp == 0) return best;
       --sp;
       const Entry e = stack[sp];
-      if (!AnyHit && e.t_entry > closest) {
+      if (!AnyHit && e.t_entry > closest && !(Collect && c.xray)) {
         if constexpr (Collect) c.culled(e.node, e.t_entry, stack_exit[sp]);
         continue;
       }
@@ -279,20 +300,14 @@ Hit traverse(const BvhView& bvh, const Ray& ray, const Collector& c) {
 /// Stack: at most three entries per wide level, and a wide path is no longer
 /// than the binary one (kBvhMaxDepth).
 template <bool AnyHit, bool Ordered, TriangleTest Test>
-Hit traverse_wide(const bvh_detail::WideBvh& wide_bvh, const BvhView& bvh, const Ray& ray) {
+Hit traverse_wide(const bvh_detail::WideNode* wide, const BvhView& bvh, const Ray& ray) {
   using bvh_detail::WideNode;
-  const WideNode* wide = wide_bvh.nodes.data();
   Hit best;
   const bvh_detail::WideSlabRay wr4(ray);
   const float tmin = ray.tmin;
   float closest = ray.tmax;
-  InlineWatertightRay wr;
+  WatertightRay wr;
   bool wr_ready = Test != TriangleTest::watertight;
-#ifdef ACCELVIZ_BVH_TRI4_SSE2
-  // Watertight leaves: four triangles per test (bvh_tri4.h).
-  constexpr bool kTri4 = Test == TriangleTest::watertight;
-  bvh_detail::Tri4Ray tr4(wr);
-#endif
 
   struct Entry {
     std::uint32_t child, meta;
@@ -318,10 +333,7 @@ Hit traverse_wide(const bvh_detail::WideBvh& wide_bvh, const BvhView& bvh, const
           slot[k++] = std::countr_zero(static_cast<unsigned>(mask));
           mask &= mask - 1;
         }
-        // Any hit: any occluder ends the walk, so the sort buys little and
-        // costs a data-dependent shuffle per node: slot order (measured on
-        // shadow rays, docs/performance.md).
-        if constexpr (Ordered && !AnyHit) {
+        if constexpr (Ordered) {
           // Insertion sort by entry distance; equal distances keep slot order.
           for (int i = 1; i < k; ++i) {
             const int v = slot[i];
@@ -340,52 +352,9 @@ Hit traverse_wide(const bvh_detail::WideBvh& wide_bvh, const BvhView& bvh, const
       }
     } else {
       if (!wr_ready) {
-        wr = InlineWatertightRay(ray);
+        wr = WatertightRay(ray.direction);
         wr_ready = true;
-#ifdef ACCELVIZ_BVH_TRI4_SSE2
-        if constexpr (kTri4) tr4 = bvh_detail::Tri4Ray(wr);
-#endif
       }
-#ifdef ACCELVIZ_BVH_TRI4_SSE2
-      if constexpr (kTri4) {
-        // Lanes in slot order are the leaf's triangles in order: the same
-        // sequence of tests and acceptances as the scalar loop below.
-        const bvh_detail::TriBlock4* blk = wide_bvh.tri_blocks.data() + wide_bvh.leaf_block[child];
-        for (std::uint32_t left = meta; left > 0; ++blk) {
-          const int valid = left >= 4 ? 0xF : (1 << left) - 1;
-          left = left >= 4 ? left - 4 : 0;
-          bvh_detail::Tri4Result r;
-          bvh_detail::intersect_tri4(*blk, tr4, tmin, r);
-          int lanes = (r.candidate | r.special) & valid;
-          while (lanes != 0) {
-            const int l = std::countr_zero(static_cast<unsigned>(lanes));
-            lanes &= lanes - 1;
-            const std::uint32_t k = blk->pos[l];
-            Hit h;
-            bool hit;
-            if ((r.special >> l) & 1) {
-              hit = intersect_watertight(ray, wr.wr, bvh.tris[k], tmin, closest, h);
-            } else {
-              hit = bvh_detail::tri4_accept(r, l, closest);
-              h.t = r.t[l];
-              h.u = r.u[l];
-              h.v = r.v[l];
-            }
-            if constexpr (AnyHit) {
-              if (hit) {
-                best = h;
-                best.prim = k;
-                return best;
-              }
-            } else if (hit && h.t < best.t) {
-              best = h;
-              best.prim = k;
-              closest = h.t;
-            }
-          }
-        }
-      } else
-#endif
       for (std::uint32_t k = child, end = child + meta; k < end; ++k) {
         Hit h;
         const bool hit = test_triangle<Test>(ray, wr, bvh.tris[k], tmin, closest, h);
@@ -414,7 +383,7 @@ Hit traverse_wide(const bvh_detail::WideBvh& wide_bvh, const BvhView& bvh, const
 }
 
 template <bool AnyHit>
-Hit dispatch_wide(const bvh_detail::WideBvh& wide, const BvhView& v, const Ray& ray, const QueryOptions& qo) {
+Hit dispatch_wide(const bvh_detail::WideNode* wide, const BvhView& v, const Ray& ray, const QueryOptions& qo) {
   const bool wt = qo.triangle_test == TriangleTest::watertight;
   if (qo.ordered)
     return wt ? traverse_wide<AnyHit, true, TriangleTest::watertight>(wide, v, ray)
@@ -438,12 +407,12 @@ Hit dispatch(const BvhView& v, const Ray& ray, const QueryOptions& qo, const Col
 Hit Bvh::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, VisitTrace* trace) const {
   const BvhView v{nodes_.data(), leaf_tris_.data(), prim_indices_.data(), nodes_.size()};
   Hit h;
-  if (stats == nullptr && trace == nullptr) {
-    h = wide_ ? dispatch_wide<false>(*wide_, v, ray, qo)
+  if (stats == nullptr && trace == nullptr && !qo.back_to_front && !qo.xray) {
+    h = wide_ ? dispatch_wide<false>(wide_->nodes.data(), v, ray, qo)
               : dispatch<false, false>(v, ray, qo, Collector{nullptr, nullptr});
   } else {
     RayStats local;
-    h = dispatch<false, true>(v, ray, qo, Collector{stats ? stats : &local, trace});
+    h = dispatch<false, true>(v, ray, qo, Collector{stats ? stats : &local, trace, qo.back_to_front, qo.xray});
   }
   if (h.valid()) {
     h.ng = triangle_normal(leaf_tris_[h.prim]);
@@ -454,10 +423,12 @@ Hit Bvh::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, Vi
 
 bool Bvh::any_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats) const {
   const BvhView v{nodes_.data(), leaf_tris_.data(), prim_indices_.data(), nodes_.size()};
-  if (stats == nullptr)
-    return wide_ ? dispatch_wide<true>(*wide_, v, ray, qo).valid()
+  if (stats == nullptr && !qo.back_to_front)
+    return wide_ ? dispatch_wide<true>(wide_->nodes.data(), v, ray, qo).valid()
                  : dispatch<true, false>(v, ray, qo, Collector{nullptr, nullptr}).valid();
-  return dispatch<true, true>(v, ray, qo, Collector{stats, nullptr}).valid();
+  RayStats local;
+  return dispatch<true, true>(v, ray, qo, Collector{stats ? stats : &local, nullptr, qo.back_to_front, false})
+      .valid();
 }
 
 }  // namespace accelviz

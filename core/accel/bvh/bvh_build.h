@@ -27,13 +27,6 @@ struct BuildPrim {
 };
 static_assert(sizeof(BuildPrim) == 40);
 
-/// The quantisation grid of the LBVH's Morton codes: 1024 cells per axis over
-/// the root's centroid bounds (lbvh_builder.cpp).
-struct MortonFrame {
-  glm::vec3 origin{0.0f};
-  float scale[3] = {0.0f, 0.0f, 0.0f};  ///< cells per unit; 0 on a flat axis
-};
-
 /// The options a splitter needs, already validated.
 struct SplitParams {
   int buckets = 16;
@@ -41,7 +34,6 @@ struct SplitParams {
   int leaf_size_cap = 16;
   float cost_traversal = 1.0f;
   float cost_intersect = 1.0f;
-  MortonFrame morton;  ///< lbvh only
 };
 
 enum class SplitOutcome {
@@ -72,15 +64,6 @@ SplitOutcome split_exact_sah(const SplitParams& params, std::span<BuildPrim> pri
                              const Aabb& centroid_bounds, SplitScratch& scratch, SplitResult& out);
 SplitOutcome split_median(const SplitParams& params, std::span<BuildPrim> prims, const Aabb& bounds,
                           const Aabb& centroid_bounds, SplitScratch& scratch, SplitResult& out);
-/// LBVH (lbvh_builder.cpp): cuts a Morton-sorted range at its highest
-/// differing code bit. The range must have been sorted by lbvh_sort.
-SplitOutcome split_lbvh(const SplitParams& params, std::span<BuildPrim> prims, const Aabb& bounds,
-                        const Aabb& centroid_bounds, SplitScratch& scratch, SplitResult& out);
-MortonFrame morton_frame(const Aabb& centroid_bounds);
-/// 30-bit Morton code of a centroid (10 bits per axis, x highest).
-std::uint32_t morton_code(const glm::vec3& centroid, const MortonFrame& frame);
-/// Sorts primitives (given in id order) by (Morton code, id): stable LSD radix sort on `threads` threads.
-void lbvh_sort(std::span<BuildPrim> prims, const MortonFrame& frame, unsigned threads);
 
 /// Bucket contents of one binned SAH pass: bounds (lanes 0..2 used; 16-byte
 /// rows so that the SIMD pass can load and store them whole) and counts, per
@@ -112,6 +95,30 @@ void bin_primitives(std::span<const BuildPrim> prims, const glm::vec3& origin, c
                     Bins& bins);
 void bin_primitives_scalar(std::span<const BuildPrim> prims, const glm::vec3& origin, const float k[3], int buckets,
                            Bins& bins);
+
+/// Box of bucket b on `axis` (empty when the bucket is).
+Aabb bucket_box(const Bins& bins, int axis, int b);
+
+/// Outcome of the binned SAH search over one node (split_binned_sah's steps
+/// 1-3; the explainer in core/analysis/insight runs the same code).
+struct BinnedSahSearch {
+  float k[3] = {0.0f, 0.0f, 0.0f};  ///< buckets per unit of centroid extent, per axis (0: axis unusable)
+  bool usable[3] = {false, false, false};  ///< the axis's centroids spread (non-zero, finite extent)
+  float best_cost = kInfinity;      ///< A_L·N_L + A_R·N_R (half areas) of the best candidate
+  std::size_t best_left = 0;        ///< primitives left of the best plane
+  int best_axis = -1;               ///< -1: no plane separates anything
+  int best_bucket = -1;             ///< the best plane lies between buckets best_bucket and best_bucket + 1
+};
+/// Cost A_L·N_L + A_R·N_R of every candidate plane b (between buckets b and
+/// b+1) per axis; NaN where one side is empty or the axis is unusable.
+using CandidateCosts = float[3][kMaxBuckets];
+
+/// Bins `prims` into `buckets` buckets over `centroid_bounds` on every
+/// usable axis and evaluates the SAH at the B-1 bucket boundaries. Returns
+/// false (bins untouched) when no axis is usable (all centroids on one
+/// point). With `costs`, also records every candidate's cost.
+bool binned_sah_search(int buckets, std::span<const BuildPrim> prims, const Aabb& centroid_bounds, Bins& bins,
+                       BinnedSahSearch& out, CandidateCosts* costs = nullptr);
 
 /// Object median split: orders the range by centroid on the axis of largest
 /// centroid extent (ties by primitive id, so the result is unique) and cuts

@@ -10,6 +10,7 @@
 #include "core/accel/bvh/bvh_build.h"
 
 #include <array>
+#include <limits>
 #include <utility>
 
 #if defined(__SSE2__) && !defined(ACCELVIZ_NO_SIMD)
@@ -79,50 +80,43 @@ void bin_primitives(std::span<const BuildPrim> prims, const glm::vec3& origin, c
 }
 #endif
 
-namespace {
-
 Aabb bucket_box(const Bins& bins, int axis, int b) {
   const float* lo = bins.lo[axis][b];
   const float* hi = bins.hi[axis][b];
   return Aabb{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}};
 }
 
-}  // namespace
+namespace {
 
-SplitOutcome split_binned_sah(const SplitParams& params, std::span<BuildPrim> prims, const Aabb& bounds,
-                              const Aabb& centroid_bounds, SplitScratch& /*scratch*/, SplitResult& out) {
-  const int nb = params.buckets;
+template <bool Record>
+bool search_impl(int nb, std::span<const BuildPrim> prims, const Aabb& centroid_bounds, Bins& bins,
+                 BinnedSahSearch& s, CandidateCosts* costs) {
   const std::size_t n = prims.size();
+  s = BinnedSahSearch{};
 
   // 1. Per-axis scale k = B / extent of the centroid bounds. An axis whose
   //    centroids do not spread (zero or denormal extent) cannot be binned.
-  float k[3];
-  bool usable[3];
   bool any_usable = false;
   for (int a = 0; a < 3; ++a) {
     const float extent = centroid_bounds.hi[a] - centroid_bounds.lo[a];
-    k[a] = extent > 0.0f ? static_cast<float>(nb) / extent : 0.0f;
-    usable[a] = extent > 0.0f && std::isfinite(k[a]) && std::isfinite(extent);
-    any_usable = any_usable || usable[a];
+    s.k[a] = extent > 0.0f ? static_cast<float>(nb) / extent : 0.0f;
+    s.usable[a] = extent > 0.0f && std::isfinite(s.k[a]) && std::isfinite(extent);
+    any_usable = any_usable || s.usable[a];
+    if constexpr (Record)
+      for (int b = 0; b < nb - 1; ++b) (*costs)[a][b] = std::numeric_limits<float>::quiet_NaN();
   }
-  if (!any_usable) return SplitOutcome::unsplittable;
+  if (!any_usable) return false;
 
-  // 2. Binning: one pass, all three axes. (Bins is left uninitialised: only
-  //    the B buckets in use are cleared.)
-  Bins bins;
+  // 2. Binning: one pass, all three axes. (Only the B buckets in use are cleared.)
   clear_bins(bins, nb);
-  const glm::vec3 lo = centroid_bounds.lo;
-  bin_primitives(prims, lo, k, nb, bins);
+  bin_primitives(prims, centroid_bounds.lo, s.k, nb, bins);
 
   // 3. SAH at every bucket boundary: a right-to-left sweep stores the right
   //    side's area and count, a left-to-right sweep completes the cost
   //    A_L·N_L + A_R·N_R (half areas; C_trav and 1/A_N are common to all
   //    candidates and enter only the leaf test).
-  float best_cost = kInfinity;
-  std::size_t best_left = 0;
-  int best_axis = -1, best_bucket = -1;
   for (int a = 0; a < 3; ++a) {
-    if (!usable[a]) continue;
+    if (!s.usable[a]) continue;
     std::array<float, kMaxBuckets> right_area;
     std::array<std::uint32_t, kMaxBuckets> right_count;
     Aabb acc;
@@ -141,14 +135,40 @@ SplitOutcome split_binned_sah(const SplitParams& params, std::span<BuildPrim> pr
       if (cnt == 0 || right_count[b] == 0) continue;
       const float cost =
           acc.half_area() * static_cast<float>(cnt) + right_area[b] * static_cast<float>(right_count[b]);
-      if (better_split(cost, cnt, n, best_cost, best_left)) {
-        best_cost = cost;
-        best_left = cnt;
-        best_axis = a;
-        best_bucket = b;
+      if constexpr (Record) (*costs)[a][b] = cost;
+      if (better_split(cost, cnt, n, s.best_cost, s.best_left)) {
+        s.best_cost = cost;
+        s.best_left = cnt;
+        s.best_axis = a;
+        s.best_bucket = b;
       }
     }
   }
+  return true;
+}
+
+}  // namespace
+
+bool binned_sah_search(int buckets, std::span<const BuildPrim> prims, const Aabb& centroid_bounds, Bins& bins,
+                       BinnedSahSearch& out, CandidateCosts* costs) {
+  return costs ? search_impl<true>(buckets, prims, centroid_bounds, bins, out, costs)
+               : search_impl<false>(buckets, prims, centroid_bounds, bins, out, nullptr);
+}
+
+SplitOutcome split_binned_sah(const SplitParams& params, std::span<BuildPrim> prims, const Aabb& bounds,
+                              const Aabb& centroid_bounds, SplitScratch& /*scratch*/, SplitResult& out) {
+  const int nb = params.buckets;
+  const std::size_t n = prims.size();
+
+  // 1-3. Scale, binning and the SAH at every bucket boundary (shared with the
+  //      explainer in core/analysis/insight). Bins is left uninitialised.
+  Bins bins;
+  BinnedSahSearch search;
+  if (!binned_sah_search(nb, prims, centroid_bounds, bins, search)) return SplitOutcome::unsplittable;
+  const float best_cost = search.best_cost;
+  const int best_axis = search.best_axis, best_bucket = search.best_bucket;
+  const glm::vec3 lo = centroid_bounds.lo;
+  const float* k = search.k;
   if (best_axis < 0) return SplitOutcome::unsplittable;
   if (sah_prefers_leaf(params, n, bounds.half_area(), best_cost)) return SplitOutcome::leaf;
 

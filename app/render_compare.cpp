@@ -1,0 +1,197 @@
+#include "app/render_compare.h"
+
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include "core/analysis/heatmap.h"
+#include "core/analysis/insight/compare_images.h"
+#include "core/query/camera.h"
+#include "core/scene/load.h"
+
+namespace accelviz::cli {
+
+namespace {
+
+template <typename T>
+T parse_number(const std::string& key, const std::string& value) {
+  try {
+    std::size_t used = 0;
+    T v;
+    if constexpr (std::is_same_v<T, int>)
+      v = std::stoi(value, &used);
+    else
+      v = std::stof(value, &used);
+    if (used != value.size()) throw std::invalid_argument("trailing");
+    return v;
+  } catch (const std::logic_error&) {
+    throw UsageError("--compare: " + key + "=" + value + ": not a number");
+  }
+}
+
+void require_one_of(const std::string& key, const std::string& value, std::initializer_list<const char*> allowed) {
+  std::string list;
+  for (const char* a : allowed) {
+    if (value == a) return;
+    list += (list.empty() ? "" : ", ") + std::string(a);
+  }
+  throw UsageError("--compare: " + key + "=" + value + ": expected one of " + list);
+}
+
+}  // namespace
+
+CompareSide parse_compare_spec(const std::string& spec, const CompareSide& a) {
+  CompareSide b = a;
+  std::string text = spec;
+  for (char& ch : text)
+    if (ch == ',') ch = ' ';
+  std::istringstream in(text);
+  std::string pair;
+  int pairs = 0;
+  while (in >> pair) {
+    ++pairs;
+    const auto eq = pair.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == pair.size())
+      throw UsageError("--compare: '" + pair + "': expected key=value");
+    const std::string key = pair.substr(0, eq), value = pair.substr(eq + 1);
+    if (key == "structure") {
+      bool known = false;
+      for (const std::string& n : structure_names()) known = known || n == value;
+      if (!known) throw UsageError("--compare: structure=" + value + ": unknown structure");
+      b.structure = value;
+    } else if (key == "splitter") {
+      require_one_of(key, value, {"binned", "exact", "median"});
+      b.structure_opts.splitter = value;
+    } else if (key == "buckets") {
+      const int v = parse_number<int>(key, value);
+      if (v < 2 || v > 256) throw UsageError("--compare: buckets=" + value + ": expected 2..256");
+      b.structure_opts.buckets = v;
+    } else if (key == "leaf" || key == "leaf-cap") {
+      const int v = parse_number<int>(key, value);
+      if (v < 1 || v > 255) throw UsageError("--compare: " + key + "=" + value + ": expected 1..255");
+      (key == "leaf" ? b.structure_opts.leaf : b.structure_opts.leaf_cap) = v;
+    } else if (key == "ctrav" || key == "cisect") {
+      const float v = parse_number<float>(key, value);
+      if (!(v > 0.0f) || !std::isfinite(v)) throw UsageError("--compare: " + key + "=" + value + ": expected > 0");
+      (key == "ctrav" ? b.structure_opts.ctrav : b.structure_opts.cisect) = v;
+    } else if (key == "embree-quality") {
+      require_one_of(key, value, {"low", "medium", "high"});
+      b.structure_opts.embree_quality = value;
+    } else if (key == "triangle-test") {
+      require_one_of(key, value, {"watertight", "fast"});
+      b.triangle_test = value;
+    } else if (key == "order") {
+      require_one_of(key, value, {"front-to-back", "back-to-front", "unordered"});
+      b.order = value;
+    } else if (key == "xray") {
+      require_one_of(key, value, {"0", "1"});
+      b.xray = value == "1";
+    } else {
+      throw UsageError("--compare: unknown key '" + key +
+                       "' (structure, splitter, buckets, leaf, leaf-cap, ctrav, cisect, embree-quality, "
+                       "triangle-test, order, xray)");
+    }
+  }
+  if (pairs == 0) throw UsageError("--compare: empty; give B's differences as key=value pairs");
+  return b;
+}
+
+ComparePaths compare_paths(const std::string& out) {
+  const std::filesystem::path p(out);
+  const std::filesystem::path dir = p.parent_path();
+  const std::string stem = p.stem().string(), ext = p.has_extension() ? p.extension().string() : ".png";
+  const auto make = [&](const char* suffix) { return (dir / (stem + suffix + ext)).string(); };
+  return {make("-a"), make("-b"), make("-diff")};
+}
+
+QueryOptions query_of(const CompareSide& side) {
+  QueryOptions q;
+  q.triangle_test = parse_triangle_test(side.triangle_test);
+  q.ordered = side.order != "unordered";
+  q.back_to_front = side.order == "back-to-front";
+  q.xray = side.xray;
+  return q;
+}
+
+int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
+  const ComparePaths paths = compare_paths(job.out);
+  for (const std::string* p : {&paths.a, &paths.b, &paths.diff}) check_output_path(*p, job.force);
+  const ImageSize size = parse_size(job.size);
+  const HeatMetric metric = parse_metric(job.metric).value();
+  if (!metric_needs_stats(metric))
+    throw UsageError("--compare: needs a cost metric (nodes, prims or cost), not --metric " + job.metric);
+  Progress progress(global.quiet);
+  progress.begin("loading " + job.scene);
+  const Scene scene = load_scene_noting_warnings(job.scene, global.quiet);
+  progress.end(std::to_string(scene.triangles.size()) + " triangles");
+  const Camera camera = camera_for(job.camera, scene, size);
+
+  nlohmann::json sides = nlohmann::json::object();
+  MetricImage images[2];
+  const CompareSide* side[2] = {&job.a, &job.b};
+  for (int s = 0; s < 2; ++s) {
+    const CompareSide& c = *side[s];
+    const char* tag = s == 0 ? "A" : "B";
+    progress.begin(std::string("building ") + tag + ": " + c.structure);
+    const StructureOptions so = c.structure_opts.to_options(job.threads, /*compute_epo=*/false);
+    const std::unique_ptr<Accelerator> accel = build_accelerator(c.structure, scene.triangles, so, progress.callback());
+    progress.end(std::to_string(static_cast<long long>(accel->build_stats().build_ms)) + " ms");
+    HeatmapOptions ho;
+    ho.metric = metric;
+    ho.width = size.width;
+    ho.height = size.height;
+    ho.threads = job.threads;
+    ho.query = query_of(c);
+    ho.c_trav = c.structure_opts.ctrav;
+    ho.c_isect = c.structure_opts.cisect;
+    progress.begin(std::string("rendering ") + tag);
+    ho.progress = progress.callback();
+    HeatmapFigures fig;
+    images[s] = render_metric(*accel, camera, ho, &fig);
+    progress.end(std::to_string(static_cast<long long>(fig.render_ms)) + " ms");
+    double total = 0.0;
+    for (const float v : images[s].values)
+      if (std::isfinite(v)) total += v;
+    sides[s == 0 ? "a" : "b"] = {{"structure", c.structure},
+                                 {"splitter", c.structure_opts.splitter},
+                                 {"buckets", c.structure_opts.buckets},
+                                 {"leaf", c.structure_opts.leaf},
+                                 {"order", c.order},
+                                 {"xray", c.xray},
+                                 {"build_ms", accel->build_stats().build_ms},
+                                 {"sah_cost", accel->build_stats().sah_cost},
+                                 {"mean", fig.mean},
+                                 {"max", fig.max},
+                                 {"total", total}};
+  }
+  ABFigures ab;
+  const MetricImage diff = difference_image(images[0], images[1], &ab);
+  const float locked = locked_scale_max(images[0], images[1], job.max);
+  ColorizeOptions co;
+  co.map = parse_colormap(job.colormap).value();
+  co.max = locked;
+  co.legend = parse_legend_placement(job.legend).value();
+  write_png(paths.a, colorize(images[0], co), job.force);
+  write_png(paths.b, colorize(images[1], co), job.force);
+  write_png(paths.diff, colorize_difference(diff, 0.0f, co.legend), job.force);
+
+  nlohmann::json figures = sides;
+  figures["scene"] = job.scene;
+  figures["metric"] = job.metric;
+  figures["width"] = size.width;
+  figures["height"] = size.height;
+  figures["scale_max"] = locked;
+  figures["total_a"] = ab.total_a;
+  figures["total_b"] = ab.total_b;
+  figures["total_diff"] = ab.total_b - ab.total_a;
+  figures["ratio_b_over_a"] = ab.total_a > 0.0 ? ab.total_b / ab.total_a : 0.0;
+  figures["max_abs_diff"] = ab.max_abs_diff;
+  figures["pixels_b_cheaper"] = ab.b_cheaper;
+  figures["pixels_b_dearer"] = ab.b_dearer;
+  figures["out"] = {{"a", absolute_path(paths.a)}, {"b", absolute_path(paths.b)}, {"diff", absolute_path(paths.diff)}};
+  std::cout << absolute_path(paths.a) << "\n" << absolute_path(paths.b) << "\n" << absolute_path(paths.diff) << "\n";
+  print_json_line(figures);
+  return 0;
+}
+
+}  // namespace accelviz::cli

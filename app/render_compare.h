@@ -1,0 +1,54 @@
+#pragma once
+// accelviz render --compare: the same view rendered with two configurations
+// (A: the command's own options; B: A with the --compare overrides), written
+// as three PNGs: A and B on one locked colour scale, and B - A on a
+// diverging colour map, with the totals of both printed.
+#include <string>
+
+#include "app/cli_common.h"
+
+namespace accelviz::cli {
+
+/// One side of a comparison: structure, its options and the query options.
+struct CompareSide {
+  std::string structure = "bvh";
+  StructureCli structure_opts;
+  std::string triangle_test = "watertight";
+  std::string order = "front-to-back";  ///< front-to-back, back-to-front, unordered
+  bool xray = false;
+};
+
+/// `spec` is "key=value key=value ..." (spaces or commas between pairs) over
+/// a copy of `a`. Keys: structure, splitter, buckets, leaf, leaf-cap, ctrav,
+/// cisect, embree-quality, triangle-test, order, xray (0/1). Throws
+/// UsageError "--compare: ..." naming the bad key or value.
+CompareSide parse_compare_spec(const std::string& spec, const CompareSide& a);
+
+/// The three output paths for `out` = DIR/NAME.png: DIR/NAME-a.png, -b.png, -diff.png.
+struct ComparePaths {
+  std::string a, b, diff;
+};
+ComparePaths compare_paths(const std::string& out);
+
+/// QueryOptions of a side (order, x-ray, triangle test).
+QueryOptions query_of(const CompareSide& side);
+
+struct CompareJob {
+  std::string scene;
+  std::string camera;
+  std::string size = "800x600";
+  std::string metric = "nodes";
+  std::string colormap = "viridis";
+  std::string legend = "bottom";
+  float max = 0.0f;
+  unsigned threads = 0;
+  std::string out;
+  bool force = false;
+  CompareSide a, b;
+};
+
+/// Runs the comparison: prints the three paths, then one JSON line with both
+/// sides' figures and totals. Returns the exit code.
+int run_render_compare(const CompareJob& job, const GlobalOptions& global);
+
+}  // namespace accelviz::cli

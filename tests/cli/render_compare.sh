@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# accelviz render --compare writes A, B (one locked colour scale) and B - A
+# (diverging colours), prints both totals, refuses to overwrite any of the
+# three, and names a bad --compare key or value.
+set -euo pipefail
+accelviz="$(realpath "$1")"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+scene='builtin:teapot?size=2000'
+
+out=$("$accelviz" -q render "$scene" --size 48x36 --out "$tmp/cmp.png" --buckets 16 --compare 'buckets=2 leaf=8')
+echo "$out"
+[ "$(sed -n 1p <<<"$out")" = "$tmp/cmp-a.png" ] || { echo "FAIL: A path"; exit 1; }
+[ "$(sed -n 2p <<<"$out")" = "$tmp/cmp-b.png" ] || { echo "FAIL: B path"; exit 1; }
+[ "$(sed -n 3p <<<"$out")" = "$tmp/cmp-diff.png" ] || { echo "FAIL: diff path"; exit 1; }
+python3 - "$tmp" "$(sed -n 4p <<<"$out")" <<'PY'
+import json, struct, sys
+d = sys.argv[1]
+for n in ["cmp-a.png", "cmp-b.png", "cmp-diff.png"]:
+    png = open(f"{d}/{n}", "rb").read()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n", n
+    w, h = struct.unpack(">II", png[16:24])
+    assert w == 48 and h > 36, (n, w, h)
+j = json.loads(sys.argv[2])
+assert j["a"]["buckets"] == 16 and j["b"]["buckets"] == 2 and j["b"]["leaf"] == 8, j
+assert j["total_a"] > 0 and j["total_b"] > 0
+assert abs(j["total_diff"] - (j["total_b"] - j["total_a"])) < 1e-6 * max(1.0, j["total_a"])
+assert j["scale_max"] >= max(j["a"]["max"], j["b"]["max"]) - 1e-6  # one locked scale
+# Bigger leaves and 2 buckets: fewer nodes per ray is not the point; the totals must differ.
+assert j["total_a"] != j["total_b"], "A and B rendered the same"
+print("compare ok:", j["total_a"], j["total_b"])
+PY
+
+# Child order: back-to-front enters more nodes than front-to-back over the view (a few pixels may
+# gain when their closest hit lies in the farther child's box).
+out=$("$accelviz" -q render "$scene" --size 40x30 --out "$tmp/order.png" --compare 'order=back-to-front')
+python3 - "$(sed -n 4p <<<"$out")" <<'PY'
+import json, sys
+j = json.loads(sys.argv[1])
+assert j["total_b"] > j["total_a"], j
+assert j["pixels_b_dearer"] > j["pixels_b_cheaper"], j
+print("order ok:", j["total_a"], j["total_b"])
+PY
+
+# X-ray: the full traversal is a superset of the traversal that stops at the first hit.
+out=$("$accelviz" -q render "$scene" --size 40x30 --metric prims --out "$tmp/xray.png" --compare 'xray=1')
+python3 - "$(sed -n 4p <<<"$out")" <<'PY'
+import json, sys
+j = json.loads(sys.argv[1])
+assert j["total_b"] > j["total_a"] and j["pixels_b_cheaper"] == 0, j
+PY
+
+# Never overwrites: any existing output stops the run before work, files untouched.
+before=$(sha256sum "$tmp/cmp-b.png")
+if "$accelviz" -q render "$scene" --size 48x36 --out "$tmp/cmp.png" --compare 'buckets=4' 2>"$tmp/err"; then
+  echo "FAIL: overwrote without --force"; exit 1
+fi
+grep -q "cmp-a.png: exists (use --force to overwrite)" "$tmp/err" || { echo "FAIL: message"; cat "$tmp/err"; exit 1; }
+[ "$before" = "$(sha256sum "$tmp/cmp-b.png")" ] || { echo "FAIL: B changed"; exit 1; }
+"$accelviz" -q render "$scene" --size 48x36 --out "$tmp/cmp.png" --compare 'buckets=4' --force >/dev/null
+
+# Bad specs: one line naming the key or value, exit 2.
+for spec in 'buckets=1' 'bogus=3' 'structure=nope' 'order=sideways' 'leaf' ''; do
+  rc=0
+  "$accelviz" -q render "$scene" --size 8x8 --out "$tmp/bad.png" --compare "$spec" 2>"$tmp/err" >/dev/null || rc=$?
+  [ "$rc" = 2 ] || { echo "FAIL: '$spec' exit $rc"; cat "$tmp/err"; exit 1; }
+  [ "$(wc -l <"$tmp/err")" -le 2 ] || { echo "FAIL: '$spec' message too long"; cat "$tmp/err"; exit 1; }
+  grep -q -- "--compare" "$tmp/err" || { echo "FAIL: '$spec' message"; cat "$tmp/err"; exit 1; }
+done
+[ ! -e "$tmp/bad-a.png" ] || { echo "FAIL: wrote on a bad spec"; exit 1; }
+echo "ok"
