@@ -9,6 +9,7 @@
 #include "core/accel/bvh/bvh.h"
 
 #include "core/accel/bvh/bvh_slab.h"
+#include "core/accel/bvh/bvh_triangle.h"
 #include "core/accel/bvh/bvh_wide.h"
 
 #include "core/analysis/epo.h"
@@ -41,7 +42,10 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
   stats_.memory_bytes += leaf_tris_.size() * sizeof(Triangle);
   if (opts_.wide_traversal && !nodes_.empty()) {
     wide_ = std::make_unique<bvh_detail::WideBvh>(bvh_detail::collapse_to_wide(nodes_));
-    stats_.memory_bytes += wide_->nodes.size() * sizeof(bvh_detail::WideNode) + wide_->source.size() * sizeof(std::uint32_t);
+    bvh_detail::build_tri4_blocks(*wide_, nodes_, leaf_tris_);
+    stats_.memory_bytes += wide_->nodes.size() * sizeof(bvh_detail::WideNode) + wide_->source.size() * sizeof(std::uint32_t) +
+                           wide_->tri_blocks.size() * sizeof(bvh_detail::TriBlock4) +
+                           wide_->leaf_block.size() * sizeof(std::uint32_t);
     stats_.extra["wide_nodes"] = static_cast<double>(wide_->nodes.size());
   }
   stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -82,7 +86,10 @@ void Bvh::refit(std::span<const Triangle> moved) {
     }
     n.bounds = b;
   }
-  if (wide_) bvh_detail::refit_wide(*wide_, nodes_);
+  if (wide_) {
+    bvh_detail::refit_wide(*wide_, nodes_);
+    bvh_detail::refit_tri4_blocks(leaf_tris_, wide_->tri_blocks);
+  }
   stats_.extra["refit_ms"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   update_quality_stats();
 }
@@ -125,13 +132,16 @@ struct Collector {
   }
 };
 
+using bvh_detail::InlineWatertightRay;
+
+/// The inline twins of triangle.cpp's tests (bvh_triangle.h): same results.
 template <TriangleTest Test>
-inline bool test_triangle(const Ray& ray, const WatertightRay& wr, const Triangle& tri, float tmin, float tmax,
-                          Hit& h) {
+[[gnu::always_inline]] inline bool test_triangle(const Ray& ray, const InlineWatertightRay& wr, const Triangle& tri,
+                                                 float tmin, float tmax, Hit& h) {
   if constexpr (Test == TriangleTest::watertight)
-    return intersect_watertight(ray, wr, tri, tmin, tmax, h);
+    return bvh_detail::intersect_watertight_inline(ray, wr, tri, tmin, tmax, h);
   else
-    return intersect_moller_trumbore(ray, tri, tmin, tmax, h);
+    return bvh_detail::intersect_moller_trumbore_inline(ray, tri, tmin, tmax, h);
 }
 
 /// Leaves of the subtree at `node` whose boxes (and their ancestors' boxes
@@ -190,7 +200,7 @@ Hit traverse(const BvhView& bvh, const Ray& ray, const Collector& c) {
   }
   if constexpr (Collect) c.entered(0, r0, r1);
   // Set up after the root test: most rays of a typical view miss the scene box.
-  const WatertightRay wr = Test == TriangleTest::watertight ? WatertightRay(ray.direction) : WatertightRay();
+  const InlineWatertightRay wr = Test == TriangleTest::watertight ? InlineWatertightRay(ray) : InlineWatertightRay();
 
   std::uint32_t node = 0;
   for (;;) {
@@ -300,14 +310,20 @@ Hit traverse(const BvhView& bvh, const Ray& ray, const Collector& c) {
 /// Stack: at most three entries per wide level, and a wide path is no longer
 /// than the binary one (kBvhMaxDepth).
 template <bool AnyHit, bool Ordered, TriangleTest Test>
-Hit traverse_wide(const bvh_detail::WideNode* wide, const BvhView& bvh, const Ray& ray) {
+Hit traverse_wide(const bvh_detail::WideBvh& wide_bvh, const BvhView& bvh, const Ray& ray) {
   using bvh_detail::WideNode;
+  const WideNode* wide = wide_bvh.nodes.data();
   Hit best;
   const bvh_detail::WideSlabRay wr4(ray);
   const float tmin = ray.tmin;
   float closest = ray.tmax;
-  WatertightRay wr;
+  InlineWatertightRay wr;
   bool wr_ready = Test != TriangleTest::watertight;
+#ifdef ACCELVIZ_BVH_TRI4_SSE2
+  // Watertight leaves: four triangles per test (bvh_tri4.h).
+  constexpr bool kTri4 = Test == TriangleTest::watertight;
+  bvh_detail::Tri4Ray tr4(wr);
+#endif
 
   struct Entry {
     std::uint32_t child, meta;
@@ -333,7 +349,10 @@ Hit traverse_wide(const bvh_detail::WideNode* wide, const BvhView& bvh, const Ra
           slot[k++] = std::countr_zero(static_cast<unsigned>(mask));
           mask &= mask - 1;
         }
-        if constexpr (Ordered) {
+        // Any hit: any occluder ends the walk, so the sort buys little and
+        // costs a data-dependent shuffle per node: slot order (measured on
+        // shadow rays, docs/performance.md).
+        if constexpr (Ordered && !AnyHit) {
           // Insertion sort by entry distance; equal distances keep slot order.
           for (int i = 1; i < k; ++i) {
             const int v = slot[i];
@@ -352,9 +371,52 @@ Hit traverse_wide(const bvh_detail::WideNode* wide, const BvhView& bvh, const Ra
       }
     } else {
       if (!wr_ready) {
-        wr = WatertightRay(ray.direction);
+        wr = InlineWatertightRay(ray);
         wr_ready = true;
+#ifdef ACCELVIZ_BVH_TRI4_SSE2
+        if constexpr (kTri4) tr4 = bvh_detail::Tri4Ray(wr);
+#endif
       }
+#ifdef ACCELVIZ_BVH_TRI4_SSE2
+      if constexpr (kTri4) {
+        // Lanes in slot order are the leaf's triangles in order: the same
+        // sequence of tests and acceptances as the scalar loop below.
+        const bvh_detail::TriBlock4* blk = wide_bvh.tri_blocks.data() + wide_bvh.leaf_block[child];
+        for (std::uint32_t left = meta; left > 0; ++blk) {
+          const int valid = left >= 4 ? 0xF : (1 << left) - 1;
+          left = left >= 4 ? left - 4 : 0;
+          bvh_detail::Tri4Result r;
+          bvh_detail::intersect_tri4(*blk, tr4, tmin, r);
+          int lanes = (r.candidate | r.special) & valid;
+          while (lanes != 0) {
+            const int l = std::countr_zero(static_cast<unsigned>(lanes));
+            lanes &= lanes - 1;
+            const std::uint32_t k = blk->pos[l];
+            Hit h;
+            bool hit;
+            if ((r.special >> l) & 1) {
+              hit = intersect_watertight(ray, wr.wr, bvh.tris[k], tmin, closest, h);
+            } else {
+              hit = bvh_detail::tri4_accept(r, l, closest);
+              h.t = r.t[l];
+              h.u = r.u[l];
+              h.v = r.v[l];
+            }
+            if constexpr (AnyHit) {
+              if (hit) {
+                best = h;
+                best.prim = k;
+                return best;
+              }
+            } else if (hit && h.t < best.t) {
+              best = h;
+              best.prim = k;
+              closest = h.t;
+            }
+          }
+        }
+      } else
+#endif
       for (std::uint32_t k = child, end = child + meta; k < end; ++k) {
         Hit h;
         const bool hit = test_triangle<Test>(ray, wr, bvh.tris[k], tmin, closest, h);
@@ -383,7 +445,7 @@ Hit traverse_wide(const bvh_detail::WideNode* wide, const BvhView& bvh, const Ra
 }
 
 template <bool AnyHit>
-Hit dispatch_wide(const bvh_detail::WideNode* wide, const BvhView& v, const Ray& ray, const QueryOptions& qo) {
+Hit dispatch_wide(const bvh_detail::WideBvh& wide, const BvhView& v, const Ray& ray, const QueryOptions& qo) {
   const bool wt = qo.triangle_test == TriangleTest::watertight;
   if (qo.ordered)
     return wt ? traverse_wide<AnyHit, true, TriangleTest::watertight>(wide, v, ray)
@@ -408,7 +470,7 @@ Hit Bvh::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, Vi
   const BvhView v{nodes_.data(), leaf_tris_.data(), prim_indices_.data(), nodes_.size()};
   Hit h;
   if (stats == nullptr && trace == nullptr && !qo.back_to_front && !qo.xray) {
-    h = wide_ ? dispatch_wide<false>(wide_->nodes.data(), v, ray, qo)
+    h = wide_ ? dispatch_wide<false>(*wide_, v, ray, qo)
               : dispatch<false, false>(v, ray, qo, Collector{nullptr, nullptr});
   } else {
     RayStats local;
@@ -424,7 +486,7 @@ Hit Bvh::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, Vi
 bool Bvh::any_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats) const {
   const BvhView v{nodes_.data(), leaf_tris_.data(), prim_indices_.data(), nodes_.size()};
   if (stats == nullptr && !qo.back_to_front)
-    return wide_ ? dispatch_wide<true>(wide_->nodes.data(), v, ray, qo).valid()
+    return wide_ ? dispatch_wide<true>(*wide_, v, ray, qo).valid()
                  : dispatch<true, false>(v, ray, qo, Collector{nullptr, nullptr}).valid();
   RayStats local;
   return dispatch<true, true>(v, ray, qo, Collector{stats ? stats : &local, nullptr, qo.back_to_front, false})

@@ -27,6 +27,13 @@ struct BuildPrim {
 };
 static_assert(sizeof(BuildPrim) == 40);
 
+/// The quantisation grid of the LBVH's Morton codes: 1024 cells per axis over
+/// the root's centroid bounds (lbvh_builder.cpp).
+struct MortonFrame {
+  glm::vec3 origin{0.0f};
+  float scale[3] = {0.0f, 0.0f, 0.0f};  ///< cells per unit; 0 on a flat axis
+};
+
 /// The options a splitter needs, already validated.
 struct SplitParams {
   int buckets = 16;
@@ -34,6 +41,7 @@ struct SplitParams {
   int leaf_size_cap = 16;
   float cost_traversal = 1.0f;
   float cost_intersect = 1.0f;
+  MortonFrame morton;  ///< lbvh only
 };
 
 enum class SplitOutcome {
@@ -64,6 +72,15 @@ SplitOutcome split_exact_sah(const SplitParams& params, std::span<BuildPrim> pri
                              const Aabb& centroid_bounds, SplitScratch& scratch, SplitResult& out);
 SplitOutcome split_median(const SplitParams& params, std::span<BuildPrim> prims, const Aabb& bounds,
                           const Aabb& centroid_bounds, SplitScratch& scratch, SplitResult& out);
+/// LBVH (lbvh_builder.cpp): cuts a Morton-sorted range at its highest
+/// differing code bit. The range must have been sorted by lbvh_sort.
+SplitOutcome split_lbvh(const SplitParams& params, std::span<BuildPrim> prims, const Aabb& bounds,
+                        const Aabb& centroid_bounds, SplitScratch& scratch, SplitResult& out);
+MortonFrame morton_frame(const Aabb& centroid_bounds);
+/// 30-bit Morton code of a centroid (10 bits per axis, x highest).
+std::uint32_t morton_code(const glm::vec3& centroid, const MortonFrame& frame);
+/// Sorts primitives (given in id order) by (Morton code, id): stable LSD radix sort on `threads` threads.
+void lbvh_sort(std::span<BuildPrim> prims, const MortonFrame& frame, unsigned threads);
 
 /// Bucket contents of one binned SAH pass: bounds (lanes 0..2 used; 16-byte
 /// rows so that the SIMD pass can load and store them whole) and counts, per
