@@ -2,6 +2,7 @@
 # Quick start command 2: install what is missing, build, run every test.
 #   1. Release build, whole suite (core unit + differential tests, CLI tests,
 #      headless GL tests through OSMesa, GUI tests under Xvfb once they exist).
+#   1b. libFuzzer targets for the loaders, bounded time (skip with ACCELVIZ_SKIP_FUZZ=1).
 #   2. Debug + AddressSanitizer + UndefinedBehaviorSanitizer build, whole suite
 #      again (skip with ACCELVIZ_SKIP_SANITIZERS=1 for a quick local run).
 set -euo pipefail
@@ -15,6 +16,13 @@ cmake --preset release >/dev/null
 cmake --build --preset release -j "$jobs"
 echo "== release tests"
 ctest --preset release -j "$jobs"
+
+if [ "${ACCELVIZ_SKIP_FUZZ:-0}" != "1" ]; then
+  # libFuzzer on the glTF/GLB, OBJ and ray-file readers (clang, ASan+UBSan),
+  # ACCELVIZ_FUZZ_SECONDS (default 45) per target, side by side.
+  echo "== fuzz (tests/fuzz/run.sh)"
+  ./tests/fuzz/run.sh
+fi
 
 if [ "${ACCELVIZ_SKIP_SANITIZERS:-0}" != "1" ]; then
   echo "== asan+ubsan build"

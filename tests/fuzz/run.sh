@@ -24,23 +24,34 @@ if [ ! -f "$build/build.ninja" ]; then
 fi
 cmake --build "$build" -j "$(nproc)"
 
+# The targets run side by side (each is one process), so the wall time is
+# about ACCELVIZ_FUZZ_SECONDS whatever the number of targets.
+run_one() {
+  local t="$1"
+  local corpus_in="tests/fuzz/corpus/${t#fuzz_}"
+  local work="$build/corpus/$t"          # grows while fuzzing; the committed seeds stay as they are
+  local artifacts="$build/artifacts/$t"
+  mkdir -p "$work" "$artifacts"
+  ASAN_OPTIONS="detect_leaks=1:allocator_may_return_null=1" UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
+    "$build/$t" "$work" "$corpus_in" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+    -malloc_limit_mb=1024 -max_len=65536 -print_final_stats=1 -artifact_prefix="$artifacts/" \
+    >"$build/$t.log" 2>&1
+}
+
+declare -A pids
+for t in $targets; do
+  echo "== $t: ${seconds}s from tests/fuzz/corpus/${t#fuzz_}"
+  run_one "$t" &
+  pids[$t]=$!
+done
 status=0
 for t in $targets; do
-  corpus_in="tests/fuzz/corpus/${t#fuzz_}"
-  work="$build/corpus/$t"          # grows while fuzzing; the committed seeds stay as they are
-  artifacts="$build/artifacts/$t"
-  mkdir -p "$work" "$artifacts"
-  echo "== $t: ${seconds}s from $corpus_in"
-  if ! ASAN_OPTIONS="detect_leaks=1:allocator_may_return_null=1" UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
-      "$build/$t" "$work" "$corpus_in" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
-      -malloc_limit_mb=1024 -max_len=65536 -print_final_stats=1 -artifact_prefix="$artifacts/" \
-      >"$build/$t.log" 2>&1; then
-    echo "$t: FAILED (log $build/$t.log, reproducer in $artifacts/)" >&2
+  if wait "${pids[$t]}"; then
+    echo "$t: $(grep -E "stat::number_of_executed_units|stat::peak_rss_mb" "$build/$t.log" | tr -s ' ' | tr '\n' ' ')-> OK"
+  else
+    echo "$t: FAILED (log $build/$t.log, reproducer in $build/artifacts/$t/)" >&2
     grep -E "ERROR|SUMMARY|==[0-9]+==|Test unit written" "$build/$t.log" | head -20 >&2 || true
     status=1
-  else
-    grep -E "stat::number_of_executed_units|stat::peak_rss_mb" "$build/$t.log" | tr '\n' ' '
-    echo "-> OK"
   fi
 done
 exit $status
