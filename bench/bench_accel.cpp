@@ -1,0 +1,129 @@
+// Google Benchmark suite: build and traversal of our BVH beside Embree's, on
+// the same triangles and the same rays (issue 11). Not a test: CI only
+// builds it. Run it by hand (Release build):
+//
+//   build/perf/bench/accelviz_gbench --benchmark_filter=Trace
+//   ACCELVIZ_BENCH_SCENE=../shared/assets/bunny.glb build/perf/bench/accelviz_gbench
+//
+// ACCELVIZ_BENCH_SCENE: any scene spec (file or builtin:...); default
+// builtin:teapot?size=100000. Rays: 256x256 primary rays through the
+// scene's framing camera, their diffuse bounces and shadow rays to a
+// synthetic light (core/query/ray_sets.h), generated once from our BVH's
+// hits. items_per_second is rays/s; compare our row with Embree's on the
+// same ray set, as a ratio (docs/performance.md).
+#include <benchmark/benchmark.h>
+
+#include <cstdlib>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/accel/bvh/bvh.h"
+#include "core/accel/embree_backend.h"
+#include "core/accel/factory.h"
+#include "core/query/batch.h"
+#include "core/query/camera.h"
+#include "core/query/ray_sets.h"
+#include "core/scene/load.h"
+
+namespace {
+
+using namespace accelviz;
+
+struct Fixture {
+  Scene scene;
+  std::vector<Ray> rays[3];  // primary, diffuse, shadow
+
+  Fixture() {
+    const char* env = std::getenv("ACCELVIZ_BENCH_SCENE");
+    scene = load_scene(env && *env ? env : "builtin:teapot?size=100000");
+    const int w = 256, h = 256;
+    const Camera cam = frame_bounds(scene.bounds(), 1.0f);
+    rays[0] = primary_rays(cam, w, h);
+    BvhOptions o;
+    o.compute_epo = false;
+    const Bvh bvh(scene.triangles, o);
+    std::vector<Hit> hits(rays[0].size());
+    trace_closest(bvh, rays[0], hits, QueryOptions{}, 0u);
+    rays[1] = diffuse_rays(scene.triangles, rays[0], hits, 1);
+    const Light light = synthetic_bench_light(scene.bounds());
+    rays[2] = shadow_rays(scene.triangles, rays[0], hits, std::span<const Light>(&light, 1));
+  }
+};
+
+const Fixture& fixture() {
+  static const Fixture f;
+  return f;
+}
+
+const char* kSetNames[3] = {"primary", "diffuse", "shadow"};
+
+std::unique_ptr<Accelerator> make(const std::string& name, unsigned threads) {
+  StructureOptions so;
+  so.threads = threads;
+  so.bvh.compute_epo = false;
+  if (name == "lbvh") {
+    so.bvh.splitter = BvhSplitter::lbvh;
+    return build_accelerator("bvh", fixture().scene.triangles, so);
+  }
+  return build_accelerator(name, fixture().scene.triangles, so);
+}
+
+/// Build time; range(0) = threads.
+void build(benchmark::State& state, const std::string& name) {
+  const auto threads = static_cast<unsigned>(state.range(0));
+  const std::size_t n = fixture().scene.triangles.size();
+  for (auto _ : state) {
+    auto accel = make(name, threads);
+    benchmark::DoNotOptimize(accel.get());
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * n));  // triangles/s
+}
+
+/// Single-thread closest hit (any = false) or any hit; range(0) = ray set.
+void trace(benchmark::State& state, const std::string& name, bool any) {
+  const std::vector<Ray>& rays = fixture().rays[state.range(0)];
+  state.SetLabel(kSetNames[state.range(0)]);
+  const auto accel = make(name, 0);
+  std::vector<Hit> hits(rays.size());
+  std::vector<std::uint8_t> occluded(rays.size());
+  for (auto _ : state) {
+    if (any)
+      trace_any(*accel, rays, occluded, QueryOptions{}, 1u);
+    else
+      trace_closest(*accel, rays, hits, QueryOptions{}, 1u);
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * rays.size()));  // rays/s
+}
+
+void register_all() {
+  std::vector<std::string> names = {"bvh", "lbvh"};
+  if (kHaveEmbree) names.push_back("embree");
+  for (const std::string& n : names) {
+    benchmark::RegisterBenchmark(("Build/" + n).c_str(), build, n)
+        ->Arg(1)
+        ->Arg(2)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+    benchmark::RegisterBenchmark(("TraceClosest/" + n).c_str(), trace, n, false)
+        ->DenseRange(0, 2)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();  // the batch may trace on a worker thread: wall time, not this thread's CPU time
+    benchmark::RegisterBenchmark(("TraceAny/" + n).c_str(), trace, n, true)
+        ->DenseRange(0, 2)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();  // the batch may trace on a worker thread: wall time, not this thread's CPU time
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  register_all();
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
