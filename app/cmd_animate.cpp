@@ -32,7 +32,7 @@ int run_animate(const AnimateOptions& o, const GlobalOptions& global) {
   progress.end(std::to_string(scene.instances.size()) + " instances");
   const SceneEffects fx = decide_effects(scene);
   if (!fx.per_frame_updates.on) {
-    std::fprintf(stderr, "accelviz: %s: nothing animates (%s); each frame would cost nothing\n", o.scene.c_str(),
+    std::fprintf(stderr, "accelviz: %s: %s; each frame costs nothing\n", o.scene.c_str(),
                  fx.per_frame_updates.reason.c_str());
   }
   progress.begin("building tlas");

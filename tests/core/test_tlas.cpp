@@ -27,11 +27,20 @@
 
 using namespace accelviz;
 
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define ACCELVIZ_TLAS_HAS_ASAN 1
+#endif
+#endif
+#ifndef ACCELVIZ_TLAS_HAS_ASAN
+#define ACCELVIZ_TLAS_HAS_ASAN 0
+#endif
+
 namespace {
 
 std::size_t ray_count() {
   if (const char* v = std::getenv("ACCELVIZ_TLAS_RAYS")) return static_cast<std::size_t>(std::strtoull(v, nullptr, 10));
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(__SANITIZE_ADDRESS__) || ACCELVIZ_TLAS_HAS_ASAN
   return 100'000;
 #else
   return 1'000'000;
