@@ -42,10 +42,9 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
   stats_.memory_bytes += leaf_tris_.size() * sizeof(Triangle);
   if (opts_.wide_traversal && !nodes_.empty()) {
     wide_ = std::make_unique<bvh_detail::WideBvh>(bvh_detail::collapse_to_wide(nodes_));
-    bvh_detail::build_tri4_blocks(*wide_, nodes_, leaf_tris_);
+    bvh_detail::build_tri4_blocks(*wide_, leaf_tris_);
     stats_.memory_bytes += wide_->nodes.size() * sizeof(bvh_detail::WideNode) + wide_->source.size() * sizeof(std::uint32_t) +
-                           wide_->tri_blocks.size() * sizeof(bvh_detail::TriBlock4) +
-                           wide_->leaf_block.size() * sizeof(std::uint32_t);
+                           wide_->tri_blocks.size() * sizeof(bvh_detail::TriBlock4);
     stats_.extra["wide_nodes"] = static_cast<double>(wide_->nodes.size());
   }
   stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -381,7 +380,7 @@ Hit traverse_wide(const bvh_detail::WideBvh& wide_bvh, const BvhView& bvh, const
       if constexpr (kTri4) {
         // Lanes in slot order are the leaf's triangles in order: the same
         // sequence of tests and acceptances as the scalar loop below.
-        const bvh_detail::TriBlock4* blk = wide_bvh.tri_blocks.data() + wide_bvh.leaf_block[child];
+        const bvh_detail::TriBlock4* blk = wide_bvh.tri_blocks.data() + child;
         for (std::uint32_t left = meta; left > 0; ++blk) {
           const int valid = left >= 4 ? 0xF : (1 << left) - 1;
           left = left >= 4 ? left - 4 : 0;
@@ -417,7 +416,9 @@ Hit traverse_wide(const bvh_detail::WideBvh& wide_bvh, const BvhView& bvh, const
         }
       } else
 #endif
-      for (std::uint32_t k = child, end = child + meta; k < end; ++k) {
+      // A wide leaf slot names its first block; the leaf's triangles are
+      // consecutive in leaf order from the block's first position.
+      for (std::uint32_t k = wide_bvh.tri_blocks[child].pos[0], end = k + meta; k < end; ++k) {
         Hit h;
         const bool hit = test_triangle<Test>(ray, wr, bvh.tris[k], tmin, closest, h);
         if constexpr (AnyHit) {

@@ -93,12 +93,13 @@ WideBvh collapse_to_wide(std::span<const BvhNode> binary) {
   return wide;
 }
 
-void build_tri4_blocks(WideBvh& wide, std::span<const BvhNode> binary, std::span<const Triangle> leaf_tris) {
+void build_tri4_blocks(WideBvh& wide, std::span<const Triangle> leaf_tris) {
   wide.tri_blocks.clear();
   wide.tri_blocks.reserve(leaf_tris.size() / 2 + 1);
-  wide.leaf_block.assign(leaf_tris.size(), 0);
-  for (const BvhNode& n : binary)
-    if (n.count > 0) wide.leaf_block[n.index] = append_tri4_blocks(leaf_tris, n.index, n.count, wide.tri_blocks);
+  for (WideNode& n : wide.nodes)
+    for (int s = 0; s < 4; ++s)
+      if (n.meta[s] != 0 && n.meta[s] != kWideEmpty)
+        n.child[s] = append_tri4_blocks(leaf_tris, n.child[s], n.meta[s], wide.tri_blocks);
   wide.tri_blocks.shrink_to_fit();
 }
 

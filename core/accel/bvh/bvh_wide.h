@@ -38,16 +38,17 @@ inline constexpr std::uint32_t kWideEmpty = 0xFFFFFFFFu;
 struct WideBvh {
   std::vector<WideNode> nodes;        ///< root at 0; empty when the binary tree is
   std::vector<std::uint32_t> source;  ///< 4 per wide node: the binary node each slot copies (kWideEmpty if unused)
-  /// The leaves' triangles as blocks of four (bvh_tri4.h), for the watertight
-  /// fast path: a leaf starting at leaf position p has its
-  /// ceil(count / 4) blocks from tri_blocks[leaf_block[p]] on.
+  /// The leaves' triangles as blocks of four (bvh_tri4.h), for the fast
+  /// path: once build_tri4_blocks has run, a leaf slot's `child` is the
+  /// index of its first block (ceil(meta / 4) consecutive blocks, in the
+  /// order the slots are laid out), no longer its first leaf position.
   std::vector<TriBlock4> tri_blocks;
-  std::vector<std::uint32_t> leaf_block;  ///< indexed by a leaf's first position; other entries unused
 };
 
-/// Fills wide.tri_blocks and wide.leaf_block from the binary leaves and the
-/// leaf-order triangles.
-void build_tri4_blocks(WideBvh& wide, std::span<const BvhNode> binary, std::span<const Triangle> leaf_tris);
+/// Fills wide.tri_blocks from the leaf-order triangles and points every
+/// leaf slot at its first block (collapse_to_wide's leaf slots name leaf
+/// positions; afterwards they name blocks).
+void build_tri4_blocks(WideBvh& wide, std::span<const Triangle> leaf_tris);
 
 /// Collapses a binary node array: each wide node takes a binary inner node's
 /// children and keeps opening the child with the largest surface area until
