@@ -94,6 +94,8 @@ class Gui final : public ScriptHost {
   std::optional<ScriptRunner> script_;
   SweepWorker sweeps_;  ///< the Cost of accuracy panel's sweeps
   panels::AccuracyPanelState accuracy_;
+  RobustnessWorker robustness_;  ///< the Robustness panel's lab runs
+  panels::RobustnessPanelState robustness_panel_;
   std::vector<std::string> dropped_;
   std::vector<KeyPress> keys_;
 
@@ -320,6 +322,23 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
     else
       app_.set_error(err);
   }
+
+  const std::shared_ptr<const RobustnessSnapshot> lab = robustness_.latest();
+  const panels::RobustnessAction ra =
+      panels::robustness_panel(robustness_panel_, lab.get(), robustness_.busy(), app_.config().structure.name, layout);
+  if (ra.cancel) robustness_.cancel();
+  if (ra.run) {
+    if (!app_.current()) {
+      app_.set_error("robustness: no scene shown yet");
+    } else {
+      RobustnessRequest r;
+      r.scene = app_.current()->scene;
+      r.options.rays = static_cast<std::size_t>(robustness_panel_.rays);
+      r.options.structure = robustness_panel_.with_structure ? app_.config().structure.name : "";
+      if (r.options.structure == "voxels" || r.options.structure == "tlas") r.options.structure.clear();
+      robustness_.request(std::move(r));
+    }
+  }
 }
 
 SavedScreenshot Gui::write_frame(const std::optional<std::filesystem::path>& explicit_path) {
@@ -453,7 +472,7 @@ int Gui::run() {
     // Idle (nothing building, tracing or scripted): sleep until input
     // arrives; otherwise keep frames coming so results show up promptly.
     // One more frame after the workers go quiet picks up their last result.
-    const bool busy = script_ || app_.build_status().busy || app_.heatmap_busy() || sweeps_.busy();
+    const bool busy = script_ || app_.build_status().busy || app_.heatmap_busy() || sweeps_.busy() || robustness_.busy();
     if (busy || was_busy_)
       glfwPollEvents();
     else
