@@ -3,12 +3,13 @@
 // traversal reports map to boxes the ray really passes through.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "core/accel/factory.h"
+#include "core/accel/tlas/tlas.h"
 #include "core/query/camera.h"
 #include "core/scene/load.h"
 #include "ui/app/structure_nodes.h"
-
-#include <cmath>
 
 using namespace accelviz;
 
@@ -153,4 +154,29 @@ TEST(AppStructureNodes, StructuresWithoutNodesHaveNone) {
   EXPECT_EQ(t.kind(), "");
   EXPECT_TRUE(t.select({BoxMode::depth, 0, 0, 0}, 10).boxes.empty());
   EXPECT_FALSE(t.box(0).has_value());
+}
+
+// Two-level: the TLAS nodes, then one leaf per instance (its world box)
+// under the TLAS leaf that holds it.
+TEST(StructureNodes, TwoLevelShowsTlasNodesAndOneLeafPerInstance) {
+  const Scene s = make_builtin("forest?size=5000&seed=2");
+  StructureOptions so;
+  so.scene = &s;
+  const auto accel = build_accelerator("tlas", s.triangles, so);
+  const auto& tlas = dynamic_cast<const Tlas&>(*accel);
+  const StructureNodes t = StructureNodes::of(*accel);
+  EXPECT_EQ(t.kind(), "tlas");
+  ASSERT_EQ(t.size(), tlas.tlas_nodes().size() + s.instances.size());
+  std::size_t leaves = 0;
+  for (std::uint32_t i = 0; i < t.size(); ++i) {
+    const StructureNode* n = t.node(i);
+    ASSERT_NE(n, nullptr);
+    if (!n->leaf) continue;
+    ++leaves;
+    EXPECT_GE(i, tlas.tlas_nodes().size()) << "TLAS leaves become parents of their instances";
+    ASSERT_LT(n->parent, tlas.tlas_nodes().size());
+    EXPECT_TRUE(t.node(n->parent)->bounds.contains(n->bounds));
+    EXPECT_GT(n->prims, 0u);
+  }
+  EXPECT_EQ(leaves, s.instances.size());
 }

@@ -1,11 +1,11 @@
 #include "ui/app/build_worker.h"
 
-#include "core/accel/factory.h"
-#include "core/scene/load.h"
-
 #include <algorithm>
 #include <chrono>
 #include <new>
+
+#include "core/accel/factory.h"
+#include "core/scene/load.h"
 
 namespace accelviz {
 namespace {
@@ -159,7 +159,9 @@ BuildOutcome BuildWorker::execute(std::uint64_t id, const BuildRequest& r) {
       fraction_ = std::clamp(f, 0.0, 1.0);
       return !cancelled(id);
     };
-    std::shared_ptr<const Accelerator> accel = build_(scene->scene.triangles, r.structure, progress);
+    StructureChoice choice = r.structure;
+    choice.options.scene = &scene->scene;  // "tlas": two levels from the scene's instances (used during the build only)
+    std::shared_ptr<const Accelerator> accel = build_(scene->scene.triangles, choice, progress);
     if (cancelled(id)) throw BuildCancelled();
     set_stage("node table");
     auto built = std::make_shared<BuiltStructure>();

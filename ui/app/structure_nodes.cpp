@@ -1,12 +1,13 @@
 #include "ui/app/structure_nodes.h"
 
+#include <algorithm>
+
 #include "core/accel/bvh/bvh.h"
 #include "core/accel/grid/grid.h"
 #include "core/accel/kdtree/kdtree.h"
 #include "core/accel/octree/octree.h"
+#include "core/accel/tlas/tlas.h"
 #include "core/accel/voxels/voxels.h"
-
-#include <algorithm>
 
 namespace accelviz {
 namespace {
@@ -44,6 +45,38 @@ StructureNodes StructureNodes::of(const Accelerator& accel) {
           }
     }
     t.finish(bvh->options().cost_traversal, bvh->options().cost_intersect);
+  } else if (const auto* tlas = dynamic_cast<const Tlas*>(&accel)) {
+    // TLAS nodes as a BVH, then one leaf per instance (its world box, the
+    // BLAS triangle count) under the TLAS leaf that holds it: the boxes view
+    // shows the top level, "leaves" shows the instances.
+    t.kind_ = "tlas";
+    const auto nodes = tlas->tlas_nodes();
+    const auto order = tlas->tlas_instance_order();
+    const auto instances = tlas->instances();
+    t.nodes_.resize(nodes.size());
+    for (std::uint32_t i = 0; i < nodes.size(); ++i) {
+      StructureNode& n = t.nodes_[i];
+      n.bounds = nodes[i].bounds;
+      if (!nodes[i].is_leaf()) {
+        for (std::uint32_t c : {nodes[i].index, nodes[i].index + 1})
+          if (c > i && c < nodes.size()) {
+            t.nodes_[c].parent = i;
+            t.nodes_[c].depth = n.depth + 1;
+          }
+        continue;
+      }
+      for (std::uint32_t k = nodes[i].index; k < nodes[i].index + nodes[i].count && k < order.size(); ++k) {
+        const TlasInstance& inst = instances[order[k]];
+        StructureNode leaf;
+        leaf.bounds = inst.world_bounds;
+        leaf.parent = i;
+        leaf.depth = t.nodes_[i].depth + 1;
+        leaf.leaf = true;
+        leaf.prims = static_cast<std::uint32_t>(tlas->blas(inst.blas).leaf_triangles().size());
+        t.nodes_.push_back(leaf);
+      }
+    }
+    t.finish(1.0f, 1.0f);
   } else if (const auto* kd = dynamic_cast<const KdTree*>(&accel)) {
     t.kind_ = "kdtree";
     const auto nodes = kd->nodes();

@@ -5,15 +5,15 @@
 // VisitTrace's node ids into boxes. BVH, K-D tree and octree nodes, the
 // voxel octree's interior nodes and full blocks, the grid's cells; brute
 // force and Embree have none.
-#include "core/accel/accel.h"
-#include "core/math/aabb.h"
-#include "ui/app/app_config.h"
-
 #include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "core/accel/accel.h"
+#include "core/math/aabb.h"
+#include "ui/app/app_config.h"
 
 namespace accelviz {
 
@@ -45,10 +45,11 @@ struct NodeBox {
 class StructureNodes {
  public:
   StructureNodes() = default;
-  /// The table of `accel` (BVH, K-D tree, octree, voxels, grid; empty for the others).
+  /// The table of `accel` (BVH, K-D tree, octree, voxels, grid, two-level: TLAS nodes, then one leaf
+  /// per instance under its TLAS leaf; empty for the others).
   static StructureNodes of(const Accelerator& accel);
 
-  /// "bvh", "kdtree", "octree", "voxels", "grid", or "" when the structure has no nodes to show.
+  /// "bvh", "kdtree", "octree", "voxels", "grid", "tlas", or "" when the structure has no nodes to show.
   const std::string& kind() const { return kind_; }
   bool empty() const { return nodes_.empty() && !grid_; }
   /// Nodes in the table (for a grid: its cells).

@@ -84,6 +84,8 @@ class Tlas final : public Accelerator {
   const Bvh& blas(std::size_t i) const { return *blas_[i]; }
   std::span<const TlasInstance> instances() const { return instances_; }
   std::span<const BvhNode> tlas_nodes() const { return tlas_nodes_; }
+  /// Instance ids in TLAS leaf order (TLAS leaves index this array).
+  std::span<const std::uint32_t> tlas_instance_order() const { return tlas_prims_; }
   /// BLAS index of scene mesh `mesh`, or -1 when no instance references it.
   int blas_of_mesh(std::uint32_t mesh) const;
 
