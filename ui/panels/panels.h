@@ -8,6 +8,7 @@
 #include "ui/app/build_worker.h"
 #include "ui/app/heatmap_worker.h"
 #include "ui/app/ray_inspection.h"
+#include "ui/app/robustness_worker.h"
 #include "ui/app/settings.h"
 #include "ui/app/structure_nodes.h"
 #include "ui/app/sweep_worker.h"
@@ -111,5 +112,22 @@ struct AccuracyAction {
 /// figure vs parameter, table, calibrated constants).
 AccuracyAction accuracy_panel(AccuracyPanelState& state, const SweepSnapshot* snap, bool busy,
                               const std::string& structure, const PanelLayout& layout);
+
+// ---- Robustness (robustness_panel.cpp) ----------------------------------------------
+struct RobustnessPanelState {
+  int rays = 20000;
+  bool with_structure = true;  ///< also the chosen structure's own traversal
+  int variant = 3;             ///< the variant of the per-ray map (3: watertight + padded slab)
+  bool collapsed_at_start = true;
+};
+struct RobustnessAction {
+  bool run = false;
+  bool cancel = false;
+};
+/// Rays field, Run/Cancel, the lab's variants side by side (misses, double
+/// hits, wrong, ms, Mrays/s; by family in a tooltip) and a per-ray status map
+/// of the selected variant.
+RobustnessAction robustness_panel(RobustnessPanelState& state, const RobustnessSnapshot* snap, bool busy,
+                                  const std::string& structure, const PanelLayout& layout);
 
 }  // namespace accelviz::panels

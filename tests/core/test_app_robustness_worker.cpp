@@ -1,0 +1,86 @@
+// RobustnessWorker (ui/app/robustness_worker.h): the Robustness panel's lab
+// runs on a worker thread, publishes its result, and is superseded/cancelled.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
+
+#include "core/scene/load.h"
+#include "ui/app/robustness_worker.h"
+
+using namespace accelviz;
+
+namespace {
+
+std::shared_ptr<const LoadedScene> teapot() {
+  auto s = std::make_shared<LoadedScene>();
+  s->spec = "builtin:teapot?size=1000";
+  s->scene = make_builtin(s->spec);
+  return s;
+}
+
+std::shared_ptr<const RobustnessSnapshot> wait_done(const RobustnessWorker& w) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (w.busy() && std::chrono::steady_clock::now() < until)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_FALSE(w.busy());
+  return w.latest();
+}
+
+}  // namespace
+
+TEST(RobustnessWorker, RunsTheLabInTheBackgroundAndPublishes) {
+  RobustnessWorker w;
+  EXPECT_EQ(w.latest(), nullptr);
+  RobustnessRequest r;
+  r.scene = teapot();
+  r.options.rays = 2000;
+  r.options.structure = "kdtree";
+  const std::uint64_t id = w.request(r);
+  const auto snap = wait_done(w);
+  ASSERT_NE(snap, nullptr);
+  EXPECT_EQ(snap->id, id);
+  EXPECT_EQ(snap->state, RobustnessSnapshot::State::done);
+  ASSERT_TRUE(snap->result.has_value());
+  EXPECT_EQ(snap->result->rays, 2000u);
+  EXPECT_EQ(snap->result->variants.size(), 6u);
+  EXPECT_EQ(snap->scene, "builtin:teapot?size=1000");
+  EXPECT_EQ(snap->result->variants[3].misses, 0u);  // watertight + padded slab
+}
+
+TEST(RobustnessWorker, BadStructureFailsWithOneLine) {
+  RobustnessWorker w;
+  RobustnessRequest r;
+  r.scene = teapot();
+  r.options.rays = 100;
+  r.options.structure = "voxels";
+  w.request(r);
+  const auto snap = wait_done(w);
+  ASSERT_NE(snap, nullptr);
+  EXPECT_EQ(snap->state, RobustnessSnapshot::State::failed);
+  EXPECT_NE(snap->error.find("voxels"), std::string::npos);
+  EXPECT_EQ(snap->error.find('\n'), std::string::npos);
+}
+
+TEST(RobustnessWorker, ANewRequestSupersedesAndCancelStops) {
+  RobustnessWorker w;
+  RobustnessRequest big;
+  big.scene = teapot();
+  big.options.rays = 400000;
+  w.request(big);
+  RobustnessRequest small = big;
+  small.options.rays = 500;
+  const std::uint64_t id = w.request(small);
+  const auto snap = wait_done(w);
+  ASSERT_NE(snap, nullptr);
+  EXPECT_EQ(snap->id, id);
+  ASSERT_TRUE(snap->result.has_value());
+  EXPECT_EQ(snap->result->rays, 500u);
+  w.request(big);
+  w.cancel();
+  const auto c = wait_done(w);
+  ASSERT_NE(c, nullptr);
+  EXPECT_NE(c->state, RobustnessSnapshot::State::running)
+      << "id " << c->id << " error " << c->error << " result " << c->result.has_value();
+  EXPECT_NE(c->state, RobustnessSnapshot::State::failed);
+}
