@@ -5,6 +5,7 @@
 // mouse and keyboard.
 #include "app/gui/gui.h"
 
+#include "app/gui/insight_views.h"
 #include "app/gui/scene_view.h"
 #include "core/scene/load.h"
 #include "ui/app/app_state.h"
@@ -94,6 +95,7 @@ class Gui final : public ScriptHost {
   std::optional<ScriptRunner> script_;
   SweepWorker sweeps_;  ///< the Cost of accuracy panel's sweeps
   panels::AccuracyPanelState accuracy_;
+  InsightViews insight_;         ///< A/B, predicted vs measured, SAH explainer, tree, scenarios
   RobustnessWorker robustness_;  ///< the Robustness panel's lab runs
   panels::RobustnessPanelState robustness_panel_;
   std::vector<std::string> dropped_;
@@ -322,6 +324,7 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
     else
       app_.set_error(err);
   }
+  insight_.draw(app_, layout);
 
   const std::shared_ptr<const RobustnessSnapshot> lab = robustness_.latest();
   const panels::RobustnessAction ra =
@@ -451,6 +454,10 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
     case K::quit:
       quit_ = true;
       return Status::done;
+    case K::scenario:
+    case K::dump_scenario:
+    case K::dump_insight:
+      return insight_.execute(app_, c);
   }
   return Status::done;
 }
@@ -472,7 +479,8 @@ int Gui::run() {
     // Idle (nothing building, tracing or scripted): sleep until input
     // arrives; otherwise keep frames coming so results show up promptly.
     // One more frame after the workers go quiet picks up their last result.
-    const bool busy = script_ || app_.build_status().busy || app_.heatmap_busy() || sweeps_.busy() || robustness_.busy();
+    const bool busy = script_ || app_.build_status().busy || app_.heatmap_busy() || sweeps_.busy() || insight_.busy() ||
+                      robustness_.busy();
     if (busy || was_busy_)
       glfwPollEvents();
     else

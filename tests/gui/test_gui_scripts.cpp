@@ -371,3 +371,47 @@ TEST_F(GuiScript, SceneArgumentOpensBeforeTheScript) {
   EXPECT_EQ(j["structure"], "bvh");
   EXPECT_EQ(j["camera"], "") << "the default view";
 }
+
+// Insight views: the Scenarios window measures the lecture's cases, moving
+// its slider moves the figures the documented way (rotated walls cost the
+// BVH more than aligned ones), and the view's insight (predicted vs
+// measured, traversal modes, hot nodes, SAH explainer) is consistent.
+TEST_F(GuiScript, InsightScenariosAndPredictedVsMeasured) {
+  const RunResult r = run(std::string("open ") + kTeapot + "\n" + "size 640 480\ncamera " + kCamera +
+                          "\nwait\n"
+                          "scenario walls 0\n"
+                          "dump-scenario " +
+                          path("aligned.json").string() +
+                          "\n"
+                          "scenario walls 45\n"
+                          "dump-scenario " +
+                          path("rotated.json").string() +
+                          "\n"
+                          "dump-insight " +
+                          path("insight.json").string() + "\nquit\n");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json a = read_json(path("aligned.json")), b = read_json(path("rotated.json"));
+  ASSERT_EQ(a["rows"].size(), 1u);
+  ASSERT_EQ(b["rows"].size(), 1u);
+  EXPECT_EQ(a["value"], 0.0);
+  EXPECT_EQ(b["value"], 45.0);
+  EXPECT_GT(b["rows"][0]["cost_per_ray"].get<double>(), a["rows"][0]["cost_per_ray"].get<double>());
+  EXPECT_GT(b["rows"][0]["leaf_volume_ratio"].get<double>(), a["rows"][0]["leaf_volume_ratio"].get<double>());
+
+  const nlohmann::json in = read_json(path("insight.json"));
+  ASSERT_TRUE(in["is_bvh"].get<bool>());
+  EXPECT_GT(in["cost"]["sah"].get<double>(), 1.0);
+  EXPECT_GT(in["cost"]["root_rays"].get<int>(), 0);
+  EXPECT_GT(in["cost"]["cost_per_ray"].get<double>(), 1.0);
+  const auto& m = in["modes"];
+  EXPECT_GE(m["back-to-front"]["nodes_per_ray"].get<double>(), m["front-to-back"]["nodes_per_ray"].get<double>());
+  EXPECT_GE(m["x-ray"]["prims_per_ray"].get<double>(), m["front-to-back"]["prims_per_ray"].get<double>());
+  EXPECT_EQ(m["x-ray"]["culled_per_ray"].get<double>(), 0.0);
+  EXPECT_GT(m["front-to-back"]["culled_per_ray"].get<double>(), 0.0);
+  ASSERT_FALSE(in["hot"].empty());
+  EXPECT_EQ(in["hot"][0]["node"], 0);  // every ray that enters anything enters the root
+  EXPECT_EQ(in["hot"][0]["visits"].get<int>(), in["cost"]["root_rays"].get<int>());
+  EXPECT_EQ(in["explainer"]["node"], 0);
+  EXPECT_GT(in["explainer"]["prims"].get<int>(), 1000);
+  EXPECT_EQ(in["explainer"]["decision"], "split");
+}

@@ -1,13 +1,15 @@
 #include "ui/app/script.h"
 
-#include "core/accel/factory.h"
-#include "ui/app/app_config.h"
-
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
+
+#include "core/accel/factory.h"
+#include "ui/app/app_config.h"
+#include "ui/app/scenarios.h"
 
 namespace accelviz {
 namespace {
@@ -81,6 +83,9 @@ constexpr NamedKind kCommands[] = {
     {"dump-ray", ScriptCommand::Kind::dump_ray},
     {"dump-stats", ScriptCommand::Kind::dump_stats},
     {"quit", ScriptCommand::Kind::quit},
+    {"scenario", ScriptCommand::Kind::scenario},
+    {"dump-scenario", ScriptCommand::Kind::dump_scenario},
+    {"dump-insight", ScriptCommand::Kind::dump_insight},
 };
 
 }  // namespace
@@ -114,7 +119,9 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
         std::find_if(std::begin(kCommands), std::end(kCommands), [&](const NamedKind& c) { return c.name == word; });
     if (it == std::end(kCommands))
       fail("unknown command '" + std::string(word) +
-           "' (valid: open, structure, set, camera, size, wait, click, step, screenshot, dump-ray, dump-stats, quit)");
+           "' (valid: open, structure, set, camera, size, wait, click, step, screenshot, dump-ray, dump-stats, quit, "
+           "scenario, dump-scenario, "
+           "dump-insight)");
 
     ScriptCommand c;
     c.kind = it->kind;
@@ -132,6 +139,8 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
       case ScriptCommand::Kind::screenshot:
       case ScriptCommand::Kind::dump_ray:
       case ScriptCommand::Kind::dump_stats:
+      case ScriptCommand::Kind::dump_scenario:
+      case ScriptCommand::Kind::dump_insight:
         // The rest of the line, so paths may hold spaces.
         need_rest(c.kind == ScriptCommand::Kind::open ? "a scene (file or builtin:NAME)" : "a file path");
         c.arg = std::string(rest);
@@ -187,6 +196,25 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
       case ScriptCommand::Kind::quit:
         no_rest();
         break;
+      case ScriptCommand::Kind::scenario: {
+        std::string_view value;
+        const std::string_view id = first_word(rest, value);
+        if (id.empty()) fail("scenario: expected NAME [VALUE]");
+        const Scenario* sc = find_scenario(id);
+        if (!sc) {
+          std::string names;
+          for (const Scenario& x : scenarios()) names += (names.empty() ? "" : ", ") + x.id;
+          fail("scenario: unknown '" + std::string(id) + "' (valid: " + names + ")");
+        }
+        c.arg = std::string(id);
+        c.value = value.empty() ? std::to_string(sc->initial) : std::string(value);
+        char* end = nullptr;
+        const float v = std::strtof(c.value.c_str(), &end);
+        if (end == c.value.c_str() || *end != '\0' || !(v >= sc->min && v <= sc->max))
+          fail("scenario " + c.arg + ": value '" + c.value + "' is not a number in " + std::to_string(sc->min) + ".." +
+               std::to_string(sc->max));
+        break;
+      }
     }
     out.push_back(std::move(c));
   }

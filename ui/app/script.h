@@ -12,7 +12,23 @@
 namespace accelviz {
 
 struct ScriptCommand {
-  enum class Kind { open, structure, set, camera, size, wait, click, step, screenshot, dump_ray, dump_stats, quit };
+  enum class Kind {
+    open,
+    structure,
+    set,
+    camera,
+    size,
+    wait,
+    click,
+    step,
+    screenshot,
+    dump_ray,
+    dump_stats,
+    quit,
+    scenario,       ///< arg: scenario id, value: slider value (insight: Scenarios window)
+    dump_scenario,  ///< arg: path; waits for the scenario's run, writes its figures
+    dump_insight,   ///< arg: path; measures the view (predicted vs measured, modes, hot nodes, explainer), writes JSON
+  };
   Kind kind = Kind::wait;
   int line = 0;       ///< 1-based line in the script file
   std::string text;   ///< the line as written (trimmed), for messages

@@ -1,0 +1,230 @@
+#include "app/gui/insight_views.h"
+
+#include <stdexcept>
+
+#include "core/accel/bvh/bvh.h"
+#include "ui/app/settings.h"
+
+namespace accelviz {
+
+namespace {
+
+std::uint32_t selected_node(const AppState& app) {
+  const int n = app.config().view.box_node;
+  return n > 0 ? static_cast<std::uint32_t>(n) : 0u;
+}
+
+void select_node(AppState& app, std::uint32_t id) {
+  ViewSettings& v = app.config().view;
+  v.show_boxes = true;
+  v.box_mode = BoxMode::subtree;
+  v.box_node = static_cast<int>(id);
+}
+
+nlohmann::json figures_json(const ScenarioFigures& f) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const ScenarioRow& r : f.rows)
+    rows.push_back({{"structure", r.structure},
+                    {"triangles", r.triangles},
+                    {"build_ms", r.build_ms},
+                    {"sah", r.sah},
+                    {"nodes_per_ray", r.nodes_per_ray},
+                    {"prims_per_ray", r.prims_per_ray},
+                    {"cost_per_ray", r.cost_per_ray},
+                    {"leaf_volume_ratio", r.leaf_volume_ratio},
+                    {"max_depth", r.max_depth}});
+  return {{"id", f.id}, {"value", f.value}, {"scene", f.scene}, {"rows", rows}, {"summary", f.summary}};
+}
+
+}  // namespace
+
+bool InsightViews::busy() {
+  return ab_job_.busy() || insight_job_.busy() || scenario_job_.busy();
+}
+
+void InsightViews::request_insight(AppState& app) {
+  ViewInsightRequest r;
+  r.built = app.current();
+  r.camera = app.camera();
+  if (app.view_width() > 0 && app.view_height() > 0)
+    r.height = std::max(16, r.width * app.view_height() / app.view_width());
+  insight_job_.request([r](const std::atomic<bool>& cancel) { return run_view_insight(r, cancel); });
+}
+
+const SplitExplanation* InsightViews::explanation(const AppState& app, std::string& note) {
+  const BuiltStructure* built = app.current().get();
+  const Bvh* bvh = built ? dynamic_cast<const Bvh*>(built->accel.get()) : nullptr;
+  if (!bvh || bvh->nodes().empty()) {
+    note = "The explainer needs a BVH (Structure: bvh).";
+    explanation_.reset();
+    explained_for_ = nullptr;
+    return nullptr;
+  }
+  const std::uint32_t node =
+      std::min<std::uint32_t>(selected_node(app), static_cast<std::uint32_t>(bvh->nodes().size() - 1));
+  if (built != explained_for_ || node != explained_node_ || explainer_.buckets != explained_buckets_) {
+    BvhOptions o = bvh->options();
+    o.buckets = explainer_.buckets;
+    try {
+      explanation_ = explain_bvh_node(*bvh, node, o);
+      explanation_note_ =
+          "Tree built with " + std::string(to_string(o.splitter)) +
+          (bvh->options().splitter == BvhSplitter::binned_sah ? " B=" + std::to_string(bvh->options().buckets)
+                                                              : std::string()) +
+          "; explaining node " + std::to_string(node) +
+          " (select one in the Tree or hot-node list) "
+          "with B=" +
+          std::to_string(explainer_.buckets) + ".";
+    } catch (const std::exception& e) {
+      explanation_.reset();
+      explanation_note_ = e.what();
+    }
+    explained_for_ = built;
+    explained_node_ = node;
+    explained_buckets_ = explainer_.buckets;
+  }
+  note = explanation_note_;
+  return explanation_ ? &*explanation_ : nullptr;
+}
+
+void InsightViews::draw(AppState& app, const panels::PanelLayout& layout) {
+  // A/B.
+  const auto ab_result = ab_job_.result();
+  const panels::ABAction aa =
+      panels::ab_panel(ab_, ab_result.get(), ab_job_.busy(), ab_job_.error(), app.config().structure, layout);
+  if (aa.pin) {
+    ab_.pinned = app.config().structure;
+    app.set_message("pinned " + describe_choice(*ab_.pinned) + " as A");
+  }
+  if (aa.compare && ab_.pinned && app.current()) {
+    ABRequest r;
+    r.scene = app.current()->scene;
+    r.a = *ab_.pinned;
+    r.b = app.config().structure;
+    r.camera = app.camera();
+    r.width = ab_.width;
+    r.height = app.view_width() > 0 ? std::max(16, ab_.width * app.view_height() / app.view_width()) : ab_.height;
+    r.metric = ab_.metric == 1 ? HeatMetric::prims : ab_.metric == 2 ? HeatMetric::cost : HeatMetric::nodes;
+    ab_job_.request([r](const std::atomic<bool>& cancel) { return run_ab(r, cancel); });
+  }
+
+  // Predicted vs measured, hot nodes.
+  const auto insight = insight_job_.result();
+  const ViewInsight* shown = insight && insight->built == app.current() ? insight.get() : nullptr;
+  const panels::InsightAction ia =
+      panels::insight_panel(shown, insight_job_.busy(), insight_job_.error(), selected_node(app), layout);
+  if (ia.refresh && app.current()) request_insight(app);
+  if (ia.select) select_node(app, *ia.select);
+
+  // Explainer.
+  std::string note;
+  const SplitExplanation* e = explanation(app, note);
+  panels::explainer_panel(explainer_, e, explained_node_, note, layout);
+
+  // Tree.
+  if (const auto pick = panels::tree_panel(app.current() ? &app.current()->nodes : nullptr,
+                                           shown ? &shown->visits : nullptr, selected_node(app), layout))
+    select_node(app, *pick);
+
+  // Scenarios.
+  const panels::ScenarioAction sa =
+      panels::scenarios_panel(scenario_, scenario_job_.figures() ? &*scenario_job_.figures() : nullptr,
+                              scenario_job_.busy(), scenario_job_.error(), layout);
+  if (sa.run && scenario_.current >= 0)
+    scenario_job_.request(scenarios()[static_cast<std::size_t>(scenario_.current)], scenario_.value, {});
+  if (sa.open) app.open_scene(*sa.open);
+}
+
+nlohmann::json InsightViews::insight_json(const AppState& app) {
+  const auto insight = insight_job_.result();
+  nlohmann::json j;
+  if (!insight) return {{"error", insight_job_.error()}};
+  const ViewInsight& v = *insight;
+  j["rays"] = v.record.pixel_count();
+  j["width"] = v.record.width;
+  j["height"] = v.record.height;
+  j["is_bvh"] = v.is_bvh;
+  if (v.is_bvh)
+    j["cost"] = {{"sah", v.cost.sah},
+                 {"epo", std::isfinite(v.cost.epo) ? nlohmann::json(v.cost.epo) : nlohmann::json()},
+                 {"root_rays", v.cost.root_rays},
+                 {"nodes_per_ray", v.cost.nodes_per_ray},
+                 {"inner_per_ray", v.cost.inner_per_ray},
+                 {"prims_per_ray", v.cost.prims_per_ray},
+                 {"cost_per_ray", v.cost.cost_per_ray},
+                 {"ratio", v.cost.ratio}};
+  nlohmann::json modes = nlohmann::json::object();
+  for (const ModeTotals& m : v.modes)
+    modes[std::string(mode_name(m.mode))] = {
+        {"nodes_per_ray", m.per_ray(m.nodes_visited)},           {"missed_per_ray", m.per_ray(m.nodes_missed)},
+        {"culled_per_ray", m.per_ray(m.nodes_culled)},           {"prims_per_ray", m.per_ray(m.prim_tests)},
+        {"leaves_skipped_per_ray", m.per_ray(m.leaves_skipped)}, {"hits", m.hits}};
+  j["modes"] = modes;
+  nlohmann::json hot = nlohmann::json::array();
+  for (const HotNode& h : v.hot) hot.push_back({{"node", h.node}, {"visits", h.visits}});
+  j["hot"] = hot;
+  std::string note;
+  if (const SplitExplanation* e = explanation(app, note)) {
+    nlohmann::json axes = nlohmann::json::array();
+    for (const AxisExplanation& ax : e->axes) {
+      nlohmann::json counts = nlohmann::json::array(), costs = nlohmann::json::array();
+      for (const BucketInfo& b : ax.buckets) counts.push_back(b.count);
+      for (const double c : ax.cost) costs.push_back(std::isfinite(c) ? nlohmann::json(c) : nlohmann::json());
+      axes.push_back({{"usable", ax.usable}, {"counts", counts}, {"cost", costs}});
+    }
+    j["explainer"] = {{"node", explained_node_},
+                      {"buckets", e->buckets},
+                      {"prims", e->prims},
+                      {"decision", to_string(e->decision)},
+                      {"chosen_axis", e->chosen_axis},
+                      {"chosen_plane", e->chosen_plane},
+                      {"leaf_cost", e->leaf_cost},
+                      {"split_cost", std::isfinite(e->split_cost) ? nlohmann::json(e->split_cost) : nlohmann::json()},
+                      {"axes", axes}};
+  }
+  return j;
+}
+
+ScriptHost::Status InsightViews::execute(AppState& app, const ScriptCommand& c) {
+  using K = ScriptCommand::Kind;
+  switch (c.kind) {
+    case K::scenario: {
+      const auto& all = scenarios();
+      for (std::size_t i = 0; i < all.size(); ++i)
+        if (all[i].id == c.arg) {
+          scenario_.current = static_cast<int>(i);
+          scenario_.value = std::stof(c.value);
+          scenario_job_.request(all[i], scenario_.value, {});
+          return ScriptHost::Status::done;
+        }
+      throw std::runtime_error("scenario: unknown '" + c.arg + "'");
+    }
+    case K::dump_scenario: {
+      if (scenario_job_.busy()) return ScriptHost::Status::again;
+      if (!scenario_job_.error().empty()) throw std::runtime_error("scenario: " + scenario_job_.error());
+      if (!scenario_job_.figures()) throw std::runtime_error("dump-scenario: no scenario run yet (use scenario first)");
+      if (const std::string err = write_file_atomic(c.arg, figures_json(*scenario_job_.figures()).dump(2) + "\n");
+          !err.empty())
+        throw std::runtime_error(err);
+      return ScriptHost::Status::done;
+    }
+    case K::dump_insight: {
+      if (!script_insight_requested_) {
+        if (!app.settled() || !app.current()) return ScriptHost::Status::again;
+        request_insight(app);
+        script_insight_requested_ = true;
+        return ScriptHost::Status::again;
+      }
+      if (insight_job_.busy()) return ScriptHost::Status::again;
+      script_insight_requested_ = false;
+      if (!insight_job_.error().empty()) throw std::runtime_error("insight: " + insight_job_.error());
+      if (const std::string err = write_file_atomic(c.arg, insight_json(app).dump(2) + "\n"); !err.empty())
+        throw std::runtime_error(err);
+      return ScriptHost::Status::done;
+    }
+    default:
+      return ScriptHost::Status::done;
+  }
+}
+
+}  // namespace accelviz

@@ -1,0 +1,398 @@
+// Insight panels: A/B comparison, predicted vs measured cost with hot nodes
+// and traversal modes, the binned-SAH explainer and the tree view. Images
+// and charts are drawn with ImGui draw lists (no GL here).
+#include "ui/panels/insight_panels.h"
+
+#include <imgui.h>
+
+#include <algorithm>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace accelviz::panels {
+namespace {
+
+void place_at(const PanelLayout& l, float x, float y, float w, float h) {
+  const float s = l.scale;
+  ImGui::SetNextWindowPos(ImVec2(x >= 0.0f ? x * s : l.width + x * s, y * s), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(w * s, h * s), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowCollapsed(true, ImGuiCond_FirstUseEver);
+}
+
+ImU32 to_u32(const glm::u8vec3& c) {
+  return IM_COL32(c.x, c.y, c.z, 255);
+}
+
+// Draws columns [x0, x1) of a metric image at `cell` pixels per image pixel,
+// merging runs of equal colour; `color` maps a value to a colour.
+template <typename ColorFn>
+void draw_image(ImDrawList* dl, ImVec2 at, const MetricImage& img, float cell, int x0, int x1, ColorFn color) {
+  for (int y = 0; y < img.height; ++y) {
+    int run_start = x0;
+    ImU32 run_color = 0;
+    for (int x = x0; x <= x1; ++x) {
+      const ImU32 c = x < x1 ? to_u32(color(img.at(x, y))) : 0;
+      if (x == x0) {
+        run_color = c;
+        continue;
+      }
+      if (c != run_color || x == x1) {
+        dl->AddRectFilled(ImVec2(at.x + run_start * cell, at.y + y * cell),
+                          ImVec2(at.x + x * cell, at.y + (y + 1) * cell), run_color);
+        run_start = x;
+        run_color = c;
+      }
+    }
+  }
+}
+
+const char* kMetricNames[] = {"nodes", "prims", "cost"};
+
+}  // namespace
+
+// ---- A/B ------------------------------------------------------------------------------
+
+ABAction ab_panel(ABPanelState& st, const ABResult* r, bool busy, const std::string& error,
+                  const StructureChoice& current, const PanelLayout& layout) {
+  ABAction act;
+  place_at(layout, 330.0f, 60.0f, 560.0f, 430.0f);
+  if (!ImGui::Begin("A/B compare")) {
+    ImGui::End();
+    return act;
+  }
+  if (ImGui::Button("Pin current as A")) act.pin = true;
+  ImGui::SameLine();
+  ImGui::BeginDisabled(!st.pinned || busy);
+  if (ImGui::Button("Compare with B (current)")) act.compare = true;
+  ImGui::EndDisabled();
+  ImGui::TextWrapped("A: %s", st.pinned ? describe_choice(*st.pinned).c_str() : "(not pinned)");
+  ImGui::TextWrapped("B: %s", describe_choice(current).c_str());
+  ImGui::SetNextItemWidth(120.0f * layout.scale);
+  ImGui::Combo("metric", &st.metric, kMetricNames, 3);
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(160.0f * layout.scale);
+  ImGui::Combo("display", &st.display, "side by side\0split\0difference B - A\0");
+  if (st.display == 1) ImGui::SliderFloat("split", &st.split, 0.0f, 1.0f, "%.2f");
+  if (busy) ImGui::TextDisabled("building and tracing A and B ...");
+  if (!error.empty()) ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.4f, 1.0f), "%s", error.c_str());
+  if (r && r->image_a.width > 0) {
+    const ABFigures& f = r->figures;
+    ImGui::Text("totals  A %.0f   B %.0f   B/A %.3f", f.total_a, f.total_b,
+                f.total_a > 0 ? f.total_b / f.total_a : 0.0);
+    ImGui::Text("mean per ray  A %.2f   B %.2f   (%s)", f.mean_a, f.mean_b,
+                std::string(metric_name(r->image_a.metric)).c_str());
+    ImGui::Text("pixels  B cheaper %" PRIu64 "   B dearer %" PRIu64 "   locked scale 0..%.3g", f.b_cheaper, f.b_dearer,
+                static_cast<double>(r->locked_max));
+    ImGui::Text("build ms  A %.1f   B %.1f    SAH  A %.2f   B %.2f", r->build_ms_a, r->build_ms_b, r->sah_a, r->sah_b);
+    const float avail = ImGui::GetContentRegionAvail().x;
+    const int w = r->image_a.width, h = r->image_a.height;
+    const float cell =
+        std::max(1.0f, std::floor((st.display == 0 ? avail / 2.0f - 4.0f : avail) / static_cast<float>(w)));
+    ImDrawList* dl = ImGui::GetWindowDrawList();
+    const ImVec2 at = ImGui::GetCursorScreenPos();
+    ColorizeOptions co;
+    const auto seq = [&](float v) { return heatmap_color(r->image_a.metric, v, r->locked_max, co); };
+    if (st.display == 0) {
+      draw_image(dl, at, r->image_a, cell, 0, w, seq);
+      draw_image(dl, ImVec2(at.x + w * cell + 8.0f, at.y), r->image_b, cell, 0, w, seq);
+      ImGui::Dummy(ImVec2(2 * w * cell + 8.0f, h * cell));
+      ImGui::Text("A (left), B (right), one colour scale");
+    } else if (st.display == 1) {
+      const int cut = std::clamp(static_cast<int>(std::lround(st.split * w)), 0, w);
+      draw_image(dl, at, r->image_a, cell, 0, cut, seq);
+      draw_image(dl, at, r->image_b, cell, cut, w, seq);
+      dl->AddLine(ImVec2(at.x + cut * cell, at.y), ImVec2(at.x + cut * cell, at.y + h * cell),
+                  IM_COL32(255, 255, 255, 255));
+      ImGui::Dummy(ImVec2(w * cell, h * cell));
+      ImGui::Text("A left of the line, B right of it");
+    } else {
+      const float s = r->diff_scale;
+      draw_image(dl, at, r->diff, cell, 0, w, [s](float v) { return difference_color(v, s, glm::vec3(0.3f)); });
+      ImGui::Dummy(ImVec2(w * cell, h * cell));
+      ImGui::Text("B - A: blue B cheaper, red B dearer, scale +-%.3g", static_cast<double>(s));
+    }
+  }
+  ImGui::End();
+  return act;
+}
+
+// ---- Predicted vs measured ----------------------------------------------------------------
+
+InsightAction insight_panel(const ViewInsight* v, bool busy, const std::string& error, std::uint32_t selected,
+                            const PanelLayout& layout) {
+  InsightAction act;
+  place_at(layout, 330.0f, 100.0f, 470.0f, 480.0f);
+  if (!ImGui::Begin("Predicted vs measured")) {
+    ImGui::End();
+    return act;
+  }
+  if (ImGui::Button(busy ? "Measuring ..." : "Measure this view")) act.refresh = true;
+  if (!error.empty()) ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.4f, 1.0f), "%s", error.c_str());
+  if (!v) {
+    ImGui::TextWrapped("Traces the view's primary rays (128 x 96) with every visit recorded.");
+    ImGui::End();
+    return act;
+  }
+  if (v->is_bvh) {
+    const CostComparison& c = v->cost;
+    if (ImGui::BeginTable("cost", 2, ImGuiTableFlags_RowBg)) {
+      const auto row2 = [](const char* name, const char* fmt, double x) {
+        ImGui::TableNextRow();
+        ImGui::TableSetColumnIndex(0);
+        ImGui::TextUnformatted(name);
+        ImGui::TableSetColumnIndex(1);
+        ImGui::Text(fmt, x);
+      };
+      row2("SAH expected cost / ray", "%.3f", c.sah);
+      row2("EPO", "%.3f", c.epo);
+      row2("measured cost / ray", "%.3f", c.cost_per_ray);
+      row2("measured / SAH", "%.3f", c.ratio);
+      row2("nodes entered / ray", "%.3f", c.nodes_per_ray);
+      row2("inner nodes / ray", "%.3f", c.inner_per_ray);
+      row2("primitive tests / ray", "%.3f", c.prims_per_ray);
+      row2("rays hitting the root", "%.0f", static_cast<double>(c.root_rays));
+      ImGui::EndTable();
+    }
+    ImGui::TextDisabled("Measured over the rays that enter the root box, the SAH's condition.");
+  } else {
+    ImGui::TextDisabled("SAH prediction: BVH only.");
+  }
+  ImGui::Separator();
+  ImGui::TextUnformatted("Traversal modes (per ray)");
+  if (ImGui::BeginTable("modes", 6, ImGuiTableFlags_RowBg | ImGuiTableFlags_Borders)) {
+    for (const char* h : {"mode", "entered", "missed", "culled", "prims", "skipped"}) ImGui::TableSetupColumn(h);
+    ImGui::TableHeadersRow();
+    for (const ModeTotals& m : v->modes) {
+      ImGui::TableNextRow();
+      ImGui::TableSetColumnIndex(0);
+      ImGui::TextUnformatted(std::string(mode_name(m.mode)).c_str());
+      const std::uint64_t vals[] = {m.nodes_visited, m.nodes_missed, m.nodes_culled, m.prim_tests, m.leaves_skipped};
+      for (int k = 0; k < 5; ++k) {
+        ImGui::TableSetColumnIndex(k + 1);
+        ImGui::Text("%.2f", m.per_ray(vals[k]));
+      }
+    }
+    ImGui::EndTable();
+  }
+  ImGui::Separator();
+  ImGui::TextUnformatted("Hot nodes (click to select)");
+  if (ImGui::BeginTable("hot", 5, ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY,
+                        ImVec2(0.0f, 160.0f * layout.scale))) {
+    for (const char* h : {"node", "visits", "depth", "p(SA)", "measured"}) ImGui::TableSetupColumn(h);
+    ImGui::TableHeadersRow();
+    for (const HotNode& hn : v->hot) {
+      ImGui::TableNextRow();
+      ImGui::TableSetColumnIndex(0);
+      char label[32];
+      std::snprintf(label, sizeof label, "%u", hn.node);
+      if (ImGui::Selectable(label, hn.node == selected, ImGuiSelectableFlags_SpanAllColumns)) act.select = hn.node;
+      ImGui::TableSetColumnIndex(1);
+      ImGui::Text("%" PRIu64, hn.visits);
+      ImGui::TableSetColumnIndex(2);
+      const StructureNode* n = v->built ? v->built->nodes.node(hn.node) : nullptr;
+      ImGui::Text("%u", n ? n->depth : 0u);
+      ImGui::TableSetColumnIndex(3);
+      if (hn.node < v->predicted.size()) ImGui::Text("%.3f", v->predicted[hn.node]);
+      ImGui::TableSetColumnIndex(4);
+      if (hn.node < v->measured.size()) ImGui::Text("%.3f", v->measured[hn.node]);
+    }
+    ImGui::EndTable();
+  }
+  // The pixels whose rays entered the selected node.
+  if (v->record.width > 0 && selected < v->visits.size()) {
+    ImGui::Text("Pixels whose rays entered node %u (%" PRIu64 " rays):", selected, v->visits[selected]);
+    const std::vector<std::uint8_t> mask = pixels_visiting(v->record, selected);
+    const float cell = 2.0f;
+    ImDrawList* dl = ImGui::GetWindowDrawList();
+    const ImVec2 at = ImGui::GetCursorScreenPos();
+    dl->AddRectFilled(at, ImVec2(at.x + v->record.width * cell, at.y + v->record.height * cell),
+                      IM_COL32(40, 40, 40, 255));
+    for (int y = 0; y < v->record.height; ++y)
+      for (int x = 0; x < v->record.width; ++x)
+        if (mask[static_cast<std::size_t>(y) * v->record.width + x])
+          dl->AddRectFilled(ImVec2(at.x + x * cell, at.y + y * cell),
+                            ImVec2(at.x + (x + 1) * cell, at.y + (y + 1) * cell), IM_COL32(255, 190, 60, 255));
+    ImGui::Dummy(ImVec2(v->record.width * cell, v->record.height * cell));
+  }
+  ImGui::End();
+  return act;
+}
+
+// ---- Explainer -------------------------------------------------------------------------------
+
+bool explainer_panel(ExplainerState& st, const SplitExplanation* e, std::uint32_t node, const std::string& note,
+                     const PanelLayout& layout) {
+  place_at(layout, 330.0f, 140.0f, 520.0f, 460.0f);
+  bool changed = false;
+  if (!ImGui::Begin("SAH explainer")) {
+    ImGui::End();
+    return false;
+  }
+  changed = ImGui::SliderInt("buckets B", &st.buckets, 2, 64, "%d", ImGuiSliderFlags_AlwaysClamp);
+  ImGui::Combo("axis", &st.axis, "x\0y\0z\0");
+  ImGui::SameLine();
+  if (ImGui::SmallButton("chosen")) st.axis = -1;
+  if (!note.empty()) ImGui::TextWrapped("%s", note.c_str());
+  if (!e) {
+    ImGui::End();
+    return changed;
+  }
+  ImGui::Text("node %u: %zu primitives, decision: %s", node, e->prims, to_string(e->decision));
+  ImGui::Text("leaf cost C_isect*N = %.3f   best split = %.3f%s", e->leaf_cost, e->split_cost,
+              e->leaf_allowed ? "" : "  (too many for a leaf)");
+  if (e->decision == SplitDecision::unsplittable)
+    ImGui::TextWrapped(
+        "All centroids lie in one bucket on every axis: the SAH cannot separate them; the builder "
+        "falls back to an object median split.");
+  const int axis = st.axis >= 0 ? st.axis : std::max(0, e->chosen_axis);
+  const AxisExplanation& ax = e->axes[axis];
+  if (!ax.usable) {
+    ImGui::Text("axis %c: centroids do not spread (no candidate planes)", "xyz"[axis]);
+    ImGui::End();
+    return changed;
+  }
+  const int nb = static_cast<int>(ax.buckets.size());
+  std::uint32_t max_count = 1;
+  for (const BucketInfo& b : ax.buckets) max_count = std::max(max_count, b.count);
+  double cmin = std::numeric_limits<double>::infinity(), cmax = -cmin;
+  for (const double c : ax.cost)
+    if (std::isfinite(c)) cmin = std::min(cmin, c), cmax = std::max(cmax, c);
+  if (!std::isfinite(cmin)) {
+    cmin = 0.0;
+    cmax = 1.0;
+  } else if (!(cmax > cmin)) {
+    cmax = cmin + 1.0;
+  }
+  const float width = ImGui::GetContentRegionAvail().x, bar_h = 100.0f * layout.scale, curve_h = 100.0f * layout.scale;
+  ImDrawList* dl = ImGui::GetWindowDrawList();
+  const ImVec2 at = ImGui::GetCursorScreenPos();
+  const float bw = width / static_cast<float>(nb);
+  // Histogram of bucket counts.
+  for (int b = 0; b < nb; ++b) {
+    const float hgt = bar_h * static_cast<float>(ax.buckets[b].count) / static_cast<float>(max_count);
+    dl->AddRectFilled(ImVec2(at.x + b * bw + 1, at.y + bar_h - hgt), ImVec2(at.x + (b + 1) * bw - 1, at.y + bar_h),
+                      IM_COL32(90, 160, 255, 255));
+  }
+  // Cost curve over the B-1 planes, below; the chosen plane in red across both.
+  const float cy = at.y + bar_h + 10.0f;
+  ImVec2 prev;
+  bool have_prev = false;
+  for (int p = 0; p + 1 < nb; ++p) {
+    if (!std::isfinite(ax.cost[p])) {
+      have_prev = false;
+      continue;
+    }
+    const ImVec2 pt(at.x + (p + 1) * bw, cy + curve_h * static_cast<float>(1.0 - (ax.cost[p] - cmin) / (cmax - cmin)));
+    if (have_prev) dl->AddLine(prev, pt, IM_COL32(255, 170, 60, 255), 2.0f);
+    dl->AddCircleFilled(pt, 2.5f, IM_COL32(255, 170, 60, 255));
+    prev = pt;
+    have_prev = true;
+  }
+  if (e->chosen_axis == axis && e->chosen_plane >= 0) {
+    const float x = at.x + (e->chosen_plane + 1) * bw;
+    dl->AddLine(ImVec2(x, at.y), ImVec2(x, cy + curve_h), IM_COL32(235, 70, 60, 255), 2.0f);
+  }
+  // The leaf cost as a dashed level when it falls within the curve's range.
+  if (e->leaf_cost >= cmin && e->leaf_cost <= cmax) {
+    const float y = cy + curve_h * static_cast<float>(1.0 - (e->leaf_cost - cmin) / (cmax - cmin));
+    for (float x = at.x; x < at.x + width; x += 8.0f)
+      dl->AddLine(ImVec2(x, y), ImVec2(x + 4.0f, y), IM_COL32(120, 220, 120, 255));
+  }
+  ImGui::Dummy(ImVec2(width, bar_h + 10.0f + curve_h));
+  ImGui::TextDisabled(
+      "blue: primitives per bucket; orange: SAH cost per plane (%.3g .. %.3g); red: chosen; green: leaf", cmin, cmax);
+  if (ImGui::BeginTable("buckets", 5, ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY,
+                        ImVec2(0.0f, 140.0f * layout.scale))) {
+    for (const char* h : {"bucket", "centroids in", "count", "plane after", "cost"}) ImGui::TableSetupColumn(h);
+    ImGui::TableHeadersRow();
+    for (int b = 0; b < nb; ++b) {
+      ImGui::TableNextRow();
+      ImGui::TableSetColumnIndex(0);
+      ImGui::Text("%d", b);
+      ImGui::TableSetColumnIndex(1);
+      ImGui::Text("[%.3g, %.3g)", static_cast<double>(ax.buckets[b].lo), static_cast<double>(ax.buckets[b].hi));
+      ImGui::TableSetColumnIndex(2);
+      ImGui::Text("%u", ax.buckets[b].count);
+      if (b + 1 < nb) {
+        ImGui::TableSetColumnIndex(3);
+        ImGui::Text("%.3g (%u | %zu)", static_cast<double>(ax.plane[b]), ax.left[b], e->prims - ax.left[b]);
+        ImGui::TableSetColumnIndex(4);
+        const bool chosen = e->chosen_axis == axis && e->chosen_plane == b;
+        if (std::isfinite(ax.cost[b]))
+          ImGui::Text(chosen ? "%.3f  <" : "%.3f", ax.cost[b]);
+        else
+          ImGui::TextDisabled("(side empty)");
+      }
+    }
+    ImGui::EndTable();
+  }
+  ImGui::End();
+  return changed;
+}
+
+// ---- Tree view -------------------------------------------------------------------------------------
+
+namespace {
+
+bool on_path(const StructureNodes& nodes, std::uint32_t id, std::uint32_t selected) {
+  for (const StructureNode* n = nodes.node(selected); n; n = nodes.node(n->parent)) {
+    if (selected == id) return true;
+    if (n->parent == 0xFFFFFFFFu) break;
+    selected = n->parent;
+  }
+  return selected == id;
+}
+
+void tree_rows(const StructureNodes& nodes, const std::vector<std::uint64_t>* visits, std::uint32_t id,
+               std::uint32_t selected, std::optional<std::uint32_t>& clicked, int budget_depth) {
+  const StructureNode* n = nodes.node(id);
+  if (!n) return;
+  char label[160];
+  const unsigned long long vis = visits && id < visits->size() ? static_cast<unsigned long long>((*visits)[id]) : 0ull;
+  if (n->leaf)
+    std::snprintf(label, sizeof label, "leaf %u  (%u prims, depth %u, SAH %.2f%%%s%llu)", id, n->prims, n->depth,
+                  100.0 * n->sah_share, visits ? ", visits " : "", visits ? vis : 0ull);
+  else
+    std::snprintf(label, sizeof label, "node %u  (depth %u, SAH %.2f%%%s%llu)", id, n->depth, 100.0 * n->sah_share,
+                  visits ? ", visits " : "", visits ? vis : 0ull);
+  ImGuiTreeNodeFlags flags = ImGuiTreeNodeFlags_OpenOnArrow | ImGuiTreeNodeFlags_SpanAvailWidth;
+  if (n->leaf) flags |= ImGuiTreeNodeFlags_Leaf | ImGuiTreeNodeFlags_NoTreePushOnOpen;
+  if (id == selected) flags |= ImGuiTreeNodeFlags_Selected;
+  if (!n->leaf && id != selected && on_path(nodes, id, selected)) ImGui::SetNextItemOpen(true, ImGuiCond_Always);
+  ImGui::PushID(static_cast<int>(id));
+  const bool open = ImGui::TreeNodeEx("n", flags, "%s", label);
+  if (ImGui::IsItemClicked() && !ImGui::IsItemToggledOpen()) clicked = id;
+  if (open && !n->leaf) {
+    if (budget_depth > 0)
+      for (const std::uint32_t c : nodes.children(id)) tree_rows(nodes, visits, c, selected, clicked, budget_depth - 1);
+    ImGui::TreePop();
+  }
+  ImGui::PopID();
+}
+
+}  // namespace
+
+std::optional<std::uint32_t> tree_panel(const StructureNodes* nodes, const std::vector<std::uint64_t>* visits,
+                                        std::uint32_t selected, const PanelLayout& layout) {
+  std::optional<std::uint32_t> clicked;
+  place_at(layout, 330.0f, 180.0f, 420.0f, 420.0f);
+  if (!ImGui::Begin("Tree")) {
+    ImGui::End();
+    return clicked;
+  }
+  if (!nodes || nodes->empty() || nodes->kind() == "grid") {
+    ImGui::TextDisabled("The structure shown has no tree.");
+  } else {
+    ImGui::TextDisabled("%s, %llu nodes; click a row to select its subtree in the 3D view", nodes->kind().c_str(),
+                        static_cast<unsigned long long>(nodes->size()));
+    tree_rows(*nodes, visits, 0, selected, clicked, 128);
+  }
+  ImGui::End();
+  return clicked;
+}
+
+}  // namespace accelviz::panels

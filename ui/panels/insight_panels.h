@@ -1,0 +1,68 @@
+#pragma once
+// The insight panels (insight_panels.cpp, scenarios_panel.cpp): A/B
+// comparison, predicted vs measured cost with hot nodes and traversal modes,
+// the binned-SAH explainer, the tree view and the lecture scenarios. Thin
+// functions over state, like panels.h; the work runs in ui/app/insight_jobs.h
+// and ui/app/scenarios.h.
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "core/analysis/insight/sah_explainer.h"
+#include "ui/app/insight_jobs.h"
+#include "ui/app/scenarios.h"
+#include "ui/panels/panels.h"
+
+namespace accelviz::panels {
+
+// ---- A/B ------------------------------------------------------------------------------
+struct ABPanelState {
+  std::optional<StructureChoice> pinned;  ///< A
+  int display = 0;                        ///< 0 side by side, 1 split, 2 difference
+  float split = 0.5f;                     ///< split: fraction of the width showing A
+  int metric = 0;                         ///< 0 nodes, 1 prims, 2 cost
+  int width = 96, height = 72;
+};
+struct ABAction {
+  bool pin = false;      ///< pin the current choice as A
+  bool compare = false;  ///< run A vs the current choice (B)
+};
+ABAction ab_panel(ABPanelState& state, const ABResult* result, bool busy, const std::string& error,
+                  const StructureChoice& current, const PanelLayout& layout);
+
+// ---- Predicted vs measured, hot nodes, traversal modes ----------------------------------
+struct InsightAction {
+  bool refresh = false;
+  std::optional<std::uint32_t> select;  ///< a hot node clicked
+};
+InsightAction insight_panel(const ViewInsight* insight, bool busy, const std::string& error, std::uint32_t selected,
+                            const PanelLayout& layout);
+
+// ---- Binned-SAH explainer -------------------------------------------------------------------
+struct ExplainerState {
+  int buckets = 16;
+  int axis = -1;  ///< -1: the chosen axis
+};
+/// Returns true when the bucket count changed (re-explain).
+bool explainer_panel(ExplainerState& state, const SplitExplanation* e, std::uint32_t node, const std::string& note,
+                     const PanelLayout& layout);
+
+// ---- Tree view ------------------------------------------------------------------------------
+/// Collapsible tree of `nodes` (count, depth, SAH share, visits when known);
+/// the path to `selected` is opened. Returns a node the user clicked.
+std::optional<std::uint32_t> tree_panel(const StructureNodes* nodes, const std::vector<std::uint64_t>* visits,
+                                        std::uint32_t selected, const PanelLayout& layout);
+
+// ---- Scenarios ------------------------------------------------------------------------------
+struct ScenarioPanelState {
+  int current = -1;    ///< index into scenarios(), -1: none chosen
+  float value = 0.0f;  ///< the slider
+};
+struct ScenarioAction {
+  bool run = false;                 ///< measure `current` at `value`
+  std::optional<std::string> open;  ///< open this scene in the main view
+};
+ScenarioAction scenarios_panel(ScenarioPanelState& state, const ScenarioFigures* figures, bool busy,
+                               const std::string& error, const PanelLayout& layout);
+
+}  // namespace accelviz::panels
