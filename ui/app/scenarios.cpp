@@ -38,7 +38,7 @@ const std::vector<Scenario>& scenarios() {
       {"same-centroid",
        "All primitives share one centroid",
        "Centroid bounds are a single point: binning has nothing to split, every node falls back to an object "
-       "median split, and every box is the whole scene. Cost per ray grows with N (slider).",
+       "median split, and every box is the whole scene. Watch cost per ray and depth as N grows (slider).",
        "triangles N",
        100.0f,
        20000.0f,
@@ -48,7 +48,7 @@ const std::vector<Scenario>& scenarios() {
       {"same-bounds",
        "All primitives share one bounding box",
        "Every triangle has the same box: no box-based split separates anything, every node's box is the root's, "
-       "so a ray enters (almost) every node it could. Cost per ray grows with N (slider).",
+       "so a ray enters (almost) every node it could. Watch cost per ray and depth as N grows (slider).",
        "triangles N",
        100.0f,
        20000.0f,
@@ -57,8 +57,8 @@ const std::vector<Scenario>& scenarios() {
        {"bvh", "kdtree"}},
       {"grass",
        "Field of grass",
-       "Uniformly spread thin blades: the case where a uniform grid does well, with cost per ray close to the "
-       "BVH's and a much cheaper build.",
+       "Uniformly spread thin blades at constant density: the case a uniform grid is made for. Compare its cost "
+       "per ray and build time with the BVH's and the K-D tree's as the field grows (slider).",
        "triangles N",
        1000.0f,
        100000.0f,
@@ -67,8 +67,10 @@ const std::vector<Scenario>& scenarios() {
        {"grid", "bvh", "kdtree"}},
       {"growth",
        "Growth with N",
-       "Random triangle soup of constant density at N = largest/64, /16, /4 and largest (slider): a grid's cells "
-       "per ray grow about as N^(1/3), a BVH's nodes per ray about as log N.",
+       "Random triangle soup of constant density at N = largest/64, /16, /4 and largest (slider), nodes entered "
+       "per ray against log N. Theory for a ray crossing the scene: a grid's cells grow as N^(1/3) (x4 for N "
+       "x64), a BVH's depth as log N; a ray through a dense soup also enters many overlapping boxes, so compare "
+       "the measured factors in the summary with both.",
        "largest N",
        4000.0f,
        64000.0f,
