@@ -19,116 +19,86 @@ std::string one_line(std::string s) {
   return s;
 }
 
+BuildWorker::LoadFn default_load(BuildWorker::LoadFn load) {
+  if (load) return load;
+  return [](const std::string& spec) { return load_scene(spec); };
+}
+
+BuildWorker::BuildFn default_build(BuildWorker::BuildFn build) {
+  if (build) return build;
+  return [](std::span<const Triangle> tris, const StructureChoice& c, const ProgressCallback& progress) {
+    return build_accelerator(c.name, tris, c.options, progress);
+  };
+}
+
 }  // namespace
 
-BuildWorker::BuildWorker(LoadFn load, BuildFn build) : load_(std::move(load)), build_(std::move(build)) {
-  if (!load_) load_ = [](const std::string& spec) { return load_scene(spec); };
-  if (!build_)
-    build_ = [](std::span<const Triangle> tris, const StructureChoice& c, const ProgressCallback& progress) {
-      return build_accelerator(c.name, tris, c.options, progress);
-    };
-  thread_ = std::thread([this] { run(); });
-}
-
-BuildWorker::~BuildWorker() {
-  {
-    std::lock_guard lock(mutex_);
-    stop_ = true;
-    queued_.reset();
-  }
-  cancel_upto_ = ~std::uint64_t{0};
-  wake_.notify_all();
-  thread_.join();
-}
-
-std::uint64_t BuildWorker::request(BuildRequest r) {
-  std::uint64_t id;
-  {
-    std::lock_guard lock(mutex_);
-    id = next_id_.fetch_add(1);
-    if (queued_) outcomes_.push_back({queued_->first, BuildOutcome::Result::cancelled, nullptr, {}, false});
-    queued_.emplace(id, std::move(r));
-    // Everything older is superseded: the running build sees this in its
-    // next progress call.
-    cancel_upto_ = id - 1;
-  }
-  wake_.notify_all();
-  return id;
-}
-
-void BuildWorker::cancel() {
-  std::lock_guard lock(mutex_);
-  if (queued_) {
-    outcomes_.push_back({queued_->first, BuildOutcome::Result::cancelled, nullptr, {}, false});
-    queued_.reset();
-  }
-  cancel_upto_ = next_id_.load() - 1;
-}
+BuildWorker::BuildWorker(LoadFn load, BuildFn build)
+    : load_(default_load(std::move(load))),
+      build_(default_build(std::move(build))),
+      worker_([this](const BuildRequest& r, std::uint64_t id, const std::function<bool()>&,
+                     const std::function<void(std::monostate)>&) { done_ = execute(id, r); },
+              {.dropped =
+                   [this](std::uint64_t id, std::monostate&) {
+                     outcomes_.push_back({id, BuildOutcome::Result::cancelled, nullptr, {}, false});
+                   },
+               .started =
+                   [this](std::uint64_t) {
+                     stage_ = "starting";
+                     fraction_ = 0.0;
+                   },
+               .finished =
+                   [this](std::uint64_t id) {
+                     // A job that finished while it was being superseded does not count:
+                     // the user has asked for something else meanwhile.
+                     if (done_.result == BuildOutcome::Result::built && cancelled(id)) {
+                       done_.result = BuildOutcome::Result::cancelled;
+                       done_.built.reset();
+                     }
+                     outcomes_.push_back(std::move(done_));
+                     done_ = {};
+                   }}) {}
 
 std::vector<BuildOutcome> BuildWorker::take_outcomes() {
-  std::lock_guard lock(mutex_);
-  std::vector<BuildOutcome> out(std::make_move_iterator(outcomes_.begin()), std::make_move_iterator(outcomes_.end()));
-  outcomes_.clear();
-  return out;
+  return worker_.with_lock([&](std::uint64_t, std::uint64_t) {
+    std::vector<BuildOutcome> out(std::make_move_iterator(outcomes_.begin()), std::make_move_iterator(outcomes_.end()));
+    outcomes_.clear();
+    return out;
+  });
 }
 
 BuildWorker::Status BuildWorker::status() const {
-  std::lock_guard lock(mutex_);
-  Status s;
-  if (running_ != 0) {
-    s.busy = true;
-    s.id = running_;
-    s.stage = stage_;
-    s.fraction = fraction_.load();
-  } else if (queued_) {
-    s.busy = true;
-    s.id = queued_->first;
-    s.stage = "queued";
-  }
-  return s;
+  return worker_.with_lock([&](std::uint64_t running, std::uint64_t queued) {
+    Status s;
+    if (running != 0) {
+      s.busy = true;
+      s.id = running;
+      s.stage = stage_;
+      s.fraction = fraction_.load();
+    } else if (queued != 0) {
+      s.busy = true;
+      s.id = queued;
+      s.stage = "queued";
+    }
+    return s;
+  });
 }
 
 bool BuildWorker::idle() const {
-  std::lock_guard lock(mutex_);
-  return running_ == 0 && !queued_ && outcomes_.empty();
+  return worker_.with_lock(
+      [&](std::uint64_t running, std::uint64_t queued) { return running == 0 && queued == 0 && outcomes_.empty(); });
 }
 
-void BuildWorker::run() {
-  for (;;) {
-    std::pair<std::uint64_t, BuildRequest> job;
-    {
-      std::unique_lock lock(mutex_);
-      wake_.wait(lock, [&] { return stop_ || queued_.has_value(); });
-      if (stop_) return;
-      job = std::move(*queued_);
-      queued_.reset();
-      running_ = job.first;
-      stage_ = "starting";
-      fraction_ = 0.0;
-    }
-    BuildOutcome outcome = execute(job.first, job.second);
-    {
-      std::lock_guard lock(mutex_);
-      // A job that finished while it was being superseded does not count:
-      // the user has asked for something else meanwhile.
-      if (outcome.result == BuildOutcome::Result::built && cancelled(job.first)) {
-        outcome.result = BuildOutcome::Result::cancelled;
-        outcome.built.reset();
-      }
-      outcomes_.push_back(std::move(outcome));
-      running_ = 0;
-    }
-  }
+void BuildWorker::set_stage(std::string s) {
+  worker_.with_lock([&](std::uint64_t, std::uint64_t) {
+    stage_ = std::move(s);
+    fraction_ = 0.0;
+  });
 }
 
 BuildOutcome BuildWorker::execute(std::uint64_t id, const BuildRequest& r) {
   BuildOutcome out;
   out.id = id;
-  auto set_stage = [&](std::string s) {
-    std::lock_guard lock(mutex_);
-    stage_ = std::move(s);
-    fraction_ = 0.0;
-  };
   try {
     std::shared_ptr<const LoadedScene> scene = scene_;
     if (!scene || scene->spec != r.scene || r.reload) {

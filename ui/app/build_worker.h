@@ -6,23 +6,21 @@
 // is ever waited for. Until a build succeeds the app keeps drawing and
 // querying the structure it has: outcomes are handed over by value
 // (shared_ptr), never swapped in behind the main thread's back.
-#include "core/accel/accel.h"
-#include "core/scene/scene.h"
-#include "ui/app/app_config.h"
-#include "ui/app/structure_nodes.h"
-
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <functional>
 #include <memory>
-#include <mutex>
-#include <optional>
 #include <span>
 #include <string>
-#include <thread>
+#include <variant>
 #include <vector>
+
+#include "core/accel/accel.h"
+#include "core/scene/scene.h"
+#include "ui/app/app_config.h"
+#include "ui/app/latest_job_worker.h"
+#include "ui/app/structure_nodes.h"
 
 namespace accelviz {
 
@@ -65,15 +63,15 @@ class BuildWorker {
   /// Empty functions mean core's load_scene and build_accelerator; tests
   /// pass their own to control timing without sleeping.
   explicit BuildWorker(LoadFn load = {}, BuildFn build = {});
-  ~BuildWorker();  ///< cancels whatever runs and joins the thread
+  ~BuildWorker() = default;  ///< cancels whatever runs and joins the thread
   BuildWorker(const BuildWorker&) = delete;
   BuildWorker& operator=(const BuildWorker&) = delete;
 
   /// Queues `r` as the next job, replacing a queued one and cancelling the
   /// one running. Returns its id (increasing from 1).
-  std::uint64_t request(BuildRequest r);
+  std::uint64_t request(BuildRequest r) { return worker_.request(std::move(r)); }
   /// Cancels the queued and the running job.
-  void cancel();
+  void cancel() { worker_.cancel(); }
   /// Outcomes finished since the last call, oldest first. A job superseded
   /// or cancelled (even one that finished while being cancelled) is reported
   /// as cancelled, never as built.
@@ -88,27 +86,22 @@ class BuildWorker {
   Status status() const;
   /// Nothing queued, nothing running, no outcome waiting to be taken.
   bool idle() const;
-  std::uint64_t latest_request() const { return next_id_.load() - 1; }
+  std::uint64_t latest_request() const { return worker_.latest_request(); }
 
  private:
-  void run();
   BuildOutcome execute(std::uint64_t id, const BuildRequest& r);
-  bool cancelled(std::uint64_t id) const { return id <= cancel_upto_.load(); }
+  bool cancelled(std::uint64_t id) const { return worker_.cancelled(id); }
+  void set_stage(std::string s);
 
   LoadFn load_;
   BuildFn build_;
-  mutable std::mutex mutex_;
-  std::condition_variable wake_;
-  std::optional<std::pair<std::uint64_t, BuildRequest>> queued_;
+  // Guarded by the worker's mutex (worker_.with_lock / its hooks):
   std::deque<BuildOutcome> outcomes_;
-  std::uint64_t running_ = 0;  ///< id of the job running, 0 when none
   std::string stage_;
   std::atomic<double> fraction_{0.0};
-  std::atomic<std::uint64_t> next_id_{1};
-  std::atomic<std::uint64_t> cancel_upto_{0};  ///< jobs with id <= this are cancelled
-  std::shared_ptr<const LoadedScene> scene_;   ///< the last scene loaded (worker thread only)
-  bool stop_ = false;
-  std::thread thread_;
+  std::shared_ptr<const LoadedScene> scene_;              ///< the last scene loaded (worker thread only)
+  BuildOutcome done_;                                     ///< the job just run (worker thread only)
+  LatestJobWorker<BuildRequest, std::monostate> worker_;  ///< last: joined before the members above go
 };
 
 }  // namespace accelviz

@@ -1,12 +1,12 @@
 #include "ui/app/heatmap_worker.h"
 
-#include "core/query/camera.h"
-#include "core/util/parallel.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
+
+#include "core/query/camera.h"
+#include "core/util/parallel.h"
 
 namespace accelviz {
 namespace {
@@ -144,70 +144,10 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
   return true;
 }
 
-HeatmapWorker::HeatmapWorker() : thread_([this] { run(); }) {}
-
-HeatmapWorker::~HeatmapWorker() {
-  {
-    std::lock_guard lock(mutex_);
-    stop_ = true;
-    queued_.reset();
-  }
-  cancel_upto_ = ~std::uint64_t{0};
-  wake_.notify_all();
-  thread_.join();
-}
-
-std::uint64_t HeatmapWorker::request(HeatmapRequest r) {
-  std::uint64_t id;
-  {
-    std::lock_guard lock(mutex_);
-    id = next_id_.fetch_add(1);
-    queued_.emplace(id, std::move(r));
-    cancel_upto_ = id - 1;
-  }
-  wake_.notify_all();
-  return id;
-}
-
-void HeatmapWorker::cancel() {
-  std::lock_guard lock(mutex_);
-  queued_.reset();
-  cancel_upto_ = next_id_.load() - 1;
-}
-
-std::shared_ptr<const HeatmapFrame> HeatmapWorker::latest() const {
-  std::lock_guard lock(mutex_);
-  return latest_;
-}
-
-bool HeatmapWorker::busy() const {
-  std::lock_guard lock(mutex_);
-  return running_ || queued_.has_value();
-}
-
-void HeatmapWorker::run() {
-  for (;;) {
-    std::pair<std::uint64_t, HeatmapRequest> job;
-    {
-      std::unique_lock lock(mutex_);
-      wake_.wait(lock, [&] { return stop_ || queued_.has_value(); });
-      if (stop_) return;
-      job = std::move(*queued_);
-      queued_.reset();
-      running_ = true;
-    }
-    const std::uint64_t id = job.first;
-    trace_progressive(
-        job.second, id, [&] { return id > cancel_upto_.load(std::memory_order_relaxed); },
-        [&](std::shared_ptr<const HeatmapFrame> f) {
-          std::lock_guard lock(mutex_);
-          if (id > cancel_upto_.load()) latest_ = std::move(f);
-        });
-    {
-      std::lock_guard lock(mutex_);
-      running_ = false;
-    }
-  }
-}
+HeatmapWorker::HeatmapWorker()
+    : worker_([](const HeatmapRequest& r, std::uint64_t id, const std::function<bool()>& keep_going,
+                 const std::function<void(std::shared_ptr<const HeatmapFrame>)>& publish) {
+        trace_progressive(r, id, keep_going, publish);
+      }) {}
 
 }  // namespace accelviz

@@ -9,18 +9,14 @@
 //
 // Rays are core's primary_ray(camera, x, y, W, H): pixel centres, row 0 at
 // the top, the same convention as `accelviz render` and the GL camera.
+#include <cstdint>
+#include <memory>
+#include <vector>
+
 #include "core/accel/accel.h"
 #include "core/analysis/heatmap.h"
 #include "ui/app/build_worker.h"
-
-#include <atomic>
-#include <condition_variable>
-#include <cstdint>
-#include <memory>
-#include <mutex>
-#include <optional>
-#include <thread>
-#include <vector>
+#include "ui/app/latest_job_worker.h"
 
 namespace accelviz {
 
@@ -80,32 +76,22 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
 class HeatmapWorker {
  public:
   HeatmapWorker();
-  ~HeatmapWorker();
   HeatmapWorker(const HeatmapWorker&) = delete;
   HeatmapWorker& operator=(const HeatmapWorker&) = delete;
 
   /// Replaces whatever is queued or running with `r`; returns its id.
-  std::uint64_t request(HeatmapRequest r);
+  std::uint64_t request(HeatmapRequest r) { return worker_.request(std::move(r)); }
   /// Stops the running job and drops the queued one.
-  void cancel();
+  void cancel() { worker_.cancel(); }
   /// The newest published level of any job (null before the first).
-  std::shared_ptr<const HeatmapFrame> latest() const;
+  std::shared_ptr<const HeatmapFrame> latest() const { return worker_.latest(); }
   /// A job is queued or running.
-  bool busy() const;
-  std::uint64_t latest_request() const { return next_id_.load() - 1; }
+  bool busy() const { return worker_.busy(); }
+  std::uint64_t latest_request() const { return worker_.latest_request(); }
 
  private:
-  void run();
-
-  mutable std::mutex mutex_;
-  std::condition_variable wake_;
-  std::optional<std::pair<std::uint64_t, HeatmapRequest>> queued_;
-  bool running_ = false;
-  std::shared_ptr<const HeatmapFrame> latest_;
-  std::atomic<std::uint64_t> next_id_{1};
-  std::atomic<std::uint64_t> cancel_upto_{0};
-  bool stop_ = false;
-  std::thread thread_;
+  /// A superseded job's levels are never shown (the default store rule).
+  LatestJobWorker<HeatmapRequest, std::shared_ptr<const HeatmapFrame>> worker_;
 };
 
 }  // namespace accelviz

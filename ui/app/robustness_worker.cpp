@@ -3,95 +3,57 @@
 #include <exception>
 
 namespace accelviz {
+namespace {
 
-RobustnessWorker::RobustnessWorker() : thread_([this] { run(); }) {}
+using Worker = LatestJobWorker<RobustnessRequest, std::shared_ptr<const RobustnessSnapshot>>;
 
-RobustnessWorker::~RobustnessWorker() {
-  {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    stop_ = true;
-    queued_.reset();
-  }
-  cancel_upto_ = next_id_.load();
-  wake_.notify_all();
-  thread_.join();
-}
-
-std::uint64_t RobustnessWorker::request(RobustnessRequest r) {
-  const std::uint64_t id = next_id_++;
-  cancel_upto_ = id - 1;  // supersedes whatever runs
+std::shared_ptr<RobustnessSnapshot> running_snapshot(std::uint64_t id, const RobustnessRequest& r) {
   auto snap = std::make_shared<RobustnessSnapshot>();
   snap->id = id;
   snap->scene = r.scene ? r.scene->spec : "";
   snap->structure = r.options.structure;
-  {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    queued_.emplace(id, std::move(r));
-    latest_ = std::move(snap);
-  }
-  wake_.notify_all();
-  return id;
+  return snap;
 }
 
-void RobustnessWorker::cancel() {
-  {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    if (queued_ && latest_ && latest_->id == queued_->first) {
-      // Dropped before it started: its snapshot says so.
-      auto snap = std::make_shared<RobustnessSnapshot>(*latest_);
+void run_lab(const RobustnessRequest& r, std::uint64_t id, const std::function<bool()>& keep_going,
+             const std::function<void(std::shared_ptr<const RobustnessSnapshot>)>& publish) {
+  auto snap = running_snapshot(id, r);
+  try {
+    if (!r.scene) throw std::invalid_argument("no scene");
+    snap->result = run_robustness_lab(r.scene->scene.triangles, r.options, keep_going);
+    snap->state = RobustnessSnapshot::State::done;
+  } catch (const BuildCancelled&) {
+    snap->state = RobustnessSnapshot::State::cancelled;
+  } catch (const std::exception& e) {
+    snap->state = RobustnessSnapshot::State::failed;
+    snap->error = e.what();
+  }
+  publish(std::move(snap));
+}
+
+Worker::Hooks robustness_hooks() {
+  Worker::Hooks h;
+  // A request shows as running at once; a job's result never replaces a newer job's snapshot.
+  h.queued = [](std::uint64_t id, const RobustnessRequest& r, std::shared_ptr<const RobustnessSnapshot>& latest) {
+    latest = running_snapshot(id, r);
+  };
+  h.store = [](std::uint64_t id, std::shared_ptr<const RobustnessSnapshot>&& s, bool, bool,
+               std::shared_ptr<const RobustnessSnapshot>& latest) {
+    if (!latest || latest->id <= id) latest = std::move(s);
+  };
+  // Dropped before it started: its snapshot says so.
+  h.dropped = [](std::uint64_t id, std::shared_ptr<const RobustnessSnapshot>& latest) {
+    if (latest && latest->id == id) {
+      auto snap = std::make_shared<RobustnessSnapshot>(*latest);
       snap->state = RobustnessSnapshot::State::cancelled;
-      latest_ = std::move(snap);
+      latest = std::move(snap);
     }
-    queued_.reset();
-  }
-  cancel_upto_ = next_id_.load();
+  };
+  return h;
 }
 
-std::shared_ptr<const RobustnessSnapshot> RobustnessWorker::latest() const {
-  const std::lock_guard<std::mutex> lock(mutex_);
-  return latest_;
-}
+}  // namespace
 
-bool RobustnessWorker::busy() const {
-  const std::lock_guard<std::mutex> lock(mutex_);
-  return running_ || queued_.has_value();
-}
-
-void RobustnessWorker::publish(std::shared_ptr<const RobustnessSnapshot> s) {
-  const std::lock_guard<std::mutex> lock(mutex_);
-  if (!latest_ || latest_->id <= s->id) latest_ = std::move(s);
-}
-
-void RobustnessWorker::run() {
-  for (;;) {
-    std::pair<std::uint64_t, RobustnessRequest> job;
-    {
-      std::unique_lock<std::mutex> lock(mutex_);
-      running_ = false;
-      wake_.wait(lock, [this] { return stop_ || queued_.has_value(); });
-      if (stop_) return;
-      job = std::move(*queued_);
-      queued_.reset();
-      running_ = true;
-    }
-    const std::uint64_t id = job.first;
-    auto snap = std::make_shared<RobustnessSnapshot>();
-    snap->id = id;
-    snap->scene = job.second.scene ? job.second.scene->spec : "";
-    snap->structure = job.second.options.structure;
-    try {
-      if (!job.second.scene) throw std::invalid_argument("no scene");
-      snap->result = run_robustness_lab(job.second.scene->scene.triangles, job.second.options,
-                                        [this, id] { return cancel_upto_.load() < id; });
-      snap->state = RobustnessSnapshot::State::done;
-    } catch (const BuildCancelled&) {
-      snap->state = RobustnessSnapshot::State::cancelled;
-    } catch (const std::exception& e) {
-      snap->state = RobustnessSnapshot::State::failed;
-      snap->error = e.what();
-    }
-    publish(std::move(snap));
-  }
-}
+RobustnessWorker::RobustnessWorker() : worker_(run_lab, robustness_hooks()) {}
 
 }  // namespace accelviz

@@ -1,16 +1,16 @@
 #include "ui/app/sweep_worker.h"
 
-#include "core/accel/bvh/bvh.h"
-#include "core/analysis/sah.h"
-#include "core/query/batch.h"
-#include "core/query/ray_sets.h"
-#include "core/util/parallel.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
 #include <stdexcept>
+
+#include "core/accel/bvh/bvh.h"
+#include "core/analysis/sah.h"
+#include "core/query/batch.h"
+#include "core/query/ray_sets.h"
+#include "core/util/parallel.h"
 
 namespace accelviz {
 
@@ -257,72 +257,27 @@ std::shared_ptr<const SweepSnapshot> run_sweep_request(
   return emit();
 }
 
-SweepWorker::SweepWorker() : thread_([this] { run(); }) {}
+namespace {
 
-SweepWorker::~SweepWorker() {
-  {
-    std::lock_guard lock(mutex_);
-    stop_ = true;
-    queued_.reset();
-  }
-  cancel_upto_ = ~std::uint64_t{0};
-  wake_.notify_all();
-  thread_.join();
+LatestJobWorker<SweepRequest, std::shared_ptr<const SweepSnapshot>>::Hooks sweep_hooks() {
+  LatestJobWorker<SweepRequest, std::shared_ptr<const SweepSnapshot>>::Hooks h;
+  h.store = [](std::uint64_t id, std::shared_ptr<const SweepSnapshot>&& s, bool superseded, bool newer_queued,
+               std::shared_ptr<const SweepSnapshot>& latest) {
+    // A superseded job's snapshots never replace a newer job's; its
+    // own final "cancelled" snapshot is shown only if nothing newer is queued.
+    if (!superseded || (!newer_queued && (!latest || latest->id <= id))) latest = std::move(s);
+  };
+  return h;
 }
 
-std::uint64_t SweepWorker::request(SweepRequest r) {
-  std::uint64_t id;
-  {
-    std::lock_guard lock(mutex_);
-    id = next_id_.fetch_add(1);
-    queued_.emplace(id, std::move(r));
-    cancel_upto_ = id - 1;
-  }
-  wake_.notify_all();
-  return id;
-}
+}  // namespace
 
-void SweepWorker::cancel() {
-  std::lock_guard lock(mutex_);
-  queued_.reset();
-  cancel_upto_ = next_id_.load() - 1;
-}
-
-std::shared_ptr<const SweepSnapshot> SweepWorker::latest() const {
-  std::lock_guard lock(mutex_);
-  return latest_;
-}
-
-bool SweepWorker::busy() const {
-  std::lock_guard lock(mutex_);
-  return running_ || queued_.has_value();
-}
-
-void SweepWorker::run() {
-  for (;;) {
-    std::pair<std::uint64_t, SweepRequest> job;
-    {
-      std::unique_lock lock(mutex_);
-      wake_.wait(lock, [&] { return stop_ || queued_.has_value(); });
-      if (stop_) return;
-      job = std::move(*queued_);
-      queued_.reset();
-      running_ = true;
-    }
-    const std::uint64_t id = job.first;
-    run_sweep_request(
-        job.second, id, [&] { return id > cancel_upto_.load(std::memory_order_relaxed); },
-        [&](std::shared_ptr<const SweepSnapshot> s) {
-          std::lock_guard lock(mutex_);
-          // A superseded job's snapshots never replace a newer job's; its
-          // own final "cancelled" snapshot is shown only if nothing newer is queued.
-          if (id > cancel_upto_.load() || (!queued_ && (!latest_ || latest_->id <= id))) latest_ = std::move(s);
-        });
-    {
-      std::lock_guard lock(mutex_);
-      running_ = false;
-    }
-  }
-}
+SweepWorker::SweepWorker()
+    : worker_(
+          [](const SweepRequest& r, std::uint64_t id, const std::function<bool()>& keep_going,
+             const std::function<void(std::shared_ptr<const SweepSnapshot>)>& publish) {
+            run_sweep_request(r, id, keep_going, publish);
+          },
+          sweep_hooks()) {}
 
 }  // namespace accelviz

@@ -6,22 +6,19 @@
 // built with default vs calibrated SAH constants. A new request supersedes
 // the one running (cancelled between or inside settings, like the build and
 // heatmap workers); cancel() stops it and keeps what was measured.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
 #include "core/analysis/calibrate.h"
 #include "core/analysis/sweep.h"
 #include "core/query/camera.h"
 #include "ui/app/app_config.h"
 #include "ui/app/build_worker.h"
-
-#include <atomic>
-#include <condition_variable>
-#include <cstdint>
-#include <memory>
-#include <mutex>
-#include <optional>
-#include <string>
-#include <string_view>
-#include <thread>
-#include <vector>
+#include "ui/app/latest_job_worker.h"
 
 namespace accelviz {
 
@@ -122,30 +119,20 @@ std::shared_ptr<const SweepSnapshot> run_sweep_request(
 class SweepWorker {
  public:
   SweepWorker();
-  ~SweepWorker();  ///< cancels and joins
+  ~SweepWorker() = default;  ///< cancels and joins
   SweepWorker(const SweepWorker&) = delete;
   SweepWorker& operator=(const SweepWorker&) = delete;
 
   /// Replaces whatever is queued or running with `r`; returns its id.
-  std::uint64_t request(SweepRequest r);
+  std::uint64_t request(SweepRequest r) { return worker_.request(std::move(r)); }
   /// Stops the running sweep (its snapshot turns `cancelled`, results kept) and drops the queued one.
-  void cancel();
+  void cancel() { worker_.cancel(); }
   /// The newest snapshot of the newest job that published (null before the first).
-  std::shared_ptr<const SweepSnapshot> latest() const;
-  bool busy() const;
+  std::shared_ptr<const SweepSnapshot> latest() const { return worker_.latest(); }
+  bool busy() const { return worker_.busy(); }
 
  private:
-  void run();
-
-  mutable std::mutex mutex_;
-  std::condition_variable wake_;
-  std::optional<std::pair<std::uint64_t, SweepRequest>> queued_;
-  bool running_ = false;
-  std::shared_ptr<const SweepSnapshot> latest_;
-  std::atomic<std::uint64_t> next_id_{1};
-  std::atomic<std::uint64_t> cancel_upto_{0};
-  bool stop_ = false;
-  std::thread thread_;
+  LatestJobWorker<SweepRequest, std::shared_ptr<const SweepSnapshot>> worker_;
 };
 
 }  // namespace accelviz
