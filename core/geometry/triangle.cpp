@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "core/geometry/triangle_inline.h"
+
 namespace accelviz {
 
 WatertightRay::WatertightRay(const glm::vec3& dir) {
@@ -23,8 +25,8 @@ namespace {
 // float products would be inf/NaN or flush to zero there. Shared vertices are
 // still sheared by one and the same computation, so neighbouring triangles
 // stay consistent with each other.
-bool intersect_watertight_double(const Ray& ray, const WatertightRay& wr, const Triangle& tri, float tmin,
-                                 float tmax, Hit& hit) {
+bool intersect_watertight_double(const Ray& ray, const WatertightRay& wr, const Triangle& tri, float tmin, float tmax,
+                                 Hit& hit) {
   const glm::dvec3 o(ray.origin), d(ray.direction);
   const double sx = d[wr.kx] / d[wr.kz], sy = d[wr.ky] / d[wr.kz], sz = 1.0 / d[wr.kz];
   const glm::dvec3 A = glm::dvec3(tri.v0) - o, B = glm::dvec3(tri.v1) - o, C = glm::dvec3(tri.v2) - o;
@@ -81,48 +83,19 @@ bool intersect_watertight(const Ray& ray, const WatertightRay& wr, const Triangl
   // Edge functions are quadratic and T cubic in the coordinates: near the
   // bottom of the float range (tiny triangles, 1e-13 and below) they lose
   // their precision in denormals; redo such a candidate in double.
-  constexpr float kLowRange = 1e-30f;
-  if (std::fabs(det) < kLowRange) return intersect_watertight_double(ray, wr, tri, tmin, tmax, hit);
+  if (std::fabs(det) < kWatertightLowRange) return intersect_watertight_double(ray, wr, tri, tmin, tmax, hit);
   // 7. Scaled distance, compared against the scaled interval to avoid a division on misses.
   const float az = wr.sz * A[wr.kz];
   const float bz = wr.sz * B[wr.kz];
   const float cz = wr.sz * C[wr.kz];
   const float T = U * az + V * bz + W * cz;
-  if (!std::isfinite(T) || (std::fabs(T) < kLowRange && T != 0.0f))
+  if (!std::isfinite(T) || (std::fabs(T) < kWatertightLowRange && T != 0.0f))
     return intersect_watertight_double(ray, wr, tri, tmin, tmax, hit);
-  if (det > 0.0f) {
-    if (T < tmin * det || T > tmax * det) return false;
-  } else {
-    if (T > tmin * det || T < tmax * det) return false;
-  }
-  const float rcp = 1.0f / det;
-  const float t = T * rcp;
-  if (!(t >= tmin && t <= tmax)) return false;  // guards rounding of the scaled compare and inf/NaN
-  hit.t = t;
-  hit.u = V * rcp;
-  hit.v = W * rcp;
-  return true;
+  return watertight_accept(V, W, det, T, tmin, tmax, hit);
 }
 
 bool intersect_moller_trumbore(const Ray& ray, const Triangle& tri, float tmin, float tmax, Hit& hit) {
-  const glm::vec3 e1 = tri.v1 - tri.v0;
-  const glm::vec3 e2 = tri.v2 - tri.v0;
-  const glm::vec3 p = glm::cross(ray.direction, e2);
-  const float det = glm::dot(e1, p);
-  if (det == 0.0f) return false;
-  const float inv = 1.0f / det;
-  const glm::vec3 s = ray.origin - tri.v0;
-  const float u = glm::dot(s, p) * inv;
-  if (u < 0.0f || u > 1.0f) return false;
-  const glm::vec3 q = glm::cross(s, e1);
-  const float v = glm::dot(ray.direction, q) * inv;
-  if (v < 0.0f || u + v > 1.0f) return false;
-  const float t = glm::dot(e2, q) * inv;
-  if (!(t >= tmin && t <= tmax)) return false;
-  hit.t = t;
-  hit.u = u;
-  hit.v = v;
-  return true;
+  return intersect_moller_trumbore_inline(ray, tri, tmin, tmax, hit);
 }
 
 glm::vec3 triangle_normal(const Triangle& tri) {

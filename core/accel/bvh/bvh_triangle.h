@@ -1,7 +1,8 @@
 #pragma once
 // Inline ray/triangle tests for the BVH traversals, bit for bit the results of
 // core/geometry/triangle.cpp's intersect_watertight and
-// intersect_moller_trumbore.
+// intersect_moller_trumbore (the steps they share are in
+// core/geometry/triangle_inline.h).
 //
 // Why: those functions live in another translation unit (a call per
 // triangle, no inlining into the traversal loop), and the watertight test
@@ -18,6 +19,7 @@
 #include <cmath>
 
 #include "core/geometry/triangle.h"
+#include "core/geometry/triangle_inline.h"
 
 namespace accelviz::bvh_detail {
 
@@ -58,50 +60,18 @@ struct InlineWatertightRay {
   if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return false;
   const float det = U + V + W;
   if (det == 0.0f) return false;
-  constexpr float kLowRange = 1e-30f;  // as in triangle.cpp
-  if (std::fabs(det) < kLowRange) return intersect_watertight(ray, wr, tri, tmin, tmax, hit);
+  if (std::fabs(det) < kWatertightLowRange) return intersect_watertight(ray, wr, tri, tmin, tmax, hit);
   const float az = wr.sz * Az;
   const float bz = wr.sz * Bz;
   const float cz = wr.sz * Cz;
   const float T = U * az + V * bz + W * cz;
-  if (!std::isfinite(T) || (std::fabs(T) < kLowRange && T != 0.0f))
+  if (!std::isfinite(T) || (std::fabs(T) < kWatertightLowRange && T != 0.0f))
     return intersect_watertight(ray, wr, tri, tmin, tmax, hit);
-  if (det > 0.0f) {
-    if (T < tmin * det || T > tmax * det) return false;
-  } else {
-    if (T > tmin * det || T < tmax * det) return false;
-  }
-  const float rcp = 1.0f / det;
-  const float t = T * rcp;
-  if (!(t >= tmin && t <= tmax)) return false;
-  hit.t = t;
-  hit.u = V * rcp;
-  hit.v = W * rcp;
-  return true;
+  return watertight_accept(V, W, det, T, tmin, tmax, hit);
 }
 
-/// Same contract and results as intersect_moller_trumbore (the same
-/// operations in the same order, here visible to the inliner).
-[[gnu::always_inline]] inline bool intersect_moller_trumbore_inline(const Ray& ray, const Triangle& tri, float tmin,
-                                                                    float tmax, Hit& hit) {
-  const glm::vec3 e1 = tri.v1 - tri.v0;
-  const glm::vec3 e2 = tri.v2 - tri.v0;
-  const glm::vec3 p = glm::cross(ray.direction, e2);
-  const float det = glm::dot(e1, p);
-  if (det == 0.0f) return false;
-  const float inv = 1.0f / det;
-  const glm::vec3 s = ray.origin - tri.v0;
-  const float u = glm::dot(s, p) * inv;
-  if (u < 0.0f || u > 1.0f) return false;
-  const glm::vec3 q = glm::cross(s, e1);
-  const float v = glm::dot(ray.direction, q) * inv;
-  if (v < 0.0f || u + v > 1.0f) return false;
-  const float t = glm::dot(e2, q) * inv;
-  if (!(t >= tmin && t <= tmax)) return false;
-  hit.t = t;
-  hit.u = u;
-  hit.v = v;
-  return true;
-}
+/// Same contract and results as intersect_moller_trumbore (whose body it is,
+/// core/geometry/triangle_inline.h).
+using accelviz::intersect_moller_trumbore_inline;
 
 }  // namespace accelviz::bvh_detail
