@@ -87,26 +87,29 @@ ReferenceTriangleHit intersect_reference(const Ray& ray, const Triangle& tri, do
   return r;
 }
 
+void fold_reference_hit(ReferenceHit& best, const ReferenceTriangleHit& h, std::uint32_t id, const Ray& ray) {
+  if (h.hit) {
+    best.near_hit = true;
+    // A hit at t within rounding of tmin or tmax (origin on the surface,
+    // a shadow ray ending on it) is a rounding decision too.
+    const bool t_inside = h.t - h.t_tolerance > ray.tmin && h.t + h.t_tolerance < ray.tmax;
+    best.robust_hit = best.robust_hit || (!h.near_edge && t_inside);
+    if (h.t < best.t || (h.t == best.t && id < best.prim)) {
+      best.prim = id;
+      best.t = h.t;
+      best.t_tolerance = h.t_tolerance;
+      best.closest_near_edge = h.near_edge;
+    }
+  } else if (h.near_miss) {
+    best.near_hit = true;
+  }
+}
+
 ReferenceHit ReferenceTracer::closest_hit(const Ray& ray) const {
   ReferenceHit best;
-  for (std::size_t i = 0; i < tris_.size(); ++i) {
-    const ReferenceTriangleHit h = intersect_reference(ray, tris_[i], ray.tmin, ray.tmax);
-    if (h.hit) {
-      best.near_hit = true;
-      // A hit at t within rounding of tmin or tmax (origin on the surface,
-      // a shadow ray ending on it) is a rounding decision too.
-      const bool t_inside = h.t - h.t_tolerance > ray.tmin && h.t + h.t_tolerance < ray.tmax;
-      best.robust_hit = best.robust_hit || (!h.near_edge && t_inside);
-      if (h.t < best.t) {
-        best.prim = static_cast<std::uint32_t>(i);
-        best.t = h.t;
-        best.t_tolerance = h.t_tolerance;
-        best.closest_near_edge = h.near_edge;
-      }
-    } else if (h.near_miss) {
-      best.near_hit = true;
-    }
-  }
+  for (std::size_t i = 0; i < tris_.size(); ++i)
+    fold_reference_hit(best, intersect_reference(ray, tris_[i], ray.tmin, ray.tmax), static_cast<std::uint32_t>(i),
+                       ray);
   return best;
 }
 
@@ -118,10 +121,14 @@ bool ReferenceTracer::any_hit(const Ray& ray) const {
 
 const char* to_string(Verdict v) {
   switch (v) {
-    case Verdict::match: return "match";
-    case Verdict::near_tie: return "near_tie";
-    case Verdict::mismatched_prim: return "mismatched_prim";
-    case Verdict::t_beyond_tolerance: return "t_beyond_tolerance";
+    case Verdict::match:
+      return "match";
+    case Verdict::near_tie:
+      return "near_tie";
+    case Verdict::mismatched_prim:
+      return "mismatched_prim";
+    case Verdict::t_beyond_tolerance:
+      return "t_beyond_tolerance";
   }
   return "?";
 }

@@ -10,11 +10,11 @@
 // legitimately answer either way. The reference therefore also reports how
 // close each decision was, and the classifier counts such disagreements as
 // near ties instead of failures.
-#include "core/accel/accel.h"
-
 #include <cstdint>
 #include <limits>
 #include <span>
+
+#include "core/accel/accel.h"
 
 namespace accelviz {
 
@@ -24,7 +24,8 @@ struct ReferenceTriangleHit {
   bool near_edge = false;  ///< some edge function lies within float rounding of zero
   bool near_miss = false;  ///< a miss, but only by float rounding (would be a hit with the edges widened)
   double t = std::numeric_limits<double>::infinity();
-  double t_tolerance = 0.0;  ///< how far a float test's t may lie from t: max(kTTolerance·max(1,|t|), rounding estimate)
+  double t_tolerance =
+      0.0;  ///< how far a float test's t may lie from t: max(kTTolerance·max(1,|t|), rounding estimate)
 };
 
 /// Relative size of the float rounding the classifier forgives on edge
@@ -52,6 +53,11 @@ struct ReferenceHit {
   bool valid() const { return prim != kInvalidId; }
 };
 
+/// Folds primitive `id`'s reference result `h` (for `ray`) into `best`: the
+/// closest hit (lowest id on an exact tie) and the rounding flags. Any order of
+/// ids gives the same `best`.
+void fold_reference_hit(ReferenceHit& best, const ReferenceTriangleHit& h, std::uint32_t id, const Ray& ray);
+
 /// Brute force in double over a triangle list (which must outlive it).
 class ReferenceTracer {
  public:
@@ -69,8 +75,8 @@ class ReferenceTracer {
 
 /// How a structure's closest hit compares with the reference.
 enum class Verdict {
-  match,               ///< same primitive at the same t (or both miss)
-  near_tie,            ///< different answer, but the difference is within rounding (equal t, or an edge/vertex/grazing decision)
+  match,     ///< same primitive at the same t (or both miss)
+  near_tie,  ///< different answer, but the difference is within rounding (equal t, or an edge/vertex/grazing decision)
   mismatched_prim,     ///< a different primitive (or hit vs miss) that rounding does not explain
   t_beyond_tolerance,  ///< the same primitive at a t outside the tolerance
 };

@@ -116,15 +116,12 @@ int lab_count(const Bvh& bvh, const Ray& ray, TriangleTest test, const Watertigh
   return count;
 }
 
-// The double-precision reference accelerated by the BVH: candidates are the
-// leaves whose box, widened by `pad` on every side, the padded slab test
-// accepts; each candidate is then tested exactly as ReferenceTracer does.
-// The widening keeps every triangle the exact ray touches (and its near
-// misses) among the candidates.
-ReferenceHit reference_closest(const Bvh& bvh, std::span<const Triangle> scene, const Ray& ray, float pad) {
-  ReferenceHit best;
+// Calls visit(id) for every primitive in the leaves whose box, widened by
+// `pad` on every side, the padded slab test accepts (near to far is not kept).
+template <class Visit>
+void for_each_padded_candidate(const Bvh& bvh, const Ray& ray, float pad, Visit&& visit) {
   const auto nodes = bvh.nodes();
-  if (nodes.empty()) return best;
+  if (nodes.empty()) return;
   const auto ids = bvh.prim_indices();
   std::uint32_t stack[kBvhMaxDepth + 2];
   int sp = 0;
@@ -141,49 +138,28 @@ ReferenceHit reference_closest(const Bvh& bvh, std::span<const Triangle> scene, 
       stack[sp++] = n.index;
       continue;
     }
-    for (std::uint32_t k = n.index; k < n.index + n.count; ++k) {
-      const std::uint32_t id = ids[k];
-      const ReferenceTriangleHit h = intersect_reference(ray, scene[id], ray.tmin, ray.tmax);
-      if (h.hit) {
-        best.near_hit = true;
-        const bool t_inside = h.t - h.t_tolerance > ray.tmin && h.t + h.t_tolerance < ray.tmax;
-        best.robust_hit = best.robust_hit || (!h.near_edge && t_inside);
-        if (h.t < best.t || (h.t == best.t && id < best.prim)) {
-          best.prim = id;
-          best.t = h.t;
-          best.t_tolerance = h.t_tolerance;
-          best.closest_near_edge = h.near_edge;
-        }
-      } else if (h.near_miss) {
-        best.near_hit = true;
-      }
-    }
+    for (std::uint32_t k = n.index; k < n.index + n.count; ++k) visit(ids[k]);
   }
+}
+
+// The double-precision reference accelerated by the BVH: candidates are the
+// leaves whose box, widened by `pad` on every side, the padded slab test
+// accepts; each candidate is then tested exactly as ReferenceTracer does.
+// The widening keeps every triangle the exact ray touches (and its near
+// misses) among the candidates.
+ReferenceHit reference_closest(const Bvh& bvh, std::span<const Triangle> scene, const Ray& ray, float pad) {
+  ReferenceHit best;
+  for_each_padded_candidate(bvh, ray, pad, [&](std::uint32_t id) {
+    fold_reference_hit(best, intersect_reference(ray, scene[id], ray.tmin, ray.tmax), id, ray);
+  });
   return best;
 }
 
 // Triangles the reference itself hits within the closest hit's tolerance window.
 int reference_count(const Bvh& bvh, std::span<const Triangle> scene, const Ray& ray, double t0, double t1, float pad) {
-  const auto nodes = bvh.nodes();
-  const auto ids = bvh.prim_indices();
-  std::uint32_t stack[kBvhMaxDepth + 2];
-  int sp = 0, count = 0;
-  stack[sp++] = 0;
-  while (sp > 0) {
-    const BvhNode& n = nodes[stack[--sp]];
-    Aabb wide = n.bounds;
-    wide.lo -= glm::vec3(pad);
-    wide.hi += glm::vec3(pad);
-    SlabInterval si;
-    if (!intersect_slab<true>(wide, ray.origin, ray.inv_dir, ray.tmin, ray.tmax, si)) continue;
-    if (!n.is_leaf()) {
-      stack[sp++] = n.index + 1;
-      stack[sp++] = n.index;
-      continue;
-    }
-    for (std::uint32_t k = n.index; k < n.index + n.count; ++k)
-      count += intersect_reference(ray, scene[ids[k]], t0, t1).hit;
-  }
+  int count = 0;
+  for_each_padded_candidate(bvh, ray, pad,
+                            [&](std::uint32_t id) { count += intersect_reference(ray, scene[id], t0, t1).hit; });
   return count;
 }
 
