@@ -23,7 +23,9 @@ glm::vec4 from_quat(const glm::quat& q) {
   return glm::vec4(q.x, q.y, q.z, q.w);
 }
 
-glm::mat4 compose(const glm::vec3& t, const glm::quat& r, const glm::vec3& s) {
+}  // namespace
+
+glm::mat4 compose_trs(const glm::vec3& t, const glm::quat& r, const glm::vec3& s) {
   glm::mat4 m = glm::mat4_cast(r);
   m[0] *= s.x;
   m[1] *= s.y;
@@ -31,8 +33,6 @@ glm::mat4 compose(const glm::vec3& t, const glm::quat& r, const glm::vec3& s) {
   m[3] = glm::vec4(t, 1.0f);
   return m;
 }
-
-}  // namespace
 
 glm::vec4 sample_channel(const AnimationChannel& c, float t) {
   using I = AnimationChannel::Interpolation;
@@ -112,7 +112,7 @@ void apply_animation(const Animation& anim, float t, std::vector<Node>& nodes, s
       case AnimationChannel::Path::weights:
         break;
     }
-    n.local = compose(n.translation, n.rotation, n.scale);
+    n.local = compose_trs(n.translation, n.rotation, n.scale);
     n.has_matrix = false;
     changed[c.node] = true;
   }

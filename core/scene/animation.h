@@ -35,6 +35,9 @@ bool scene_animates(const Scene& scene);
 /// `changed` (resized to nodes.size()). Weight channels are ignored.
 void apply_animation(const Animation& anim, float t, std::vector<Node>& nodes, std::vector<bool>& changed);
 
+/// The local matrix T * R * S of a node's translation, rotation and scale.
+glm::mat4 compose_trs(const glm::vec3& translation, const glm::quat& rotation, const glm::vec3& scale);
+
 /// World (object-to-world) matrix of every node: parent chain of locals.
 std::vector<glm::mat4> node_world_transforms(std::span<const Node> nodes);
 

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/scene/animation.h"
 #include "core/scene/procedural/common.h"
 #include "core/scene/procedural/generators.h"
 #include "core/scene/procedural/random.h"
@@ -21,15 +22,6 @@ namespace {
 constexpr int kKeys = 5;           // keys at t = 0, 1, 2, 3, 4 s; the last repeats the first (a loop)
 constexpr float kBoxHalf = 0.04f;  // half edge of a box
 constexpr float kGrassHeight = 0.3f;
-
-glm::mat4 compose(const glm::vec3& t, const glm::quat& r, const glm::vec3& s) {
-  glm::mat4 m = glm::mat4_cast(r);
-  m[0] *= s.x;
-  m[1] *= s.y;
-  m[2] *= s.z;
-  m[3] = glm::vec4(t, 1.0f);
-  return m;
-}
 
 glm::quat axis_angle(const glm::vec3& axis, double angle) {
   const SinCos h = sin_cos(0.5 * angle);
@@ -113,7 +105,7 @@ Scene make_dynamic(const BuiltinArgs& args) {
     node.translation = p0;
     node.rotation = q0;
     node.scale = glm::vec3(s0);
-    node.local = compose(p0, q0, node.scale);
+    node.local = compose_trs(p0, q0, node.scale);  // as apply_animation does
     scene.nodes.push_back(node);
     const int node_id = static_cast<int>(scene.nodes.size()) - 1;
     Instance inst;
