@@ -9,6 +9,7 @@
 #include "app/gui/scene_view.h"
 #include "core/scene/load.h"
 #include "ui/app/app_state.h"
+#include "ui/app/dynamics.h"
 #include "ui/app/script.h"
 #include "ui/app/sweep_worker.h"
 #include "ui/app/settings.h"
@@ -79,6 +80,10 @@ class Gui final : public ScriptHost {
  private:
   void handle_input(int fbw, int fbh, int ww, int wh);
   void draw_panels(const panels::PanelLayout& layout);
+  /// The effects of the shown scene under the user's forces (recomputed when either changes).
+  const SceneEffects* effects();
+  /// The Dynamics panel: the timeline and per-frame figures while per-frame updates are on.
+  void draw_dynamics(const panels::PanelLayout& layout);
   void take_screenshot();
   SavedScreenshot write_frame(const std::optional<std::filesystem::path>& explicit_path);
   void report_errors();
@@ -98,6 +103,14 @@ class Gui final : public ScriptHost {
   InsightViews insight_;         ///< A/B, predicted vs measured, SAH explainer, tree, scenarios
   RobustnessWorker robustness_;  ///< the Robustness panel's lab runs
   panels::RobustnessPanelState robustness_panel_;
+  DynamicsWorker dynamics_;  ///< steps the shown scene's animation off the UI thread
+  DynamicsPlayer player_;
+  std::optional<SceneEffects> effects_;
+  const Scene* effects_scene_ = nullptr;
+  EffectForces effects_forces_;
+  const LoadedScene* dynamics_scene_ = nullptr;  ///< the scene the player was reset for
+  Clock::time_point dynamics_clock_ = Clock::now();
+  std::optional<std::uint64_t> play_target_;  ///< script `play`: the frame count to reach
   std::vector<std::string> dropped_;
   std::vector<KeyPress> keys_;
 
@@ -256,6 +269,11 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
   if (sa.open) app_.open_scene(*sa.open);
   if (sa.camera) app_.use_scene_camera(*sa.camera);
   if (sa.reset_view) app_.reset_camera();
+  if (const auto force = panels::scene_effects_section(effects())) {
+    const std::string err = force_effect(app_.config(), force->first, force->second);
+    if (!err.empty()) app_.set_error(err);
+  }
+  draw_dynamics(layout);
 
   const BuildWorker::Status st = app_.build_status();
   panels::BuildProgress bp;
@@ -342,6 +360,50 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
       robustness_.request(std::move(r));
     }
   }
+}
+
+const SceneEffects* Gui::effects() {
+  const Scene* scene = app_.scene();
+  if (!scene) return nullptr;
+  const EffectForces& f = app_.config().effects;
+  const bool same_forces = f.shadow_rays == effects_forces_.shadow_rays &&
+                           f.per_frame_updates == effects_forces_.per_frame_updates &&
+                           f.two_level == effects_forces_.two_level && f.textures == effects_forces_.textures;
+  if (!effects_ || scene != effects_scene_ || !same_forces) {
+    effects_ = decide_effects(*scene, f);
+    effects_scene_ = scene;
+    effects_forces_ = f;
+  }
+  return &*effects_;
+}
+
+void Gui::draw_dynamics(const panels::PanelLayout& layout) {
+  const auto now = Clock::now();
+  const double dt = std::chrono::duration<double>(now - dynamics_clock_).count();
+  dynamics_clock_ = now;
+  const SceneEffects* fx = effects();
+  const std::shared_ptr<const BuiltStructure>& cur = app_.current();
+  if (!fx || !cur || !fx->per_frame_updates.on) {
+    if (dynamics_scene_) dynamics_.request({});  // releases the worker's copy of the structure
+    dynamics_scene_ = nullptr;
+    player_.playing = false;
+    return;
+  }
+  if (dynamics_scene_ != cur->scene.get()) {  // a new scene: the timeline starts over
+    dynamics_scene_ = cur->scene.get();
+    player_ = DynamicsPlayer{};
+    player_.duration = animation_duration(cur->scene->scene);
+    player_.seek(0.0f);
+  }
+  if (player_.tick(dt, dynamics_.busy())) {
+    DynamicsRequest r;
+    r.scene = cur->scene;
+    r.time = player_.time();
+    dynamics_.request(std::move(r));
+  }
+  std::shared_ptr<const DynamicsSnapshot> snap = dynamics_.latest();
+  if (snap && snap->scene != cur->scene.get()) snap.reset();
+  panels::dynamics_panel(player_, snap.get(), dynamics_.busy(), layout);
 }
 
 SavedScreenshot Gui::write_frame(const std::optional<std::filesystem::path>& explicit_path) {
@@ -454,6 +516,58 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
     case K::quit:
       quit_ = true;
       return Status::done;
+    case K::force_effect:
+      fail_if(force_effect(app_.config(), c.arg, c.value == "on"));
+      return Status::done;
+    case K::play: {
+      if (app_.loading_scene() || !app_.current()) return Status::again;
+      const SceneEffects* fx = effects();
+      if (!fx || !fx->per_frame_updates.on)
+        throw std::runtime_error("play: " + app_.scene_spec() + ": per-frame updates are off (" +
+                                 (fx ? fx->per_frame_updates.reason : std::string("no scene")) + ")");
+      const std::shared_ptr<const DynamicsSnapshot> snap = dynamics_.latest();
+      const bool ours = snap && snap->scene == app_.current()->scene.get();
+      if (!snap || !ours) {  // the worker has not set the scene up yet
+        player_.playing = true;
+        return Status::again;
+      }
+      if (!snap->error.empty()) throw std::runtime_error(snap->error);
+      if (!play_target_) {
+        play_target_ = snap->frames + static_cast<std::uint64_t>(c.x);
+        player_.playing = true;
+      }
+      if (snap->frames < *play_target_) return Status::again;
+      play_target_.reset();
+      player_.playing = false;
+      return Status::done;
+    }
+    case K::dump_dynamics: {
+      const SceneEffects* fx = effects();
+      if (!fx) throw std::runtime_error("dump-dynamics: no scene shown yet");
+      nlohmann::json doc = {{"scene", app_.scene_spec()}, {"effects", effects_json(*fx)}};
+      const std::shared_ptr<const DynamicsSnapshot> snap = dynamics_.latest();
+      if (snap && app_.current() && snap->scene == app_.current()->scene.get()) {
+        nlohmann::json frames = nlohmann::json::array();
+        for (const FrameStats& f : snap->history)
+          frames.push_back({{"frame", f.frame},
+                            {"time", f.time},
+                            {"moved_instances", f.moved_instances},
+                            {"refits", f.refits},
+                            {"rebuilds", f.rebuilds},
+                            {"tlas_rebuilt", f.tlas_rebuilt},
+                            {"tlas_rebuild_ms", f.tlas_rebuild_ms},
+                            {"refit_ms", f.refit_ms},
+                            {"rebuild_ms", f.rebuild_ms},
+                            {"sah_refit", f.sah_refit},
+                            {"sah_rebuilt", f.sah_rebuilt}});
+        doc["dynamics"] = {{"frames_stepped", snap->frames}, {"setup_ms", snap->setup_ms}, {"duration", snap->duration},
+                           {"animates", snap->animates},     {"error", snap->error},       {"history", frames}};
+      } else {
+        doc["dynamics"] = nullptr;
+      }
+      fail_if(write_file_atomic(c.arg, doc.dump(2) + "\n"));
+      return Status::done;
+    }
     case K::scenario:
     case K::dump_scenario:
     case K::dump_insight:
@@ -480,7 +594,7 @@ int Gui::run() {
     // arrives; otherwise keep frames coming so results show up promptly.
     // One more frame after the workers go quiet picks up their last result.
     const bool busy = script_ || app_.build_status().busy || app_.heatmap_busy() || sweeps_.busy() || insight_.busy() ||
-                      robustness_.busy();
+                      robustness_.busy() || dynamics_.busy() || player_.playing;
     if (busy || was_busy_)
       glfwPollEvents();
     else

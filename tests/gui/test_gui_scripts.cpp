@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -414,4 +415,51 @@ TEST_F(GuiScript, InsightScenariosAndPredictedVsMeasured) {
   EXPECT_EQ(in["explainer"]["node"], 0);
   EXPECT_GT(in["explainer"]["prims"].get<int>(), 1000);
   EXPECT_EQ(in["explainer"]["decision"], "split");
+}
+
+// The Dynamics panel plays builtin:dynamic off the UI thread: `play 3` waits
+// for three stepped frames, whose figures come from a SceneAnimator over the
+// scene's two-level structure. A static OBJ without lights reports shadow
+// rays and per-frame updates off, and a force turns shadow rays on, said so.
+TEST_F(GuiScript, DynamicsPanelPlaysFramesAndEffectsFollowTheScene) {
+  const RunResult r = run("open builtin:dynamic?size=6000\nsize 480 360\nwait\nplay 3\ndump-dynamics " +
+                          path("dyn.json").string() + "\nquit\n");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json d = read_json(path("dyn.json"));
+  ASSERT_TRUE(d["dynamics"].is_object()) << d.dump();
+  EXPECT_GE(d["dynamics"]["frames_stepped"].get<int>(), 3);
+  EXPECT_EQ(d["dynamics"]["error"], "");
+  const auto& h = d["dynamics"]["history"];
+  ASSERT_GE(h.size(), 3u);
+  const auto& last = h.back();
+  EXPECT_GT(last["moved_instances"].get<int>(), 0);
+  EXPECT_GT(last["tlas_rebuild_ms"].get<double>(), 0.0);
+  EXPECT_EQ(last["refits"].get<int>() + last["rebuilds"].get<int>(), 1);  // the one grass BLAS
+  EXPECT_GT(last["refit_ms"].get<double>() + last["rebuild_ms"].get<double>(), 0.0);
+  EXPECT_GT(last["sah_refit"].get<double>(), 0.0);
+  EXPECT_GT(last["sah_rebuilt"].get<double>(), 0.0);
+  std::map<std::string, bool> on;
+  for (const auto& e : d["effects"]) on[e["name"].get<std::string>()] = e["on"].get<bool>();
+  EXPECT_TRUE(on["per-frame-updates"]);
+  EXPECT_TRUE(on["two-level"]);
+
+  const fs::path obj = path("tri.obj");
+  std::ofstream(obj) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n";
+  const RunResult s = run("open " + obj.string() + "\nwait\ndump-dynamics " + path("static.json").string() +
+                          "\nforce-effect shadow-rays\ndump-dynamics " + path("forced.json").string() + "\nquit\n");
+  ASSERT_EQ(s.code, 0) << s.err;
+  for (const char* file : {"static.json", "forced.json"}) {
+    const nlohmann::json st = read_json(path(file));
+    EXPECT_TRUE(st["dynamics"].is_null()) << file << ": nothing animates, nothing is stepped";
+    for (const auto& e : st["effects"]) {
+      if (e["name"] == "per-frame-updates") {
+        EXPECT_FALSE(e["on"].get<bool>()) << file;
+      }
+      if (e["name"] != "shadow-rays") continue;
+      const bool forced = std::string(file) == "forced.json";
+      EXPECT_EQ(e["on"].get<bool>(), forced) << file;
+      EXPECT_EQ(e["forced"].get<bool>(), forced) << file;
+      EXPECT_NE(e["reason"].get<std::string>().find("no lights"), std::string::npos) << e.dump();
+    }
+  }
 }

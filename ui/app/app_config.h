@@ -10,6 +10,7 @@
 #include "core/accel/factory.h"
 #include "core/analysis/colormap.h"
 #include "core/analysis/heatmap.h"
+#include "core/scene/effects.h"
 
 #include <string>
 #include <string_view>
@@ -60,6 +61,9 @@ struct ViewSettings {
 struct AppConfig {
   StructureChoice structure;
   ViewSettings view;
+  /// Effects the user forced on in the Scene panel (ui/app/dynamics.h
+  /// force_effect); not in the option table or the settings file.
+  EffectForces effects;
 };
 
 /// One named option.

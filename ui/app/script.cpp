@@ -9,6 +9,7 @@
 
 #include "core/accel/factory.h"
 #include "ui/app/app_config.h"
+#include "ui/app/dynamics.h"
 #include "ui/app/scenarios.h"
 
 namespace accelviz {
@@ -86,6 +87,9 @@ constexpr NamedKind kCommands[] = {
     {"scenario", ScriptCommand::Kind::scenario},
     {"dump-scenario", ScriptCommand::Kind::dump_scenario},
     {"dump-insight", ScriptCommand::Kind::dump_insight},
+    {"force-effect", ScriptCommand::Kind::force_effect},
+    {"play", ScriptCommand::Kind::play},
+    {"dump-dynamics", ScriptCommand::Kind::dump_dynamics},
 };
 
 }  // namespace
@@ -121,7 +125,7 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
       fail("unknown command '" + std::string(word) +
            "' (valid: open, structure, set, camera, size, wait, click, step, screenshot, dump-ray, dump-stats, quit, "
            "scenario, dump-scenario, "
-           "dump-insight)");
+           "dump-insight, force-effect, play, dump-dynamics)");
 
     ScriptCommand c;
     c.kind = it->kind;
@@ -141,6 +145,7 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
       case ScriptCommand::Kind::dump_stats:
       case ScriptCommand::Kind::dump_scenario:
       case ScriptCommand::Kind::dump_insight:
+      case ScriptCommand::Kind::dump_dynamics:
         // The rest of the line, so paths may hold spaces.
         need_rest(c.kind == ScriptCommand::Kind::open ? "a scene (file or builtin:NAME)" : "a file path");
         c.arg = std::string(rest);
@@ -195,6 +200,21 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
       case ScriptCommand::Kind::wait:
       case ScriptCommand::Kind::quit:
         no_rest();
+        break;
+      case ScriptCommand::Kind::force_effect: {
+        std::string_view value;
+        const std::string_view effect = first_word(rest, value);
+        if (effect.empty()) fail("force-effect: expected NAME [on|off]");
+        c.arg = std::string(effect);
+        c.value = value.empty() ? "on" : std::string(value);
+        if (c.value != "on" && c.value != "off") fail("force-effect: expected on or off, got '" + c.value + "'");
+        AppConfig probe;
+        const std::string error = force_effect(probe, c.arg, true);
+        if (!error.empty()) fail(error);
+        break;
+      }
+      case ScriptCommand::Kind::play:
+        if (!parse_int(rest, c.x) || c.x < 1 || c.x > 100000) fail("play: expected FRAMES (an integer in 1..100000)");
         break;
       case ScriptCommand::Kind::scenario: {
         std::string_view value;

@@ -28,6 +28,9 @@ struct ScriptCommand {
     scenario,       ///< arg: scenario id, value: slider value (insight: Scenarios window)
     dump_scenario,  ///< arg: path; waits for the scenario's run, writes its figures
     dump_insight,   ///< arg: path; measures the view (predicted vs measured, modes, hot nodes, explainer), writes JSON
+    force_effect,   ///< arg: effect name, value: "on" | "off" (Scene panel's force checkbox)
+    play,           ///< x: frames; plays the Dynamics timeline until that many more frames were stepped
+    dump_dynamics,  ///< arg: path; the effects and the Dynamics panel's per-frame figures as JSON
   };
   Kind kind = Kind::wait;
   int line = 0;       ///< 1-based line in the script file

@@ -6,6 +6,7 @@
 #include "core/scene/scene.h"
 #include "ui/app/app_config.h"
 #include "ui/app/build_worker.h"
+#include "ui/app/dynamics.h"
 #include "ui/app/heatmap_worker.h"
 #include "ui/app/ray_inspection.h"
 #include "ui/app/robustness_worker.h"
@@ -16,6 +17,7 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace accelviz::panels {
@@ -129,5 +131,15 @@ struct RobustnessAction {
 /// of the selected variant.
 RobustnessAction robustness_panel(RobustnessPanelState& state, const RobustnessSnapshot* snap, bool busy,
                                   const std::string& structure, const PanelLayout& layout);
+
+// ---- Effects and Dynamics (dynamics_panel.cpp) ---------------------------------------
+/// Appends the scene's effects to the Scene window: each effect on or off
+/// with its reason, and a "force" checkbox. Returns (name, forced) when one
+/// was ticked or unticked.
+std::optional<std::pair<std::string, bool>> scene_effects_section(const SceneEffects* effects);
+/// Play/pause, speed, the time slider, and the per-frame figures of `snap`
+/// plotted over time (TLAS rebuild ms, refit ms, rebuild ms, SAH refitted
+/// vs rebuilt).
+void dynamics_panel(DynamicsPlayer& player, const DynamicsSnapshot* snap, bool busy, const PanelLayout& layout);
 
 }  // namespace accelviz::panels
