@@ -106,9 +106,9 @@ class Gui final : public ScriptHost {
   DynamicsWorker dynamics_;  ///< steps the shown scene's animation off the UI thread
   DynamicsPlayer player_;
   std::optional<SceneEffects> effects_;
-  const Scene* effects_scene_ = nullptr;
+  std::shared_ptr<const LoadedScene> effects_scene_;  ///< held: a freed scene's address may come back
   EffectForces effects_forces_;
-  const LoadedScene* dynamics_scene_ = nullptr;  ///< the scene the player was reset for
+  std::shared_ptr<const LoadedScene> dynamics_scene_;  ///< the scene the player was reset for
   Clock::time_point dynamics_clock_ = Clock::now();
   std::optional<std::uint64_t> play_target_;  ///< script `play`: the frame count to reach
   std::vector<std::string> dropped_;
@@ -363,14 +363,14 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
 }
 
 const SceneEffects* Gui::effects() {
-  const Scene* scene = app_.scene();
-  if (!scene) return nullptr;
+  if (!app_.current()) return nullptr;
+  const std::shared_ptr<const LoadedScene>& scene = app_.current()->scene;
   const EffectForces& f = app_.config().effects;
   const bool same_forces = f.shadow_rays == effects_forces_.shadow_rays &&
                            f.per_frame_updates == effects_forces_.per_frame_updates &&
                            f.two_level == effects_forces_.two_level && f.textures == effects_forces_.textures;
   if (!effects_ || scene != effects_scene_ || !same_forces) {
-    effects_ = decide_effects(*scene, f);
+    effects_ = decide_effects(scene->scene, f);
     effects_scene_ = scene;
     effects_forces_ = f;
   }
@@ -385,12 +385,12 @@ void Gui::draw_dynamics(const panels::PanelLayout& layout) {
   const std::shared_ptr<const BuiltStructure>& cur = app_.current();
   if (!fx || !cur || !fx->per_frame_updates.on) {
     if (dynamics_scene_) dynamics_.request({});  // releases the worker's copy of the structure
-    dynamics_scene_ = nullptr;
+    dynamics_scene_.reset();
     player_.playing = false;
     return;
   }
-  if (dynamics_scene_ != cur->scene.get()) {  // a new scene: the timeline starts over
-    dynamics_scene_ = cur->scene.get();
+  if (dynamics_scene_ != cur->scene) {  // a new scene: the timeline starts over
+    dynamics_scene_ = cur->scene;
     player_ = DynamicsPlayer{};
     player_.duration = animation_duration(cur->scene->scene);
     player_.seek(0.0f);
