@@ -1,0 +1,182 @@
+#include "ui/render/gpu_trace.h"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "core/query/camera.h"
+#include "core/query/ray_sets.h"
+
+namespace accelviz {
+namespace {
+
+/// shaders/trace_bvh.comp PixelOut: eight 32-bit words per pixel.
+struct GpuPixel {
+  std::uint32_t nodes_visited;
+  std::uint32_t box_tests;
+  std::uint32_t prim_tests;
+  std::uint32_t nodes_culled;
+  std::uint32_t nodes_missed;
+  std::uint32_t prim;
+  float t;
+  std::uint32_t pad;
+};
+static_assert(sizeof(GpuPixel) == 32);
+static_assert(sizeof(Triangle) == 36, "the shader reads triangles as 9 packed floats");
+
+constexpr int kGroup = 8;  // local_size_x/y of trace_bvh.comp
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// A storage buffer with `bytes` of `data` (at least 4 bytes: GL rejects empty stores).
+GlObject make_storage(const void* data, std::size_t bytes, const char* what) {
+  GLint64 limit = 0;
+  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &limit);
+  if (limit > 0 && static_cast<GLint64>(bytes) > limit)
+    throw GlError(std::string("GPU trace: ") + what + " need " + std::to_string(bytes) +
+                  " bytes, more than this GL's storage-block limit of " + std::to_string(limit));
+  GlObject buf = GlObject::create(GlObject::Kind::buffer);
+  const std::uint32_t zero = 0;
+  glNamedBufferStorage(buf.id(), static_cast<GLsizeiptr>(bytes > 0 ? bytes : sizeof zero), bytes > 0 ? data : &zero, 0);
+  return buf;
+}
+
+}  // namespace
+
+std::string gpu_trace_unsupported(const std::string& structure_name) {
+  if (structure_name != "bvh") return "only the bvh structure is traced on the GPU";
+  return {};
+}
+
+GpuBvhTracer::GpuBvhTracer() : program_(ShaderProgram::build({"trace_bvh.comp"})) {
+  check_gl_errors("GPU trace setup");
+}
+
+void GpuBvhTracer::upload(const Bvh& bvh) {
+  const std::span<const BvhNode> nodes = bvh.nodes();
+  const std::span<const Triangle> tris = bvh.leaf_triangles();
+  nodes_ = make_storage(nodes.data(), nodes.size_bytes(), "the BVH nodes");
+  tris_ = make_storage(tris.data(), tris.size_bytes(), "the triangles");
+  node_count_ = nodes.size();
+  prim_ids_.assign(bvh.prim_indices().begin(), bvh.prim_indices().end());
+  normals_.resize(tris.size());
+  for (std::size_t k = 0; k < tris.size(); ++k) normals_[k] = triangle_normal(tris[k]);
+  uploaded_ = true;
+  check_gl_errors("GPU trace upload");
+}
+
+GpuTraceResult GpuBvhTracer::trace(const Camera& camera, int width, int height, const QueryOptions& query) {
+  if (width <= 0 || height <= 0) throw std::invalid_argument("GPU trace: image size must be positive");
+  if (!uploaded_) throw std::logic_error("GPU trace: no BVH uploaded");
+  const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  const std::size_t bytes = n * sizeof(GpuPixel);
+  if (!out_ || out_bytes_ < bytes) {
+    out_ = GlObject::create(GlObject::Kind::buffer);
+    glNamedBufferStorage(out_.id(), static_cast<GLsizeiptr>(bytes), nullptr, GL_MAP_READ_BIT);
+    out_bytes_ = bytes;
+  }
+
+  // The per-camera constants of core's camera_ray, computed by the same C++.
+  const float aspect = camera_aspect(camera, width, height);
+  const float tan_half = std::tan(0.5f * camera.yfov);
+  const glm::vec3 right = glm::cross(camera.forward, camera.up);
+  program_.set("u_width", width);
+  program_.set("u_height", height);
+  glProgramUniform1ui(program_.id(), glGetUniformLocation(program_.id(), "u_node_count"),
+                      static_cast<GLuint>(node_count_));
+  program_.set("u_position", camera.position);
+  program_.set("u_forward", camera.forward);
+  program_.set("u_up", camera.up);
+  program_.set("u_right", right);
+  program_.set("u_tan_half", tan_half);
+  program_.set("u_aspect", aspect);
+  program_.set("u_slab_scale", kSlabExitScale);
+  program_.set("u_ordered", query.ordered ? 1 : 0);
+  program_.set("u_back_to_front", query.back_to_front ? 1 : 0);
+  program_.set("u_xray", query.xray ? 1 : 0);
+  program_.set("u_watertight", query.triangle_test == TriangleTest::watertight ? 1 : 0);
+
+  GpuTraceResult r;
+  r.width = width;
+  r.height = height;
+  program_.use();
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, nodes_.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, tris_.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, out_.id());
+  glFinish();  // nothing queued before counts against the trace
+  const auto t0 = std::chrono::steady_clock::now();
+  glDispatchCompute(static_cast<GLuint>((width + kGroup - 1) / kGroup),
+                    static_cast<GLuint>((height + kGroup - 1) / kGroup), 1);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_CLIENT_MAPPED_BUFFER_BARRIER_BIT);
+  glFinish();
+  r.trace_ms = ms_since(t0);
+  check_gl_errors("GPU trace dispatch");
+
+  const auto t1 = std::chrono::steady_clock::now();
+  std::vector<GpuPixel> px(n);
+  glGetNamedBufferSubData(out_.id(), 0, static_cast<GLsizeiptr>(bytes), px.data());
+  for (GLuint b = 0; b < 3; ++b) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b, 0);
+  glUseProgram(0);
+  check_gl_errors("GPU trace readback");
+
+  r.stats.resize(n);
+  r.hits.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const GpuPixel& p = px[i];
+    RayStats& s = r.stats[i];
+    s.nodes_visited = p.nodes_visited;
+    s.box_tests = p.box_tests;
+    s.prim_tests = p.prim_tests;
+    s.nodes_culled = p.nodes_culled;
+    s.nodes_missed = p.nodes_missed;
+    Hit& h = r.hits[i];
+    if (p.prim != kInvalidId && p.prim < prim_ids_.size()) {
+      h.prim = prim_ids_[p.prim];  // as Bvh::closest_hit maps its leaf-order hit
+      h.ng = normals_[p.prim];
+      h.t = p.t;
+    }
+  }
+  r.readback_ms = ms_since(t1);
+  return r;
+}
+
+MetricImage gpu_render_metric(GpuBvhTracer& tracer, const Camera& camera, const HeatmapOptions& opts,
+                              HeatmapFigures* figures, GpuTraceResult* raw) {
+  if (opts.width <= 0 || opts.height <= 0) throw std::invalid_argument("heatmap: image size must be positive");
+  GpuTraceResult r = tracer.trace(camera, opts.width, opts.height, opts.query);
+  // The rays again on the CPU, for the metrics that need the direction (shaded).
+  const std::vector<Ray> rays = primary_rays(camera, opts.width, opts.height);
+
+  MetricImage img;
+  img.width = opts.width;
+  img.height = opts.height;
+  img.metric = opts.metric;
+  img.values.resize(rays.size());
+  double sum = 0.0, max = 0.0;
+  std::uint64_t counted = 0, hit_count = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const float v = metric_value(opts.metric, rays[i], r.hits[i], r.stats[i], opts.c_trav, opts.c_isect);
+    img.values[i] = v;
+    if (r.hits[i].valid()) ++hit_count;
+    if (std::isfinite(v)) {
+      sum += v;
+      max = counted == 0 ? v : std::max<double>(max, v);
+      ++counted;
+    }
+  }
+  if (figures) {
+    figures->rays = rays.size();
+    figures->hits = hit_count;
+    figures->mean = counted ? sum / static_cast<double>(counted) : 0.0;
+    figures->max = max;
+    figures->render_ms = r.trace_ms;
+    figures->rays_per_s = r.trace_ms > 0.0 ? static_cast<double>(rays.size()) / (r.trace_ms * 1e-3) : 0.0;
+  }
+  if (raw) *raw = std::move(r);
+  return img;
+}
+
+}  // namespace accelviz
