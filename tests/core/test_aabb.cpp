@@ -5,6 +5,9 @@
 
 #include "core/math/aabb.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_aabb {
+
 using namespace accelviz;
 
 namespace {
@@ -131,3 +134,4 @@ TEST(SlabHardCases, PaddingNeverShrinksTheInterval) {
     }
   }
 }
+}  // namespace unity_test_aabb

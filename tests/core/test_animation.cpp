@@ -18,6 +18,9 @@
 #include "core/scene/effects.h"
 #include "core/scene/load.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_animation {
+
 using namespace accelviz;
 
 namespace {
@@ -255,3 +258,4 @@ TEST(Effects, InstancedSceneBuildsEachUniqueMeshOnce) {
   for (const char* name : {"shadow-rays", "per-frame-updates", "two-level", "textures"})
     EXPECT_NE(text.find(name), std::string::npos) << name;
 }
+}  // namespace unity_test_animation

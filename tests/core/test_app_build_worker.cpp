@@ -5,15 +5,18 @@
 // events is forced, not timed.
 #include <gtest/gtest.h>
 
-#include "core/accel/brute_force.h"
-#include "core/query/camera.h"
-#include "ui/app/app_state.h"
-
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
 #include <thread>
+
+#include "core/accel/brute_force.h"
+#include "core/query/camera.h"
+#include "ui/app/app_state.h"
+
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_app_build_worker {
 
 using namespace accelviz;
 using namespace std::chrono_literals;
@@ -265,3 +268,4 @@ TEST(AppBuildWorker, ReopeningTheSameSceneReloadsIt) {
   EXPECT_EQ(app.settings().recent, std::vector<std::string>{"scene"});
   EXPECT_EQ(app.settings().last_scene, "scene");
 }
+}  // namespace unity_test_app_build_worker

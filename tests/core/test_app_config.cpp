@@ -3,9 +3,12 @@
 // descriptions/captions say what the picture shows.
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include "ui/app/app_config.h"
 
-#include <set>
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_app_config {
 
 using namespace accelviz;
 
@@ -191,3 +194,4 @@ TEST(AppConfig, NumbersRoundTripShortest) {
   for (float f : {0.1f, 1.0f / 3.0f, 3.14159265f, 1e-7f, 123456.789f, -2.5f})
     EXPECT_EQ(std::stof(format_number(f)), f) << format_number(f);
 }
+}  // namespace unity_test_app_config

@@ -2,12 +2,15 @@
 // panel (ui/app/shortcuts.h), every option key and every script command.
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <sstream>
+
 #include "ui/app/app_config.h"
 #include "ui/app/script.h"
 #include "ui/app/shortcuts.h"
 
-#include <fstream>
-#include <sstream>
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_app_docs {
 
 using namespace accelviz;
 
@@ -57,3 +60,4 @@ TEST(AppDocs, EveryScriptCommandIsDocumented) {
     EXPECT_NE(docs.find("| `" + std::string(command_name(k))), std::string::npos)
         << "docs/gui.md has no row for script command " << command_name(k);
 }
+}  // namespace unity_test_app_docs

@@ -10,6 +10,9 @@
 #include "ui/app/dynamics.h"
 #include "ui/app/script.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_app_dynamics {
+
 using namespace accelviz;
 
 namespace {
@@ -158,3 +161,4 @@ TEST(AppDynamicsScript, CommandsAreCheckedAtParseTime) {
     }
   }
 }
+}  // namespace unity_test_app_dynamics

@@ -3,15 +3,18 @@
 // and the worker always ending on its newest request.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <thread>
+
 #include "core/accel/factory.h"
 #include "core/query/camera.h"
 #include "core/scene/load.h"
 #include "ui/app/heatmap_worker.h"
 
-#include <atomic>
-#include <chrono>
-#include <cmath>
-#include <thread>
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_app_heatmap {
 
 using namespace accelviz;
 using namespace std::chrono_literals;
@@ -148,3 +151,4 @@ TEST(AppHeatmap, WorkerEndsOnTheNewestRequest) {
   EXPECT_EQ(f->image.width, 52);
   EXPECT_EQ(worker.latest_request(), last);
 }
+}  // namespace unity_test_app_heatmap

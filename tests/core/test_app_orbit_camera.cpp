@@ -3,10 +3,13 @@
 // --camera spec that reproduces a view in `accelviz render`.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "core/query/camera.h"
 #include "ui/app/orbit_camera.h"
 
-#include <cmath>
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_app_orbit_camera {
 
 using namespace accelviz;
 
@@ -182,3 +185,4 @@ TEST(ViewCamera, SpecReproducesTheOrbitInRender) {
   EXPECT_THROW(ViewCamera::from_spec("gltf:3", s, 1.5f), std::invalid_argument);
   EXPECT_THROW(ViewCamera::from_spec("1,2,3", s, 1.5f), std::invalid_argument);
 }
+}  // namespace unity_test_app_orbit_camera

@@ -3,13 +3,16 @@
 // the replay walks the trace in order.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "core/accel/brute_force.h"
 #include "core/accel/factory.h"
 #include "core/query/camera.h"
 #include "core/scene/load.h"
 #include "ui/app/ray_inspection.h"
 
-#include <cmath>
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_app_ray_inspection {
 
 using namespace accelviz;
 
@@ -148,3 +151,4 @@ TEST(AppRayInspection, JsonListsHitStepsAndShadows) {
   EXPECT_TRUE(saw_null);
   EXPECT_EQ(j.dump().find("inf"), std::string::npos);
 }
+}  // namespace unity_test_app_ray_inspection

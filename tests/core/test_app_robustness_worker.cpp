@@ -8,6 +8,9 @@
 #include "core/scene/load.h"
 #include "ui/app/robustness_worker.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_app_robustness_worker {
+
 using namespace accelviz;
 
 namespace {
@@ -84,3 +87,4 @@ TEST(RobustnessWorker, ANewRequestSupersedesAndCancelStops) {
       << "id " << c->id << " error " << c->error << " result " << c->result.has_value();
   EXPECT_NE(c->state, RobustnessSnapshot::State::failed);
 }
+}  // namespace unity_test_app_robustness_worker

@@ -10,6 +10,9 @@
 #include "ui/app/scenarios.h"
 #include "ui/app/script.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_app_scenarios {
+
 using namespace accelviz;
 
 namespace {
@@ -96,3 +99,4 @@ TEST(AppScenarios, ScriptCommands) {
     EXPECT_NE(std::string(e.what()).find("t:1: scenario"), std::string::npos) << e.what();
   }
 }
+}  // namespace unity_test_app_scenarios

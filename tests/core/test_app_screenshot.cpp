@@ -2,13 +2,16 @@
 // caption strip, and the JSON side-car with what reproduces the picture.
 #include <gtest/gtest.h>
 
-#include "core/query/camera.h"
-#include "ui/app/screenshot_files.h"
-
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+
+#include "core/query/camera.h"
+#include "ui/app/screenshot_files.h"
+
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_app_screenshot {
 
 using namespace accelviz;
 namespace fs = std::filesystem;
@@ -201,3 +204,4 @@ TEST(AppScreenshot, DefaultFolderFollowsXdgPictures) {
   if (old_pics) setenv("XDG_PICTURES_DIR", saved_pics.c_str(), 1);
   if (old_home) setenv("HOME", saved_home.c_str(), 1);
 }
+}  // namespace unity_test_app_screenshot

@@ -7,6 +7,9 @@
 
 #include <functional>
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_app_script {
+
 using namespace accelviz;
 using K = ScriptCommand::Kind;
 
@@ -170,3 +173,4 @@ TEST(AppScript, ACommandThatNeverCompletesTimesOut) {
   EXPECT_EQ(runner.advance(host, 110.5), ScriptRunner::State::failed);
   EXPECT_EQ(runner.error(), "s.txt:1: wait: not complete after 10 s");
 }
+}  // namespace unity_test_app_script

@@ -2,12 +2,15 @@
 // unusable files reported in one line and replaced by defaults.
 #include <gtest/gtest.h>
 
-#include "ui/app/settings.h"
-
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+
+#include "ui/app/settings.h"
+
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_app_settings {
 
 using namespace accelviz;
 namespace fs = std::filesystem;
@@ -180,3 +183,4 @@ TEST(AppSettings, RecentFilesMostRecentFirstWithoutDuplicates) {
   add_recent(s, "");
   EXPECT_EQ(s.recent.front(), "scene10");
 }
+}  // namespace unity_test_app_settings

@@ -11,6 +11,9 @@
 #include "core/scene/load.h"
 #include "ui/app/structure_nodes.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_app_structure_nodes {
+
 using namespace accelviz;
 
 namespace {
@@ -180,3 +183,4 @@ TEST(StructureNodes, TwoLevelShowsTlasNodesAndOneLeafPerInstance) {
   }
   EXPECT_EQ(leaves, s.instances.size());
 }
+}  // namespace unity_test_app_structure_nodes

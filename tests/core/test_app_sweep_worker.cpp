@@ -2,13 +2,6 @@
 // text, applying a clicked point to the structure choice, chart series, the
 // synchronous sweep with live snapshots and cancel, the worker's supersession,
 // and the default-vs-calibrated BVH comparison.
-#include "ui/app/sweep_worker.h"
-
-#include "core/accel/factory.h"
-#include "core/query/camera.h"
-#include "core/query/ray_sets.h"
-#include "core/scene/load.h"
-
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -16,7 +9,14 @@
 #include <stdexcept>
 #include <thread>
 
-namespace accelviz {
+#include "core/accel/factory.h"
+#include "core/query/camera.h"
+#include "core/query/ray_sets.h"
+#include "core/scene/load.h"
+#include "ui/app/sweep_worker.h"
+
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace accelviz::unity_test_app_sweep_worker {
 namespace {
 
 std::shared_ptr<const LoadedScene> scene_of(const std::string& spec) {
@@ -244,4 +244,4 @@ TEST(CalibratedBvh, BuildsWithTheMeasuredRatioAndJudgesBothTreesAlike) {
 }
 
 }  // namespace
-}  // namespace accelviz
+}  // namespace accelviz::unity_test_app_sweep_worker

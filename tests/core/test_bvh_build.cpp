@@ -17,6 +17,9 @@
 #include "core/accel/bvh/bvh.h"
 #include "core/accel/bvh/bvh_build.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_bvh_build {
+
 using namespace accelviz;
 
 namespace {
@@ -579,3 +582,4 @@ TEST(BvhBuild, LeafSizeCapLetsTheSahKeepLargerLeaves) {
   EXPECT_LT(large.build_stats().sah_cost, small.build_stats().sah_cost);
   expect_valid_tree(large, tris, o);
 }
+}  // namespace unity_test_bvh_build

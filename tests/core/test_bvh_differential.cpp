@@ -14,9 +14,6 @@
 // concentric, zero-area and coplanar triangles).
 #include <gtest/gtest.h>
 
-#include "core/accel/brute_force.h"
-#include "core/accel/bvh/bvh.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -24,11 +21,19 @@
 #include <string>
 #include <vector>
 
+#include "core/accel/brute_force.h"
+#include "core/accel/bvh/bvh.h"
+
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_bvh_differential {
+
 using namespace accelviz;
 
 namespace {
 
-float uniform(std::mt19937& rng) { return static_cast<float>(rng() >> 8) * (1.0f / 16777216.0f); }
+float uniform(std::mt19937& rng) {
+  return static_cast<float>(rng() >> 8) * (1.0f / 16777216.0f);
+}
 
 glm::vec3 random_direction(std::mt19937& rng) {
   for (;;) {
@@ -261,8 +266,7 @@ void check_scene(const std::string& name, std::span<const Triangle> tris, std::s
           if (!ok && ++tally.mismatches <= 10) {
             const Ray& ray = rays[i];
             ADD_FAILURE() << name << " " << to_string(o.splitter) << " B=" << o.buckets << " leaf=" << o.max_leaf_size
-                          << (o.wide_traversal ? " wide" : " binary")
-                          << (ordered ? " ordered" : " unordered")
+                          << (o.wide_traversal ? " wide" : " binary") << (ordered ? " ordered" : " unordered")
                           << (test == TriangleTest::watertight ? " watertight" : " MT") << " ray " << i << " o=("
                           << ray.origin.x << "," << ray.origin.y << "," << ray.origin.z << ") d=(" << ray.direction.x
                           << "," << ray.direction.y << "," << ray.direction.z << ") [" << ray.tmin << "," << ray.tmax
@@ -305,8 +309,8 @@ TEST(BvhDifferential, MatchesBruteForceOnALargerSoupWithThreadedBuild) {
   for (const Ray& ray : rays) {
     const Hit r = bf.closest_hit(ray, {});
     const Hit h = bvh.closest_hit(ray, {});
-    const bool same = h.valid() == r.valid() &&
-                      (!r.valid() || h.prim == r.prim || std::fabs(h.t - r.t) <= 1e-6f * std::max(1.0f, std::fabs(r.t)));
+    const bool same = h.valid() == r.valid() && (!r.valid() || h.prim == r.prim ||
+                                                 std::fabs(h.t - r.t) <= 1e-6f * std::max(1.0f, std::fabs(r.t)));
     if (!same || bvh.any_hit(ray, {}) != r.valid()) ++bad;
   }
   EXPECT_EQ(bad, 0u);
@@ -343,3 +347,4 @@ TEST(BvhDifferential, StatisticsPathAnswersAsTheFastPath) {
     }
   }
 }
+}  // namespace unity_test_bvh_differential

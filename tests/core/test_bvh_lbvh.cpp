@@ -10,6 +10,9 @@
 #include "core/accel/bvh/bvh_build.h"
 #include "core/scene/load.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_bvh_lbvh {
+
 using namespace accelviz;
 using namespace accelviz::bvh_detail;
 
@@ -103,3 +106,4 @@ TEST(BvhLbvh, QualityIsBelowBinnedSahButBounded) {
   EXPECT_GT(lbvh.build_stats().sah_cost, sah.build_stats().sah_cost);
   EXPECT_LT(lbvh.build_stats().sah_cost, 2.0 * sah.build_stats().sah_cost);
 }
+}  // namespace unity_test_bvh_lbvh

@@ -3,22 +3,27 @@
 // any-hit, ids and normals, deep trees, and refitting.
 #include <gtest/gtest.h>
 
-#include "core/accel/brute_force.h"
-#include "core/accel/bvh/bvh.h"
-#include "core/accel/bvh/bvh_slab.h"
-#include "core/accel/bvh/bvh_wide.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
 #include <vector>
 
+#include "core/accel/brute_force.h"
+#include "core/accel/bvh/bvh.h"
+#include "core/accel/bvh/bvh_slab.h"
+#include "core/accel/bvh/bvh_wide.h"
+
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_bvh_query {
+
 using namespace accelviz;
 
 namespace {
 
-float uniform(std::mt19937& rng) { return static_cast<float>(rng() >> 8) * (1.0f / 16777216.0f); }
+float uniform(std::mt19937& rng) {
+  return static_cast<float>(rng() >> 8) * (1.0f / 16777216.0f);
+}
 
 glm::vec3 random_direction(std::mt19937& rng) {
   for (;;) {
@@ -75,7 +80,7 @@ TEST(BvhSlab, SimdAgreesWithScalarTwinOnRandomAndAdversarialInput) {
       glm::vec3 a(uniform(rng), uniform(rng), uniform(rng)), b(uniform(rng), uniform(rng), uniform(rng));
       if (i % 5 == 1) b[static_cast<int>(rng() % 3)] = a[static_cast<int>(rng() % 3)];  // flat on some axis
       if (i % 7 == 2) std::swap(a, b);                                                  // possibly empty
-      if (i % 11 == 3) a[static_cast<int>(rng() % 3)] = -kInfinity;                    // unbounded
+      if (i % 11 == 3) a[static_cast<int>(rng() % 3)] = -kInfinity;                     // unbounded
       n.bounds = {glm::min(a, b), glm::max(a, b)};
       if (i % 7 == 2) n.bounds = {a, b};
       n.index = rng();  // garbage in the lane the loads pick up
@@ -85,8 +90,8 @@ TEST(BvhSlab, SimdAgreesWithScalarTwinOnRandomAndAdversarialInput) {
     glm::vec3 d = random_direction(rng);
     for (int a = 0; a < 3; ++a) {
       const unsigned r = rng() % 8;
-      if (r == 0) d[a] = (rng() & 1) ? 0.0f : -0.0f;         // axis-parallel
-      if (r == 1) o[a] = pair[0].bounds.lo[a];               // on a face plane
+      if (r == 0) d[a] = (rng() & 1) ? 0.0f : -0.0f;  // axis-parallel
+      if (r == 1) o[a] = pair[0].bounds.lo[a];        // on a face plane
       if (r == 2) o[a] = pair[0].bounds.hi[a];
       if (r == 3) d[a] = specials[rng() % 9];
     }
@@ -100,8 +105,10 @@ TEST(BvhSlab, SimdAgreesWithScalarTwinOnRandomAndAdversarialInput) {
       const bool simd_hit = bvh_detail::slab_test(pair[c], sr, ray.tmin, ray.tmax, t0, t1);
       ASSERT_EQ(simd_hit, scalar_hit[c]) << "case " << i;
       // Equal values (+0 and -0 may differ in sign, which no comparison sees).
-      ASSERT_TRUE(t0 == s0[c] || (std::isnan(t0) && std::isnan(s0[c]))) << "case " << i << ": " << t0 << " vs " << s0[c];
-      ASSERT_TRUE(t1 == s1[c] || (std::isnan(t1) && std::isnan(s1[c]))) << "case " << i << ": " << t1 << " vs " << s1[c];
+      ASSERT_TRUE(t0 == s0[c] || (std::isnan(t0) && std::isnan(s0[c])))
+          << "case " << i << ": " << t0 << " vs " << s0[c];
+      ASSERT_TRUE(t1 == s1[c] || (std::isnan(t1) && std::isnan(s1[c])))
+          << "case " << i << ": " << t1 << " vs " << s1[c];
     }
     const int mask = bvh_detail::slab_test_pair(pair, sr, ray.tmin, ray.tmax, v0, v1);
     ASSERT_EQ(mask, (scalar_hit[0] ? 1 : 0) | (scalar_hit[1] ? 2 : 0)) << "case " << i;
@@ -465,3 +472,4 @@ TEST(BvhRefit, EmptyTreeRefitsToNothing) {
   EXPECT_NO_THROW(bvh.refit(none));
   EXPECT_TRUE(bvh.nodes().empty());
 }
+}  // namespace unity_test_bvh_query

@@ -12,6 +12,9 @@
 
 #include "core/accel/bvh/bvh_triangle.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_bvh_triangle {
+
 using namespace accelviz;
 
 namespace {
@@ -109,3 +112,4 @@ TEST(BvhInlineTriangle, SpecialPathsAgree) {
   EXPECT_GT(c.hits, 1000);
   EXPECT_GT(c.misses, 1000);
 }
+}  // namespace unity_test_bvh_triangle

@@ -1,12 +1,13 @@
 // Calibration: figures are positive and the implied constants finite (no
 // timing thresholds: the figures depend on the machine and its load).
-#include "core/analysis/calibrate.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-namespace accelviz {
+#include "core/analysis/calibrate.h"
+
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace accelviz::unity_test_calibrate {
 namespace {
 
 TEST(Calibrate, FiguresArePositiveAndRatiosFinite) {
@@ -29,4 +30,4 @@ TEST(Calibrate, FiguresArePositiveAndRatiosFinite) {
 }
 
 }  // namespace
-}  // namespace accelviz
+}  // namespace accelviz::unity_test_calibrate

@@ -1,12 +1,15 @@
 #include <gtest/gtest.h>
 
-#include "core/query/camera.h"
-#include "core/accel/brute_force.h"
-#include "core/query/batch.h"
-#include "core/query/ray_sets.h"
-
 #include <algorithm>
 #include <cmath>
+
+#include "core/accel/brute_force.h"
+#include "core/query/batch.h"
+#include "core/query/camera.h"
+#include "core/query/ray_sets.h"
+
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_camera {
 
 using namespace accelviz;
 
@@ -18,7 +21,9 @@ float angle_between(const glm::vec3& a, const glm::vec3& b) {
   return std::acos(std::clamp(glm::dot(glm::normalize(a), glm::normalize(b)), -1.0f, 1.0f));
 }
 
-Camera test_camera() { return look_at({1.0f, 2.0f, 3.0f}, {-2.0f, 0.5f, -1.0f}, 50.0f * kPi / 180.0f); }
+Camera test_camera() {
+  return look_at({1.0f, 2.0f, 3.0f}, {-2.0f, 0.5f, -1.0f}, 50.0f * kPi / 180.0f);
+}
 
 }  // namespace
 
@@ -143,8 +148,8 @@ TEST(Camera, SpecDefaultUsesSceneCameraThenBounds) {
 
 TEST(Camera, BadSpecsThrowOneLine) {
   Scene scene;
-  for (const char* bad : {"1,2,3", "1,2,3,4,5,x", "1,2,3,1,2,3", "0,0,1,0,0,0,0", "0,0,1,0,0,0,180", "gltf:",
-                          "gltf:0", "gltf:-1", "nan,0,0,0,0,0", "1,2,3,4,5,6,7,8"}) {
+  for (const char* bad : {"1,2,3", "1,2,3,4,5,x", "1,2,3,1,2,3", "0,0,1,0,0,0,0", "0,0,1,0,0,0,180", "gltf:", "gltf:0",
+                          "gltf:-1", "nan,0,0,0,0,0", "1,2,3,4,5,6,7,8"}) {
     try {
       camera_from_spec(bad, scene, 1.0f);
       ADD_FAILURE() << "accepted " << bad;
@@ -158,13 +163,14 @@ TEST(Camera, BadSpecsThrowOneLine) {
 
 // ---- ray sets built on the camera (core/query/ray_sets) ----
 
-
 namespace {
 
 /// A floor and a wall facing the camera, so primary rays hit two orientations.
 std::vector<Triangle> floor_and_wall() {
-  return {{{-5, 0, -5}, {5, 0, -5}, {-5, 0, 5}}, {{5, 0, -5}, {5, 0, 5}, {-5, 0, 5}},
-          {{-5, 0, -3}, {5, 0, -3}, {-5, 6, -3}}, {{5, 0, -3}, {5, 6, -3}, {-5, 6, -3}}};
+  return {{{-5, 0, -5}, {5, 0, -5}, {-5, 0, 5}},
+          {{5, 0, -5}, {5, 0, 5}, {-5, 0, 5}},
+          {{-5, 0, -3}, {5, 0, -3}, {-5, 6, -3}},
+          {{5, 0, -3}, {5, 6, -3}, {-5, 6, -3}}};
 }
 
 }  // namespace
@@ -198,7 +204,7 @@ TEST(RaySets, DiffuseRaysLeaveTheSurfaceOnTheCameraSideAndAreSeeded) {
     if (glm::dot(n, primary[i].direction) > 0.0f) n = -n;
     EXPECT_GT(glm::dot(a[k].direction, n), 0.0f);  // into the hemisphere the camera sees
     EXPECT_NEAR(glm::length(a[k].direction), 1.0f, 1e-5f);
-    EXPECT_EQ(a[k].direction, b[k].direction);   // same seed, same rays
+    EXPECT_EQ(a[k].direction, b[k].direction);  // same seed, same rays
     // The origin is on the camera side of the surface and leaves it: nothing at t = 0.
     EXPECT_FALSE(accel.closest_hit(Ray(a[k].origin, a[k].direction, 0.0f, 1e-3f), {}).valid());
     mean_cos += glm::dot(a[k].direction, n);
@@ -258,3 +264,4 @@ TEST(RaySets, ShadowRaysGoToLightsInFrontOfTheSurface) {
   const Light synthetic = synthetic_bench_light(Aabb{{-5, 0, -5}, {5, 6, 5}});
   EXPECT_GT(synthetic.position.y, 6.0f);
 }
+}  // namespace unity_test_camera

@@ -1,9 +1,10 @@
 // Chart drawing: nice ticks, and pixels where the data say they should be.
-#include "core/analysis/chart.h"
-
 #include <gtest/gtest.h>
 
-namespace accelviz {
+#include "core/analysis/chart.h"
+
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace accelviz::unity_test_chart {
 namespace {
 
 TEST(Chart, NiceTicksCoverTheRangeInOneTwoFiveSteps) {
@@ -54,4 +55,4 @@ TEST(Chart, CategoricalAxisAndEmptyChartDraw) {
 }
 
 }  // namespace
-}  // namespace accelviz
+}  // namespace accelviz::unity_test_chart

@@ -1,8 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "core/analysis/colormap.h"
 
-#include <cmath>
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_colormap {
 
 using namespace accelviz;
 
@@ -80,3 +83,4 @@ TEST(ColorMap, NamesRoundTrip) {
     EXPECT_EQ(parse_colormap(colormap_name(m)), m);
   EXPECT_FALSE(parse_colormap("jet").has_value());
 }
+}  // namespace unity_test_colormap

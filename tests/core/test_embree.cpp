@@ -1,10 +1,13 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <random>
+
 #include "core/accel/brute_force.h"
 #include "core/accel/embree_backend.h"
 
-#include <cmath>
-#include <random>
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_embree {
 
 using namespace accelviz;
 
@@ -43,7 +46,9 @@ std::vector<Ray> random_rays(std::size_t n, std::uint32_t seed) {
   return rays;
 }
 
-bool same_t(float a, float b) { return std::abs(a - b) <= 1e-4f * std::max(1.0f, std::abs(b)); }
+bool same_t(float a, float b) {
+  return std::abs(a - b) <= 1e-4f * std::max(1.0f, std::abs(b));
+}
 
 }  // namespace
 
@@ -149,6 +154,9 @@ TEST(Embree, BinaryBvhOfSoupIsAFullBinaryTree) {
 
 #else
 
-TEST(Embree, NotBuilt) { GTEST_SKIP() << "built without ACCELVIZ_WITH_EMBREE"; }
+TEST(Embree, NotBuilt) {
+  GTEST_SKIP() << "built without ACCELVIZ_WITH_EMBREE";
+}
 
 #endif
+}  // namespace unity_test_embree

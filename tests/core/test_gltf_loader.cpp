@@ -1,21 +1,23 @@
 // load_gltf: every fixture is written by the test into its own temp directory.
 #include <gtest/gtest.h>
-
-#include "core/scene/load.h"
-
-#include <glm/gtc/matrix_transform.hpp>
-#include <glm/gtc/quaternion.hpp>
-#include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <string>
-#include <unistd.h>
 #include <vector>
+
+#include "core/scene/load.h"
+
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_gltf_loader {
 
 using namespace accelviz;
 using nlohmann::json;
@@ -158,8 +160,7 @@ class GltfLoader : public ::testing::Test {
  protected:
   void SetUp() override {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("accelviz_test_gltf_loader_" + std::to_string(::getpid())) / info->name();
+    dir_ = fs::temp_directory_path() / ("accelviz_test_gltf_loader_" + std::to_string(::getpid())) / info->name();
     fs::create_directories(dir_);
   }
   void TearDown() override {
@@ -436,11 +437,11 @@ TEST_F(GltfLoader, ManyWarningsAreCapped) {
 
 TEST_F(GltfLoader, PerspectiveCameraConvertedToWorldSpace) {
   GltfBuilder b = one_triangle();
-  b.doc["cameras"] = json::array({json{{"type", "perspective"},
-                                       {"name", "main"},
-                                       {"perspective", {{"yfov", 0.5}, {"aspectRatio", 1.5}, {"znear", 0.1}}}},
-                                  json{{"type", "orthographic"},
-                                       {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0.1}, {"zfar", 10}}}}});
+  b.doc["cameras"] = json::array(
+      {json{{"type", "perspective"},
+            {"name", "main"},
+            {"perspective", {{"yfov", 0.5}, {"aspectRatio", 1.5}, {"znear", 0.1}}}},
+       json{{"type", "orthographic"}, {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0.1}, {"zfar", 10}}}}});
   const glm::quat r = glm::angleAxis(glm::radians(90.0f), glm::vec3(0, 1, 0));
   const int cam = b.node({{"camera", 0}, {"translation", {0, 0, 10}}, {"rotation", {r.x, r.y, r.z, r.w}}});
   const int ortho = b.node({{"camera", 1}});
@@ -467,8 +468,7 @@ TEST_F(GltfLoader, PunctualLightsConvertedToWorldSpace) {
   b.doc["extensionsRequired"] = {"KHR_lights_punctual"};
   b.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array(
       {json{{"type", "point"}, {"color", {1, 0.5, 0.25}}, {"intensity", 20}, {"range", 50}, {"name", "bulb"}},
-       json{{"type", "spot"}, {"spot", {{"outerConeAngle", 0.5}}}},
-       json{{"type", "directional"}, {"intensity", 3}}});
+       json{{"type", "spot"}, {"spot", {{"outerConeAngle", 0.5}}}}, json{{"type", "directional"}, {"intensity", 3}}});
   const glm::quat down = glm::angleAxis(glm::radians(-90.0f), glm::vec3(1, 0, 0));
   const int point = b.node({{"translation", {1, 2, 3}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
   const int spot = b.node({{"translation", {0, 5, 0}},
@@ -500,16 +500,15 @@ TEST_F(GltfLoader, AnimationsAreKeptAsData) {
   const int rotations = b.floats({0, 0, 0, 1, 0, 0.70710678f, 0, 0.70710678f}, "VEC4", 4);
   // Cubic spline: in-tangent, value, out-tangent per key.
   const int scales = b.floats({0, 0, 0, 1, 1, 1, 0, 0, 0, 0, 0, 0, 2, 2, 2, 0, 0, 0}, "VEC3", 3);
-  b.doc["animations"] = json::array({json{
-      {"name", "wobble"},
-      {"samplers",
-       {{{"input", times}, {"output", translations}},
-        {{"input", times}, {"output", rotations}, {"interpolation", "STEP"}},
-        {{"input", times}, {"output", scales}, {"interpolation", "CUBICSPLINE"}}}},
-      {"channels",
-       {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}},
-        {{"sampler", 1}, {"target", {{"node", 0}, {"path", "rotation"}}}},
-        {{"sampler", 2}, {"target", {{"node", 0}, {"path", "scale"}}}}}}}});
+  b.doc["animations"] = json::array({json{{"name", "wobble"},
+                                          {"samplers",
+                                           {{{"input", times}, {"output", translations}},
+                                            {{"input", times}, {"output", rotations}, {"interpolation", "STEP"}},
+                                            {{"input", times}, {"output", scales}, {"interpolation", "CUBICSPLINE"}}}},
+                                          {"channels",
+                                           {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}},
+                                            {{"sampler", 1}, {"target", {{"node", 0}, {"path", "rotation"}}}},
+                                            {{"sampler", 2}, {"target", {{"node", 0}, {"path", "scale"}}}}}}}});
   const Scene s = load_gltf(write_glb(b));
   ASSERT_EQ(s.animations.size(), 1u);
   const Animation& a = s.animations[0];
@@ -578,8 +577,10 @@ TEST_F(GltfLoader, DeepChainOf100000NodesLoadsWithoutRecursion) {
   json nodes = json::array();
   for (int i = 0; i < kDepth; ++i) {
     json n = {{"translation", {1, 0, 0}}};
-    if (i + 1 < kDepth) n["children"] = {i + 1};
-    else n["mesh"] = 0;
+    if (i + 1 < kDepth)
+      n["children"] = {i + 1};
+    else
+      n["mesh"] = 0;
     nodes.push_back(std::move(n));
   }
   b.doc["nodes"] = std::move(nodes);
@@ -596,7 +597,9 @@ TEST_F(GltfLoader, DeepChainOf100000NodesLoadsWithoutRecursion) {
 
 // --- errors: every message names the file and the problem -----------------------
 
-TEST_F(GltfLoader, MissingFile) { expect_error(path("absent.gltf"), "no such file"); }
+TEST_F(GltfLoader, MissingFile) {
+  expect_error(path("absent.gltf"), "no such file");
+}
 
 TEST_F(GltfLoader, Directory) {
   fs::create_directories(dir_ / "folder.gltf");
@@ -683,7 +686,8 @@ TEST_F(GltfLoader, IndexValueOutOfRange) {
   const int idx = b.indices<std::uint16_t>({0, 1, 7}, kU16);
   b.mesh({b.primitive(pos, idx)});
   b.node({{"mesh", 0}});
-  expect_error(write_gltf(b), "index 7 at position 2 of accessor 1 is out of range (mesh 0 primitive 0 has 3 vertices)");
+  expect_error(write_gltf(b),
+               "index 7 at position 2 of accessor 1 is out of range (mesh 0 primitive 0 has 3 vertices)");
 }
 
 TEST_F(GltfLoader, NonFloatPositionsRejected) {
@@ -701,9 +705,8 @@ TEST_F(GltfLoader, SparseAccessorRejected) {
   const std::vector<float> value = {5, 5, 5};
   const int iv = b.view(which.data(), 2);
   const int vv = b.view(value.data(), 12);
-  b.doc["accessors"][0]["sparse"] = {{"count", 1},
-                                     {"indices", {{"bufferView", iv}, {"componentType", kU16}}},
-                                     {"values", {{"bufferView", vv}}}};
+  b.doc["accessors"][0]["sparse"] = {
+      {"count", 1}, {"indices", {{"bufferView", iv}, {"componentType", kU16}}}, {"values", {{"bufferView", vv}}}};
   expect_error(write_gltf(b), "uses sparse storage, which is not supported");
 }
 
@@ -711,7 +714,8 @@ TEST_F(GltfLoader, NodeCycle) {
   GltfBuilder b = one_triangle();
   b.doc.erase("scenes");
   b.doc.erase("scene");
-  b.doc["nodes"] = json::array({json{{"mesh", 0}, {"children", {1}}}, json{{"children", {2}}}, json{{"children", {0}}}});
+  b.doc["nodes"] =
+      json::array({json{{"mesh", 0}, {"children", {1}}}, json{{"children", {2}}}, json{{"children", {0}}}});
   expect_error(write_gltf(b), "node cycle: 0 -> 1 -> 2 -> 0");
 }
 
@@ -822,9 +826,11 @@ TEST_F(GltfLoader, LoadSceneRejectsUnknownExtensionsAndMissingFiles) {
     return std::string("<no error>");
   };
   write_file(dir_ / "mesh.xyz", "solid");
-  EXPECT_EQ(message(path("mesh.xyz")), path("mesh.xyz") + ": unsupported file type '.xyz' (expected .gltf, .glb or .obj)");
+  EXPECT_EQ(message(path("mesh.xyz")),
+            path("mesh.xyz") + ": unsupported file type '.xyz' (expected .gltf, .glb or .obj)");
   write_file(dir_ / "noext", "solid");
-  EXPECT_EQ(message(path("noext")), path("noext") + ": unsupported file type (no extension) (expected .gltf, .glb or .obj)");
+  EXPECT_EQ(message(path("noext")),
+            path("noext") + ": unsupported file type (no extension) (expected .gltf, .glb or .obj)");
   EXPECT_EQ(message(path("absent.glb")), path("absent.glb") + ": no such file");
 }
 
@@ -844,3 +850,4 @@ TEST(GltfLoaderAssets, StanfordBunny) {
 }
 
 }  // namespace
+}  // namespace unity_test_gltf_loader

@@ -1,18 +1,20 @@
 // write_gltf: round trips through load_gltf, the file layout, and refusals.
 #include <gtest/gtest.h>
-
-#include "core/scene/gltf_writer.h"
-#include "core/scene/load.h"
-
-#include <glm/gtc/matrix_transform.hpp>
-#include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <glm/gtc/matrix_transform.hpp>
 #include <iterator>
+#include <nlohmann/json.hpp>
 #include <string>
-#include <unistd.h>
+
+#include "core/scene/gltf_writer.h"
+#include "core/scene/load.h"
+
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_gltf_writer {
 
 using namespace accelviz;
 using nlohmann::json;
@@ -73,7 +75,8 @@ Scene sample_scene() {
   child.name = "child";
   child.parent = 0;
   child.has_matrix = true;
-  child.local = glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, 4)) * glm::rotate(glm::mat4(1.0f), 1.0f, glm::vec3(0, 1, 0));
+  child.local =
+      glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, 4)) * glm::rotate(glm::mat4(1.0f), 1.0f, glm::vec3(0, 1, 0));
   child.mesh = 0;
   Node other;
   other.parent = 0;
@@ -320,3 +323,4 @@ TEST_F(GltfWriter, InvalidNodeGraphIsRefused) {
 }
 
 }  // namespace
+}  // namespace unity_test_gltf_writer

@@ -15,6 +15,9 @@
 #include "core/accel/kdtree/spatial_traversal.h"
 #include "core/geometry/tri_box_overlap.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_grid {
+
 using namespace accelviz;
 
 namespace {
@@ -26,7 +29,9 @@ struct Rng {
     return static_cast<double>(s >> 11) * (1.0 / 9007199254740992.0);
   }
   float range(float a, float b) { return a + (b - a) * static_cast<float>(next()); }
-  glm::vec3 in_box(const glm::vec3& lo, const glm::vec3& hi) { return {range(lo.x, hi.x), range(lo.y, hi.y), range(lo.z, hi.z)}; }
+  glm::vec3 in_box(const glm::vec3& lo, const glm::vec3& hi) {
+    return {range(lo.x, hi.x), range(lo.y, hi.y), range(lo.z, hi.z)};
+  }
   glm::vec3 unit() {
     for (;;) {
       const glm::vec3 v(range(-1, 1), range(-1, 1), range(-1, 1));
@@ -38,7 +43,8 @@ struct Rng {
 
 using Scene = std::vector<Triangle>;
 
-Scene soup(std::uint64_t seed, int n, float size, const glm::vec3& lo = glm::vec3(-1), const glm::vec3& hi = glm::vec3(1)) {
+Scene soup(std::uint64_t seed, int n, float size, const glm::vec3& lo = glm::vec3(-1),
+           const glm::vec3& hi = glm::vec3(1)) {
   Rng rng{seed};
   Scene s;
   for (int i = 0; i < n; ++i) {
@@ -60,7 +66,8 @@ Scene integer_lattice(std::uint64_t seed) {
   Rng rng{seed};
   Scene s;
   const auto lattice_point = [&] {
-    return glm::vec3(std::floor(rng.range(0, 4.999f)), std::floor(rng.range(0, 4.999f)), std::floor(rng.range(0, 4.999f)));
+    return glm::vec3(std::floor(rng.range(0, 4.999f)), std::floor(rng.range(0, 4.999f)),
+                     std::floor(rng.range(0, 4.999f)));
   };
   quad(s, {0, 0, 0}, {4, 0, 0}, {4, 4, 0}, {0, 4, 0});  // pin the bounds to [0, 4]^3
   quad(s, {0, 0, 4}, {4, 0, 4}, {4, 4, 4}, {0, 4, 4});
@@ -76,8 +83,8 @@ Scene integer_lattice(std::uint64_t seed) {
   if (h.valid() != b.valid() || hs.prim != h.prim || a.any_hit(r, qo) != b.valid())
     return ::testing::AssertionFailure() << "validity: grid " << h.valid() << " brute " << b.valid();
   if (h.valid() && h.prim != b.prim && std::fabs(h.t - b.t) > 1e-6f * std::max(1.0f, std::fabs(b.t)))
-    return ::testing::AssertionFailure() << "grid prim " << h.prim << " t " << h.t << ", brute prim " << b.prim
-                                         << " t " << b.t;
+    return ::testing::AssertionFailure() << "grid prim " << h.prim << " t " << h.t << ", brute prim " << b.prim << " t "
+                                         << b.t;
   return ::testing::AssertionSuccess();
 }
 
@@ -163,7 +170,9 @@ TEST(Grid, FlatBoundsGiveThatAxisOneCell) {
   }
   // A ray lying in the wall's plane (z = 5, direction z = ±0) grazes edges.
   for (int i = 0; i < 200; ++i)
-    ASSERT_TRUE(agrees(g, bf, Ray({rng.range(-1, 3), rng.range(-1, 2), 5}, {rng.range(-1, 1), rng.range(-1, 1), (i & 1) ? 0.0f : -0.0f})));
+    ASSERT_TRUE(agrees(
+        g, bf,
+        Ray({rng.range(-1, 3), rng.range(-1, 2), 5}, {rng.range(-1, 1), rng.range(-1, 1), (i & 1) ? 0.0f : -0.0f})));
 }
 
 TEST(Grid, CsrListsHoldExactlyTheOverlappingTriangles) {
@@ -251,13 +260,15 @@ TEST(Grid, RaysThroughCellEdgesAndCornersExactly) {
   int hits = 0, n = 0;
   for (int i = 0; i <= 4; ++i)
     for (int j = 0; j <= 4; ++j)
-      for (const glm::vec3 d : {glm::vec3(1, 1, 1), glm::vec3(1, -1, 1), glm::vec3(-1, 1, 1), glm::vec3(1, 1, -1),
-                                glm::vec3(1, 1, 0), glm::vec3(1, -0.0f, 1), glm::vec3(0, 0, 1), glm::vec3(-0.0f, -0.0f, -1)}) {
+      for (const glm::vec3 d :
+           {glm::vec3(1, 1, 1), glm::vec3(1, -1, 1), glm::vec3(-1, 1, 1), glm::vec3(1, 1, -1), glm::vec3(1, 1, 0),
+            glm::vec3(1, -0.0f, 1), glm::vec3(0, 0, 1), glm::vec3(-0.0f, -0.0f, -1)}) {
         // Through lattice points: from outside, corners of cells all the way.
         const glm::vec3 p(static_cast<float>(i), static_cast<float>(j), 2.0f);
         for (const float back : {6.0f, 0.0f}) {
           const Ray r(p - back * d, d);
-          EXPECT_TRUE(agrees(g, bf, r)) << "through (" << i << "," << j << ",2) d=(" << d.x << "," << d.y << "," << d.z << ")";
+          EXPECT_TRUE(agrees(g, bf, r)) << "through (" << i << "," << j << ",2) d=(" << d.x << "," << d.y << "," << d.z
+                                        << ")";
           hits += bf.closest_hit(r, {}).valid();
           ++n;
         }
@@ -279,7 +290,7 @@ TEST(Grid, RaysThroughCellEdgesAndCornersExactly) {
 // in between. The far hit must not end the walk.
 TEST(Grid, HitBeyondTheCurrentCellDoesNotEndTheWalk) {
   Scene s;
-  s.push_back({{-2, -4, -1}, {3, 1, -1}, {2, 0, 3}});               // A: x = 2 + y, met at x = 2
+  s.push_back({{-2, -4, -1}, {3, 1, -1}, {2, 0, 3}});                // A: x = 2 + y, met at x = 2
   s.push_back({{1, -0.2f, -0.2f}, {1, 0.2f, -0.2f}, {1, 0, 0.2f}});  // B: x = 1
   GridOptions o;
   o.resolution = {10, 1, 10};  // one tall row in y: A lies in every cell of the ray's row
@@ -375,3 +386,4 @@ TEST(Grid, ProgressAndCancellation) {
   EXPECT_DOUBLE_EQ(last, 1.0);
   EXPECT_THROW(Grid(s, {}, [](double f) { return f < 0.3; }), BuildCancelled);
 }
+}  // namespace unity_test_grid

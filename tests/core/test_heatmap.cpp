@@ -1,14 +1,16 @@
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
 
 #include "core/accel/brute_force.h"
 #include "core/analysis/heatmap.h"
 #include "core/query/batch.h"
-#include "core/query/ray_sets.h"
 #include "core/query/camera.h"
+#include "core/query/ray_sets.h"
 
-#include <filesystem>
-
-#include <unistd.h>
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_heatmap {
 
 using namespace accelviz;
 namespace fs = std::filesystem;
@@ -26,7 +28,9 @@ std::vector<Triangle> tiny_scene() {
   };
 }
 
-Camera tiny_camera() { return look_at({0.3f, 0.2f, 8.0f}, {0.0f, 0.0f, 0.0f}, 0.9f); }
+Camera tiny_camera() {
+  return look_at({0.3f, 0.2f, 8.0f}, {0.0f, 0.0f, 0.0f}, 0.9f);
+}
 
 std::string temp_png(const std::string& name) {
   return (fs::temp_directory_path() / ("accelviz_test_heatmap_" + std::to_string(::getpid()) + "_" + name)).string();
@@ -61,8 +65,12 @@ TEST(Heatmap, PixelValuesEqualWhatTheAcceleratorReports) {
         hits += h.valid();
         const float v = img.at(x, y);
         switch (metric) {
-          case HeatMetric::prims: EXPECT_EQ(v, static_cast<float>(st.prim_tests)); break;
-          case HeatMetric::cost: EXPECT_FLOAT_EQ(v, 1.5f * st.nodes_visited + 0.5f * st.prim_tests); break;
+          case HeatMetric::prims:
+            EXPECT_EQ(v, static_cast<float>(st.prim_tests));
+            break;
+          case HeatMetric::cost:
+            EXPECT_FLOAT_EQ(v, 1.5f * st.nodes_visited + 0.5f * st.prim_tests);
+            break;
           case HeatMetric::depth:
             if (h.valid()) {
               EXPECT_EQ(v, h.t);
@@ -77,7 +85,8 @@ TEST(Heatmap, PixelValuesEqualWhatTheAcceleratorReports) {
               EXPECT_TRUE(std::isnan(v));
             }
             break;
-          default: break;
+          default:
+            break;
         }
         if (std::isfinite(v)) {
           max = std::max<double>(max, v);
@@ -159,7 +168,8 @@ TEST(Heatmap, LegendPlacements) {
   // The bottom legend's gradient spans the map: its left end is the map's 0.
   bool found_low = false;
   for (int y = 48; y < bottom.height && !found_low; ++y)
-    for (int x = 0; x < 64 && !found_low; ++x) found_low = bottom.at(x, y) == to_rgb8(colormap(ColorMap::viridis, 0.0f));
+    for (int x = 0; x < 64 && !found_low; ++x)
+      found_low = bottom.at(x, y) == to_rgb8(colormap(ColorMap::viridis, 0.0f));
   EXPECT_TRUE(found_low);
   img.metric = HeatMetric::shaded;
   EXPECT_EQ(colorize(img, co).height, 48);  // no legend for the shaded picture
@@ -207,7 +217,6 @@ TEST(Heatmap, BitmapTextDrawsKnownGlyphsOnly) {
 }
 
 // ---- the batch tracer under the heatmap (core/query/batch) ----
-
 
 TEST(Batch, ResultsDoNotDependOnTheThreadCount) {
   const std::vector<Triangle> tris = tiny_scene();
@@ -280,3 +289,4 @@ TEST(Batch, SizeMismatchThrows) {
   std::vector<RayStats> stats(3);
   EXPECT_THROW(trace_closest(accel, rays, hits, {}, 1u, stats), std::invalid_argument);
 }
+}  // namespace unity_test_heatmap

@@ -10,6 +10,9 @@
 #include "core/analysis/insight/compare_images.h"
 #include "core/analysis/insight/visit_attribution.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_insight_attribution {
+
 using namespace accelviz;
 
 namespace {
@@ -160,3 +163,4 @@ TEST(InsightCompare, DifferenceTotalsAndColours) {
   c.height = 3;
   EXPECT_THROW(difference_image(a, c), std::invalid_argument);
 }
+}  // namespace unity_test_insight_attribution

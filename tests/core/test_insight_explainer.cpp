@@ -10,6 +10,9 @@
 #include "core/accel/bvh/bvh.h"
 #include "core/analysis/insight/sah_explainer.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_insight_explainer {
+
 using namespace accelviz;
 
 namespace {
@@ -179,3 +182,4 @@ TEST(InsightExplainer, MatchesWhatTheBuilderDid) {
   }
   EXPECT_THROW(explain_bvh_node(Bvh(tris, o), 1u << 30, o), std::out_of_range);
 }
+}  // namespace unity_test_insight_explainer

@@ -12,6 +12,9 @@
 #include "core/analysis/insight/visit_attribution.h"
 #include "core/analysis/sah.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_insight_predicted {
+
 using namespace accelviz;
 
 namespace {
@@ -147,3 +150,4 @@ TEST(InsightTraversal, ModeTotalsOverRays) {
   EXPECT_EQ(any.leaves_skipped, 2u);
   EXPECT_EQ(mode_name(TraversalMode::back_to_front), "back-to-front");
 }
+}  // namespace unity_test_insight_predicted

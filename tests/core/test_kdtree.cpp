@@ -14,6 +14,9 @@
 #include "core/accel/kdtree/kdtree.h"
 #include "core/geometry/tri_box_overlap.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_kdtree {
+
 using namespace accelviz;
 
 namespace {
@@ -25,7 +28,9 @@ struct Rng {
     return static_cast<double>(s >> 11) * (1.0 / 9007199254740992.0);
   }
   float range(float a, float b) { return a + (b - a) * static_cast<float>(next()); }
-  glm::vec3 in_box(const glm::vec3& lo, const glm::vec3& hi) { return {range(lo.x, hi.x), range(lo.y, hi.y), range(lo.z, hi.z)}; }
+  glm::vec3 in_box(const glm::vec3& lo, const glm::vec3& hi) {
+    return {range(lo.x, hi.x), range(lo.y, hi.y), range(lo.z, hi.z)};
+  }
   glm::vec3 unit() {
     for (;;) {
       const glm::vec3 v(range(-1, 1), range(-1, 1), range(-1, 1));
@@ -296,8 +301,10 @@ TEST(KdTree, SplitDistanceEqualToTminOrTmax) {
       if (k & 4) d[(a + 1) % 3] = 0.25f;
       o[a] = p - d[a];  // the plane is crossed at t = 1 exactly
       Ray r(o, d);
-      if (k & 2) r.tmin = 1.0f;  // segment starts on the plane
-      else r.tmax = 1.0f;        // segment ends on the plane
+      if (k & 2)
+        r.tmin = 1.0f;  // segment starts on the plane
+      else
+        r.tmax = 1.0f;  // segment ends on the plane
       EXPECT_TRUE(agrees(kd, bf, r)) << "axis " << a << " split " << p << " k " << k;
       ++checked;
       hits += bf.closest_hit(r, {}).valid();
@@ -500,3 +507,4 @@ TEST(KdTree, ProgressAndCancellation) {
   EXPECT_THROW(KdTree(s, {}, [&](double) { return ++seen < 3; }), BuildCancelled);
   EXPECT_EQ(seen, 3);
 }
+}  // namespace unity_test_kdtree

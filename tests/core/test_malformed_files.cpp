@@ -18,6 +18,9 @@
 #include "core/query/ray_file.h"
 #include "core/scene/load.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_malformed_files {
+
 using namespace accelviz;
 using nlohmann::json;
 namespace fs = std::filesystem;
@@ -349,3 +352,4 @@ TEST_F(Malformed, GlbChunkTypeAndAlignment) {
   total_short[8] = static_cast<char>(static_cast<unsigned char>(total_short[8]) - 4);
   EXPECT_FALSE(gltf_error(write("total.glb", total_short)).empty());
 }
+}  // namespace unity_test_malformed_files

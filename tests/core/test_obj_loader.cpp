@@ -1,12 +1,15 @@
 // load_obj: every fixture is written by the test into its own temp directory.
 #include <gtest/gtest.h>
-
-#include "core/scene/load.h"
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <unistd.h>
+
+#include "core/scene/load.h"
+
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_obj_loader {
 
 using namespace accelviz;
 namespace fs = std::filesystem;
@@ -67,9 +70,9 @@ TEST_F(ObjLoader, SingleTriangle) {
 
 TEST_F(ObjLoader, PolygonsAreFanTriangulatedInFileOrder) {
   // A quad and a pentagon: 2 + 3 triangles, fans from each face's first vertex.
-  const Scene s = load_obj(write(
-      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 3 0 0\nv 3 1 0\nv 2.5 2 0\nv 2 1 0\n"
-      "f 1 2 3 4\nf 5 6 7 8 9\n"));
+  const Scene s =
+      load_obj(write("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 3 0 0\nv 3 1 0\nv 2.5 2 0\nv 2 1 0\n"
+                     "f 1 2 3 4\nf 5 6 7 8 9\n"));
   ASSERT_EQ(s.meshes.size(), 1u);
   const Mesh& m = s.meshes[0];
   ASSERT_EQ(m.indices.size(), 5u);
@@ -81,9 +84,9 @@ TEST_F(ObjLoader, PolygonsAreFanTriangulatedInFileOrder) {
 }
 
 TEST_F(ObjLoader, OneMeshPerShapeWithCompactedVertices) {
-  const Scene s = load_obj(write(
-      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 5\nv 1 0 5\nv 0 1 5\n"
-      "o first\nf 1 2 3\no second\nf 4 5 6\nf 6 5 4\n"));
+  const Scene s =
+      load_obj(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 5\nv 1 0 5\nv 0 1 5\n"
+                     "o first\nf 1 2 3\no second\nf 4 5 6\nf 6 5 4\n"));
   ASSERT_EQ(s.meshes.size(), 2u);
   EXPECT_EQ(s.meshes[0].name, "first");
   EXPECT_EQ(s.meshes[1].name, "second");
@@ -99,9 +102,9 @@ TEST_F(ObjLoader, OneMeshPerShapeWithCompactedVertices) {
 }
 
 TEST_F(ObjLoader, RelativeIndicesAndTextureNormalReferences) {
-  const Scene s = load_obj(write(
-      "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n"
-      "f -3/1/1 -2/1/1 -1/1/1\nf 1//1 2//1 3//1\nf 1/1 2/1 3/1\n"));
+  const Scene s =
+      load_obj(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n"
+                     "f -3/1/1 -2/1/1 -1/1/1\nf 1//1 2//1 3//1\nf 1/1 2/1 3/1\n"));
   ASSERT_EQ(s.triangles.size(), 3u);
   expect_vec3_near(s.triangles[0].v2, {0, 1, 0});
 }
@@ -155,9 +158,9 @@ TEST_F(ObjLoader, LinesAndPointsAreSkippedWithAWarning) {
 
 TEST_F(ObjLoader, NonFiniteVerticesAreDroppedAndCounted) {
   // tinyobjloader alone would read "nan" and "inf" as 0 and keep the triangles.
-  const Scene s = load_obj(write(
-      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv nan 0 0\nv 0 -inf 0\nv 1e999 0 0\n"
-      "f 1 2 3\nf 1 2 4\nf 1 5 3\nf 6 2 3\n"));
+  const Scene s =
+      load_obj(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nv nan 0 0\nv 0 -inf 0\nv 1e999 0 0\n"
+                     "f 1 2 3\nf 1 2 4\nf 1 5 3\nf 6 2 3\n"));
   EXPECT_EQ(s.triangles.size(), 1u);
   EXPECT_EQ(s.report.dropped_nonfinite, 3u);
 }
@@ -170,7 +173,9 @@ TEST_F(ObjLoader, DegenerateTrianglesAreKeptAndCounted) {
 
 // --- errors ---------------------------------------------------------------------
 
-TEST_F(ObjLoader, MissingFile) { expect_error((dir_ / "absent.obj").string(), "no such file"); }
+TEST_F(ObjLoader, MissingFile) {
+  expect_error((dir_ / "absent.obj").string(), "no such file");
+}
 
 TEST_F(ObjLoader, IndexOutOfRange) {
   expect_error(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"),
@@ -198,8 +203,10 @@ TEST_F(ObjLoader, MalformedFaceLine) {
   expect_error(write("v 0 0 0\nv 1 0 0\nf 1 2\n", "two.obj"), "line 3: face has 2 vertices (expected at least 3)");
   expect_error(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1/1 2 3\n", "four.obj"), "malformed vertex reference '1/1/1/1'");
   expect_error(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/ 2 3\n", "slash.obj"), "malformed vertex reference '1/'");
-  expect_error(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1/ 2 3\n", "trailing.obj"), "malformed vertex reference '1/1/'");
-  expect_error(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//0 2 3\n", "normal.obj"), "texture/normal index 0 in '1//0' is invalid");
+  expect_error(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1/ 2 3\n", "trailing.obj"),
+               "malformed vertex reference '1/1/'");
+  expect_error(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//0 2 3\n", "normal.obj"),
+               "texture/normal index 0 in '1//0' is invalid");
 }
 
 TEST_F(ObjLoader, EmptySceneIsAnError) {
@@ -209,3 +216,4 @@ TEST_F(ObjLoader, EmptySceneIsAnError) {
 }
 
 }  // namespace
+}  // namespace unity_test_obj_loader

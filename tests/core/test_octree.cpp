@@ -13,6 +13,9 @@
 #include "core/accel/octree/octree.h"
 #include "core/geometry/tri_box_overlap.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_octree {
+
 using namespace accelviz;
 
 namespace {
@@ -24,7 +27,9 @@ struct Rng {
     return static_cast<double>(s >> 11) * (1.0 / 9007199254740992.0);
   }
   float range(float a, float b) { return a + (b - a) * static_cast<float>(next()); }
-  glm::vec3 in_box(const glm::vec3& lo, const glm::vec3& hi) { return {range(lo.x, hi.x), range(lo.y, hi.y), range(lo.z, hi.z)}; }
+  glm::vec3 in_box(const glm::vec3& lo, const glm::vec3& hi) {
+    return {range(lo.x, hi.x), range(lo.y, hi.y), range(lo.z, hi.z)};
+  }
   glm::vec3 unit() {
     for (;;) {
       const glm::vec3 v(range(-1, 1), range(-1, 1), range(-1, 1));
@@ -36,7 +41,8 @@ struct Rng {
 
 using Scene = std::vector<Triangle>;
 
-Scene soup(std::uint64_t seed, int n, float size, const glm::vec3& lo = glm::vec3(-1), const glm::vec3& hi = glm::vec3(1)) {
+Scene soup(std::uint64_t seed, int n, float size, const glm::vec3& lo = glm::vec3(-1),
+           const glm::vec3& hi = glm::vec3(1)) {
   Rng rng{seed};
   Scene s;
   for (int i = 0; i < n; ++i) {
@@ -320,3 +326,4 @@ TEST(Octree, ProgressAndCancellation) {
   EXPECT_DOUBLE_EQ(last, 1.0);
   EXPECT_THROW(Octree(s, {}, [](double f) { return f < 0.5; }), BuildCancelled);
 }
+}  // namespace unity_test_octree

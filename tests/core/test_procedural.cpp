@@ -4,11 +4,6 @@
 // promises.
 #include <gtest/gtest.h>
 
-#include "core/scene/load.h"
-#include "core/scene/procedural/generators.h"
-#include "core/scene/procedural/spec.h"
-#include "core/scene/procedural/teapot.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -18,6 +13,14 @@
 #include <string>
 #include <tuple>
 #include <vector>
+
+#include "core/scene/load.h"
+#include "core/scene/procedural/generators.h"
+#include "core/scene/procedural/spec.h"
+#include "core/scene/procedural/teapot.h"
+
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_procedural {
 
 using namespace accelviz;
 namespace proc = accelviz::procedural;
@@ -34,19 +37,20 @@ std::vector<std::string> all_names() {
   return names;
 }
 
-bool is_random_scene(const std::string& name) { return name != "teapot" && name != "teapot-stadium"; }
+bool is_random_scene(const std::string& name) {
+  return name != "teapot" && name != "teapot-stadium";
+}
 
 /// The documented range of the triangle count for SIZE (docs/builtin-scenes.md).
 struct CountRange {
   std::int64_t lo, hi;
 };
 CountRange documented_range(const std::string& name, std::int64_t size) {
-  if (name == "soup" || name == "same-centroid" || name == "same-bounds" || name == "duplicates" ||
-      name == "flat-wall")
+  if (name == "soup" || name == "same-centroid" || name == "same-bounds" || name == "duplicates" || name == "flat-wall")
     return {size, size};
-  if (name == "grass") return {size + 1, size + 3};                // 3 per blade, rounded, + 2 ground
-  if (name == "forest") return {size - 48 + 2, size + 48 + 2};     // 96 per tree, rounded, + 2 ground
-  if (name == "dynamic") return {size - 12, size + 3};             // 12 per box, rounded down; lawn 3 per blade + 2
+  if (name == "grass") return {size + 1, size + 3};             // 3 per blade, rounded, + 2 ground
+  if (name == "forest") return {size - 48 + 2, size + 48 + 2};  // 96 per tree, rounded, + 2 ground
+  if (name == "dynamic") return {size - 12, size + 3};          // 12 per box, rounded down; lawn 3 per blade + 2
   if (name == "island") {  // size = unique; default copies 4: about 0.1 size + 0.9 size 4 instanced, within 10%
     const auto n = static_cast<std::int64_t>(3.7 * static_cast<double>(size));
     return {n - n / 10, n + n / 10};
@@ -58,7 +62,9 @@ CountRange documented_range(const std::string& name, std::int64_t size) {
   return {size - tol, size + tol};
 }
 
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 bool same_triangles(const Scene& a, const Scene& b) {
   return a.triangles.size() == b.triangles.size() &&
@@ -140,7 +146,8 @@ TEST(BuiltinSpec, FullSeedRangeAccepted) {
 }
 
 TEST(BuiltinSpec, UnknownNameListsValidNames) {
-  expect_spec_error("builtin:teapt", "teapt", {"unknown scene", "teapot", "teapot-stadium", "walls-rotated", "flat-wall"});
+  expect_spec_error("builtin:teapt", "teapt",
+                    {"unknown scene", "teapot", "teapot-stadium", "walls-rotated", "flat-wall"});
   expect_spec_error("grasss?size=10", "grasss", {"unknown scene", "grass"});
 }
 
@@ -207,9 +214,9 @@ TEST(BuiltinSpec, ValueParsers) {
 }
 
 TEST(BuiltinSpec, ListingNamesEveryScene) {
-  const std::vector<std::string> expected = {"teapot", "teapot-stadium", "grass", "terrain", "soup", "walls",
-                                             "walls-rotated", "forest", "island", "dynamic", "same-centroid", "same-bounds",
-                                             "duplicates", "flat-wall"};
+  const std::vector<std::string> expected = {"teapot",        "teapot-stadium", "grass",      "terrain",  "soup",
+                                             "walls",         "walls-rotated",  "forest",     "island",   "dynamic",
+                                             "same-centroid", "same-bounds",    "duplicates", "flat-wall"};
   EXPECT_EQ(all_names(), expected);
   for (const BuiltinSceneInfo& info : builtin_scenes()) {
     EXPECT_FALSE(info.description.empty());
@@ -308,20 +315,13 @@ TEST_P(EveryScene, SeedChangesRandomScenesOnly) {
 // core/scene/procedural/random.h and reproducible_fp.h).
 TEST_P(EveryScene, GoldenHash) {
   static const std::map<std::string, std::uint64_t> golden = {
-      {"teapot", 0xbe4dd8e594c2c97bull},
-      {"teapot-stadium", 0xd43e12938aa38678ull},
-      {"grass", 0xbd42c5aa9385ff35ull},
-      {"terrain", 0xb5b8c65231b7bf17ull},
-      {"soup", 0x21e1844ccb60b34aull},
-      {"walls", 0x71bc978aa0e5e6b5ull},
-      {"walls-rotated", 0x5999be285abc8ecdull},
-      {"forest", 0xf72b94ca7905172dull},
-      {"island", 0xfadeb096a51b8fdfull},
-      {"dynamic", 0x30df047b654b8c71ull},
-      {"same-centroid", 0xea4d7d6f960d8d37ull},
-      {"same-bounds", 0x8b2a829be763e3c3ull},
-      {"duplicates", 0x16d3fef73e72cf05ull},
-      {"flat-wall", 0x69260de40b55b2edull},
+      {"teapot", 0xbe4dd8e594c2c97bull},        {"teapot-stadium", 0xd43e12938aa38678ull},
+      {"grass", 0xbd42c5aa9385ff35ull},         {"terrain", 0xb5b8c65231b7bf17ull},
+      {"soup", 0x21e1844ccb60b34aull},          {"walls", 0x71bc978aa0e5e6b5ull},
+      {"walls-rotated", 0x5999be285abc8ecdull}, {"forest", 0xf72b94ca7905172dull},
+      {"island", 0xfadeb096a51b8fdfull},        {"dynamic", 0x30df047b654b8c71ull},
+      {"same-centroid", 0xea4d7d6f960d8d37ull}, {"same-bounds", 0x8b2a829be763e3c3ull},
+      {"duplicates", 0x16d3fef73e72cf05ull},    {"flat-wall", 0x69260de40b55b2edull},
   };
   const Scene s = make_builtin(GetParam() + "?size=2000&seed=5");
   const auto it = golden.find(GetParam());
@@ -396,7 +396,8 @@ TEST(Teapot, SeamsAreWeldedAndWindingIsConsistent) {
     double volume = 0.0;
     for (const glm::uvec3& t : mesh.indices)
       volume += glm::dot(glm::dvec3(mesh.positions[t.x]),
-                         glm::cross(glm::dvec3(mesh.positions[t.y]), glm::dvec3(mesh.positions[t.z]))) / 6.0;
+                         glm::cross(glm::dvec3(mesh.positions[t.y]), glm::dvec3(mesh.positions[t.z]))) /
+                6.0;
     EXPECT_GT(volume, 20.0);
     EXPECT_LT(volume, 30.0);
   }
@@ -442,7 +443,8 @@ TEST(TeapotStadium, BoundsRatioIsTheRatioKey) {
 TEST(TeapotStadium, SeatsCameraLooksAtTheTeapotAndOneLight) {
   const Scene s = make_builtin("teapot-stadium?size=20000");
   const Aabb teapot_box = bounds_of(s, s.instances[0].first_triangle, s.instances[0].triangle_count);
-  const auto seats = std::find_if(s.cameras.begin(), s.cameras.end(), [](const Camera& c) { return c.name == "seats"; });
+  const auto seats =
+      std::find_if(s.cameras.begin(), s.cameras.end(), [](const Camera& c) { return c.name == "seats"; });
   ASSERT_NE(seats, s.cameras.end());
   // In the stands: far from the teapot, above the ground, inside the bowl.
   const float horizontal = glm::length(glm::vec2(seats->position.x, seats->position.z));
@@ -712,3 +714,4 @@ TEST(BuiltinScale, MillionTrianglesOfEverySceneQuickly) {
 #endif
   }
 }
+}  // namespace unity_test_procedural

@@ -1,6 +1,5 @@
 #include <gtest/gtest.h>
-
-#include "core/query/ray_file.h"
+#include <unistd.h>
 
 #include <cmath>
 #include <cstring>
@@ -8,7 +7,10 @@
 #include <fstream>
 #include <random>
 
-#include <unistd.h>
+#include "core/query/ray_file.h"
+
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_ray_file {
 
 using namespace accelviz;
 namespace fs = std::filesystem;
@@ -20,8 +22,8 @@ class RayFileTest : public ::testing::Test {
  protected:
   void SetUp() override {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("accelviz_test_ray_file_" + std::string(info->name()) + "_" +
-                                        std::to_string(::getpid()));
+    dir_ = fs::temp_directory_path() /
+           ("accelviz_test_ray_file_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -248,3 +250,4 @@ TEST_F(RayFileTest, InvalidHitsAndOcclusion) {
   spit(path("o.occl"), b);
   expect_error(path("o.occl"), "record 1: value 7", [&] { read_occlusion(path("o.occl")); });
 }
+}  // namespace unity_test_ray_file

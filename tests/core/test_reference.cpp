@@ -6,6 +6,9 @@
 #include "core/accel/reference.h"
 #include "core/analysis/verify.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_reference {
+
 using namespace accelviz;
 
 namespace {
@@ -157,3 +160,4 @@ TEST(Verify, RaysAreDeterministic) {
     EXPECT_EQ(a[i].direction, b[i].direction);
   }
 }
+}  // namespace unity_test_reference

@@ -1,15 +1,15 @@
 // Refit decay: motion keeps shared vertices together, and the rebuild rule
 // fires exactly where refit SAH / fresh SAH exceeds the ratio (and never with
 // a huge ratio), on a scripted perturbation.
-#include "core/analysis/refit_decay.h"
-
-#include "core/scene/load.h"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
-namespace accelviz {
+#include "core/analysis/refit_decay.h"
+#include "core/scene/load.h"
+
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace accelviz::unity_test_refit_decay {
 namespace {
 
 TEST(RefitDecay, MotionIsDeterministicAndKeepsSharedVerticesTogether) {
@@ -94,4 +94,4 @@ TEST(RefitDecay, RejectsBadOptions) {
 }
 
 }  // namespace
-}  // namespace accelviz
+}  // namespace accelviz::unity_test_refit_decay

@@ -36,6 +36,9 @@
 #include "core/geometry/shapes.h"
 #include "core/util/parallel.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_robustness_catalogue {
+
 using namespace accelviz;
 
 namespace {
@@ -891,3 +894,4 @@ TEST(CatalogueBuilders, TenMillionPrimitivesBvh) {
   EXPECT_TRUE(bvh->closest_hit(rays.back(), {}).valid());
 #endif
 }
+}  // namespace unity_test_robustness_catalogue

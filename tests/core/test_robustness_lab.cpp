@@ -8,6 +8,9 @@
 #include "core/analysis/robustness_lab.h"
 #include "core/scene/load.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_robustness_lab {
+
 using namespace accelviz;
 
 namespace {
@@ -135,3 +138,4 @@ TEST(RobustnessLab, BadStructureAndCancel) {
   const LabResult empty = run_robustness_lab({}, o);
   EXPECT_EQ(empty.rays, 0u);
 }
+}  // namespace unity_test_robustness_lab

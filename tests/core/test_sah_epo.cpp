@@ -3,19 +3,24 @@
 // polygon clipping), never the library's own helpers.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <random>
+#include <vector>
+
 #include "core/accel/bvh/bvh.h"
 #include "core/analysis/epo.h"
 #include "core/analysis/sah.h"
 
-#include <cmath>
-#include <random>
-#include <vector>
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_sah_epo {
 
 using namespace accelviz;
 
 namespace {
 
-float uniform(std::mt19937& rng) { return static_cast<float>(rng() >> 8) * (1.0f / 16777216.0f); }
+float uniform(std::mt19937& rng) {
+  return static_cast<float>(rng() >> 8) * (1.0f / 16777216.0f);
+}
 
 std::vector<Triangle> soup(std::size_t n, std::uint32_t seed, float size) {
   std::mt19937 rng(seed);
@@ -82,11 +87,12 @@ void collect(std::span<const BvhNode> nodes, std::span<const std::uint32_t> ids,
 
 /// EPO by definition: for every node, every triangle outside its subtree,
 /// the area of that triangle inside the node's box, weighted by the node's cost.
-double reference_epo(std::span<const BvhNode> nodes, std::span<const std::uint32_t> ids,
-                     std::span<const Triangle> tris, double ct, double ci) {
+double reference_epo(std::span<const BvhNode> nodes, std::span<const std::uint32_t> ids, std::span<const Triangle> tris,
+                     double ct, double ci) {
   double total_area = 0.0;
   for (const Triangle& t : tris)
-    total_area += 0.5 * glm::length(glm::cross(glm::dvec3(t.v1) - glm::dvec3(t.v0), glm::dvec3(t.v2) - glm::dvec3(t.v0)));
+    total_area +=
+        0.5 * glm::length(glm::cross(glm::dvec3(t.v1) - glm::dvec3(t.v0), glm::dvec3(t.v2) - glm::dvec3(t.v0)));
   double sum = 0.0;
   for (std::uint32_t i = 0; i < nodes.size(); ++i) {
     std::vector<char> mine(tris.size(), 0);
@@ -168,13 +174,13 @@ TEST(Sah, TreeShapeMatchesTheStats) {
 // ---- EPO ----
 
 TEST(Epo, ClippedAreaOfKnownCases) {
-  const Triangle t{{0, 0, 0}, {2, 0, 0}, {0, 2, 0}};  // area 2
+  const Triangle t{{0, 0, 0}, {2, 0, 0}, {0, 2, 0}};                               // area 2
   EXPECT_DOUBLE_EQ(clipped_triangle_area(t, {glm::vec3(-1), glm::vec3(3)}), 2.0);  // fully inside
   // x <= 1 cuts off the corner triangle (1,0),(2,0),(1,1) of area 0.5.
   EXPECT_NEAR(clipped_triangle_area(t, {glm::vec3(-1), glm::vec3(1, 3, 3)}), 1.5, 1e-12);
   // The unit square [0,1]² lies wholly inside the triangle.
   EXPECT_NEAR(clipped_triangle_area(t, {glm::vec3(0, 0, -1), glm::vec3(1, 1, 1)}), 1.0, 1e-12);
-  EXPECT_EQ(clipped_triangle_area(t, {glm::vec3(5), glm::vec3(6)}), 0.0);      // disjoint
+  EXPECT_EQ(clipped_triangle_area(t, {glm::vec3(5), glm::vec3(6)}), 0.0);              // disjoint
   EXPECT_EQ(clipped_triangle_area(t, {glm::vec3(0, 0, 1), glm::vec3(2, 2, 2)}), 0.0);  // above its plane
   EXPECT_EQ(clipped_triangle_area(t, Aabb::empty()), 0.0);
   // Against the independent clipper on random pairs.
@@ -248,3 +254,4 @@ TEST(Epo, RejectsMismatchedInput) {
   EXPECT_THROW(bvh_epo(bvh.nodes(), bvh.prim_indices(), fewer, 1, 1), std::invalid_argument);
   EXPECT_EQ(bvh_epo({}, {}, {}, 1, 1), 0.0);
 }
+}  // namespace unity_test_sah_epo

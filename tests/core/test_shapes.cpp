@@ -6,6 +6,9 @@
 #include "core/geometry/shapes.h"
 #include "core/geometry/triangle.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_shapes {
+
 using namespace accelviz;
 
 TEST(Plane, HitAndParallelMiss) {
@@ -50,7 +53,7 @@ TEST(Cylinder, CentredLateralAndCaps) {
   ASSERT_TRUE(intersect_cylinder(Ray({0.3f, -3, 0.2f}, {0, 1, 0}), c, 0, kInfinity, h));  // bottom cap
   EXPECT_NEAR(h.t, 3.0f, 1e-5f);
   EXPECT_NEAR(h.ng.y, -1.0f, 1e-6f);
-  EXPECT_FALSE(intersect_cylinder(Ray({-5, 2.5f, 0}, {1, 0, 0}), c, 0, kInfinity, h));  // above the top
+  EXPECT_FALSE(intersect_cylinder(Ray({-5, 2.5f, 0}, {1, 0, 0}), c, 0, kInfinity, h));   // above the top
   EXPECT_FALSE(intersect_cylinder(Ray({1.5f, 10, 0}, {0, -1, 0}), c, 0, kInfinity, h));  // outside the radius
 }
 
@@ -79,7 +82,8 @@ TEST(OffsetHardCases, ShadowRayDoesNotReHitItsOwnTriangleAtManyScales) {
   };
   for (float scale : {1e-3f, 1.0f, 1e3f, 1e5f, 1e7f}) {
     const glm::vec3 base(scale, -0.5f * scale, 0.25f * scale);
-    const Triangle t{base, base + glm::vec3(scale, 0.1f * scale, 0), base + glm::vec3(0.2f * scale, scale, 0.3f * scale)};
+    const Triangle t{base, base + glm::vec3(scale, 0.1f * scale, 0),
+                     base + glm::vec3(0.2f * scale, scale, 0.3f * scale)};
     const glm::vec3 n = triangle_normal(t);
     int self_hits = 0;
     for (int i = 0; i < 2000; ++i) {
@@ -111,3 +115,4 @@ TEST(OffsetHardCases, OffsetIsSmallRelativeToScale) {
   const glm::vec3 o = offset_ray_origin(p, glm::vec3(0, 0, -1));
   EXPECT_FLOAT_EQ(p.z - o.z, 1.0f / 65536.0f);
 }
+}  // namespace unity_test_shapes

@@ -2,6 +2,9 @@
 
 #include "core/accel/brute_force.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_smoke {
+
 using namespace accelviz;
 
 TEST(BruteForce, FindsNearestOfTwoTriangles) {
@@ -17,3 +20,4 @@ TEST(BruteForce, FindsNearestOfTwoTriangles) {
   EXPECT_TRUE(bf.any_hit(Ray({0, 0, 0}, {0, 0, 1}), {}));
   EXPECT_FALSE(bf.any_hit(Ray({0, 0, 0}, {0, 0, -1}), {}));
 }
+}  // namespace unity_test_smoke

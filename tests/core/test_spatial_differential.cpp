@@ -25,6 +25,9 @@
 #include "core/accel/octree/octree.h"
 #include "core/util/parallel.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_spatial_differential {
+
 using namespace accelviz;
 
 namespace {
@@ -37,7 +40,9 @@ struct Rng {
   }
   float range(float a, float b) { return a + (b - a) * static_cast<float>(next()); }
   int below(int n) { return static_cast<int>(next() * n) % n; }
-  glm::vec3 in_box(const glm::vec3& lo, const glm::vec3& hi) { return {range(lo.x, hi.x), range(lo.y, hi.y), range(lo.z, hi.z)}; }
+  glm::vec3 in_box(const glm::vec3& lo, const glm::vec3& hi) {
+    return {range(lo.x, hi.x), range(lo.y, hi.y), range(lo.z, hi.z)};
+  }
   glm::vec3 unit() {
     for (;;) {
       const glm::vec3 v(range(-1, 1), range(-1, 1), range(-1, 1));
@@ -168,8 +173,10 @@ Scene with_degenerate_triangles(std::uint64_t seed) {
   Rng rng{seed};
   Scene s = soup(seed, 300);
   for (std::size_t i = 0; i < s.size(); i += 3) {
-    if (rng.next() < 0.5) s[i].v2 = s[i].v1;                        // segment
-    else s[i].v1 = s[i].v2 = s[i].v0;                              // point
+    if (rng.next() < 0.5)
+      s[i].v2 = s[i].v1;  // segment
+    else
+      s[i].v1 = s[i].v2 = s[i].v0;  // point
   }
   return s;
 }
@@ -209,8 +216,8 @@ std::vector<Ray> make_rays(const Scene& scene, std::uint64_t seed, int n) {
       if (kind == 9) d[(a + 1) % 3] = rng.next() < 0.5 ? 1.0f : -1.0f;
       // Origin: inside, or outside behind a point of the bounds; sometimes
       // exactly at a scene vertex's coordinates (rays along triangle planes).
-      const glm::vec3 p = !scene.empty() && kind == 8 ? scene[rng.below(static_cast<int>(scene.size()))].v0
-                                                      : rng.in_box(b.lo, b.hi);
+      const glm::vec3 p =
+          !scene.empty() && kind == 8 ? scene[rng.below(static_cast<int>(scene.size()))].v0 : rng.in_box(b.lo, b.hi);
       o = rng.next() < 0.5 ? p : p - 2.0f * r * d;
       have_target = false;
       rays.emplace_back(o, d);
@@ -368,14 +375,37 @@ void check(const Scene& scene, std::uint64_t seed, int rays, bool use_moller_tru
 
 }  // namespace
 
-TEST(SpatialDifferential, RandomSoup) { check(soup(1, 2000), 101, 30000); }
-TEST(SpatialDifferential, RandomSoupSecondSeed) { check(soup(2, 800), 102, 30000); }
-TEST(SpatialDifferential, TeapotInStadium) { check(teapot_in_stadium(3), 103, 30000); }
-TEST(SpatialDifferential, ThinWallsRotated45) { check(thin_walls_45(), 104, 50000); }
-TEST(SpatialDifferential, LatticeBoxesInSplitPlanes) { check(lattice_boxes(5), 105, 50000); }
-TEST(SpatialDifferential, AllCentroidsEqual) { check(same_centroid(6), 106, 40000); }
-TEST(SpatialDifferential, Duplicates) { check(duplicates(), 107, 30000); }
-TEST(SpatialDifferential, FlatWall) { check(flat_wall(), 108, 30000); }
-TEST(SpatialDifferential, DegenerateTriangles) { check(with_degenerate_triangles(9), 109, 30000, false); }
-TEST(SpatialDifferential, OnePrimitive) { check({{{-0.5f, -0.5f, 0}, {0.5f, -0.5f, 0}, {0, 0.5f, 0.2f}}}, 110, 20000); }
-TEST(SpatialDifferential, NoPrimitive) { check({}, 111, 10000); }
+TEST(SpatialDifferential, RandomSoup) {
+  check(soup(1, 2000), 101, 30000);
+}
+TEST(SpatialDifferential, RandomSoupSecondSeed) {
+  check(soup(2, 800), 102, 30000);
+}
+TEST(SpatialDifferential, TeapotInStadium) {
+  check(teapot_in_stadium(3), 103, 30000);
+}
+TEST(SpatialDifferential, ThinWallsRotated45) {
+  check(thin_walls_45(), 104, 50000);
+}
+TEST(SpatialDifferential, LatticeBoxesInSplitPlanes) {
+  check(lattice_boxes(5), 105, 50000);
+}
+TEST(SpatialDifferential, AllCentroidsEqual) {
+  check(same_centroid(6), 106, 40000);
+}
+TEST(SpatialDifferential, Duplicates) {
+  check(duplicates(), 107, 30000);
+}
+TEST(SpatialDifferential, FlatWall) {
+  check(flat_wall(), 108, 30000);
+}
+TEST(SpatialDifferential, DegenerateTriangles) {
+  check(with_degenerate_triangles(9), 109, 30000, false);
+}
+TEST(SpatialDifferential, OnePrimitive) {
+  check({{{-0.5f, -0.5f, 0}, {0.5f, -0.5f, 0}, {0, 0.5f, 0.2f}}}, 110, 20000);
+}
+TEST(SpatialDifferential, NoPrimitive) {
+  check({}, 111, 10000);
+}
+}  // namespace unity_test_spatial_differential

@@ -2,11 +2,6 @@
 // points, shared-edge leak counting, and small end-to-end sweeps whose
 // figures must be sane (no timing thresholds: only positivity and orderings
 // that do not depend on the machine).
-#include "core/analysis/sweep.h"
-
-#include "core/query/camera.h"
-#include "core/scene/load.h"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -15,7 +10,12 @@
 #include <cstdio>
 #include <map>
 
-namespace accelviz {
+#include "core/analysis/sweep.h"
+#include "core/query/camera.h"
+#include "core/scene/load.h"
+
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace accelviz::unity_test_sweep {
 namespace {
 
 std::vector<Ray> small_primary(const Scene& scene, int w = 48, int h = 36) {
@@ -343,4 +343,4 @@ TEST(Sweep, CsvHasAHeaderAndOneRowPerSetting) {
 }
 
 }  // namespace
-}  // namespace accelviz
+}  // namespace accelviz::unity_test_sweep

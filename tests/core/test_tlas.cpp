@@ -26,6 +26,9 @@
 #include "core/scene/load.h"
 #include "core/util/parallel.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_tlas {
+
 using namespace accelviz;
 
 #if defined(__has_feature)
@@ -478,3 +481,4 @@ TEST(Tlas, RefitThenQueryEqualsRebuildThenQuery) {
   EXPECT_EQ(c.unexplained.load(), 0u) << c.report();
   EXPECT_THROW(rebuilt.rebuild_blas(b, std::span<const Triangle>(tris).first(3)), std::invalid_argument);
 }
+}  // namespace unity_test_tlas

@@ -11,6 +11,9 @@
 
 #include "core/geometry/tri_box_overlap.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_tri_box_overlap {
+
 using namespace accelviz;
 
 namespace {
@@ -191,8 +194,8 @@ TEST(TriBoxOverlap, RandomTouchingCases) {
     const Aabb box{{0, 0, 0}, {1, 1, 1}};
     glm::vec3 p = rng.vec(0, 1);
     const int a = it % 3;
-    p[a] = 1.0f;  // on the face x_a = 1
-    if (it % 5 == 0) p[(a + 1) % 3] = 0.0f;  // on an edge
+    p[a] = 1.0f;                              // on the face x_a = 1
+    if (it % 5 == 0) p[(a + 1) % 3] = 0.0f;   // on an edge
     if (it % 25 == 0) p[(a + 2) % 3] = 1.0f;  // on a corner
     glm::vec3 q = p + rng.vec(0.1f, 1.0f), r = p + rng.vec(0.1f, 1.0f);
     q[a] = std::max(q[a], 1.1f);
@@ -272,3 +275,4 @@ TEST(ClippedTriangleBounds, RandomContainsEverySampleInside) {
       }
   }
 }
+}  // namespace unity_test_tri_box_overlap

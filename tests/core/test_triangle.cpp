@@ -6,6 +6,9 @@
 
 #include "core/geometry/triangle.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_triangle {
+
 using namespace accelviz;
 
 namespace {
@@ -195,3 +198,4 @@ TEST(TriangleHardCases, SceneTranslatedBy1e7) {
     ASSERT_GE(count_hits(tris, Ray(o, target - o), true), 1) << "i=" << i;
   }
 }
+}  // namespace unity_test_triangle

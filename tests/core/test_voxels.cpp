@@ -11,6 +11,9 @@
 #include "core/accel/voxels/dense_voxels.h"
 #include "core/accel/voxels/voxels.h"
 
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_voxels {
+
 using namespace accelviz;
 
 namespace {
@@ -23,7 +26,9 @@ struct Rng {
   }
   float range(float a, float b) { return a + (b - a) * static_cast<float>(next()); }
   int below(int n) { return static_cast<int>(next() * n) % n; }
-  glm::vec3 in_box(const glm::vec3& lo, const glm::vec3& hi) { return {range(lo.x, hi.x), range(lo.y, hi.y), range(lo.z, hi.z)}; }
+  glm::vec3 in_box(const glm::vec3& lo, const glm::vec3& hi) {
+    return {range(lo.x, hi.x), range(lo.y, hi.y), range(lo.z, hi.z)};
+  }
   glm::vec3 unit() {
     for (;;) {
       const glm::vec3 v(range(-1, 1), range(-1, 1), range(-1, 1));
@@ -58,7 +63,8 @@ Scene sphere_and_floor() {
   const int n = 24;
   const auto p = [&](int i, int j) {
     const float th = 3.14159265f * static_cast<float>(i) / n, ph = 6.2831853f * static_cast<float>(j) / n;
-    return glm::vec3(0.2f, 0.1f, -0.1f) + 0.7f * glm::vec3(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph));
+    return glm::vec3(0.2f, 0.1f, -0.1f) +
+           0.7f * glm::vec3(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph));
   };
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) quad(s, p(i, j), p(i + 1, j), p(i + 1, j + 1), p(i, j + 1));
@@ -184,7 +190,8 @@ TEST(Voxels, OccupancyEqualsIndependentDenseVoxelization) {
       Rng rng{static_cast<std::uint64_t>(level) + 5};
       const std::uint32_t r = v.domain().resolution;
       for (int k = 0; k < 2000; ++k) {
-        const std::uint32_t x = rng.below(static_cast<int>(r)), y = rng.below(static_cast<int>(r)), z = rng.below(static_cast<int>(r));
+        const std::uint32_t x = rng.below(static_cast<int>(r)), y = rng.below(static_cast<int>(r)),
+                            z = rng.below(static_cast<int>(r));
         ASSERT_EQ(v.occupied(x, y, z), ref.get(x, y, z));
       }
     }
@@ -346,3 +353,4 @@ TEST(VoxelsDifferential, MarchEqualsDenseReference) {
   bad += compare_with_dense(soup(3, 4000, 0.4f), 4, 16, 10000);
   EXPECT_EQ(bad, 0);
 }
+}  // namespace unity_test_voxels
