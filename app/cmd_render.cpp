@@ -1,19 +1,21 @@
 // accelviz render: a per-pixel metric heatmap (nodes visited, primitive tests,
 // cost, shading, depth) of one structure, written as a PNG with a legend.
 // Also the no-subcommand demo, which renders the demo scene the same way.
-#include "app/cli_common.h"
-#include "app/render_raster.h"
-#include "app/render_compare.h"
-
-#include "core/analysis/heatmap.h"
-#include "core/query/camera.h"
-#include "core/scene/load.h"
-
 #include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 #include <optional>
+
+#include "app/cli_common.h"
+#include "app/render_compare.h"
+#include "app/render_raster.h"
+#include "core/accel/bvh/bvh.h"
+#include "core/analysis/heatmap.h"
+#include "core/query/camera.h"
+#include "core/scene/load.h"
+#include "ui/gl/osmesa_context.h"
+#include "ui/render/gpu_trace.h"
 
 namespace accelviz::cli {
 
@@ -33,12 +35,13 @@ struct RenderOptions {
   std::string triangle_test = "watertight";
   bool force = false;
   std::string order = "front-to-back";  ///< child order: front-to-back, back-to-front, unordered
-  bool xray = false;                     ///< count the full traversal as if no hit ended it
-  std::optional<std::string> compare;    ///< B's differences from A (render --compare)
+  bool xray = false;                    ///< count the full traversal as if no hit ended it
+  std::optional<std::string> compare;   ///< B's differences from A (render --compare)
   StructureCli structure_opts;
   std::string view = "heatmap";
   RasterOptions raster;
   std::string ray_pixel;
+  std::string device = "cpu";  ///< where the heatmap's rays are traced: cpu, gpu (OSMesa compute shader, bvh only)
 };
 
 /// --ray-pixel "X,Y".
@@ -74,8 +77,11 @@ int run_render_raster(const RenderOptions& o, const GlobalOptions& global) {
   if (!o.ray_pixel.empty()) ro.ray_pixel = parse_pixel(o.ray_pixel);
   QueryOptions query;
   query.triangle_test = parse_triangle_test(o.triangle_test);
-  nlohmann::json figures = {{"scene", o.scene}, {"structure", o.structure}, {"width", size.width},
-                            {"height", size.height}, {"triangles", scene.triangles.size()},
+  nlohmann::json figures = {{"scene", o.scene},
+                            {"structure", o.structure},
+                            {"width", size.width},
+                            {"height", size.height},
+                            {"triangles", scene.triangles.size()},
                             {"build_ms", accel->build_stats().build_ms}};
   progress.begin("drawing the raster view");
   render_raster(scene, *accel, camera, size, ro, o.metric, o.colormap, o.max, query, o.structure_opts.ctrav,
@@ -119,11 +125,31 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
   ho.query.xray = o.xray;
   ho.c_trav = o.structure_opts.ctrav;
   ho.c_isect = o.structure_opts.cisect;
-  progress.begin("rendering " + o.metric);
-  ho.progress = progress.callback();
   HeatmapFigures fig;
-  const MetricImage img = render_metric(*accel, camera, ho, &fig);
-  progress.end(std::to_string(static_cast<long long>(fig.render_ms)) + " ms");
+  MetricImage img;
+  nlohmann::json gpu_figures;
+  if (o.device == "gpu") {
+    // Headless GL 4.5 (OSMesa); the image size of the context is irrelevant:
+    // the compute shader writes a storage buffer.
+    progress.begin("compiling the trace shader, uploading the bvh");
+    OsMesaContext context(1, 1);
+    const auto t_setup = Clock::now();
+    GpuBvhTracer tracer;
+    tracer.upload(dynamic_cast<const Bvh&>(*accel));
+    const double setup_ms = ms_since(t_setup);
+    progress.end(std::to_string(static_cast<long long>(setup_ms)) + " ms");
+    progress.begin("rendering " + o.metric + " on the GPU (" + context.info().renderer + ")");
+    GpuTraceResult raw;
+    img = gpu_render_metric(tracer, camera, ho, &fig, &raw);
+    progress.end(std::to_string(static_cast<long long>(fig.render_ms)) + " ms");
+    gpu_figures = {
+        {"gpu_renderer", context.info().renderer}, {"gpu_setup_ms", setup_ms}, {"gpu_readback_ms", raw.readback_ms}};
+  } else {
+    progress.begin("rendering " + o.metric);
+    ho.progress = progress.callback();
+    img = render_metric(*accel, camera, ho, &fig);
+    progress.end(std::to_string(static_cast<long long>(fig.render_ms)) + " ms");
+  }
 
   ColorizeOptions co;
   co.map = parse_colormap(o.colormap).value();
@@ -153,10 +179,18 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
         {"yfov_deg", camera.yfov * 180.0 / 3.14159265358979}}},
   };
   if (metric_needs_stats(metric)) figures["instrumented"] = true;  // render_ms includes counting
+  figures["device"] = o.device;
+  for (const auto& [key, value] : gpu_figures.items()) figures[key] = value;
   return colorize(img, co);
 }
 
 int run_render(const RenderOptions& o, const GlobalOptions& global) {
+  if (o.device == "gpu") {
+    if (const std::string why = gpu_trace_unsupported(o.structure); !why.empty())
+      throw UsageError("--device gpu: " + why);
+    if (o.compare) throw UsageError("--device gpu: --compare traces on the CPU only");
+    if (o.view != "heatmap") throw UsageError("--device gpu needs --view heatmap");
+  }
   if (o.compare) {
     if (o.view != "heatmap") throw UsageError("--compare needs --view heatmap");
     CompareJob job{o.scene, o.camera, o.size, o.metric, o.colormap, o.legend, o.max, o.threads, o.out, o.force, {}, {}};
@@ -166,8 +200,7 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
   }
   check_output_path(o.out, o.force);  // before any long work
   if (o.view == "raster") return run_render_raster(o, global);
-  if (o.raster.box_depth >= 0 || o.raster.leaves || !o.ray_pixel.empty() || o.raster.blend > 0.0f ||
-      o.raster.wireframe)
+  if (o.raster.box_depth >= 0 || o.raster.leaves || !o.ray_pixel.empty() || o.raster.blend > 0.0f || o.raster.wireframe)
     throw UsageError("--depth, --depth-last, --leaves, --ray-pixel, --blend and --wireframe need --view raster");
   nlohmann::json figures;
   const RgbImage rgb = render_job(o, global, figures);
@@ -188,8 +221,7 @@ std::string write_unique_demo_png(const RgbImage& rgb) {
   char stamp[32];
   std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &tm);
   for (int k = 0; k < 1000; ++k) {
-    const std::string name =
-        std::string("accelviz-demo-") + stamp + (k == 0 ? "" : "-" + std::to_string(k)) + ".png";
+    const std::string name = std::string("accelviz-demo-") + stamp + (k == 0 ? "" : "-" + std::to_string(k)) + ".png";
     std::error_code ec;
     if (fs::exists(name, ec)) continue;
     try {
@@ -207,8 +239,9 @@ std::string write_unique_demo_png(const RgbImage& rgb) {
 
 Command add_render_command(CLI::App& parent, const GlobalOptions& global) {
   auto o = std::make_shared<RenderOptions>();
-  CLI::App* sub = parent.add_subcommand("render", "Render a per-pixel metric heatmap of a structure to a PNG "
-                                                  "(with a legend bar)");
+  CLI::App* sub = parent.add_subcommand("render",
+                                        "Render a per-pixel metric heatmap of a structure to a PNG "
+                                        "(with a legend bar)");
   sub->add_option("SCENE", o->scene, "Scene file (.gltf, .glb, .obj) or builtin:NAME[?key=value&...]")->required();
   sub->add_option("--out,-o", o->out, "Output PNG file (never overwritten without --force)")->required();
   sub->add_option("--structure,-s", o->structure, "Acceleration structure")
@@ -269,6 +302,11 @@ Command add_render_command(CLI::App& parent, const GlobalOptions& global) {
                   "raster: blend the --metric heatmap over the mesh with this opacity (0: none, 1: full screen)")
       ->check(CLI::Range(0.0f, 1.0f));
   sub->add_flag("--wireframe", o->raster.wireframe, "raster: draw triangle edges over the mesh");
+  sub->add_option("--device", o->device,
+                  "Where the heatmap's rays are traced: cpu (all threads), gpu (an OpenGL 4.5 compute shader "
+                  "through headless OSMesa; --structure bvh only; same counts as the CPU)")
+      ->check(CLI::IsMember({"cpu", "gpu"}))
+      ->capture_default_str();
   o->structure_opts.add_to(sub);
   return {sub, [o, &global] { return run_render(*o, global); }};
 }
