@@ -9,6 +9,7 @@
 #include "core/geometry/triangle.h"
 #include "core/math/aabb.h"
 #include "core/math/ray.h"
+#include "core/util/random.h"
 
 #include <algorithm>
 #include <chrono>
@@ -22,13 +23,8 @@ namespace {
 volatile double g_sink = 0;  // results of the timed loops end here
 
 struct Rng {
-  std::uint64_t s;
-  double next() {
-    std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return static_cast<double>((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
-  }
+  SplitMix64 g;
+  double next() { return g.uniform_double(); }
   glm::vec3 point() { return {float(next()), float(next()), float(next())}; }
 };
 
@@ -67,7 +63,7 @@ double time_tests(const CalibrateOptions& o, double& hit_fraction, Test&& test) 
 Calibration calibrate(const CalibrateOptions& opts) {
   CalibrateOptions o = opts;
   o.items = std::max<std::size_t>(o.items, 1);
-  Rng rng{o.seed};
+  Rng rng{SplitMix64(o.seed)};
   // Rays from points in the unit cube towards other points in it; boxes and
   // triangles of a size that gives a mix of hits and misses (a test that
   // always misses early would flatter the fast path).

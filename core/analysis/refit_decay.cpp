@@ -3,6 +3,7 @@
 
 #include "core/query/batch.h"
 #include "core/util/parallel.h"
+#include "core/util/random.h"
 
 #include <chrono>
 #include <cmath>
@@ -13,11 +14,6 @@ namespace accelviz {
 
 namespace {
 
-std::uint64_t mix(std::uint64_t z) {
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
-}
 
 double unit(std::uint64_t h) { return static_cast<double>(h >> 11) * 0x1.0p-53; }
 
@@ -25,10 +21,10 @@ double unit(std::uint64_t h) { return static_cast<double>(h >> 11) * 0x1.0p-53; 
 glm::vec3 displace(const glm::vec3& p, float amplitude, double time, std::uint64_t seed) {
   std::uint32_t bits[3];
   std::memcpy(bits, &p, sizeof bits);
-  std::uint64_t h = mix(seed ^ 0x9E3779B97F4A7C15ull);
-  for (std::uint32_t b : bits) h = mix(h ^ b);
-  const double z = 2.0 * unit(mix(h + 1)) - 1.0, phi = 6.283185307179586 * unit(mix(h + 2));
-  const double phase = unit(mix(h + 3));
+  std::uint64_t h = mix64(seed ^ kGolden64);
+  for (std::uint32_t b : bits) h = mix64(h ^ b);
+  const double z = 2.0 * unit(mix64(h + 1)) - 1.0, phi = 6.283185307179586 * unit(mix64(h + 2));
+  const double phase = unit(mix64(h + 3));
   const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
   const double s = amplitude * std::sin(6.283185307179586 * (time + phase));
   return p + glm::vec3(static_cast<float>(s * r * std::cos(phi)), static_cast<float>(s * r * std::sin(phi)),

@@ -9,6 +9,7 @@
 #include "core/accel/factory.h"
 #include "core/accel/reference.h"
 #include "core/util/parallel.h"
+#include "core/util/random.h"
 
 namespace accelviz {
 
@@ -30,25 +31,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-struct Rng {
-  std::uint64_t s;
-  std::uint64_t next() {
-    std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  }
-  float uniform() { return static_cast<float>(next() >> 40) * (1.0f / 16777216.0f); }
-  float range(float a, float b) { return a + (b - a) * uniform(); }
-  std::size_t below(std::size_t n) { return static_cast<std::size_t>(next() % n); }
-  glm::vec3 unit() {
-    for (;;) {
-      const glm::vec3 v(range(-1, 1), range(-1, 1), range(-1, 1));
-      const float l = glm::length(v);
-      if (l > 0.05f && l <= 1.0f) return v / l;
-    }
-  }
-};
+using Rng = SplitMix64;  // core/util/random.h
 
 glm::vec3 vertex_of(const Triangle& t, std::size_t i) {
   return i == 0 ? t.v0 : i == 1 ? t.v1 : t.v2;
@@ -179,7 +162,7 @@ std::vector<LabRay> lab_rays(std::span<const Triangle> triangles, std::size_t co
     // Non-degenerate triangles only, a few tries.
     const Triangle* t = &triangles[r.below(triangles.size())];
     for (int k = 0; k < 8 && !(t->area() > 0.0f); ++k) t = &triangles[r.below(triangles.size())];
-    const glm::vec3 outside = centre + r.unit() * radius * r.range(0.6f, 1.5f);
+    const glm::vec3 outside = centre + r.unit_vector() * radius * r.uniform(0.6f, 1.5f);
     glm::vec3 o, d;
     switch (family) {
       case LabFamily::vertex:
@@ -212,7 +195,7 @@ std::vector<LabRay> lab_rays(std::span<const Triangle> triangles, std::size_t co
         const float u = r.uniform(), v = r.uniform() * (1.0f - u);
         const glm::vec3 p = t->v0 + u * (t->v1 - t->v0) + v * (t->v2 - t->v0);
         const glm::vec3 n = triangle_normal(*t);
-        glm::vec3 in_plane = glm::cross(n, r.unit());
+        glm::vec3 in_plane = glm::cross(n, r.unit_vector());
         if (!(glm::length(in_plane) > 0.0f)) in_plane = t->v1 - t->v0;
         in_plane = glm::normalize(in_plane);
         o = p - in_plane * radius;

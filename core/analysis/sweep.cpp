@@ -3,6 +3,7 @@
 
 #include "core/query/batch.h"
 #include "core/util/parallel.h"
+#include "core/util/random.h"
 
 #include <algorithm>
 #include <array>
@@ -60,14 +61,6 @@ std::string joined(const std::vector<std::string>& v) {
   return s;
 }
 
-std::uint64_t splitmix64(std::uint64_t& state) {
-  std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
-}
-
-double unit(std::uint64_t& state) { return static_cast<double>(splitmix64(state) >> 11) * 0x1.0p-53; }
 
 }  // namespace
 
@@ -229,7 +222,7 @@ std::vector<EdgeProbe> shared_edge_probes(std::span<const Triangle> triangles, s
   const std::size_t n = std::min(max_probes, shared.size());
   std::vector<EdgeProbe> out;
   out.reserve(n);
-  std::uint64_t state = seed;
+  SplitMix64 rng(seed);
   for (std::size_t k = 0; k < n; ++k) {
     const auto& [e, tris] = shared[k * shared.size() / n];
     const glm::vec3 a(e[0], e[1], e[2]), b(e[3], e[4], e[5]);
@@ -249,7 +242,7 @@ std::vector<EdgeProbe> shared_edge_probes(std::span<const Triangle> triangles, s
     glm::vec3 dir(0.0f);
     bool found = false;
     for (int attempt = 0; attempt < 32 && !found; ++attempt) {
-      const double z = 2.0 * unit(state) - 1.0, phi = 6.283185307179586 * unit(state);
+      const double z = 2.0 * rng.uniform_double() - 1.0, phi = 6.283185307179586 * rng.uniform_double();
       const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
       dir = glm::vec3(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
                       static_cast<float>(z));

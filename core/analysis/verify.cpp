@@ -2,6 +2,7 @@
 
 #include "core/query/camera.h"
 #include "core/util/parallel.h"
+#include "core/util/random.h"
 
 #include <algorithm>
 #include <chrono>
@@ -68,30 +69,13 @@ std::vector<VerifyStructure> parse_verify_structures(const std::string& list, un
 
 namespace {
 
-// splitmix64: one independent stream per ray index, so the rays do not
-// depend on the order they are generated in.
-struct Rng {
-  std::uint64_t s;
-  std::uint64_t next_u64() {
-    std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  }
-  double uniform() { return static_cast<double>(next_u64() >> 11) * (1.0 / 9007199254740992.0); }
-  float range(float a, float b) { return a + (b - a) * static_cast<float>(uniform()); }
-  std::size_t below(std::size_t n) { return static_cast<std::size_t>(next_u64() % n); }
-  glm::vec3 in_box(const glm::vec3& lo, const glm::vec3& hi) {
-    return {range(lo.x, hi.x), range(lo.y, hi.y), range(lo.z, hi.z)};
-  }
-  glm::vec3 unit() {
-    for (;;) {
-      const glm::vec3 v(range(-1, 1), range(-1, 1), range(-1, 1));
-      const float l = glm::length(v);
-      if (l > 0.05f && l <= 1.0f) return v / l;
-    }
-  }
-};
+// One independent stream per ray index, so the rays do not depend on the
+// order they are generated in.
+using Rng = SplitMix64;  // core/util/random.h
+
+glm::vec3 in_box(Rng& r, const glm::vec3& lo, const glm::vec3& hi) {
+  return {r.uniform(lo.x, hi.x), r.uniform(lo.y, hi.y), r.uniform(lo.z, hi.z)};  // braces: x, y, z in order
+}
 
 Aabb scene_bounds(std::span<const Triangle> tris) {
   Aabb b;
@@ -113,7 +97,7 @@ std::vector<Ray> verify_rays(std::span<const Triangle> triangles, std::size_t co
   const Camera cam = frame_bounds(b, 1.0f);
   const bool have_tris = !triangles.empty();
 
-  auto outside_point = [&](Rng& r) { return centre + r.unit() * (radius * r.range(0.6f, 1.5f)); };
+  auto outside_point = [&](Rng& r) { return centre + r.unit_vector() * (radius * r.uniform(0.6f, 1.5f)); };
   auto vertex = [&](const Triangle& t, std::size_t i) { return i == 0 ? t.v0 : i == 1 ? t.v1 : t.v2; };
 
   for (std::size_t i = 0; i < count; ++i) {
@@ -124,11 +108,11 @@ std::vector<Ray> verify_rays(std::span<const Triangle> triangles, std::size_t co
       // Random: half from inside/around the bounds in any direction, half
       // from outside aimed into the bounds.
       if (r.uniform() < 0.5) {
-        o = r.in_box(wide_lo, wide_hi);
-        d = r.unit();
+        o = in_box(r, wide_lo, wide_hi);
+        d = r.unit_vector();
       } else {
         o = outside_point(r);
-        d = r.in_box(b.lo, b.hi) - o;
+        d = in_box(r, b.lo, b.hi) - o;
       }
     } else if (kind < 0.85) {
       const Triangle& t = triangles[r.below(triangles.size())];
@@ -142,13 +126,13 @@ std::vector<Ray> verify_rays(std::span<const Triangle> triangles, std::size_t co
         const std::size_t e = r.below(3);
         const glm::vec3 a = vertex(t, e), c = vertex(t, (e + 1) % 3);
         const float s = r.uniform() < 0.2 ? 0.5f : static_cast<float>(r.uniform());
-        o = r.uniform() < 0.5 ? outside_point(r) : r.in_box(wide_lo, wide_hi);
+        o = r.uniform() < 0.5 ? outside_point(r) : in_box(r, wide_lo, wide_hi);
         d = (a + s * (c - a)) - o;
       } else if (sub < 0.65) {
         // Axis-aligned through a vertex or a random point, with +0/-0 in the
         // other components (1/±0 = ±inf in the slab tests).
         const int axis = static_cast<int>(r.below(3));
-        const glm::vec3 target = r.uniform() < 0.5 ? vertex(t, r.below(3)) : r.in_box(b.lo, b.hi);
+        const glm::vec3 target = r.uniform() < 0.5 ? vertex(t, r.below(3)) : in_box(r, b.lo, b.hi);
         const float sign = r.uniform() < 0.5 ? 1.0f : -1.0f;
         d = glm::vec3(r.uniform() < 0.5 ? 0.0f : -0.0f, r.uniform() < 0.5 ? 0.0f : -0.0f,
                       r.uniform() < 0.5 ? 0.0f : -0.0f);
@@ -159,17 +143,17 @@ std::vector<Ray> verify_rays(std::span<const Triangle> triangles, std::size_t co
         // Grazing: in the triangle's plane, through a point inside it.
         const float u = static_cast<float>(r.uniform()), v = static_cast<float>(r.uniform()) * (1.0f - u);
         const glm::vec3 p = t.v0 + u * (t.v1 - t.v0) + v * (t.v2 - t.v0);
-        const float w = r.range(-1.0f, 1.0f);
+        const float w = r.uniform(-1.0f, 1.0f);
         d = (t.v1 - t.v0) + w * (t.v2 - t.v0);
-        o = p - d * r.range(0.5f, 4.0f);
+        o = p - d * r.uniform(0.5f, 4.0f);
       } else {
         // Origin on a face or mid-plane of the bounds (root splits, cell and
         // node boundaries), direction random or axis-aligned along that plane.
-        o = r.in_box(b.lo, b.hi);
+        o = in_box(r, b.lo, b.hi);
         const int axis = static_cast<int>(r.below(3));
         const int which = static_cast<int>(r.below(3));
         o[axis] = which == 0 ? b.lo[axis] : which == 1 ? b.hi[axis] : centre[axis];
-        d = r.unit();
+        d = r.unit_vector();
         if (r.uniform() < 0.3) d[axis] = 0.0f;  // in the plane
       }
     } else {

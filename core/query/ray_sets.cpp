@@ -2,6 +2,7 @@
 
 #include "core/geometry/shapes.h"
 #include "core/query/camera.h"
+#include "core/util/random.h"
 
 #include <cmath>
 
@@ -11,19 +12,13 @@ namespace {
 
 constexpr float kTwoPi = 6.28318530717959f;
 
-/// SplitMix64 (Steele, Lea, Flood 2014) as a counter-based hash: ray i's
-/// numbers come from hashing (seed, i, k), so the result never depends on
-/// which thread traced what or in what order.
-std::uint64_t splitmix64(std::uint64_t x) {
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
+/// hash64 (core/util/random.h) as a counter-based hash: ray i's numbers come
+/// from hashing (seed, i, k), so the result never depends on which thread
+/// traced what or in what order.
 
 /// Uniform float in [0, 1) from the top 24 bits.
 float uniform01(std::uint64_t seed, std::uint64_t index, std::uint64_t k) {
-  const std::uint64_t h = splitmix64(splitmix64(seed ^ splitmix64(index)) + k);
+  const std::uint64_t h = hash64(hash64(seed ^ hash64(index)) + k);
   return static_cast<float>(h >> 40) * (1.0f / 16777216.0f);
 }
 

@@ -35,6 +35,7 @@
 #include "core/accel/voxels/dense_voxels.h"
 #include "core/geometry/shapes.h"
 #include "core/util/parallel.h"
+#include "core/util/random.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_robustness_catalogue {
@@ -45,24 +46,7 @@ namespace {
 
 // ---------------------------------------------------------------- scenes
 
-struct Rng {
-  std::uint64_t s;
-  std::uint64_t next() {
-    std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  }
-  float uniform() { return static_cast<float>(next() >> 40) * (1.0f / 16777216.0f); }
-  float range(float a, float b) { return a + (b - a) * uniform(); }
-  glm::vec3 unit() {
-    for (;;) {
-      const glm::vec3 v(range(-1, 1), range(-1, 1), range(-1, 1));
-      const float l = glm::length(v);
-      if (l > 0.05f && l <= 1.0f) return v / l;
-    }
-  }
-};
+using Rng = SplitMix64;  // core/util/random.h
 
 // A closed convex mesh: an icosahedron subdivided `levels` times, vertices on
 // the sphere of `radius` around `centre`, computed once per vertex so shared
@@ -141,8 +125,8 @@ std::vector<Triangle> cubes_and_soup() {
       }
   Rng r{7};
   for (int i = 0; i < 120; ++i) {
-    const glm::vec3 p(r.range(-1, 6), r.range(-1, 6), r.range(-1, 6));
-    out.push_back({p, p + 0.7f * r.unit(), p + 0.7f * r.unit()});
+    const glm::vec3 p(r.uniform(-1, 6), r.uniform(-1, 6), r.uniform(-1, 6));
+    out.push_back({p, p + 0.7f * r.unit_vector(), p + 0.7f * r.unit_vector()});
   }
   return out;
 }
@@ -290,7 +274,7 @@ std::vector<Ray> rays_at_vertices_and_edges(std::span<const Triangle> tris, glm:
 std::vector<Ray> random_rays_from(glm::vec3 o, int n, std::uint64_t seed) {
   Rng r{seed};
   std::vector<Ray> rays;
-  for (int i = 0; i < n; ++i) rays.emplace_back(o, r.unit());
+  for (int i = 0; i < n; ++i) rays.emplace_back(o, r.unit_vector());
   return rays;
 }
 
@@ -478,7 +462,7 @@ TEST_P(Catalogue, PlusAndMinusZeroDirectionComponents) {
     d[axis] = sign;
     for (int k = 0; k < 3; ++k)
       if (k != axis) d[k] = (r.next() & 1) ? -0.0f : 0.0f;
-    glm::vec3 o(r.range(b.lo.x, b.hi.x), r.range(b.lo.y, b.hi.y), r.range(b.lo.z, b.hi.z));
+    glm::vec3 o(r.uniform(b.lo.x, b.hi.x), r.uniform(b.lo.y, b.hi.y), r.uniform(b.lo.z, b.hi.z));
     // Half the rays exactly on a cube coordinate (0,1,2,...) in the other axes.
     if (i % 2 == 0)
       for (int k = 0; k < 3; ++k)
@@ -486,7 +470,7 @@ TEST_P(Catalogue, PlusAndMinusZeroDirectionComponents) {
     o[axis] = sign > 0 ? b.lo[axis] - 1.0f : b.hi[axis] + 1.0f;
     rays.emplace_back(o, d);
     // One component ±0, the others not: diagonal rays in axis planes.
-    glm::vec3 d2 = r.unit();
+    glm::vec3 d2 = r.unit_vector();
     rays.emplace_back(o, zero_signed(d2, (axis + 1) % 3, r.next() & 1));
   }
   check(tris, rays, false);
@@ -500,9 +484,9 @@ TEST_P(Catalogue, RaysParallelToAndLyingInSlabAndSplitPlanes) {
   std::vector<Ray> rays;
   for (const auto& [axis, v] : structure_planes(*accel, tris)) {
     for (int k = 0; k < 3; ++k) {
-      glm::vec3 o(r.range(b.lo.x - 1, b.hi.x + 1), r.range(b.lo.y - 1, b.hi.y + 1), r.range(b.lo.z - 1, b.hi.z + 1));
+      glm::vec3 o(r.uniform(b.lo.x - 1, b.hi.x + 1), r.uniform(b.lo.y - 1, b.hi.y + 1), r.uniform(b.lo.z - 1, b.hi.z + 1));
       o[axis] = k == 0 ? v : k == 1 ? std::nextafter(v, kInfinity) : std::nextafter(v, -kInfinity);
-      const glm::vec3 d = zero_signed(r.unit(), axis, r.next() & 1);  // in (or parallel to) the plane
+      const glm::vec3 d = zero_signed(r.unit_vector(), axis, r.next() & 1);  // in (or parallel to) the plane
       rays.emplace_back(o, d);
     }
     // In the plane, aimed at the scene centre's projection: crosses the scene.
@@ -525,10 +509,10 @@ TEST_P(Catalogue, OriginExactlyOnBoxFace) {
   const Aabb b = bounds_of(tris);
   for (int i = 0; i < 400; ++i) {
     const int axis = static_cast<int>(r.next() % 3);
-    glm::vec3 o(r.range(b.lo.x, b.hi.x), r.range(b.lo.y, b.hi.y), r.range(b.lo.z, b.hi.z));
+    glm::vec3 o(r.uniform(b.lo.x, b.hi.x), r.uniform(b.lo.y, b.hi.y), r.uniform(b.lo.z, b.hi.z));
     const int cube = static_cast<int>(r.next() % 3);
     o[axis] = i % 4 == 0 ? (r.next() & 1 ? b.lo[axis] : b.hi[axis]) : 2.0f * static_cast<float>(cube) + (r.next() & 1);
-    glm::vec3 d = r.unit();
+    glm::vec3 d = r.unit_vector();
     if (i % 3 == 0) d = zero_signed(d, axis, r.next() & 1);
     rays.emplace_back(o, d);
   }
@@ -545,7 +529,7 @@ TEST_P(Catalogue, TSplitEqualToTminOrTmax) {
   Rng r{24};
   std::vector<Ray> rays;
   for (const auto& [axis, v] : structure_planes(*accel, tris)) {
-    glm::vec3 o(r.range(b.lo.x, b.hi.x), r.range(b.lo.y, b.hi.y), r.range(b.lo.z, b.hi.z));
+    glm::vec3 o(r.uniform(b.lo.x, b.hi.x), r.uniform(b.lo.y, b.hi.y), r.uniform(b.lo.z, b.hi.z));
     if (r.next() & 1)
       for (int k = 0; k < 3; ++k)
         if (k != axis) o[k] = std::round(o[k]);
@@ -557,7 +541,7 @@ TEST_P(Catalogue, TSplitEqualToTminOrTmax) {
       rays.emplace_back(o, d, 0.0f, t_plane);       // t_split == tmax
       rays.emplace_back(o, d, t_plane, kInfinity);  // t_split == tmin
       rays.emplace_back(o, d, t_plane, t_plane);    // both
-      glm::vec3 dd = r.unit();
+      glm::vec3 dd = r.unit_vector();
       dd[axis] = sign * std::fabs(dd[axis]) + sign * 0.1f;
       rays.emplace_back(o, dd, 0.0f, (v - o[axis]) / dd[axis]);
     }
@@ -614,18 +598,18 @@ TEST_P(Catalogue, RaysStartingInsideALeafOrCell) {
   Rng r{26};
   std::vector<Ray> rays;
   for (int i = 0; i < 300; ++i)
-    rays.emplace_back(glm::vec3(r.range(b.lo.x, b.hi.x), r.range(b.lo.y, b.hi.y), r.range(b.lo.z, b.hi.z)), r.unit());
+    rays.emplace_back(glm::vec3(r.uniform(b.lo.x, b.hi.x), r.uniform(b.lo.y, b.hi.y), r.uniform(b.lo.z, b.hi.z)), r.unit_vector());
   for (int i = 0; i < 60; ++i) {
     const Triangle& t = tris[r.next() % tris.size()];
     const float u = r.uniform() * 0.5f, v = r.uniform() * 0.5f;
-    rays.emplace_back(t.v0 + u * (t.v1 - t.v0) + v * (t.v2 - t.v0), r.unit());
+    rays.emplace_back(t.v0 + u * (t.v1 - t.v0) + v * (t.v2 - t.v0), r.unit_vector());
   }
   check(tris, rays, false);
   std::vector<Ray> inside;
   for (int i = 0; i < 200; ++i) {
     const glm::vec3 cube(2.0f * static_cast<float>(r.next() % 3), 2.0f * static_cast<float>(r.next() % 3),
                          2.0f * static_cast<float>(r.next() % 3));
-    inside.emplace_back(cube + glm::vec3(r.range(0.1f, 0.9f), r.range(0.1f, 0.9f), r.range(0.1f, 0.9f)), r.unit());
+    inside.emplace_back(cube + glm::vec3(r.uniform(0.1f, 0.9f), r.uniform(0.1f, 0.9f), r.uniform(0.1f, 0.9f)), r.unit_vector());
   }
   check(tris, inside, true);
 }
@@ -636,8 +620,8 @@ TEST_P(Catalogue, InfiniteAndHugeTmax) {
   Rng r{27};
   std::vector<Ray> rays;
   for (int i = 0; i < 200; ++i) {
-    const glm::vec3 o = b.center() + r.unit() * 20.0f;
-    const glm::vec3 target(r.range(b.lo.x, b.hi.x), r.range(b.lo.y, b.hi.y), r.range(b.lo.z, b.hi.z));
+    const glm::vec3 o = b.center() + r.unit_vector() * 20.0f;
+    const glm::vec3 target(r.uniform(b.lo.x, b.hi.x), r.uniform(b.lo.y, b.hi.y), r.uniform(b.lo.z, b.hi.z));
     const float tmax = i % 3 == 0 ? kInfinity : i % 3 == 1 ? std::numeric_limits<float>::max() : kRayFileUnbounded;
     rays.emplace_back(o, target - o, 0.0f, tmax);
     rays.emplace_back(o, (target - o) * 1e-3f, 1.0f, tmax);  // short direction: large t
@@ -652,7 +636,7 @@ TEST_P(Catalogue, BuilderAllCentroidsEqual) {
   std::vector<Triangle> tris;
   const glm::vec3 c(1.0f, 2.0f, 3.0f);
   for (int i = 0; i < 300; ++i) {
-    const glm::vec3 a = r.unit() * r.range(0.1f, 2.0f), b = r.unit() * r.range(0.1f, 2.0f);
+    const glm::vec3 a = r.unit_vector() * r.uniform(0.1f, 2.0f), b = r.unit_vector() * r.uniform(0.1f, 2.0f);
     tris.push_back({c + a, c + b, c - a - b});  // centroid c up to rounding
   }
   const auto rays = random_rays_from(c, 300, 32);
@@ -687,12 +671,12 @@ TEST_P(Catalogue, BuilderFlatAxisAlignedWall) {
   Rng r{36};
   std::vector<Ray> hits, other;
   for (int i = 0; i < 300; ++i) {
-    const glm::vec3 p(r.range(0.0f, 20.0f), r.range(0.0f, 20.0f), 3.0f);
+    const glm::vec3 p(r.uniform(0.0f, 20.0f), r.uniform(0.0f, 20.0f), 3.0f);
     const glm::vec3 v(static_cast<float>(r.next() % 21), static_cast<float>(r.next() % 21), 3.0f);
     const float side = (i & 1) ? 1.0f : -1.0f;
     hits.emplace_back(p + glm::vec3(0, 0, side * 2.0f), glm::vec3(0, (i & 2) ? 0.0f : -0.0f, -side));
     hits.emplace_back(v + glm::vec3(0.3f, -0.2f, side * 2.0f), glm::vec3(-0.3f, 0.2f, -side * 2.0f));  // at a vertex
-    other.emplace_back(glm::vec3(p.x, p.y, 3.0f), zero_signed(r.unit(), 2, i & 1));                    // in the wall
+    other.emplace_back(glm::vec3(p.x, p.y, 3.0f), zero_signed(r.unit_vector(), 2, i & 1));                    // in the wall
   }
   check(tris, hits, true);
   check(tris, other, false);
@@ -718,7 +702,7 @@ TEST_P(Catalogue, BuilderIdenticalDuplicatedTriangles) {
   for (int i = 0; i < 200; ++i) {
     const float u = r.uniform() * 0.5f, v = r.uniform() * 0.5f;
     rays.emplace_back(glm::vec3(u, v, (i & 1) ? 2.0f : -2.0f), glm::vec3(0, 0, (i & 1) ? -1.0f : 1.0f));
-    rays.emplace_back(glm::vec3(2.2f, 2.2f, 5.0f) + r.unit() * 0.01f, glm::vec3(0.0f, 0.0f, -1.0f));
+    rays.emplace_back(glm::vec3(2.2f, 2.2f, 5.0f) + r.unit_vector() * 0.01f, glm::vec3(0.0f, 0.0f, -1.0f));
   }
   check(tris, rays, true);
 }
@@ -729,9 +713,9 @@ TEST_P(Catalogue, BuilderOnePrimitive) {
   std::vector<Ray> rays, misses;
   for (int i = 0; i < 100; ++i) {
     const float u = r.uniform() * 0.5f, v = r.uniform() * 0.5f;
-    rays.emplace_back(glm::vec3(u, v, 0.0f) + r.unit() * 3.0f, glm::vec3(0.0f));
+    rays.emplace_back(glm::vec3(u, v, 0.0f) + r.unit_vector() * 3.0f, glm::vec3(0.0f));
     rays.back() = Ray(rays.back().origin, glm::vec3(u, v, 0.0f) - rays.back().origin);
-    misses.emplace_back(glm::vec3(2.0f + u, v, 1.0f), r.unit());
+    misses.emplace_back(glm::vec3(2.0f + u, v, 1.0f), r.unit_vector());
   }
   check(tris, rays, true);
   check(tris, misses, false);
@@ -763,8 +747,8 @@ void shadow_rays(const Structure& s, glm::vec3 centre, float scale, float gap, i
   Rng r{41};
   const QueryOptions q;
   for (int i = 0; i < 400; ++i) {
-    const glm::vec3 target = centre + glm::vec3(r.range(-0.45f, 0.45f) * scale, r.range(-0.45f, 0.45f) * scale, 0.0f);
-    const glm::vec3 eye = centre + glm::vec3(r.range(-1, 1), r.range(-1, 1), 1.0f) * scale;
+    const glm::vec3 target = centre + glm::vec3(r.uniform(-0.45f, 0.45f) * scale, r.uniform(-0.45f, 0.45f) * scale, 0.0f);
+    const glm::vec3 eye = centre + glm::vec3(r.uniform(-1, 1), r.uniform(-1, 1), 1.0f) * scale;
     const Ray primary(eye, target - eye);
     const Hit h = accel->closest_hit(primary, q);
     if (s.factory == "voxels") {
@@ -780,7 +764,7 @@ void shadow_rays(const Structure& s, glm::vec3 centre, float scale, float gap, i
     glm::vec3 nrm = triangle_normal(tris[h.prim]);
     if (glm::dot(nrm, primary.direction) > 0.0f) nrm = -nrm;  // the side the primary came from
     // Towards a light above: nothing there, own triangle excluded.
-    const glm::vec3 light = centre + glm::vec3(r.range(-1, 1), r.range(-1, 1), 2.0f) * scale;
+    const glm::vec3 light = centre + glm::vec3(r.uniform(-1, 1), r.uniform(-1, 1), 2.0f) * scale;
     const glm::vec3 o_up = offset_ray_origin(p, nrm);
     const Ray up(o_up, light - o_up, 0.0f, 1.0f);
     const Hit hu = accel->closest_hit(up, q);
@@ -791,7 +775,7 @@ void shadow_rays(const Structure& s, glm::vec3 centre, float scale, float gap, i
     }
     // Into the slab: must hit the bottom layer, not the own triangle.
     const glm::vec3 o_down = offset_ray_origin(p, -nrm);
-    const glm::vec3 dir = glm::normalize(glm::vec3(r.range(-0.3f, 0.3f), r.range(-0.3f, 0.3f), -1.0f));
+    const glm::vec3 dir = glm::normalize(glm::vec3(r.uniform(-0.3f, 0.3f), r.uniform(-0.3f, 0.3f), -1.0f));
     const Ray down(o_down, dir);
     const Hit hd = accel->closest_hit(down, q);
     if (!hd.valid() || hd.prim < static_cast<std::uint32_t>(n * n * 2)) {
@@ -872,8 +856,8 @@ TEST(CatalogueBuilders, TenMillionPrimitivesBvh) {
   Rng r{51};
   std::vector<Ray> rays;
   for (int i = 0; i < 6; ++i) {
-    const glm::vec3 target(r.range(0, nx), r.range(0, ny), r.range(0, 10));
-    const glm::vec3 o = target + r.unit() * 50.0f + glm::vec3(0, 0, 30);
+    const glm::vec3 target(r.uniform(0, nx), r.uniform(0, ny), r.uniform(0, 10));
+    const glm::vec3 o = target + r.unit_vector() * 50.0f + glm::vec3(0, 0, 30);
     rays.emplace_back(o, target - o);
   }
   // Vertex-exact rays: straight down through a lattice vertex.

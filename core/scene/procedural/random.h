@@ -12,6 +12,8 @@
 // trigonometry below uses only +, -, *, / and sqrt, which IEEE 754 rounds
 // exactly. (Contracting a*b+c into an FMA would still change the last bit;
 // x86-64 builds without -mfma never do it.)
+#include "core/util/random.h"
+
 #include <glm/glm.hpp>
 
 #include <cmath>
@@ -19,56 +21,10 @@
 
 namespace accelviz::procedural {
 
-/// SplitMix64: one 64-bit state, a Weyl sequence scrambled by a bijective mix.
-class SplitMix64 {
- public:
-  explicit SplitMix64(std::uint64_t seed) : state_(seed) {}
-
-  std::uint64_t next() {
-    std::uint64_t z = (state_ += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  }
-  /// Uniform in [0, 1): the top 24 bits, so every value is an exact float.
-  float uniform() { return static_cast<float>(next() >> 40) * 0x1.0p-24f; }
-  /// Uniform in [lo, hi).
-  float uniform(float lo, float hi) { return lo + (hi - lo) * uniform(); }
-  /// Two or three draws in [lo, hi), taken in the order x, y, z. Never write
-  /// glm::vec3(rng.uniform(), rng.uniform(), ...): C++ leaves the order in
-  /// which function arguments are evaluated unspecified (GCC goes right to
-  /// left, Clang left to right), and the scene would differ between them.
-  glm::vec2 uniform2(float lo, float hi) {
-    const float x = uniform(lo, hi);
-    const float y = uniform(lo, hi);
-    return {x, y};
-  }
-  glm::vec3 uniform3(float lo, float hi) {
-    const float x = uniform(lo, hi);
-    const float y = uniform(lo, hi);
-    const float z = uniform(lo, hi);
-    return {x, y, z};
-  }
-  /// Uniform in [0, 1) with 53 bits.
-  double uniform_double() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
-  /// Uniform integer in [0, n) (n > 0), by Lemire's multiply-shift; the bias
-  /// (below n / 2^64) is irrelevant for scene layout.
-  std::uint64_t below(std::uint64_t n) {
-    return static_cast<std::uint64_t>((static_cast<unsigned __int128>(next()) * n) >> 64);
-  }
-
- private:
-  std::uint64_t state_;
-};
-
-/// Stateless hash of a 64-bit key (the SplitMix64 finaliser): used where a
-/// value must depend on a position rather than on draw order (value noise).
-inline std::uint64_t hash64(std::uint64_t x) {
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
+// SplitMix64 and hash64 live in core/util/random.h (shared with the ray
+// sets, the sweeps, the verification and the robustness lab).
+using accelviz::hash64;
+using accelviz::SplitMix64;
 
 inline constexpr double kPi = 3.141592653589793238462643383279502884;
 
