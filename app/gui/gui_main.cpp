@@ -5,6 +5,7 @@
 // mouse and keyboard.
 #include "app/gui/gui.h"
 
+#include "app/gui/gpu_heatmap.h"
 #include "app/gui/insight_views.h"
 #include "app/gui/scene_view.h"
 #include "core/scene/load.h"
@@ -97,6 +98,7 @@ class Gui final : public ScriptHost {
   std::unique_ptr<GlfwContext> window_;
   std::unique_ptr<ImGuiContextGuard> imgui_;
   std::unique_ptr<SceneView> view_;
+  std::unique_ptr<GpuHeatmap> gpu_heatmap_;  ///< View panel "Trace on: GPU" (window's context)
   std::optional<ScriptRunner> script_;
   SweepWorker sweeps_;  ///< the Cost of accuracy panel's sweeps
   panels::AccuracyPanelState accuracy_;
@@ -152,6 +154,10 @@ Gui::Gui(const GuiOptions& options, AppSettings settings, std::optional<ScriptRu
       window_->window(),
       options_.use_settings ? std::optional<std::filesystem::path>(imgui_ini_file(config_dir_)) : std::nullopt);
   view_ = std::make_unique<SceneView>();
+  gpu_heatmap_ = std::make_unique<GpuHeatmap>();
+  // Called from app_.update() on this thread, with the window's context current.
+  app_.set_gpu_heatmap_tracer(
+      [this](const HeatmapRequest& r, std::uint64_t id) { return gpu_heatmap_->trace(r, id); });
   if (!settings_error.empty()) app_.set_error(settings_error);
 }
 
@@ -298,6 +304,8 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
   const glm::vec2 range = view_->heatmap_range(app_);
   vi.range_min = range.x;
   vi.range_max = range.y;
+  vi.heatmap_on_gpu = app_.heatmap_on_gpu();
+  vi.gpu_note = app_.gpu_heatmap_note();
   panels::view_panel(app_.config().view, vi, layout);
 
   const auto& insp = app_.inspection();

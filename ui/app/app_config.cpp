@@ -283,6 +283,9 @@ const std::vector<Entry>& entries() {
                                          {"shaded", HeatMetric::shaded},
                                          {"depth", HeatMetric::depth}},
                                         [](AppConfig& c) -> HeatMetric& { return c.view.metric; }));
+    t.push_back(bool_option("heatmap-gpu",
+                            "trace the heatmap on the GPU (compute shader, BVH only; otherwise on the CPU)",
+                            [](AppConfig& c) -> bool& { return c.view.heatmap_gpu; }));
     t.push_back(enum_option<ColorMap>(
         "colormap", "viridis|inferno|turbo", "heatmap colour map",
         {{"viridis", ColorMap::viridis}, {"inferno", ColorMap::inferno}, {"turbo", ColorMap::turbo}},

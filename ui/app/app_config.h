@@ -46,6 +46,7 @@ struct ViewSettings {
 
   HeatmapDisplay heatmap = HeatmapDisplay::off;
   HeatMetric metric = HeatMetric::nodes;
+  bool heatmap_gpu = false;  ///< trace the heatmap on the GPU (compute shader; BVH only, else the CPU worker)
   ColorMap colormap = ColorMap::viridis;
   float opacity = 0.6f;    ///< blend: heatmap alpha over the mesh
   bool auto_scale = true;  ///< [0, image max]; else [scale_min, scale_max]

@@ -80,6 +80,7 @@ AppState::HeatmapKey AppState::heatmap_key(int w, int h) const {
   // The cost metric weighs with the BVH's C_trav/C_isect, as `render --ctrav/--cisect` does.
   k.c_trav = config().structure.options.bvh.cost_traversal;
   k.c_isect = config().structure.options.bvh.cost_intersect;
+  k.gpu = config().view.heatmap_gpu;
   return k;
 }
 
@@ -153,7 +154,25 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
       r.c_trav = key.c_trav;
       r.c_isect = key.c_isect;
       r.threads = settings_.config.structure.options.threads;
-      heatmaps_.request(std::move(r));
+      heatmap_on_gpu_ = false;
+      gpu_note_.clear();
+      if (key.gpu) {
+        if (!gpu_tracer_)
+          gpu_note_ = "no GPU tracer in this session";
+        else if (current_->choice.name != "bvh")
+          gpu_note_ = "only the bvh structure is traced on the GPU";
+        else {
+          try {
+            heatmaps_.cancel();
+            heatmap_ = gpu_tracer_(r, ++gpu_frame_id_);
+            heatmap_on_gpu_ = true;
+            u.heatmap_changed = true;
+          } catch (const std::exception& e) {
+            gpu_note_ = e.what();
+          }
+        }
+      }
+      if (!heatmap_on_gpu_) heatmaps_.request(std::move(r));
       heatmap_requested_ = key;
     }
     // Query options changed: the inspected ray is re-cast with them.
@@ -161,7 +180,7 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
     if (inspection_ && (q.triangle_test != inspected_query_.triangle_test || q.ordered != inspected_query_.ordered))
       recast();
   }
-  if (auto latest = heatmaps_.latest(); latest != heatmap_) {
+  if (auto latest = heatmaps_.latest(); !heatmap_on_gpu_ && latest != heatmap_) {
     heatmap_ = std::move(latest);
     u.heatmap_changed = true;
   }
@@ -176,7 +195,7 @@ bool AppState::settled() const {
     return false;
   if (!current_ || view_w_ <= 0 || view_h_ <= 0) return true;
   if (!heatmap_requested_ || !(*heatmap_requested_ == heatmap_key(view_w_, view_h_))) return false;
-  return heatmap_ && heatmap_->id == heatmaps_.latest_request() && heatmap_->complete;
+  return heatmap_ && (heatmap_on_gpu_ || heatmap_->id == heatmaps_.latest_request()) && heatmap_->complete;
 }
 
 void AppState::reset_camera() {
@@ -288,7 +307,9 @@ nlohmann::json AppState::stats_json() const {
                  {"mean_value", s.mean_value},
                  {"max_value", s.max_value},
                  {"render_ms", s.render_ms},
-                 {"rays_per_s", s.rays_per_s}};
+                 {"rays_per_s", s.rays_per_s},
+                 {"device", heatmap_on_gpu_ ? "gpu" : "cpu"},
+                 {"gpu_note", gpu_note_}};
   }
   return j;
 }

@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -63,6 +64,18 @@ class AppState {
   const std::shared_ptr<const HeatmapFrame>& heatmap() const { return heatmap_; }
   BuildWorker::Status build_status() const { return builds_.status(); }
   bool heatmap_busy() const { return heatmaps_.busy(); }
+
+  /// Traces a heatmap request on the GPU, synchronously, returning the whole
+  /// frame (the GUI installs one over its GL context: app/gui/gpu_heatmap.h).
+  /// It throws to report why it cannot.
+  using GpuHeatmapTracer = std::function<std::shared_ptr<const HeatmapFrame>(const HeatmapRequest&, std::uint64_t)>;
+  /// With a tracer set and the View's heatmap-gpu on, the heatmap of a BVH
+  /// view is traced by it instead of the CPU worker.
+  void set_gpu_heatmap_tracer(GpuHeatmapTracer tracer) { gpu_tracer_ = std::move(tracer); }
+  /// Why heatmap-gpu is on but the CPU traced the heatmap ("" otherwise).
+  const std::string& gpu_heatmap_note() const { return gpu_note_; }
+  /// The heatmap shown was traced on the GPU.
+  bool heatmap_on_gpu() const { return heatmap_on_gpu_; }
   /// No build queued or running and the heatmap of the current view
   /// complete (what the script's `wait` waits for).
   bool settled() const;
@@ -120,6 +133,7 @@ class AppState {
     TriangleTest test = TriangleTest::watertight;
     bool ordered = true;
     float c_trav = 1.0f, c_isect = 1.0f;
+    bool gpu = false;  ///< heatmap-gpu
     bool operator==(const HeatmapKey&) const = default;
   };
   HeatmapKey heatmap_key(int w, int h) const;
@@ -140,6 +154,10 @@ class AppState {
   std::shared_ptr<const BuiltStructure> current_;
   std::shared_ptr<const HeatmapFrame> heatmap_;
   std::optional<HeatmapKey> heatmap_requested_;
+  GpuHeatmapTracer gpu_tracer_;
+  std::string gpu_note_;
+  bool heatmap_on_gpu_ = false;
+  std::uint64_t gpu_frame_id_ = 0;
 
   ViewCamera camera_;
   int view_w_ = 0, view_h_ = 0;

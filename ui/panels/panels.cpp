@@ -389,6 +389,15 @@ bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout
     v.metric = static_cast<HeatMetric>(metric);
     changed = true;
   }
+  int device = v.heatmap_gpu ? 1 : 0;
+  if (combo("Trace on", device, {"CPU", "GPU"})) {
+    v.heatmap_gpu = device == 1;
+    changed = true;
+  }
+  if (v.heatmap_gpu && !info.gpu_note.empty())
+    ImGui::TextDisabled("GPU unavailable (%s): traced on the CPU", info.gpu_note.c_str());
+  else if (v.heatmap_gpu && info.heatmap_on_gpu)
+    ImGui::TextDisabled("compute shader: primary rays, same counts as the CPU");
   int map = static_cast<int>(v.colormap);
   if (combo("Colour map", map, {"viridis", "inferno", "turbo"})) {
     v.colormap = static_cast<ColorMap>(map);

@@ -64,6 +64,8 @@ struct ViewInfo {
   std::uint64_t boxes_drawn = 0;
   bool boxes_truncated = false;
   float range_min = 0.0f, range_max = 1.0f;  ///< the heatmap range in use
+  bool heatmap_on_gpu = false;                ///< the heatmap shown was traced on the GPU
+  std::string gpu_note;                       ///< why "Trace on: GPU" fell back to the CPU ("" when it did not)
 };
 /// Every renderer layer: mesh, wireframe, node boxes (selection, colouring),
 /// heatmap (display, metric, colour map, scale, opacity, legend), ray path,
