@@ -2,6 +2,8 @@
 // traversal in instance space (see tlas.h).
 #include "core/accel/tlas/tlas.h"
 
+#include "core/accel/tlas/tlas_overlap.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -85,6 +87,15 @@ Tlas::Tlas(const Scene& scene, const TlasOptions& opts, const ProgressCallback& 
   instanced_triangles_ = next;
   stats_.extra["tlas_ms"] = build_top();
   stats_.build_ms = ms_since(t0);
+  {  // at build time (not per frame: an update's timings stay the TLAS's own)
+    std::vector<Aabb> boxes;
+    boxes.reserve(instances_.size());
+    for (const TlasInstance& inst : instances_) boxes.push_back(inst.world_bounds);
+    const InstanceOverlap ov = instance_overlap(boxes);
+    stats_.extra["instance_overlap_area"] = ov.area_ratio;
+    stats_.extra["instance_overlap_volume"] = ov.volume_ratio;
+    stats_.extra["instance_overlap_pairs"] = static_cast<double>(ov.overlapping_pairs);
+  }
   update_memory_stats();
   if (progress) progress(1.0);
 }
