@@ -110,7 +110,8 @@ class Gui final : public ScriptHost {
   std::optional<SceneEffects> effects_;
   std::shared_ptr<const LoadedScene> effects_scene_;  ///< held: a freed scene's address may come back
   EffectForces effects_forces_;
-  std::shared_ptr<const LoadedScene> dynamics_scene_;  ///< the scene the player was reset for
+  std::shared_ptr<const LoadedScene> dynamics_scene_;    ///< the scene the player was reset for
+  std::shared_ptr<const BuiltStructure> dynamics_rest_;  ///< the build the shown frames are made for
   Clock::time_point dynamics_clock_ = Clock::now();
   std::optional<std::uint64_t> play_target_;  ///< script `play`: the frame count to reach
   std::vector<std::string> dropped_;
@@ -371,8 +372,8 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
 }
 
 const SceneEffects* Gui::effects() {
-  if (!app_.current()) return nullptr;
-  const std::shared_ptr<const LoadedScene>& scene = app_.current()->scene;
+  if (!app_.rest()) return nullptr;
+  const std::shared_ptr<const LoadedScene>& scene = app_.rest()->scene;  // at rest: a shown frame is a copy
   const EffectForces& f = app_.config().effects;
   const bool same_forces = f.shadow_rays == effects_forces_.shadow_rays &&
                            f.per_frame_updates == effects_forces_.per_frame_updates &&
@@ -390,11 +391,13 @@ void Gui::draw_dynamics(const panels::PanelLayout& layout) {
   const double dt = std::chrono::duration<double>(now - dynamics_clock_).count();
   dynamics_clock_ = now;
   const SceneEffects* fx = effects();
-  const std::shared_ptr<const BuiltStructure>& cur = app_.current();
+  const std::shared_ptr<const BuiltStructure>& cur = app_.rest();
   if (!fx || !cur || !fx->per_frame_updates.on) {
     if (dynamics_scene_) dynamics_.request({});  // releases the worker's copy of the structure
     dynamics_scene_.reset();
+    dynamics_rest_.reset();
     player_.playing = false;
+    app_.show_rest();
     return;
   }
   if (dynamics_scene_ != cur->scene) {  // a new scene: the timeline starts over
@@ -403,14 +406,20 @@ void Gui::draw_dynamics(const panels::PanelLayout& layout) {
     player_.duration = animation_duration(cur->scene->scene);
     player_.seek(0.0f);
   }
+  if (dynamics_rest_ != cur) {  // a new build (another structure): pose the current time with it
+    dynamics_rest_ = cur;
+    player_.seek(player_.time());
+  }
   if (player_.tick(dt, dynamics_.busy())) {
     DynamicsRequest r;
     r.scene = cur->scene;
     r.time = player_.time();
+    r.structure = cur->choice;  // the view shows this frame (latest frame wins)
     dynamics_.request(std::move(r));
   }
   std::shared_ptr<const DynamicsSnapshot> snap = dynamics_.latest();
   if (snap && snap->scene != cur->scene.get()) snap.reset();
+  if (snap && snap->frame) app_.show_frame(snap->frame, snap->scene);  // refused when of another build
   panels::dynamics_panel(player_, snap.get(), dynamics_.busy(), layout);
 }
 
@@ -534,7 +543,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
         throw std::runtime_error("play: " + app_.scene_spec() + ": per-frame updates are off (" +
                                  (fx ? fx->per_frame_updates.reason : std::string("no scene")) + ")");
       const std::shared_ptr<const DynamicsSnapshot> snap = dynamics_.latest();
-      const bool ours = snap && snap->scene == app_.current()->scene.get();
+      const bool ours = snap && snap->scene == app_.rest()->scene.get();
       if (!snap || !ours) {  // the worker has not set the scene up yet
         player_.playing = true;
         return Status::again;
@@ -545,6 +554,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
         player_.playing = true;
       }
       if (snap->frames < *play_target_) return Status::again;
+      if (snap->frame) app_.show_frame(snap->frame, snap->scene);  // what the next command sees
       play_target_.reset();
       player_.playing = false;
       return Status::done;
@@ -554,7 +564,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       if (!fx) throw std::runtime_error("dump-dynamics: no scene shown yet");
       nlohmann::json doc = {{"scene", app_.scene_spec()}, {"effects", effects_json(*fx)}};
       const std::shared_ptr<const DynamicsSnapshot> snap = dynamics_.latest();
-      if (snap && app_.current() && snap->scene == app_.current()->scene.get()) {
+      if (snap && app_.rest() && snap->scene == app_.rest()->scene.get()) {
         nlohmann::json frames = nlohmann::json::array();
         for (const FrameStats& f : snap->history)
           frames.push_back({{"frame", f.frame},
@@ -570,6 +580,15 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
                             {"sah_rebuilt", f.sah_rebuilt}});
         doc["dynamics"] = {{"frames_stepped", snap->frames}, {"setup_ms", snap->setup_ms}, {"duration", snap->duration},
                            {"animates", snap->animates},     {"error", snap->error},       {"history", frames}};
+        doc["dynamics"]["shown_frame"] = nullptr;
+        if (app_.showing_frame() && snap->frame == app_.current()) {
+          const auto root = app_.current()->nodes.box(0);
+          doc["dynamics"]["shown_frame"] = {
+              {"time", snap->frame_time},
+              {"build_ms", snap->frame_build_ms},
+              {"root_lo", root ? std::vector<float>{root->lo.x, root->lo.y, root->lo.z} : std::vector<float>{}},
+              {"root_hi", root ? std::vector<float>{root->hi.x, root->hi.y, root->hi.z} : std::vector<float>{}}};
+        }
       } else {
         doc["dynamics"] = nullptr;
       }

@@ -142,10 +142,7 @@ std::vector<glm::mat4> node_world_transforms(std::span<const Node> nodes) {
   return world;
 }
 
-std::vector<Triangle> deformed_triangles(const Mesh& mesh, const MeshDeformer& d, float t) {
-  const auto finite3 = [](const glm::vec3& v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-  };
+std::vector<glm::vec3> deformed_positions(const Mesh& mesh, const MeshDeformer& d, float t) {
   const float w0 = 2.0f * 3.14159265358979f * d.frequency * t;
   std::vector<glm::vec3> moved(mesh.positions.size());
   for (std::size_t i = 0; i < moved.size(); ++i) {
@@ -155,6 +152,14 @@ std::vector<Triangle> deformed_triangles(const Mesh& mesh, const MeshDeformer& d
     const float w = w0 + 0.7f * p.x + 0.5f * p.z;
     moved[i] = p + glm::vec3(sway * std::sin(w), 0.0f, 0.5f * sway * std::cos(w));
   }
+  return moved;
+}
+
+std::vector<Triangle> deformed_triangles(const Mesh& mesh, const MeshDeformer& d, float t) {
+  const auto finite3 = [](const glm::vec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+  };
+  const std::vector<glm::vec3> moved = deformed_positions(mesh, d, t);
   std::vector<Triangle> out;
   out.reserve(mesh.indices.size());
   for (const glm::uvec3& idx : mesh.indices) {
@@ -162,6 +167,23 @@ std::vector<Triangle> deformed_triangles(const Mesh& mesh, const MeshDeformer& d
     if (!finite3(a) || !finite3(b) || !finite3(c)) continue;  // as the BLAS was built
     out.push_back({moved[idx.x], moved[idx.y], moved[idx.z]});
   }
+  return out;
+}
+
+Scene posed_scene(const Scene& scene, float t) {
+  Scene out = scene;
+  const float duration = animation_duration(scene);
+  if (duration > 0.0f) t = std::fmod(std::max(t, 0.0f), duration);
+  std::vector<bool> changed;
+  for (const Animation& a : scene.animations) apply_animation(a, t, out.nodes, changed);
+  if (std::find(changed.begin(), changed.end(), true) != changed.end()) {
+    const std::vector<glm::mat4> world = node_world_transforms(out.nodes);
+    for (Instance& inst : out.instances)
+      if (inst.node < world.size()) inst.transform = world[inst.node];
+  }
+  for (const MeshDeformer& d : scene.deformers)
+    if (d.mesh < out.meshes.size()) out.meshes[d.mesh].positions = deformed_positions(scene.meshes[d.mesh], d, t);
+  if (!scene.triangles.empty()) out.flatten();
   return out;
 }
 

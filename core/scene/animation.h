@@ -41,8 +41,19 @@ glm::mat4 compose_trs(const glm::vec3& translation, const glm::quat& rotation, c
 /// World (object-to-world) matrix of every node: parent chain of locals.
 std::vector<glm::mat4> node_world_transforms(std::span<const Node> nodes);
 
+/// Object-space vertex positions of MESH deformed by D at time T.
+std::vector<glm::vec3> deformed_positions(const Mesh& mesh, const MeshDeformer& d, float t);
+
 /// Object-space triangles of MESH deformed by D at time T, in index order.
 std::vector<Triangle> deformed_triangles(const Mesh& mesh, const MeshDeformer& d, float t);
+
+/// SCENE as it stands at time T (wrapped into the animation's duration, as
+/// SceneAnimator::step does): nodes driven by channels take their sampled
+/// TRS, every instance its node's world transform, deformed meshes their
+/// moved vertices; the world triangle list is flattened again when SCENE's
+/// was (an instanced scene left unflattened stays so). At T = 0 of a scene
+/// whose rest pose is its first key this is SCENE's geometry.
+Scene posed_scene(const Scene& scene, float t);
 
 struct AnimatorOptions {
   /// Rebuild a deforming BLAS when refit SAH / fresh SAH exceeds this (> 1);

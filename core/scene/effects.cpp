@@ -1,6 +1,7 @@
 // Effects by scene (see effects.h).
 #include "core/scene/effects.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 
@@ -30,7 +31,7 @@ void apply_force(Effect& e, bool force) {
 SceneEffects decide_effects(const Scene& scene, const EffectForces& forces) {
   SceneEffects fx;
   fx.shadow_rays.name = "shadow-rays";
-  fx.shadow_rays.on = !scene.lights.empty();
+  fx.shadow_rays.on = shadow_rays_wanted(scene, {});
   fx.shadow_rays.reason = scene.lights.empty()
                               ? "no lights: nothing casts a shadow"
                               : count(scene.lights.size(), "light") + ": one any-hit ray per light per hit";
@@ -72,6 +73,8 @@ SceneEffects decide_effects(const Scene& scene, const EffectForces& forces) {
   fx.textures.reason = "no view draws textures or materials: the loader skips image decoding";
 
   apply_force(fx.shadow_rays, forces.shadow_rays);
+  if (fx.shadow_rays.forced && scene.lights.empty())
+    fx.shadow_rays.reason += "; they aim at a synthetic point light above the scene";
   apply_force(fx.per_frame_updates, forces.per_frame_updates);
   apply_force(fx.two_level, forces.two_level);
   apply_force(fx.textures, forces.textures);
@@ -103,6 +106,34 @@ std::string effects_text(const SceneEffects& fx) {
   return out;
 }
 
+bool shadow_rays_wanted(const Scene& scene, const EffectForces& forces) {
+  return !scene.lights.empty() || forces.shadow_rays;
+}
+
+std::vector<Light> shadow_lights(const Scene& scene, bool wanted) {
+  if (!wanted) return {};
+  if (!scene.lights.empty()) return scene.lights;
+  const Aabb b = scene.bounds();
+  Light l;
+  l.name = "synthetic";
+  l.kind = Light::Kind::point;
+  if (!b.is_empty()) {
+    const glm::vec3 e = b.extent();
+    l.position = b.center() + glm::vec3(0.0f, 2.0f * std::max({e.x, e.y, e.z}), 0.0f);
+  }
+  return {l};
+}
+
+Ray shadow_ray(const Ray& primary, const Hit& h, const Light& l) {
+  const glm::vec3 p = primary.at(h.t);
+  // Offset along the normal, toward the side the ray came from.
+  const glm::vec3 n = glm::dot(h.ng, primary.direction) < 0.0f ? h.ng : -h.ng;
+  const glm::vec3 o = p + n * (1e-4f * (1.0f + glm::length(p)));
+  const bool directional = l.kind == Light::Kind::directional;
+  const glm::vec3 d = directional ? -l.direction : l.position - o;
+  return Ray(o, d, 0.0f, directional ? kInfinity : 1.0f);
+}
+
 FrameCounters run_frame(const Scene& scene, const SceneEffects& fx, const Accelerator& accel, const Camera& camera,
                         int width, int height, SceneAnimator* animator, float t) {
   FrameCounters c;
@@ -114,22 +145,16 @@ FrameCounters run_frame(const Scene& scene, const SceneEffects& fx, const Accele
     c.moved_instances = fs.moved_instances;
   }
   const QueryOptions qo;
+  const std::vector<Light> lights = shadow_lights(scene, fx.shadow_rays.on);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
       const Ray ray = primary_ray(camera, x, y, width, height);
       ++c.primary_rays;
       const Hit h = accel.closest_hit(ray, qo);
       if (!h.valid() || !fx.shadow_rays.on) continue;
-      const glm::vec3 p = ray.at(h.t);
-      // Offset along the normal, toward the side the ray came from.
-      const glm::vec3 n = glm::dot(h.ng, ray.direction) < 0.0f ? h.ng : -h.ng;
-      const glm::vec3 o = p + n * (1e-4f * (1.0f + glm::length(p)));
-      for (const Light& l : scene.lights) {
-        const bool directional = l.kind == Light::Kind::directional;
-        const glm::vec3 d = directional ? -l.direction : l.position - o;
-        const Ray shadow(o, d, 0.0f, directional ? kInfinity : 1.0f);
+      for (const Light& l : lights) {
         ++c.shadow_rays;
-        (void)accel.any_hit(shadow, qo);
+        (void)accel.any_hit(shadow_ray(ray, h, l), qo);
       }
     }
   return c;

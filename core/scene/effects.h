@@ -53,6 +53,21 @@ bool set_force(EffectForces& forces, const std::string& name);
 /// "name  on|off  [forced]  reason" lines, for `accelviz info`.
 std::string effects_text(const SceneEffects& effects);
 
+/// Whether shadow rays are traced: the scene has lights, or the user forced
+/// them on (what decide_effects() says, without the rest of its work).
+bool shadow_rays_wanted(const Scene& scene, const EffectForces& forces);
+
+/// The lights shadow rays aim at: the scene's own, or, when shadow rays are
+/// forced on a scene without lights, one synthetic point light named
+/// "synthetic" above the scene: at the bounds' centre raised by twice the
+/// box's largest extent along +y. Empty when WANTED is false.
+std::vector<Light> shadow_lights(const Scene& scene, bool wanted);
+
+/// The shadow (any-hit) ray from PRIMARY's hit H toward L: starts a little
+/// off the surface on the side the primary came from; ends at a point
+/// light (t in [0, 1]) or runs to infinity against a directional one.
+Ray shadow_ray(const Ray& primary, const Hit& h, const Light& l);
+
 /// What one frame did.
 struct FrameCounters {
   std::uint64_t primary_rays = 0;
@@ -65,8 +80,9 @@ struct FrameCounters {
 
 /// One frame at time T: the animator steps only when per-frame updates are
 /// on (ANIMATOR may be null), WIDTH x HEIGHT primary rays from CAMERA are
-/// traced on ACCEL, and for each primary hit one shadow ray per light when
-/// shadow rays are on.
+/// traced on ACCEL, and for each primary hit one shadow ray per light of
+/// shadow_lights() when shadow rays are on (a synthetic light when forced
+/// without lights).
 FrameCounters run_frame(const Scene& scene, const SceneEffects& effects, const Accelerator& accel, const Camera& camera,
                         int width, int height, SceneAnimator* animator, float t);
 

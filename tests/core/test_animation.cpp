@@ -225,13 +225,21 @@ TEST(Effects, ALightTurnsShadowRaysOn) {
   const FrameCounters c = run_frame(s, fx, bvh, s.cameras.front(), 40, 30, nullptr, 0.0f);
   EXPECT_GT(c.shadow_rays, 0u);
   EXPECT_LT(c.shadow_rays, c.primary_rays);  // one per primary hit, and some rays miss
-  // Forcing shadow rays on a scene without lights is allowed but traces none (no light to aim at).
+  // Without lights and not forced: none. Forced on a scene without lights:
+  // they go to one synthetic light above the scene.
   s.lights.clear();
+  EXPECT_EQ(run_frame(s, decide_effects(s), bvh, s.cameras.front(), 10, 10, nullptr, 0.0f).shadow_rays, 0u);
   EffectForces f;
   f.shadow_rays = true;
   const SceneEffects forced = decide_effects(s, f);
   EXPECT_TRUE(forced.shadow_rays.forced);
-  EXPECT_EQ(run_frame(s, forced, bvh, s.cameras.front(), 10, 10, nullptr, 0.0f).shadow_rays, 0u);
+  const std::vector<Light> synthetic = shadow_lights(s, forced.shadow_rays.on);
+  ASSERT_EQ(synthetic.size(), 1u);
+  EXPECT_EQ(synthetic[0].name, "synthetic");
+  EXPECT_GT(synthetic[0].position.y, s.bounds().hi.y);
+  const FrameCounters fc = run_frame(s, forced, bvh, s.cameras.front(), 10, 10, nullptr, 0.0f);
+  EXPECT_GT(fc.shadow_rays, 0u);
+  EXPECT_LE(fc.shadow_rays, fc.primary_rays);
 }
 
 TEST(Effects, InstancedSceneBuildsEachUniqueMeshOnce) {

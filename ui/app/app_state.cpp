@@ -1,6 +1,7 @@
 #include "ui/app/app_state.h"
 
 #include "core/query/camera.h"
+#include "core/scene/effects.h"
 
 #include <algorithm>
 #include <cmath>
@@ -80,6 +81,7 @@ AppState::HeatmapKey AppState::heatmap_key(int w, int h) const {
   // The cost metric weighs with the BVH's C_trav/C_isect, as `render --ctrav/--cisect` does.
   k.c_trav = config().structure.options.bvh.cost_traversal;
   k.c_isect = config().structure.options.bvh.cost_intersect;
+  k.shadows = current_ && shadow_rays_wanted(current_->scene->scene, config().effects);
   k.gpu = config().view.heatmap_gpu;
   return k;
 }
@@ -106,8 +108,9 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
     if (o.id >= scene_request_id_ && o.result != BuildOutcome::Result::cancelled) scene_loading_ = false;
     if (o.id != request_id_) continue;
     if (o.result == BuildOutcome::Result::built) {
-      const bool new_scene = !current_ || current_->scene != o.built->scene;
+      const bool new_scene = !rest_ || rest_->scene != o.built->scene;
       current_ = std::move(o.built);
+      rest_ = current_;
       u.structure_changed = true;
       const Scene& scene = current_->scene->scene;
       if (new_scene) {
@@ -154,6 +157,7 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
       r.c_trav = key.c_trav;
       r.c_isect = key.c_isect;
       r.threads = settings_.config.structure.options.threads;
+      r.shadow_lights = shadow_lights(current_->scene->scene, key.shadows);
       heatmap_on_gpu_ = false;
       gpu_note_.clear();
       if (key.gpu) {
@@ -185,6 +189,23 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
     u.heatmap_changed = true;
   }
   return u;
+}
+
+bool AppState::show_frame(std::shared_ptr<const BuiltStructure> frame, const LoadedScene* rest_scene) {
+  if (!frame || !rest_ || rest_->scene.get() != rest_scene || frame->choice.name != rest_->choice.name ||
+      !same_build(frame->choice, rest_->choice))
+    return false;
+  if (current_ != frame) {
+    current_ = std::move(frame);
+    recast();
+  }
+  return true;
+}
+
+void AppState::show_rest() {
+  if (current_ == rest_) return;
+  current_ = rest_;
+  recast();
 }
 
 bool AppState::settled() const {
@@ -306,6 +327,10 @@ nlohmann::json AppState::stats_json() const {
                  {"max_prims", s.max_prims},
                  {"mean_value", s.mean_value},
                  {"max_value", s.max_value},
+                 {"shadow_rays", s.shadow_rays},
+                 {"shadowed", s.shadowed},
+                 {"mean_shadow_nodes", s.mean_shadow_nodes},
+                 {"mean_shadow_prims", s.mean_shadow_prims},
                  {"render_ms", s.render_ms},
                  {"rays_per_s", s.rays_per_s},
                  {"device", heatmap_on_gpu_ ? "gpu" : "cpu"},

@@ -54,6 +54,20 @@ class AppState {
 
   // ---- what is shown -----------------------------------------------------------
   const std::shared_ptr<const BuiltStructure>& current() const { return current_; }
+  /// The structure the build worker made over the scene at rest; current()
+  /// is it unless a Dynamics frame is shown (show_frame()).
+  const std::shared_ptr<const BuiltStructure>& rest() const { return rest_; }
+  /// Shows FRAME (the chosen structure built over the scene posed at some
+  /// time, DynamicsSnapshot::frame) in place of the rest build, so the 3D
+  /// view, the heatmap and the ray inspector show that frame. Accepted only
+  /// when REST_SCENE is the rest build's scene and FRAME was built with its
+  /// choice (a stale frame of another scene or structure is ignored); a
+  /// newer build replaces the frame. Returns whether FRAME is shown.
+  bool show_frame(std::shared_ptr<const BuiltStructure> frame, const LoadedScene* rest_scene);
+  /// Back to the rest build (no-op when it is shown).
+  void show_rest();
+  /// A Dynamics frame is shown instead of the rest build.
+  bool showing_frame() const { return current_ && current_ != rest_; }
   const Scene* scene() const { return current_ ? &current_->scene->scene : nullptr; }
   /// The scene shown ("" before the first one is ready).
   std::string scene_spec() const { return current_ ? current_->scene->spec : std::string(); }
@@ -133,7 +147,8 @@ class AppState {
     TriangleTest test = TriangleTest::watertight;
     bool ordered = true;
     float c_trav = 1.0f, c_isect = 1.0f;
-    bool gpu = false;  ///< heatmap-gpu
+    bool shadows = false;  ///< shadow rays traced (scene lights or forced on)
+    bool gpu = false;      ///< heatmap-gpu
     bool operator==(const HeatmapKey&) const = default;
   };
   HeatmapKey heatmap_key(int w, int h) const;
@@ -152,6 +167,7 @@ class AppState {
   std::uint64_t request_id_ = 0;
 
   std::shared_ptr<const BuiltStructure> current_;
+  std::shared_ptr<const BuiltStructure> rest_;  ///< the last build (current_ unless a frame is shown)
   std::shared_ptr<const HeatmapFrame> heatmap_;
   std::optional<HeatmapKey> heatmap_requested_;
   GpuHeatmapTracer gpu_tracer_;

@@ -5,6 +5,7 @@
 #include <exception>
 #include <optional>
 
+#include "core/accel/factory.h"
 #include "core/accel/tlas/tlas.h"
 
 namespace accelviz {
@@ -97,6 +98,34 @@ DynamicsWorker::DynamicsWorker()
               ++s.snap->frames;
             } catch (const std::exception& e) {
               s.snap->error = std::string("dynamics: ") + e.what();
+            }
+            if (r.structure && s.snap->error.empty() && !s.snap->history.empty()) {
+              // The frame for display: the scene posed at this time and the
+              // chosen structure built over it (the app's build, as the
+              // build worker makes it, but for this pose).
+              const auto t0 = std::chrono::steady_clock::now();
+              try {
+                auto posed = std::make_shared<LoadedScene>();
+                posed->spec = r.scene->spec;
+                posed->scene = posed_scene(r.scene->scene, s.snap->history.back().time);
+                StructureChoice choice = *r.structure;
+                choice.options.scene = &posed->scene;
+                std::shared_ptr<const Accelerator> accel = build_accelerator(
+                    choice.name, posed->scene.triangles, choice.options, [&](double) { return keep_going(); });
+                auto built = std::make_shared<BuiltStructure>();
+                built->nodes = StructureNodes::of(*accel);
+                built->accel = std::move(accel);
+                built->scene = std::move(posed);
+                built->choice = *r.structure;
+                built->wall_ms = ms_since(t0);
+                s.snap->frame = std::move(built);
+                s.snap->frame_time = s.snap->history.back().time;
+                s.snap->frame_build_ms = ms_since(t0);
+              } catch (const BuildCancelled&) {
+                // superseded: the next request poses its own frame
+              } catch (const std::exception& e) {
+                s.snap->error = std::string("dynamics: frame structure: ") + e.what();
+              }
             }
             // Published even when superseded: the frame was stepped and belongs
             // to the history (the store rule below keeps the newest scene's).

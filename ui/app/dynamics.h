@@ -12,11 +12,14 @@
 //    history the Dynamics panel plots;
 //  - DynamicsPlayer: play/pause, scrub, speed: which time the worker is asked
 //    to step to next.
-// The view does not show the moved scene: the structure the heatmap and the
-// raster view use is the static build (see docs/gui.md).
+// With a structure choice in the request, each frame also carries the
+// scene posed at that time (posed_scene()) and the chosen structure built
+// over it: AppState::show_frame() makes it the one the 3D view, the heatmap
+// and the ray inspector use (see docs/dynamics.md).
 #include <cstdint>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,6 +46,9 @@ struct DynamicsRequest {
   std::shared_ptr<const LoadedScene> scene;
   float time = 0.0f;  ///< seconds: the frame to step to
   double rebuild_ratio = 1.3;
+  /// The structure the view shows: when set, each stepped frame is also
+  /// posed and this structure built over it (DynamicsSnapshot::frame).
+  std::optional<StructureChoice> structure;
 };
 
 struct DynamicsSnapshot {
@@ -54,6 +60,12 @@ struct DynamicsSnapshot {
   std::uint64_t frames = 0;  ///< frames stepped since the scene was set up (history may hold fewer)
   std::vector<FrameStats> history;
   std::string error;  ///< one line, when set-up or a step failed
+  /// The newest frame built for display: the scene posed at frame_time and
+  /// the requested structure over it (null before the first, or without a
+  /// structure in the requests).
+  std::shared_ptr<const BuiltStructure> frame;
+  float frame_time = 0.0f;
+  double frame_build_ms = 0.0;  ///< posing + building that frame's structure
 };
 
 class DynamicsWorker {

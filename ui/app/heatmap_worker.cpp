@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "core/query/camera.h"
+#include "core/scene/effects.h"
 #include "core/util/parallel.h"
 
 namespace accelviz {
@@ -15,9 +16,15 @@ struct Accumulator {
   std::uint64_t rays = 0, hits = 0, valued = 0;
   double sum_nodes = 0.0, sum_prims = 0.0, sum_value = 0.0, max_value = 0.0;
   std::uint32_t max_nodes = 0, max_prims = 0;
+  std::uint64_t shadow_rays = 0, shadowed = 0;
+  double shadow_nodes = 0.0, shadow_prims = 0.0;
 
   void add(const PixelFigures& p) {
     ++rays;
+    shadow_rays += p.shadow_rays;
+    shadowed += p.shadowed;
+    shadow_nodes += p.shadow_nodes;
+    shadow_prims += p.shadow_prims;
     if (p.prim != kInvalidId) ++hits;
     sum_nodes += p.nodes;
     sum_prims += p.prims;
@@ -32,6 +39,10 @@ struct Accumulator {
   void merge(const Accumulator& o) {
     rays += o.rays;
     hits += o.hits;
+    shadow_rays += o.shadow_rays;
+    shadowed += o.shadowed;
+    shadow_nodes += o.shadow_nodes;
+    shadow_prims += o.shadow_prims;
     valued += o.valued;
     sum_nodes += o.sum_nodes;
     sum_prims += o.sum_prims;
@@ -56,6 +67,12 @@ HeatmapSummary summarise(const Accumulator& a, double render_ms) {
   s.max_value = a.max_value;
   s.render_ms = render_ms;
   s.rays_per_s = render_ms > 0.0 ? static_cast<double>(a.rays) / (render_ms * 1e-3) : 0.0;
+  s.shadow_rays = a.shadow_rays;
+  s.shadowed = a.shadowed;
+  if (a.shadow_rays > 0) {
+    s.mean_shadow_nodes = a.shadow_nodes / static_cast<double>(a.shadow_rays);
+    s.mean_shadow_prims = a.shadow_prims / static_cast<double>(a.shadow_rays);
+  }
   return s;
 }
 
@@ -107,6 +124,15 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
           p.prims = stats.prim_tests;
           p.prim = hit.prim;
           p.t = hit.t;
+          p.shadow_rays = p.shadow_nodes = p.shadow_prims = p.shadowed = 0;
+          if (hit.valid())
+            for (const Light& l : r.shadow_lights) {
+              RayStats ss;
+              p.shadowed += accel.any_hit(shadow_ray(ray, hit, l), r.query, &ss) ? 1u : 0u;
+              ++p.shadow_rays;
+              p.shadow_nodes += ss.nodes_visited;
+              p.shadow_prims += ss.prim_tests;
+            }
           image.values[static_cast<std::size_t>(y) * w + x] = p.value;
           acc[ti].add(p);
         }

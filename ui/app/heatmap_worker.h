@@ -31,6 +31,10 @@ struct HeatmapRequest {
   float c_isect = 1.0f;
   unsigned threads = 0;  ///< 0: all hardware threads
   int coarsest = 8;      ///< first lattice spacing (a power of two >= 1)
+  /// Shadow rays (effects by scene): from each primary hit, one any-hit ray
+  /// per light here (core/scene/effects.h shadow_lights(); empty: none).
+  /// Their work is counted apart from the primary ray's (PixelFigures::shadow_*).
+  std::vector<Light> shadow_lights;
 };
 
 /// What one pixel's ray found (the hover tooltip shows these).
@@ -40,6 +44,10 @@ struct PixelFigures {
   std::uint32_t prims = 0;           ///< RayStats::prim_tests
   std::uint32_t prim = 0xFFFFFFFFu;  ///< hit primitive (kInvalidId: miss)
   float t = 0.0f;                    ///< hit distance (inf: miss)
+  std::uint32_t shadow_rays = 0;     ///< any-hit rays traced from the hit toward the lights
+  std::uint32_t shadow_nodes = 0;    ///< their RayStats::nodes_visited, summed
+  std::uint32_t shadow_prims = 0;    ///< their RayStats::prim_tests, summed
+  std::uint32_t shadowed = 0;        ///< of them, rays that found an occluder
 };
 
 /// Figures over the pixels traced so far (all of them once complete).
@@ -51,6 +59,10 @@ struct HeatmapSummary {
   double mean_value = 0.0, max_value = 0.0;  ///< of the metric, over pixels with a value
   double render_ms = 0.0;                    ///< tracing time of all levels so far (instrumented)
   double rays_per_s = 0.0;
+  std::uint64_t shadow_rays = 0;   ///< shadow (any-hit) rays traced (0 when the request has no lights)
+  std::uint64_t shadowed = 0;      ///< of them, occluded
+  double mean_shadow_nodes = 0.0;  ///< per shadow ray
+  double mean_shadow_prims = 0.0;  ///< per shadow ray
 };
 
 struct HeatmapFrame {

@@ -35,7 +35,11 @@ nlohmann::json settings_to_json(const AppSettings& s) {
           {"recent", s.recent},
           {"screenshot_dir", s.screenshot_dir},
           {"window", {{"width", s.window_width}, {"height", s.window_height}}},
-          {"options", options}};
+          {"options", options},
+          {"effects",
+           {{"shadow-rays", s.config.effects.shadow_rays},
+            {"per-frame-updates", s.config.effects.per_frame_updates},
+            {"two-level", s.config.effects.two_level}}}};
 }
 
 AppSettings settings_from_json(const nlohmann::json& j) {
@@ -68,6 +72,20 @@ AppSettings settings_from_json(const nlohmann::json& j) {
     };
     side("width", s.window_width);
     side("height", s.window_height);
+  }
+  if (j.contains("effects")) {  // the Scene panel's force-on checkboxes
+    const auto& e = j["effects"];
+    if (!e.is_object()) throw runtime_error("effects: expected an object");
+    for (const auto& [name, on] : e.items()) {
+      bool* force = name == "shadow-rays"         ? &s.config.effects.shadow_rays
+                    : name == "per-frame-updates" ? &s.config.effects.per_frame_updates
+                    : name == "two-level"         ? &s.config.effects.two_level
+                                                  : nullptr;
+      if (!force)
+        throw runtime_error("effects." + name + ": unknown effect (valid: shadow-rays, per-frame-updates, two-level)");
+      if (!on.is_boolean()) throw runtime_error("effects." + name + ": expected true or false");
+      *force = on.get<bool>();
+    }
   }
   if (j.contains("options")) {
     const auto& o = j["options"];

@@ -43,8 +43,10 @@ inline std::filesystem::path imgui_ini_file(const std::filesystem::path& dir) {
 }
 
 /// Settings as written to disk: {"version": 1, "last_scene", "recent",
-/// "screenshot_dir", "window": {"width", "height"}, "options": {KEY: VALUE}}
-/// with every key of option_table() (values as option_value writes them).
+/// "screenshot_dir", "window": {"width", "height"}, "options": {KEY: VALUE},
+/// "effects": {"shadow-rays", "per-frame-updates", "two-level": bool}} with
+/// every key of option_table() (values as option_value writes them) and the
+/// effect forces (AppConfig::effects).
 nlohmann::json settings_to_json(const AppSettings& s);
 /// The reverse; throws std::runtime_error with one line naming the first
 /// problem (wrong type, unknown version, an option apply_option refuses).

@@ -107,7 +107,10 @@ void dynamics_panel(DynamicsPlayer& player, const DynamicsSnapshot* snap, bool b
   }
   plot("SAH refitted", sah_r, lo, hi, h);
   plot("SAH rebuilt", sah_b, lo, hi, h);
-  ImGui::TextDisabled("The 3D view and heatmap show the scene at rest (the structure the app built).");
+  if (snap->frame)
+    ImGui::Text("view: frame t=%.3f s (%s rebuilt over the posed scene in %.1f ms)",
+                static_cast<double>(snap->frame_time), snap->frame->choice.name.c_str(), snap->frame_build_ms);
+  ImGui::TextDisabled("The 3D view, heatmap and ray inspector show the latest frame stepped.");
   ImGui::End();
 }
 

@@ -309,6 +309,13 @@ void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const Pa
       row("hits", "%" PRIu64 " of %" PRIu64, s.hits, s.rays);
       row("heatmap ms", "%.1f", s.render_ms);
       row("rays / s", "%.3g", s.rays_per_s);
+      if (!view->request.shadow_lights.empty()) {
+        const bool synthetic = view->request.shadow_lights.front().name == "synthetic";
+        row("shadow rays", "%" PRIu64 " (%" PRIu64 " occluded)%s", s.shadow_rays, s.shadowed,
+            synthetic ? ", to a synthetic light" : "");
+        row("nodes / shadow ray", "%.2f", s.mean_shadow_nodes);
+        row("prim tests / shadow ray", "%.2f", s.mean_shadow_prims);
+      }
       ImGui::EndTable();
     }
   }
