@@ -211,7 +211,11 @@ void Gui::handle_input(int fbw, int fbh, int ww, int wh) {
   if (!io.WantCaptureMouse) {
     const ImVec2 d = io.MouseDelta;
     const bool moved = d.x != 0.0f || d.y != 0.0f;
-    if (press_in_view_ && ImGui::IsMouseDragging(ImGuiMouseButton_Left) && moved) {
+    // Ctrl+drag: select a region of the view's rays (insight: nodes and primitives they touched).
+    if (press_in_view_ && io.KeyCtrl && ImGui::IsMouseDragging(ImGuiMouseButton_Left)) {
+      const ImVec2 o = io.MouseClickedPos[ImGuiMouseButton_Left];
+      ImGui::GetForegroundDrawList()->AddRect(o, io.MousePos, IM_COL32(255, 255, 255, 255), 0.0f, 0, 1.5f);
+    } else if (press_in_view_ && ImGui::IsMouseDragging(ImGuiMouseButton_Left) && moved) {
       cam.unfix();
       if (io.KeyShift)
         cam.orbit.pan(d.x * sx, d.y * sy, fbh);
@@ -231,6 +235,11 @@ void Gui::handle_input(int fbw, int fbh, int ww, int wh) {
         cam.unfix();
         cam.orbit.set_pivot(*p);
       }
+    } else if (ImGui::IsMouseReleased(ImGuiMouseButton_Left) && press_in_view_ && io.KeyCtrl &&
+               io.MouseDragMaxDistanceSqr[ImGuiMouseButton_Left] >= io.MouseDragThreshold * io.MouseDragThreshold) {
+      const ImVec2 o = io.MouseClickedPos[ImGuiMouseButton_Left];
+      insight_.select_view_region(app_, static_cast<int>(std::floor(o.x * sx)), static_cast<int>(std::floor(o.y * sy)),
+                                  px, py);
     } else if (ImGui::IsMouseReleased(ImGuiMouseButton_Left) && press_in_view_ && over_view &&
                io.MouseDragMaxDistanceSqr[ImGuiMouseButton_Left] < io.MouseDragThreshold * io.MouseDragThreshold) {
       if (const std::string e = app_.cast_ray(px, py); !e.empty()) app_.set_error(e);
@@ -307,7 +316,7 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
   vi.range_max = range.y;
   vi.heatmap_on_gpu = app_.heatmap_on_gpu();
   vi.gpu_note = app_.gpu_heatmap_note();
-  panels::view_panel(app_.config().view, vi, layout);
+  panels::view_panel(app_.config().view, vi, layout, &app_.config().structure.query);
 
   const auto& insp = app_.inspection();
   if (const auto step = panels::ray_panel(insp ? &*insp : nullptr, app_.replay_step(),
@@ -352,6 +361,7 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
       app_.set_error(err);
   }
   insight_.draw(app_, layout);
+  view_->set_box_insight(insight_.box_insight(app_));
 
   const std::shared_ptr<const RobustnessSnapshot> lab = robustness_.latest();
   const panels::RobustnessAction ra =
@@ -427,6 +437,7 @@ SavedScreenshot Gui::write_frame(const std::optional<std::filesystem::path>& exp
   // Draw the current state now, so the file is exactly what the view shows
   // after this frame's changes (uploads included).
   const int w = window_->width(), h = window_->height();
+  view_->set_box_insight(insight_.box_insight(app_));
   view_->sync(app_);
   view_->draw(app_, w, h);
   const RgbImage frame = to_rgb(view_->renderer().read_pixels());
@@ -598,6 +609,9 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
     case K::scenario:
     case K::dump_scenario:
     case K::dump_insight:
+    case K::select_region:
+    case K::pin_a:
+    case K::dump_ab:
       return insight_.execute(app_, c);
   }
   return Status::done;

@@ -1,5 +1,7 @@
 #include "app/gui/insight_views.h"
 
+#include <imgui.h>
+
 #include <stdexcept>
 
 #include "core/accel/bvh/bvh.h"
@@ -39,7 +41,75 @@ nlohmann::json figures_json(const ScenarioFigures& f) {
 }  // namespace
 
 bool InsightViews::busy() {
-  return ab_job_.busy() || insight_job_.busy() || scenario_job_.busy();
+  return ab_job_.busy() || insight_job_.busy() || scenario_job_.busy() || ab_dump_job_.busy();
+}
+
+std::shared_ptr<const ViewInsight> InsightViews::shown_insight(const AppState& app) {
+  const auto& insight = insight_job_.result();
+  return insight && app.current() && insight->built == app.current() ? insight : nullptr;
+}
+
+std::shared_ptr<const RegionTouch> InsightViews::region(const std::shared_ptr<const ViewInsight>& insight) {
+  if (!insight || !insight_state_.region || insight_state_.region->empty()) {
+    region_.reset();
+    region_for_ = nullptr;
+    return nullptr;
+  }
+  const PixelRect& r = *insight_state_.region;
+  if (!region_ || region_for_ != insight.get() || r.x0 != region_rect_for_.x0 || r.y0 != region_rect_for_.y0 ||
+      r.x1 != region_rect_for_.x1 || r.y1 != region_rect_for_.y1) {
+    region_ = std::make_shared<const RegionTouch>(region_touch(insight->record, r.x0, r.y0, r.x1, r.y1));
+    region_for_ = insight.get();
+    region_rect_for_ = r;
+  }
+  return region_;
+}
+
+BoxInsight InsightViews::box_insight(const AppState& app) {
+  BoxInsight b;
+  b.insight = shown_insight(app);
+  b.color_by_visits = insight_state_.hot_boxes;
+  b.region = region(b.insight);
+  return b;
+}
+
+void InsightViews::select_view_region(AppState& app, int ax, int ay, int bx, int by) {
+  const auto insight = shown_insight(app);
+  if (!insight) {  // measured first, then applied (draw())
+    pending_view_region_ = PixelRect{ax, ay, bx, by};
+    if (!insight_job_.busy() && app.current()) request_insight(app);
+    return;
+  }
+  pending_view_region_.reset();
+  const PixelRect r = view_rect_to_record(ax, ay, bx, by, app.view_width(), app.view_height(), insight->record.width,
+                                          insight->record.height);
+  if (r.empty())
+    insight_state_.region.reset();
+  else
+    insight_state_.region = r;
+}
+
+void InsightViews::draw_labels(const AppState& app, const ViewInsight& v, const panels::PanelLayout& layout) {
+  const std::uint32_t sel = selected_node(app);
+  const std::vector<NodeLabel> labels =
+      node_labels(v.built->nodes, v.visits, v.hot, static_cast<std::size_t>(std::max(0, insight_state_.labels)),
+                  app.config().view.show_boxes ? std::optional<std::uint32_t>(sel) : std::nullopt);
+  if (labels.empty() || app.view_width() <= 0 || app.view_height() <= 0) return;
+  // Behind every window, over the 3D view; framebuffer pixels to ImGui's window units.
+  ImDrawList* dl = ImGui::GetBackgroundDrawList();
+  const float sx = layout.width / static_cast<float>(app.view_width());
+  const float sy = layout.height / static_cast<float>(app.view_height());
+  const Camera cam = app.camera();
+  for (const NodeLabel& l : labels) {
+    const auto p = project_to_pixel(cam, l.anchor, app.view_width(), app.view_height());
+    if (!p) continue;
+    const ImVec2 at(p->x * sx, p->y * sy);
+    const ImVec2 size = ImGui::CalcTextSize(l.text.c_str());
+    dl->AddRectFilled(ImVec2(at.x - 2.0f, at.y - size.y - 2.0f), ImVec2(at.x + size.x + 2.0f, at.y),
+                      l.selected ? IM_COL32(150, 60, 20, 220) : IM_COL32(20, 20, 20, 200), 3.0f);
+    dl->AddText(ImVec2(at.x, at.y - size.y - 1.0f), IM_COL32(255, 255, 255, 255), l.text.c_str());
+    dl->AddCircleFilled(at, 2.5f, IM_COL32(255, 255, 255, 255));
+  }
 }
 
 void InsightViews::request_insight(AppState& app) {
@@ -108,13 +178,35 @@ void InsightViews::draw(AppState& app, const panels::PanelLayout& layout) {
     ab_job_.request([r](const std::atomic<bool>& cancel) { return run_ab(r, cancel); });
   }
 
+  // A click in the 3D view: the leaf its hit lies in becomes the selection
+  // (its path opens in the tree, which scrolls to it).
+  if (app.inspection_version() != inspection_seen_) {
+    inspection_seen_ = app.inspection_version();
+    const auto& insp = app.inspection();
+    if (insight_state_.click_selects_leaf && insp && app.current())
+      if (const auto leaf = hit_leaf(insp->trace, insp->hit, app.current()->nodes)) {
+        select_node(app, *leaf);
+        insight_state_.region.reset();
+        scroll_tree_ = true;
+      }
+  }
+
   // Predicted vs measured, hot nodes.
-  const auto insight = insight_job_.result();
-  const ViewInsight* shown = insight && insight->built == app.current() ? insight.get() : nullptr;
-  const panels::InsightAction ia =
-      panels::insight_panel(shown, insight_job_.busy(), insight_job_.error(), selected_node(app), layout);
+  const auto insight = shown_insight(app);
+  const ViewInsight* shown = insight.get();
+  if (pending_view_region_ && shown) {
+    const PixelRect p = *pending_view_region_;
+    select_view_region(app, p.x0, p.y0, p.x1, p.y1);
+  }
+  const auto touched = region(insight);
+  const panels::InsightAction ia = panels::insight_panel(insight_state_, shown, touched.get(), insight_job_.busy(),
+                                                         insight_job_.error(), selected_node(app), layout);
   if (ia.refresh && app.current()) request_insight(app);
-  if (ia.select) select_node(app, *ia.select);
+  if (ia.select) {
+    select_node(app, *ia.select);
+    insight_state_.region.reset();
+  }
+  if (shown) draw_labels(app, *shown, layout);
 
   // Explainer.
   std::string note;
@@ -122,9 +214,12 @@ void InsightViews::draw(AppState& app, const panels::PanelLayout& layout) {
   panels::explainer_panel(explainer_, e, explained_node_, note, layout);
 
   // Tree.
-  if (const auto pick = panels::tree_panel(app.current() ? &app.current()->nodes : nullptr,
-                                           shown ? &shown->visits : nullptr, selected_node(app), layout))
+  if (const auto pick =
+          panels::tree_panel(app.current() ? &app.current()->nodes : nullptr, shown ? &shown->visits : nullptr,
+                             selected_node(app), scroll_tree_, layout)) {
     select_node(app, *pick);
+    insight_state_.region.reset();
+  }
 
   // Scenarios.
   const panels::ScenarioAction sa =
@@ -163,6 +258,26 @@ nlohmann::json InsightViews::insight_json(const AppState& app) {
   nlohmann::json hot = nlohmann::json::array();
   for (const HotNode& h : v.hot) hot.push_back({{"node", h.node}, {"visits", h.visits}});
   j["hot"] = hot;
+  const std::uint32_t sel = selected_node(app);
+  j["selected"] = sel;
+  if (v.built) {
+    const StructureNode* n = v.built->nodes.node(sel);
+    j["selected_is_leaf"] = n && n->leaf;
+    j["selected_path"] = path_to(v.built->nodes, sel);
+  }
+  if (const auto touched = region(insight)) {
+    const PixelRect& r = *insight_state_.region;
+    j["region"] = {{"x0", r.x0},
+                   {"y0", r.y0},
+                   {"x1", r.x1},
+                   {"y1", r.y1},
+                   {"rays", touched->rays},
+                   {"nodes", touched->nodes.size()},
+                   {"prims", touched->prims.size()},
+                   {"hit_prims", touched->hit_prims.size()}};
+  } else {
+    j["region"] = nullptr;
+  }
   std::string note;
   if (const SplitExplanation* e = explanation(app, note)) {
     nlohmann::json axes = nlohmann::json::array();
@@ -219,6 +334,68 @@ ScriptHost::Status InsightViews::execute(AppState& app, const ScriptCommand& c) 
       script_insight_requested_ = false;
       if (!insight_job_.error().empty()) throw std::runtime_error("insight: " + insight_job_.error());
       if (const std::string err = write_file_atomic(c.arg, insight_json(app).dump(2) + "\n"); !err.empty())
+        throw std::runtime_error(err);
+      return ScriptHost::Status::done;
+    }
+    case K::select_region: {
+      // Needs the view measured: measure first when it is not (or is stale).
+      if (!shown_insight(app)) {
+        if (!app.settled() || !app.current()) return ScriptHost::Status::again;
+        if (!insight_job_.busy() && !script_insight_requested_) {
+          request_insight(app);
+          script_insight_requested_ = true;
+        }
+        if (insight_job_.busy()) return ScriptHost::Status::again;
+        script_insight_requested_ = false;
+        if (!insight_job_.error().empty()) throw std::runtime_error("insight: " + insight_job_.error());
+        if (!shown_insight(app)) return ScriptHost::Status::again;
+      }
+      select_view_region(app, c.x, c.y, c.x2, c.y2);
+      if (!insight_state_.region) throw std::runtime_error("select-region: the rectangle lies outside the view");
+      return ScriptHost::Status::done;
+    }
+    case K::pin_a:
+      ab_.pinned = app.config().structure;
+      app.set_message("pinned " + describe_choice(*ab_.pinned) + " as A");
+      return ScriptHost::Status::done;
+    case K::dump_ab: {
+      if (!ab_.pinned) throw std::runtime_error("dump-ab: nothing pinned as A (use pin-a first)");
+      if (!script_ab_requested_) {
+        if (!app.settled() || !app.current()) return ScriptHost::Status::again;
+        ABRequest r;
+        r.scene = app.current()->scene;
+        r.a = *ab_.pinned;
+        r.b = app.config().structure;
+        r.camera = app.camera();
+        r.width = ab_.width;
+        r.height = app.view_width() > 0 ? std::max(16, ab_.width * app.view_height() / app.view_width()) : ab_.height;
+        ab_dump_job_.request([r](const std::atomic<bool>& cancel) {
+          // Both metrics the lecture compares, each over the same view.
+          nlohmann::json out = {
+              {"a", describe_choice(r.a)}, {"b", describe_choice(r.b)}, {"width", r.width}, {"height", r.height}};
+          for (const HeatMetric m : {HeatMetric::nodes, HeatMetric::prims}) {
+            ABRequest rm = r;
+            rm.metric = m;
+            const ABResult res = run_ab(rm, cancel);
+            const ABFigures& f = res.figures;
+            out[std::string(metric_name(m))] = {
+                {"total_a", f.total_a},     {"total_b", f.total_b},   {"mean_a", f.mean_a}, {"mean_b", f.mean_b},
+                {"b_cheaper", f.b_cheaper}, {"b_dearer", f.b_dearer}, {"pixels", f.pixels}};
+            out["build_ms_a"] = res.build_ms_a;
+            out["build_ms_b"] = res.build_ms_b;
+            out["sah_a"] = res.sah_a;
+            out["sah_b"] = res.sah_b;
+          }
+          return out;
+        });
+        script_ab_requested_ = true;
+        return ScriptHost::Status::again;
+      }
+      if (ab_dump_job_.busy()) return ScriptHost::Status::again;
+      script_ab_requested_ = false;
+      if (!ab_dump_job_.error().empty()) throw std::runtime_error("A/B: " + ab_dump_job_.error());
+      if (!ab_dump_job_.result()) throw std::runtime_error("A/B: no result");
+      if (const std::string err = write_file_atomic(c.arg, ab_dump_job_.result()->dump(2) + "\n"); !err.empty())
         throw std::runtime_error(err);
       return ScriptHost::Status::done;
     }

@@ -7,8 +7,10 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "app/gui/scene_view.h"
 #include "core/analysis/insight/sah_explainer.h"
 #include "ui/app/app_state.h"
+#include "ui/app/hot_nodes.h"
 #include "ui/app/insight_jobs.h"
 #include "ui/app/scenarios.h"
 #include "ui/app/script.h"
@@ -19,19 +21,37 @@ namespace accelviz {
 class InsightViews {
  public:
   void draw(AppState& app, const panels::PanelLayout& layout);
-  /// scenario, dump-scenario, dump-insight.
+  /// scenario, dump-scenario, dump-insight, select-region, pin-a, dump-ab.
   ScriptHost::Status execute(AppState& app, const ScriptCommand& c);
+  /// What the 3D view shows of the insight: boxes by visits, a region's nodes and primitives.
+  BoxInsight box_insight(const AppState& app);
+  /// Selects the record pixels under a rectangle of the 3D view (view pixels, corners in any order).
+  void select_view_region(AppState& app, int ax, int ay, int bx, int by);
   /// A job is running (keep frames coming).
   bool busy();
 
  private:
   void request_insight(AppState& app);
+  /// The measured insight when it belongs to the structure shown.
+  std::shared_ptr<const ViewInsight> shown_insight(const AppState& app);
+  /// What the selected region's rays touched (cached per insight and rectangle).
+  std::shared_ptr<const RegionTouch> region(const std::shared_ptr<const ViewInsight>& insight);
+  void draw_labels(const AppState& app, const ViewInsight& v, const panels::PanelLayout& layout);
   const SplitExplanation* explanation(const AppState& app, std::string& note);
   nlohmann::json insight_json(const AppState& app);
 
   panels::ABPanelState ab_;
   AsyncJob<ABResult> ab_job_;
   AsyncJob<ViewInsight> insight_job_;
+  panels::InsightPanelState insight_state_;
+  std::shared_ptr<const RegionTouch> region_;
+  const ViewInsight* region_for_ = nullptr;
+  PixelRect region_rect_for_;
+  std::optional<PixelRect> pending_view_region_;  ///< select-region before a measurement: applied once measured
+  std::uint64_t inspection_seen_ = 0;
+  bool scroll_tree_ = false;
+  AsyncJob<nlohmann::json> ab_dump_job_;
+  bool script_ab_requested_ = false;
   panels::ExplainerState explainer_;
   panels::ScenarioPanelState scenario_;
   ScenarioJob scenario_job_;

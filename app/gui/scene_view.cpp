@@ -1,9 +1,10 @@
 #include "app/gui/scene_view.h"
 
-#include "ui/render/box_selection.h"
-
 #include <algorithm>
 #include <cmath>
+
+#include "ui/app/hot_nodes.h"
+#include "ui/render/box_selection.h"
 
 namespace accelviz {
 
@@ -38,7 +39,24 @@ void SceneView::upload_boxes(const AppState& app) {
   const ViewSettings& v = app.config().view;
   const BuiltStructure* built = app.current().get();
   // Everything the selection and its colours depend on.
+  const ViewInsight* insight =
+      box_insight_.insight && box_insight_.insight->built.get() == built ? box_insight_.insight.get() : nullptr;
+  const RegionTouch* region = insight ? box_insight_.region.get() : nullptr;
+  const bool by_visits = insight && box_insight_.color_by_visits;
+  // Primitives the selected region's rays tested, on the surface.
+  if (static_cast<const void*>(region) != region_uploaded_) {
+    region_uploaded_ = region;
+    std::vector<std::uint32_t> prims;
+    if (region && built && built->nodes.kind() != "voxels") {
+      const std::size_t n = built->scene->scene.triangles.size();
+      for (const std::uint32_t p : region->prims)
+        if (p < n) prims.push_back(p);
+    }
+    renderer_.set_highlighted_primitives(prims);
+  }
   const std::string key =
+      std::to_string(reinterpret_cast<std::uintptr_t>(insight)) + "/" + std::to_string(by_visits) + "/" +
+      std::to_string(reinterpret_cast<std::uintptr_t>(region)) + "/" +
       std::to_string(reinterpret_cast<std::uintptr_t>(built)) + "/" + std::to_string(static_cast<int>(v.box_mode)) +
       "/" + std::to_string(v.box_depth) + "/" + std::to_string(v.box_depth_last) + "/" + std::to_string(v.box_node) +
       "/" + std::to_string(static_cast<int>(v.box_color)) + "/" + std::to_string(static_cast<int>(v.colormap));
@@ -55,7 +73,21 @@ void SceneView::upload_boxes(const AppState& app) {
   sel.depth = static_cast<std::uint32_t>(v.box_depth);
   sel.depth_last = static_cast<std::uint32_t>(std::max(v.box_depth, v.box_depth_last));
   sel.node = static_cast<std::uint32_t>(v.box_node);
-  const StructureNodes::Selection s = built->nodes.select(sel, kMaxBoxes);
+  StructureNodes::Selection s;
+  if (region) {  // the nodes the region's rays entered, instead of the view's selection
+    for (const std::uint32_t id : region->nodes) {
+      if (s.boxes.size() >= kMaxBoxes) {
+        s.truncated = true;
+        break;
+      }
+      if (const StructureNode* n = built->nodes.node(id))
+        s.boxes.push_back({n->bounds, id, n->depth, n->leaf, n->sah_share});
+      else if (const auto b = built->nodes.box(id))
+        s.boxes.push_back({*b, id, 1, true, 0.0f});
+    }
+  } else {
+    s = built->nodes.select(sel, kMaxBoxes);
+  }
   boxes_drawn_ = s.boxes.size();
   boxes_truncated_ = s.truncated;
 
@@ -63,10 +95,18 @@ void SceneView::upload_boxes(const AppState& app) {
   boxes.reserve(s.boxes.size());
   float max_share = 0.0f;
   for (const NodeBox& b : s.boxes) max_share = std::max(max_share, b.sah_share);
-  for (const NodeBox& b : s.boxes) {
+  // Hot nodes: every box on the colour map by its visits (the hottest on top).
+  const std::vector<glm::vec4> hot =
+      by_visits ? visit_colors(s.boxes, insight->visits, v.colormap) : std::vector<glm::vec4>();
+  for (std::size_t i = 0; i < s.boxes.size(); ++i) {
+    const NodeBox& b = s.boxes[i];
     ColoredBox c;
     c.box = b.bounds;
-    if (v.box_color == BoxColorBy::depth) {
+    if (by_visits) {
+      c.color = hot[i];
+    } else if (region) {
+      c.color = glm::vec4(1.0f, 0.55f, 0.1f, 1.0f);
+    } else if (v.box_color == BoxColorBy::depth) {
       c.color = glm::vec4(qualitative_color(b.depth), 1.0f);
     } else {
       // Shares span orders of magnitude (the root's area against a leaf's):

@@ -2,13 +2,23 @@
 // The 3D view: keeps the renderer's uploads (triangles, node boxes, heatmap,
 // colour map, ray path) in step with the AppState and maps the user's view
 // settings onto a RenderView. Needs the window's GL context current.
-#include "ui/app/app_state.h"
-#include "ui/render/renderer.h"
-
 #include <cstdint>
 #include <string>
 
+#include "ui/app/app_state.h"
+#include "ui/app/insight_jobs.h"
+#include "ui/render/renderer.h"
+
 namespace accelviz {
+
+/// What the insight views add to the 3D view: the node boxes coloured by
+/// hot-node visits, and a heatmap region's nodes and primitives highlighted.
+/// Applies only while `insight` was measured on the structure shown.
+struct BoxInsight {
+  std::shared_ptr<const ViewInsight> insight;
+  bool color_by_visits = false;
+  std::shared_ptr<const RegionTouch> region;  ///< when set: its nodes are the boxes drawn, its primitives highlighted
+};
 
 class SceneView {
  public:
@@ -22,6 +32,9 @@ class SceneView {
   RenderView render_view(const AppState& app) const;
   /// Draws the view into the renderer's frame (width × height pixels).
   void draw(const AppState& app, int width, int height);
+
+  /// The insight views' overlay (sync() uploads it when it changed).
+  void set_box_insight(BoxInsight b) { box_insight_ = std::move(b); }
 
   Renderer& renderer() { return renderer_; }
   /// The heatmap range the legend shows under the current settings.
@@ -42,7 +55,9 @@ class SceneView {
   Renderer renderer_;
   const void* scene_ = nullptr;          ///< identity of the uploaded scene
   const void* heatmap_frame_ = nullptr;  ///< identity of the uploaded heatmap level
+  BoxInsight box_insight_;
   std::string box_key_;
+  const void* region_uploaded_ = nullptr;
   std::string ray_key_;
   int colormap_ = -1;
   bool has_heatmap_ = false;

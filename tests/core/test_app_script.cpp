@@ -117,6 +117,35 @@ TEST(AppScript, ErrorsNameFileAndLine) {
   EXPECT_EQ(parse_error("set leaf-cap 32\nset leaf 8\n"), "(no error)");
 }
 
+TEST(AppScript, InsightRegionAndABCommands) {
+  const auto cmds = parse_script(
+      "select-region 10 20 30 5\npin-a\ndump-ab /tmp/ab out.json\nset xray on\n"
+      "set back-to-front on\n",
+      "s.txt");
+  ASSERT_EQ(cmds.size(), 5u);
+  EXPECT_EQ(cmds[0].kind, K::select_region);
+  EXPECT_EQ(cmds[0].x, 10);
+  EXPECT_EQ(cmds[0].y, 20);
+  EXPECT_EQ(cmds[0].x2, 30);
+  EXPECT_EQ(cmds[0].y2, 5);
+  EXPECT_EQ(cmds[1].kind, K::pin_a);
+  EXPECT_EQ(cmds[2].kind, K::dump_ab);
+  EXPECT_EQ(cmds[2].arg, "/tmp/ab out.json");
+  EXPECT_EQ(command_name(K::select_region), "select-region");
+  for (const auto& [text, expected] : {
+           std::pair{"select-region 1 2 3\n", "s.txt:1: select-region: expected X0 Y0 X1 Y1"},
+           std::pair{"select-region 1 2 3 4 5\n", "s.txt:1: select-region: expected X0 Y0 X1 Y1"},
+           std::pair{"select-region 1 -2 3 4\n", "s.txt:1: select-region: expected X0 Y0 X1 Y1"},
+           std::pair{"select-region 5 2 5 4\n", "s.txt:1: select-region: the rectangle is empty"},
+           std::pair{"pin-a now\n", "s.txt:1: pin-a: takes no argument"},
+           std::pair{"dump-ab\n", "s.txt:1: dump-ab: expected a file path"},
+           std::pair{"set xray maybe\n", "s.txt:1: set xray: expected on or off"},
+       }) {
+    const std::string e = parse_error(text);
+    EXPECT_EQ(e.rfind(expected, 0), 0u) << "script: " << text << "\ngot: " << e;
+  }
+}
+
 TEST(AppScript, MissingFileIsAnError) {
   try {
     load_script("/nonexistent/dir/script.txt");

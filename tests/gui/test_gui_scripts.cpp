@@ -462,6 +462,81 @@ TEST_F(GuiScript, DynamicsPanelPlaysFramesAndEffectsFollowTheScene) {
       EXPECT_NE(e["reason"].get<std::string>().find("no lights"), std::string::npos) << e.dump();
     }
   }
+  // The counters: no lights, none traced; forced on, one per primary hit (to the synthetic light).
+  const nlohmann::json sv = read_json(path("static_stats.json"))["view"];
+  const nlohmann::json fv = read_json(path("forced_stats.json"))["view"];
+  EXPECT_EQ(sv["shadow_rays"].get<std::uint64_t>(), 0u);
+  EXPECT_GT(fv["shadow_rays"].get<std::uint64_t>(), 0u);
+  EXPECT_EQ(fv["shadow_rays"].get<std::uint64_t>(), fv["hits"].get<std::uint64_t>());
+}
+
+// Hot nodes in the window: a heatmap region selected with `select-region`
+// (3D-view pixels) reports the nodes and primitives its rays touched, fewer
+// for a smaller region inside it; a click in the 3D view selects the leaf
+// its hit lies in, with its path from the root.
+TEST_F(GuiScript, InsightRegionSelectionAndClickSelectsTheHitLeaf) {
+  const RunResult r = run(std::string("open ") + kTeapot + "\nsize 640 480\ncamera " + kCamera +
+                          "\nwait\n"
+                          "select-region 160 120 480 360\n"
+                          "dump-insight " +
+                          path("big.json").string() +
+                          "\nselect-region 330 250 300 220\n"  // corners in any order
+                          "dump-insight " +
+                          path("small.json").string() +
+                          "\nclick 320 240\n"
+                          "dump-insight " +
+                          path("click.json").string() + "\ndump-ray " + path("ray.json").string() + "\nquit\n");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json big = read_json(path("big.json")), small = read_json(path("small.json"));
+  ASSERT_TRUE(big["region"].is_object()) << big.dump();
+  ASSERT_TRUE(small["region"].is_object()) << small.dump();
+  EXPECT_GT(small["region"]["nodes"].get<int>(), 0);
+  EXPECT_GT(small["region"]["prims"].get<int>(), 0);
+  EXPECT_GT(big["region"]["rays"].get<int>(), small["region"]["rays"].get<int>());
+  EXPECT_GT(big["region"]["nodes"].get<int>(), small["region"]["nodes"].get<int>());
+  EXPECT_GT(big["region"]["prims"].get<int>(), small["region"]["prims"].get<int>());
+  // 640×480 onto the 128-wide record: x 160..480 -> 32..96.
+  EXPECT_EQ(big["region"]["x0"], 32);
+  EXPECT_EQ(big["region"]["x1"], 96);
+
+  const nlohmann::json c = read_json(path("click.json")), ray = read_json(path("ray.json"));
+  ASSERT_FALSE(ray["hit"].is_null()) << "the middle pixel hits the teapot";
+  EXPECT_TRUE(c["selected_is_leaf"].get<bool>()) << c["selected"];
+  EXPECT_TRUE(c["region"].is_null()) << "a new selection replaces the region";
+  const auto& p = c["selected_path"];
+  ASSERT_GE(p.size(), 2u);
+  EXPECT_EQ(p.front(), 0);
+  EXPECT_EQ(p.back(), c["selected"]);
+  // The leaf is one the clicked ray entered.
+  bool entered = false;
+  for (const auto& st : ray["steps"]) entered |= st["kind"] == "entered" && st["id"] == c["selected"];
+  EXPECT_TRUE(entered) << c["selected"];
+}
+
+// A/B from a script: A pinned with leaf size 1, B with leaf size 16 on the
+// same view: B tests more primitives and enters fewer nodes. Then x-ray on
+// (the heatmap's traversal toggle): the heatmap and B count more primitive
+// tests than front-to-back with early termination.
+TEST_F(GuiScript, ABFromAScriptAndTheHeatmapsXray) {
+  const RunResult r = run(std::string("open ") + kTeapot + "\nsize 480 360\ncamera " + kCamera +
+                          "\nset leaf 1\nset heatmap full\nwait\npin-a\nset leaf 16\nwait\n"
+                          "dump-ab " +
+                          path("leaf.json").string() + "\ndump-stats " + path("plain.json").string() +
+                          "\npin-a\nset xray on\nwait\ndump-stats " + path("xray.json").string() + "\ndump-ab " +
+                          path("xray-ab.json").string() + "\nquit\n");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json leaf = read_json(path("leaf.json"));
+  EXPECT_NE(leaf["a"].get<std::string>().find("leaf 1"), std::string::npos) << leaf["a"];
+  EXPECT_NE(leaf["b"].get<std::string>().find("leaf 16"), std::string::npos) << leaf["b"];
+  EXPECT_GT(leaf["prims"]["total_b"].get<double>(), leaf["prims"]["total_a"].get<double>());
+  EXPECT_LT(leaf["nodes"]["total_b"].get<double>(), leaf["nodes"]["total_a"].get<double>());
+  EXPECT_GT(leaf["prims"]["pixels"].get<int>(), 0);
+
+  const nlohmann::json plain = read_json(path("plain.json")), xray = read_json(path("xray.json"));
+  EXPECT_GT(xray["view"]["mean_prims"].get<double>(), plain["view"]["mean_prims"].get<double>());
+  const nlohmann::json xab = read_json(path("xray-ab.json"));
+  EXPECT_NE(xab["b"].get<std::string>().find("x-ray"), std::string::npos) << xab["b"];
+  EXPECT_GT(xab["prims"]["total_b"].get<double>(), xab["prims"]["total_a"].get<double>());
 }
 
 // View panel "Trace on: GPU" (`set heatmap-gpu on`): the BVH's heatmap is

@@ -249,6 +249,10 @@ const std::vector<Entry>& entries() {
         [](AppConfig& c) -> TriangleTest& { return c.structure.query.triangle_test; }));
     t.push_back(bool_option("ordered", "front-to-back child order (off: fixed order)",
                             [](AppConfig& c) -> bool& { return c.structure.query.ordered; }));
+    t.push_back(bool_option("back-to-front", "BVH, ordered: the farther child first (the worst order; same hit)",
+                            [](AppConfig& c) -> bool& { return c.structure.query.back_to_front; }));
+    t.push_back(bool_option("xray", "BVH: count the full traversal as if no hit ended it (same hit)",
+                            [](AppConfig& c) -> bool& { return c.structure.query.xray; }));
     // View layers.
     t.push_back(bool_option("mesh", "shaded mesh", [](AppConfig& c) -> bool& { return c.view.show_mesh; }));
     t.push_back(
@@ -414,7 +418,11 @@ std::string describe_structure(const StructureChoice& choice) {
 std::string screenshot_caption(const AppConfig& config) {
   std::string s = describe_structure(config.structure);
   s += ", " + option_value(config, "triangle-test");
-  if (!config.structure.query.ordered) s += ", unordered";
+  if (!config.structure.query.ordered)
+    s += ", unordered";
+  else if (config.structure.query.back_to_front)
+    s += ", back-to-front";
+  if (config.structure.query.xray) s += ", x-ray";
   if (config.view.heatmap != HeatmapDisplay::off) {
     s += ", heatmap " + std::string(metric_name(config.view.metric)) + " " +
          std::string(colormap_name(config.view.colormap)) + " scale " + option_value(config, "scale");

@@ -78,6 +78,8 @@ AppState::HeatmapKey AppState::heatmap_key(int w, int h) const {
   k.metric = config().view.metric;
   k.test = config().structure.query.triangle_test;
   k.ordered = config().structure.query.ordered;
+  k.back_to_front = config().structure.query.back_to_front;
+  k.xray = config().structure.query.xray;
   // The cost metric weighs with the BVH's C_trav/C_isect, as `render --ctrav/--cisect` does.
   k.c_trav = config().structure.options.bvh.cost_traversal;
   k.c_isect = config().structure.options.bvh.cost_intersect;
@@ -181,7 +183,8 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
     }
     // Query options changed: the inspected ray is re-cast with them.
     const QueryOptions& q = config().structure.query;
-    if (inspection_ && (q.triangle_test != inspected_query_.triangle_test || q.ordered != inspected_query_.ordered))
+    if (inspection_ && (q.triangle_test != inspected_query_.triangle_test || q.ordered != inspected_query_.ordered ||
+                        q.back_to_front != inspected_query_.back_to_front || q.xray != inspected_query_.xray))
       recast();
   }
   if (auto latest = heatmaps_.latest(); !heatmap_on_gpu_ && latest != heatmap_) {

@@ -146,6 +146,7 @@ class AppState {
     HeatMetric metric = HeatMetric::nodes;
     TriangleTest test = TriangleTest::watertight;
     bool ordered = true;
+    bool back_to_front = false, xray = false;
     float c_trav = 1.0f, c_isect = 1.0f;
     bool shadows = false;  ///< shadow rays traced (scene lights or forced on)
     bool gpu = false;      ///< heatmap-gpu

@@ -90,6 +90,9 @@ constexpr NamedKind kCommands[] = {
     {"force-effect", ScriptCommand::Kind::force_effect},
     {"play", ScriptCommand::Kind::play},
     {"dump-dynamics", ScriptCommand::Kind::dump_dynamics},
+    {"select-region", ScriptCommand::Kind::select_region},
+    {"pin-a", ScriptCommand::Kind::pin_a},
+    {"dump-ab", ScriptCommand::Kind::dump_ab},
 };
 
 }  // namespace
@@ -125,7 +128,7 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
       fail("unknown command '" + std::string(word) +
            "' (valid: open, structure, set, camera, size, wait, click, step, screenshot, dump-ray, dump-stats, quit, "
            "scenario, dump-scenario, "
-           "dump-insight, force-effect, play, dump-dynamics)");
+           "dump-insight, force-effect, play, dump-dynamics, select-region, pin-a, dump-ab)");
 
     ScriptCommand c;
     c.kind = it->kind;
@@ -146,6 +149,7 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
       case ScriptCommand::Kind::dump_scenario:
       case ScriptCommand::Kind::dump_insight:
       case ScriptCommand::Kind::dump_dynamics:
+      case ScriptCommand::Kind::dump_ab:
         // The rest of the line, so paths may hold spaces.
         need_rest(c.kind == ScriptCommand::Kind::open ? "a scene (file or builtin:NAME)" : "a file path");
         c.arg = std::string(rest);
@@ -197,8 +201,26 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
           fail("step: expected N (>= 0), next, prev, first or last, got '" + c.arg + "'");
         break;
       }
+      case ScriptCommand::Kind::select_region: {
+        int v[4] = {0, 0, 0, 0};
+        std::string_view left = rest;
+        for (int& x : v) {
+          std::string_view after;
+          const std::string_view w = first_word(left, after);
+          if (!parse_int(w, x) || x < 0) fail("select-region: expected X0 Y0 X1 Y1 (four integers >= 0)");
+          left = after;
+        }
+        if (!left.empty()) fail("select-region: expected X0 Y0 X1 Y1 (four integers >= 0)");
+        if (v[0] == v[2] || v[1] == v[3]) fail("select-region: the rectangle is empty");
+        c.x = v[0];
+        c.y = v[1];
+        c.x2 = v[2];
+        c.y2 = v[3];
+        break;
+      }
       case ScriptCommand::Kind::wait:
       case ScriptCommand::Kind::quit:
+      case ScriptCommand::Kind::pin_a:
         no_rest();
         break;
       case ScriptCommand::Kind::force_effect: {

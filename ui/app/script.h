@@ -31,14 +31,18 @@ struct ScriptCommand {
     force_effect,   ///< arg: effect name, value: "on" | "off" (Scene panel's force checkbox)
     play,           ///< x: frames; plays the Dynamics timeline until that many more frames were stepped
     dump_dynamics,  ///< arg: path; the effects and the Dynamics panel's per-frame figures as JSON
+    select_region,  ///< x, y, x2, y2: a rectangle of the 3D view (pixels); selects the insight record's pixels under it
+    pin_a,          ///< pins the current structure and query options as A (A/B compare)
+    dump_ab,        ///< arg: path; compares A with the current choice (B) on this view, writes the totals as JSON
   };
   Kind kind = Kind::wait;
-  int line = 0;       ///< 1-based line in the script file
-  std::string text;   ///< the line as written (trimmed), for messages
-  std::string arg;    ///< open: scene; structure: name; set: key; camera: spec; step: N|next|prev|first|last;
-                      ///< screenshot/dump-*: path
-  std::string value;  ///< set: value
-  int x = 0, y = 0;   ///< size: width, height; click: pixel
+  int line = 0;        ///< 1-based line in the script file
+  std::string text;    ///< the line as written (trimmed), for messages
+  std::string arg;     ///< open: scene; structure: name; set: key; camera: spec; step: N|next|prev|first|last;
+                       ///< screenshot/dump-*: path
+  std::string value;   ///< set: value
+  int x = 0, y = 0;    ///< size: width, height; click: pixel; select-region: first corner
+  int x2 = 0, y2 = 0;  ///< select-region: second corner
 };
 
 /// The command's name as written in scripts ("dump-ray").

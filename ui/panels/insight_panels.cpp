@@ -122,8 +122,8 @@ ABAction ab_panel(ABPanelState& st, const ABResult* r, bool busy, const std::str
 
 // ---- Predicted vs measured ----------------------------------------------------------------
 
-InsightAction insight_panel(const ViewInsight* v, bool busy, const std::string& error, std::uint32_t selected,
-                            const PanelLayout& layout) {
+InsightAction insight_panel(InsightPanelState& st, const ViewInsight* v, const RegionTouch* region, bool busy,
+                            const std::string& error, std::uint32_t selected, const PanelLayout& layout) {
   InsightAction act;
   place_at(layout, 330.0f, 100.0f, 470.0f, 480.0f);
   if (!ImGui::Begin("Predicted vs measured")) {
@@ -202,21 +202,67 @@ InsightAction insight_panel(const ViewInsight* v, bool busy, const std::string& 
     }
     ImGui::EndTable();
   }
-  // The pixels whose rays entered the selected node.
-  if (v->record.width > 0 && selected < v->visits.size()) {
-    ImGui::Text("Pixels whose rays entered node %u (%" PRIu64 " rays):", selected, v->visits[selected]);
+  ImGui::Checkbox("Colour boxes by visits", &st.hot_boxes);
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(90.0f * layout.scale);
+  ImGui::SliderInt("labels", &st.labels, 0, 20, "top %d");
+  ImGui::Checkbox("3D click selects the hit's leaf", &st.click_selects_leaf);
+  // The view's rays: nodes entered per pixel, the selected node's pixels in
+  // orange; drag a rectangle to select a region.
+  const int rw = v->record.width, rh = v->record.height;
+  if (rw > 0 && rh > 0 && v->record.stats.size() == static_cast<std::size_t>(rw) * rh) {
+    ImGui::Text("Nodes entered per pixel; orange: rays that entered node %u (%llu rays)", selected,
+                static_cast<unsigned long long>(selected < v->visits.size() ? v->visits[selected] : 0));
+    ImGui::TextDisabled("Drag on the image to select a region (or Ctrl+drag in the 3D view).");
     const std::vector<std::uint8_t> mask = pixels_visiting(v->record, selected);
-    const float cell = 2.0f;
+    std::uint32_t max_nodes = 1;
+    for (const RayStats& r : v->record.stats) max_nodes = std::max(max_nodes, r.nodes_visited);
+    const float cell = std::max(1.0f, std::floor(2.0f * layout.scale));
     ImDrawList* dl = ImGui::GetWindowDrawList();
     const ImVec2 at = ImGui::GetCursorScreenPos();
-    dl->AddRectFilled(at, ImVec2(at.x + v->record.width * cell, at.y + v->record.height * cell),
-                      IM_COL32(40, 40, 40, 255));
-    for (int y = 0; y < v->record.height; ++y)
-      for (int x = 0; x < v->record.width; ++x)
-        if (mask[static_cast<std::size_t>(y) * v->record.width + x])
-          dl->AddRectFilled(ImVec2(at.x + x * cell, at.y + y * cell),
-                            ImVec2(at.x + (x + 1) * cell, at.y + (y + 1) * cell), IM_COL32(255, 190, 60, 255));
-    ImGui::Dummy(ImVec2(v->record.width * cell, v->record.height * cell));
+    for (int y = 0; y < rh; ++y)
+      for (int x = 0; x < rw; ++x) {
+        const std::size_t p = static_cast<std::size_t>(y) * rw + x;
+        const glm::vec3 c =
+            mask[p] ? glm::vec3(1.0f, 0.75f, 0.25f)
+                    : colormap(ColorMap::viridis, static_cast<float>(v->record.stats[p].nodes_visited) / max_nodes);
+        dl->AddRectFilled(
+            ImVec2(at.x + x * cell, at.y + y * cell), ImVec2(at.x + (x + 1) * cell, at.y + (y + 1) * cell),
+            IM_COL32(static_cast<int>(c.x * 255), static_cast<int>(c.y * 255), static_cast<int>(c.z * 255), 255));
+      }
+    ImGui::InvisibleButton("record", ImVec2(rw * cell, rh * cell));
+    const ImVec2 m = ImGui::GetIO().MousePos;
+    const int mx = std::clamp(static_cast<int>(std::floor((m.x - at.x) / cell)), 0, rw);
+    const int my = std::clamp(static_cast<int>(std::floor((m.y - at.y) / cell)), 0, rh);
+    if (ImGui::IsItemActivated()) {
+      st.dragging = true;
+      st.drag_x = mx;
+      st.drag_y = my;
+    }
+    std::optional<PixelRect> shown = st.region;
+    if (st.dragging) {
+      const PixelRect r{std::min(st.drag_x, mx), std::min(st.drag_y, my), std::max(st.drag_x, mx) + 1,
+                        std::max(st.drag_y, my) + 1};
+      shown = PixelRect{r.x0, r.y0, std::min(r.x1, rw), std::min(r.y1, rh)};
+      if (!ImGui::IsItemActive()) {
+        st.dragging = false;
+        st.region = shown;
+      }
+    }
+    if (shown && !shown->empty())
+      dl->AddRect(ImVec2(at.x + shown->x0 * cell, at.y + shown->y0 * cell),
+                  ImVec2(at.x + shown->x1 * cell, at.y + shown->y1 * cell), IM_COL32(255, 255, 255, 255), 0.0f, 0,
+                  2.0f);
+  }
+  if (st.region) {
+    if (region)
+      ImGui::TextWrapped(
+          "Region x %d..%d, y %d..%d: %llu rays entered %zu nodes, tested %zu primitives, hit %zu "
+          "(boxes and primitives highlighted in the 3D view)",
+          st.region->x0, st.region->x1 - 1, st.region->y0, st.region->y1 - 1,
+          static_cast<unsigned long long>(region->rays), region->nodes.size(), region->prims.size(),
+          region->hit_prims.size());
+    if (ImGui::SmallButton("Clear region")) st.region.reset();
   }
   ImGui::End();
   return act;
@@ -348,7 +394,7 @@ bool on_path(const StructureNodes& nodes, std::uint32_t id, std::uint32_t select
 }
 
 void tree_rows(const StructureNodes& nodes, const std::vector<std::uint64_t>* visits, std::uint32_t id,
-               std::uint32_t selected, std::optional<std::uint32_t>& clicked, int budget_depth) {
+               std::uint32_t selected, std::optional<std::uint32_t>& clicked, bool& scroll, int budget_depth) {
   const StructureNode* n = nodes.node(id);
   if (!n) return;
   char label[160];
@@ -366,9 +412,14 @@ void tree_rows(const StructureNodes& nodes, const std::vector<std::uint64_t>* vi
   ImGui::PushID(static_cast<int>(id));
   const bool open = ImGui::TreeNodeEx("n", flags, "%s", label);
   if (ImGui::IsItemClicked() && !ImGui::IsItemToggledOpen()) clicked = id;
+  if (id == selected && scroll) {
+    ImGui::SetScrollHereY(0.5f);
+    scroll = false;
+  }
   if (open && !n->leaf) {
     if (budget_depth > 0)
-      for (const std::uint32_t c : nodes.children(id)) tree_rows(nodes, visits, c, selected, clicked, budget_depth - 1);
+      for (const std::uint32_t c : nodes.children(id))
+        tree_rows(nodes, visits, c, selected, clicked, scroll, budget_depth - 1);
     ImGui::TreePop();
   }
   ImGui::PopID();
@@ -377,7 +428,7 @@ void tree_rows(const StructureNodes& nodes, const std::vector<std::uint64_t>* vi
 }  // namespace
 
 std::optional<std::uint32_t> tree_panel(const StructureNodes* nodes, const std::vector<std::uint64_t>* visits,
-                                        std::uint32_t selected, const PanelLayout& layout) {
+                                        std::uint32_t selected, bool& scroll_to_selected, const PanelLayout& layout) {
   std::optional<std::uint32_t> clicked;
   place_at(layout, 330.0f, 180.0f, 420.0f, 420.0f);
   if (!ImGui::Begin("Tree")) {
@@ -389,7 +440,7 @@ std::optional<std::uint32_t> tree_panel(const StructureNodes* nodes, const std::
   } else {
     ImGui::TextDisabled("%s, %llu nodes; click a row to select its subtree in the 3D view", nodes->kind().c_str(),
                         static_cast<unsigned long long>(nodes->size()));
-    tree_rows(*nodes, visits, 0, selected, clicked, 128);
+    tree_rows(*nodes, visits, 0, selected, clicked, scroll_to_selected, 128);
   }
   ImGui::End();
   return clicked;

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/analysis/insight/sah_explainer.h"
+#include "ui/app/hot_nodes.h"
 #include "ui/app/insight_jobs.h"
 #include "ui/app/scenarios.h"
 #include "ui/panels/panels.h"
@@ -31,12 +32,21 @@ ABAction ab_panel(ABPanelState& state, const ABResult* result, bool busy, const 
                   const StructureChoice& current, const PanelLayout& layout);
 
 // ---- Predicted vs measured, hot nodes, traversal modes ----------------------------------
+struct InsightPanelState {
+  bool hot_boxes = true;            ///< colour the 3D view's boxes by visits
+  int labels = 5;                   ///< label the selected node and this many hot nodes in the 3D view
+  bool click_selects_leaf = true;   ///< a click in the 3D view selects the leaf its hit lies in
+  std::optional<PixelRect> region;  ///< selected pixels of the record (drag on the image)
+  bool dragging = false;
+  int drag_x = 0, drag_y = 0;  ///< record pixel where the drag started
+};
 struct InsightAction {
   bool refresh = false;
   std::optional<std::uint32_t> select;  ///< a hot node clicked
 };
-InsightAction insight_panel(const ViewInsight* insight, bool busy, const std::string& error, std::uint32_t selected,
-                            const PanelLayout& layout);
+/// `region`: what the rays of state.region touched (null when none is selected).
+InsightAction insight_panel(InsightPanelState& state, const ViewInsight* insight, const RegionTouch* region, bool busy,
+                            const std::string& error, std::uint32_t selected, const PanelLayout& layout);
 
 // ---- Binned-SAH explainer -------------------------------------------------------------------
 struct ExplainerState {
@@ -49,9 +59,10 @@ bool explainer_panel(ExplainerState& state, const SplitExplanation* e, std::uint
 
 // ---- Tree view ------------------------------------------------------------------------------
 /// Collapsible tree of `nodes` (count, depth, SAH share, visits when known);
-/// the path to `selected` is opened. Returns a node the user clicked.
+/// the path to `selected` is opened (and scrolled to when `scroll_to_selected`
+/// is set; it is cleared once done). Returns a node the user clicked.
 std::optional<std::uint32_t> tree_panel(const StructureNodes* nodes, const std::vector<std::uint64_t>* visits,
-                                        std::uint32_t selected, const PanelLayout& layout);
+                                        std::uint32_t selected, bool& scroll_to_selected, const PanelLayout& layout);
 
 // ---- Scenarios ------------------------------------------------------------------------------
 struct ScenarioPanelState {

@@ -324,7 +324,7 @@ void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const Pa
 
 // ---- View -----------------------------------------------------------------------------------
 
-bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout) {
+bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout, QueryOptions* query) {
   bool changed = false;
   place(layout, -438, 356, 320, 404);
   if (!ImGui::Begin("View")) {
@@ -409,6 +409,22 @@ bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout
   if (combo("Colour map", map, {"viridis", "inferno", "turbo"})) {
     v.colormap = static_cast<ColorMap>(map);
     changed = true;
+  }
+  if (query) {
+    // Same hit in every mode; only the work counted changes (docs/insight.md).
+    int order = !query->ordered ? 2 : query->back_to_front ? 1 : 0;
+    if (combo("Traversal", order, {"front-to-back", "back-to-front", "unordered"})) {
+      query->ordered = order != 2;
+      query->back_to_front = order == 1;
+      changed = true;
+    }
+    changed |= checkbox("X-ray", query->xray,
+                        "count the full traversal as if no hit ended it (the cost behind the first surface)");
+    if (info.node_kind != "bvh" && (query->back_to_front || query->xray))
+      ImGui::TextDisabled("back-to-front and x-ray apply to the BVH only; %s ignores them",
+                          info.node_kind.empty() ? "this structure" : info.node_kind.c_str());
+    else if (info.node_kind != "bvh")
+      ImGui::TextDisabled("back-to-front and x-ray: BVH only");
   }
   if (v.heatmap == HeatmapDisplay::blend)
     changed |= ImGui::SliderFloat("Opacity", &v.opacity, 0.0f, 1.0f, "%.2f", ImGuiSliderFlags_AlwaysClamp);

@@ -70,7 +70,9 @@ struct ViewInfo {
 /// Every renderer layer: mesh, wireframe, node boxes (selection, colouring),
 /// heatmap (display, metric, colour map, scale, opacity, legend), ray path,
 /// multisampling. Returns true when `view` changed.
-bool view_panel(ViewSettings& view, const ViewInfo& info, const PanelLayout& layout);
+/// `query` (optional): the heatmap section's traversal order (front-to-back,
+/// back-to-front, unordered) and x-ray toggle, BVH only (a note elsewhere).
+bool view_panel(ViewSettings& view, const ViewInfo& info, const PanelLayout& layout, QueryOptions* query = nullptr);
 
 // ---- Ray -------------------------------------------------------------------------------
 /// Origin, direction, hit, barycentrics, counters, shadow rays, and the

@@ -53,6 +53,11 @@ void Renderer::set_ray_path(const RayPath& path) {
   has_ray_path_ = true;
 }
 
+void Renderer::set_highlighted_primitives(std::vector<std::uint32_t> prims, glm::vec4 color) {
+  region_prims_ = std::move(prims);
+  region_color_ = color;
+}
+
 void Renderer::clear_ray_path() {
   ray_geometry_.upload({});
   visited_boxes_.upload({});
@@ -155,6 +160,12 @@ void Renderer::render(const RenderView& view, int width, int height) {
   if (heatmap_on && hv.mode == HeatmapMode::blend) {
     heatmap_.draw(programs_.heatmap, range, hv.opacity);
     check_gl_errors("heatmap pass");
+  }
+
+  // 2b. Highlighted primitives (a heatmap region's).
+  if (view.show_mesh && !region_prims_.empty()) {
+    mesh_.draw_primitives(programs_.mesh, m, region_prims_, region_color_);
+    check_gl_errors("highlight pass");
   }
 
   // 3. Box overlays.

@@ -39,6 +39,9 @@ class Renderer {
   void set_quads(std::span<const TranslucentQuad> quads);
   void set_ray_path(const RayPath& path);
   void clear_ray_path();
+  /// Primitives drawn highlighted on the surface regardless of the ray path
+  /// (a heatmap region's tested primitives); empty: none.
+  void set_highlighted_primitives(std::vector<std::uint32_t> prims, glm::vec4 color = {1.0f, 0.55f, 0.1f, 1.0f});
   /// The metric image shown when RenderView::heatmap.mode is not off.
   void set_heatmap(const MetricImage& image);
   /// The heatmap colour map (viridis until set).
@@ -86,6 +89,8 @@ class Renderer {
   HeatmapPass heatmap_;
   LegendPass legend_;
   std::vector<std::uint32_t> highlighted_;
+  std::vector<std::uint32_t> region_prims_;
+  glm::vec4 region_color_{1.0f};
   RayPathStyle ray_style_;
   bool has_ray_path_ = false;
 };
