@@ -45,6 +45,8 @@ const std::map<std::string, std::string> kOtherValues = {
     {"embree-robust", "on"},
     {"triangle-test", "fast"},
     {"ordered", "off"},
+    {"back-to-front", "on"},
+    {"xray", "on"},
     {"mesh", "off"},
     {"wireframe", "on"},
     {"boxes", "off"},
