@@ -169,8 +169,11 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
           gpu_note_ = "only the bvh structure is traced on the GPU";
         else {
           try {
+            // Primary rays only: shadow rays (scene lights) are not traced on the GPU.
+            HeatmapRequest primary = r;
+            primary.shadow_lights.clear();
             heatmaps_.cancel();
-            heatmap_ = gpu_tracer_(r, ++gpu_frame_id_);
+            heatmap_ = gpu_tracer_(primary, ++gpu_frame_id_);
             heatmap_on_gpu_ = true;
             u.heatmap_changed = true;
           } catch (const std::exception& e) {
