@@ -230,6 +230,9 @@ InsightAction insight_panel(InsightPanelState& st, const ViewInsight* v, const R
             ImVec2(at.x + x * cell, at.y + y * cell), ImVec2(at.x + (x + 1) * cell, at.y + (y + 1) * cell),
             IM_COL32(static_cast<int>(c.x * 255), static_cast<int>(c.y * 255), static_cast<int>(c.z * 255), 255));
       }
+    st.image_x = at.x;
+    st.image_y = at.y;
+    st.image_cell = cell;
     ImGui::InvisibleButton("record", ImVec2(rw * cell, rh * cell));
     const ImVec2 m = ImGui::GetIO().MousePos;
     const int mx = std::clamp(static_cast<int>(std::floor((m.x - at.x) / cell)), 0, rw);

@@ -39,6 +39,7 @@ struct InsightPanelState {
   std::optional<PixelRect> region;  ///< selected pixels of the record (drag on the image)
   bool dragging = false;
   int drag_x = 0, drag_y = 0;  ///< record pixel where the drag started
+  float image_x = 0.0f, image_y = 0.0f, image_cell = 0.0f;  ///< where the record image was last drawn (screen)
 };
 struct InsightAction {
   bool refresh = false;
