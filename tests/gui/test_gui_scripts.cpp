@@ -422,9 +422,9 @@ TEST_F(GuiScript, InsightScenariosAndPredictedVsMeasured) {
 // scene's two-level structure. A static OBJ without lights reports shadow
 // rays and per-frame updates off, and a force turns shadow rays on, said so.
 TEST_F(GuiScript, DynamicsPanelPlaysFramesAndEffectsFollowTheScene) {
-  const RunResult r = run("open builtin:dynamic?size=6000\nsize 480 360\nwait\ndump-stats " + path("rest.json").string() +
-                          "\nplay 3\nwait\ndump-dynamics " + path("dyn.json").string() + "\ndump-stats " +
-                          path("frame.json").string() + "\nquit\n");
+  const RunResult r = run("open builtin:dynamic?size=6000\nsize 480 360\nwait\ndump-stats " +
+                          path("rest.json").string() + "\nplay 3\nwait\ndump-dynamics " + path("dyn.json").string() +
+                          "\ndump-stats " + path("frame.json").string() + "\nquit\n");
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json d = read_json(path("dyn.json"));
   ASSERT_TRUE(d["dynamics"].is_object()) << d.dump();
@@ -449,7 +449,6 @@ TEST_F(GuiScript, DynamicsPanelPlaysFramesAndEffectsFollowTheScene) {
   EXPECT_GT(shown["time"].get<double>(), 0.0);
   const nlohmann::json rest_view = read_json(path("rest.json"))["view"];
   const nlohmann::json frame_view = read_json(path("frame.json"))["view"];
-  
   EXPECT_NE(frame_view["mean_nodes"].get<double>(), rest_view["mean_nodes"].get<double>());
 
   const fs::path obj = path("tri.obj");
@@ -473,12 +472,6 @@ TEST_F(GuiScript, DynamicsPanelPlaysFramesAndEffectsFollowTheScene) {
       EXPECT_NE(e["reason"].get<std::string>().find("no lights"), std::string::npos) << e.dump();
     }
   }
-  // The counters: no lights, none traced; forced on, one per primary hit (to the synthetic light).
-  const nlohmann::json sv = read_json(path("static_stats.json"))["view"];
-  const nlohmann::json fv = read_json(path("forced_stats.json"))["view"];
-  EXPECT_EQ(sv["shadow_rays"].get<std::uint64_t>(), 0u);
-  EXPECT_GT(fv["shadow_rays"].get<std::uint64_t>(), 0u);
-  EXPECT_EQ(fv["shadow_rays"].get<std::uint64_t>(), fv["hits"].get<std::uint64_t>());
   // The counters: no lights, none traced; forced on, one per primary hit (to the synthetic light).
   const nlohmann::json sv = read_json(path("static_stats.json"))["view"];
   const nlohmann::json fv = read_json(path("forced_stats.json"))["view"];
