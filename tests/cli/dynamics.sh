@@ -87,4 +87,22 @@ rc=$?
 set -e
 [ $rc -eq 2 ] || { echo "FAIL: unknown effect: exit $rc"; exit 1; }
 grep -q "motion-blur" <<<"$msg" || { echo "FAIL: message should name the effect: $msg"; exit 1; }
+# flatten: the what-if traces the same rays through both (same hits); bad ids are a usage error.
+"$accelviz" -q flatten 'builtin:forest?size=20000&seed=3' --instances 0,1,2 --size 40x30 --json -j 1 | python3 -c '
+import json, sys
+j = json.load(sys.stdin)
+a, b = j["two_level"], j["flattened"]
+assert j["merged_instances"] == 3 and j["merged_triangles"] > 0, j
+assert b["instances"] == a["instances"] - 2, j
+assert a["rays"] == b["rays"] == 1200 and a["hits"] == b["hits"] > 0, j
+assert a["sah_cost"] > 0 and b["sah_cost"] > 0 and a["mean_instances"] > 0, j
+print("flatten what-if ok")'
+for ids in "0,0" "x" "99999"; do
+  set +e
+  msg=$("$accelviz" flatten 'builtin:forest?size=2000' --instances "$ids" 2>&1)
+  rc=$?
+  set -e
+  [ $rc -eq 2 ] || { echo "FAIL: flatten --instances $ids: exit $rc, expected 2"; exit 1; }
+  grep -q -- "--instances" <<<"$msg" || { echo "FAIL: message should name --instances: $msg"; exit 1; }
+done
 echo "dynamics cli ok"
