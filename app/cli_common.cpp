@@ -67,6 +67,12 @@ void StructureCli::add_to(CLI::App* app) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str()
       ->group("Structure");
+  app->add_option("--wide", wide,
+                  "BVH fast path: width of the SIMD tree the uninstrumented queries walk: 0 = 8 (AVX2) where the "
+                  "CPU has AVX2, else 4 (SSE); 4; 8 (4 without AVX2)")
+      ->check(CLI::IsMember({0, 4, 8}))
+      ->capture_default_str()
+      ->group("Structure");
   app->add_option("--embree-quality", embree_quality, "Embree build quality: low, medium, high")
       ->check(CLI::IsMember({"low", "medium", "high"}))
       ->capture_default_str()
@@ -87,6 +93,7 @@ StructureOptions StructureCli::to_options(unsigned threads, bool compute_epo) co
   o.bvh.cost_traversal = ctrav;
   o.bvh.cost_intersect = cisect;
   o.bvh.compute_epo = compute_epo;
+  o.bvh.wide_width = wide;
   o.embree.quality = parse_embree_quality(embree_quality).value_or(EmbreeQuality::medium);
   return o;
 }

@@ -71,6 +71,7 @@ struct StructureCli {
   int buckets = BvhOptions{}.buckets;
   int leaf = BvhOptions{}.max_leaf_size;
   int leaf_cap = BvhOptions{}.leaf_size_cap;
+  int wide = BvhOptions{}.wide_width;
   float ctrav = BvhOptions{}.cost_traversal;
   float cisect = BvhOptions{}.cost_intersect;
   std::string embree_quality = "medium";

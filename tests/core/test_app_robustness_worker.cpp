@@ -48,7 +48,17 @@ TEST(RobustnessWorker, RunsTheLabInTheBackgroundAndPublishes) {
   EXPECT_EQ(snap->result->rays, 2000u);
   EXPECT_EQ(snap->result->variants.size(), 6u);
   EXPECT_EQ(snap->scene, "builtin:teapot?size=1000");
-  EXPECT_EQ(snap->result->variants[3].misses, 0u);  // watertight + padded slab
+  // The worker publishes what the lab computes on the calling thread.
+  const LabResult direct = run_robustness_lab(r.scene->scene.triangles, r.options);
+  ASSERT_EQ(direct.variants.size(), snap->result->variants.size());
+  for (std::size_t v = 0; v < direct.variants.size(); ++v) {
+    EXPECT_EQ(snap->result->variants[v].name, direct.variants[v].name);
+    EXPECT_EQ(snap->result->variants[v].misses, direct.variants[v].misses);
+    EXPECT_EQ(snap->result->variants[v].double_hits, direct.variants[v].double_hits);
+    EXPECT_EQ(snap->result->variants[v].per_ray, direct.variants[v].per_ray);
+  }
+  // Watertight + padded slab leaves far fewer holes than Moller-Trumbore.
+  EXPECT_LT(snap->result->variants[3].misses * 4, snap->result->variants[0].misses);
 }
 
 TEST(RobustnessWorker, BadStructureFailsWithOneLine) {

@@ -165,17 +165,20 @@ TEST(BvhBuild, StatsMatchTheNodeArray) {
   EXPECT_EQ(st.leaf_count, leaves);
   EXPECT_EQ(st.max_depth, max_depth);
   EXPECT_NEAR(st.avg_leaf_depth, depth_sum / static_cast<double>(leaves), 1e-9);
-  // Nodes, indices, the leaf-order triangles, and the 4-wide copy (128-byte
-  // nodes plus the binary id each of its four slots copies; the leaves'
-  // triangles in 160-byte blocks of four, ceil(count / 4) per leaf).
+  // Nodes, indices, the leaf-order triangles, and the W-wide copy (W = 4:
+  // 128-byte nodes, W = 8: 256-byte nodes, plus the binary id each of its W
+  // slots copies; the leaves' triangles in 160-byte blocks of four,
+  // ceil(count / 4) per leaf).
   const std::size_t wide = static_cast<std::size_t>(st.extra.at("wide_nodes"));
+  const auto width = static_cast<std::size_t>(st.extra.at("wide_width"));
+  ASSERT_TRUE(width == 4 || width == 8);
   EXPECT_GT(wide, 0u);
   EXPECT_LT(wide, bvh.nodes().size() / 2);
   std::size_t blocks = 0;
   for (const BvhNode& n : bvh.nodes())
     if (n.count > 0) blocks += (n.count + 3) / 4;
   EXPECT_EQ(st.memory_bytes, bvh.nodes().size() * 32 + tris.size() * 4 + tris.size() * sizeof(Triangle) +
-                                 wide * (128 + 16) + blocks * 160);
+                                 wide * width * (32 + 4) + blocks * 160);
   o.wide_traversal = false;
   const Bvh binary_only(tris, o);
   EXPECT_EQ(binary_only.build_stats().memory_bytes,

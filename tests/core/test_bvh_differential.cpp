@@ -193,6 +193,9 @@ std::vector<BvhOptions> option_sets() {
     o.threads = 1;
     o.max_leaf_size = leaf;
     o.leaf_size_cap = std::max(leaf, 16);
+    // Leaf 4: the 4-wide SSE fast path; otherwise the default (8-wide AVX2
+    // where this CPU has AVX2, else 4-wide).
+    o.wide_width = leaf == 4 ? 4 : 0;
     for (int b : {2, 16, 256}) {
       o.splitter = BvhSplitter::binned_sah;
       o.buckets = b;

@@ -173,6 +173,128 @@ TEST(BvhSlab, WideTestAgreesWithScalarTwinPerSlot) {
   }
 }
 
+#ifdef ACCELVIZ_BVH_WIDE8_AVX2
+// The AVX2 test inlines only into AVX2 code (called when the CPU has it).
+[[gnu::target("avx2")]] int wide8_slab_test(const bvh_detail::WideNode8& n, const Ray& ray, float* te, float* tx) {
+  return bvh_detail::wide_slab_test8(n, bvh_detail::WideSlabRay8(ray), ray.tmin, ray.tmax, te, tx);
+}
+
+TEST(BvhSlab, EightWideAvx2TestAgreesWithScalarTwinPerSlot) {
+  if (!bvh_detail::cpu_has_wide8()) GTEST_SKIP() << "this CPU has no AVX2";
+  std::mt19937 rng(8);
+  const float specials[] = {0.0f, -0.0f, 1.0f, -1.0f, kInfinity, -kInfinity, 1e-30f};
+  for (int i = 0; i < 50000; ++i) {
+    bvh_detail::WideNode8 n;
+    for (int s = 0; s < 8; ++s) {
+      glm::vec3 a(uniform(rng), uniform(rng), uniform(rng)), b(uniform(rng), uniform(rng), uniform(rng));
+      if (i % 5 == 1) b[static_cast<int>(rng() % 3)] = a[static_cast<int>(rng() % 3)];
+      Aabb box{glm::min(a, b), glm::max(a, b)};
+      if (i % 7 == 2 && s == 5) box = Aabb::empty();
+      for (int r = 0; r < 3; ++r) {
+        n.bounds[r][s] = box.lo[r];
+        n.bounds[3 + r][s] = box.hi[r];
+      }
+      n.child[s] = rng();
+      n.meta[s] = (i % 9 == 4 && s >= 6) ? bvh_detail::kWideEmpty : rng() % 5;
+    }
+    glm::vec3 o(2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f);
+    glm::vec3 d = random_direction(rng);
+    for (int a = 0; a < 3; ++a) {
+      const unsigned r = rng() % 8;
+      if (r == 0) d[a] = (rng() & 1) ? 0.0f : -0.0f;
+      if (r == 1) o[a] = n.bounds[a][3];  // on a face plane of slot 3
+      if (r == 2) d[a] = specials[rng() % 7];
+    }
+    const Ray ray(o, d, (i % 3 == 0) ? -1.0f : 0.0f, (i % 4 == 0) ? 1.5f : kInfinity);
+    float se[8], sx[8];
+    alignas(32) float ve[8], vx[8];
+    int scalar = bvh_detail::wide_slab_test_scalar<8>(n, ray, ray.tmin, ray.tmax, se, sx);
+    for (int s = 0; s < 8; ++s)
+      if (n.meta[s] == bvh_detail::kWideEmpty) scalar &= ~(1 << s);
+    const int simd = wide8_slab_test(n, ray, ve, vx);
+    ASSERT_EQ(simd, scalar) << "case " << i;
+    for (int s = 0; s < 8; ++s) {
+      ASSERT_EQ(std::memcmp(&ve[s], &se[s], 4), 0) << "case " << i << " slot " << s;
+      ASSERT_EQ(std::memcmp(&vx[s], &sx[s], 4), 0) << "case " << i << " slot " << s;
+    }
+  }
+}
+#endif
+
+TEST(BvhWide, EightWideCollapseKeepsEveryLeafOnceAndRefitsWithTheBinaryTree) {
+  const auto tris = soup(3000, 31);
+  const Bvh bvh(tris, quiet());
+  const auto nodes = bvh.nodes();
+  bvh_detail::WideBvh8 wide;
+  bvh_detail::collapse_to_wide(nodes, wide);
+  ASSERT_EQ(wide.source.size(), 8 * wide.nodes.size());
+  std::vector<int> leaf_seen(nodes.size(), 0);
+  std::size_t used_slots = 0;
+  for (std::size_t w = 0; w < wide.nodes.size(); ++w)
+    for (int s = 0; s < 8; ++s) {
+      const bvh_detail::WideNode8& n = wide.nodes[w];
+      if (n.meta[s] == bvh_detail::kWideEmpty) continue;
+      ++used_slots;
+      const std::uint32_t src = wide.source[8 * w + s];
+      ASSERT_LT(src, nodes.size());
+      EXPECT_EQ(n.bounds[3][s], nodes[src].bounds.hi.x);
+      if (n.meta[s] == 0) {
+        ASSERT_GT(n.child[s], w);
+      } else {
+        EXPECT_EQ(n.meta[s], nodes[src].count);
+        ++leaf_seen[src];
+      }
+    }
+  for (std::size_t i = 0; i < nodes.size(); ++i) EXPECT_EQ(leaf_seen[i], nodes[i].count > 0 ? 1 : 0) << i;
+  // Every wide node but the root is one slot of its parent: slots = nodes - 1 + leaves.
+  const auto leaves =
+      static_cast<std::size_t>(std::count_if(nodes.begin(), nodes.end(), [](const BvhNode& n) { return n.count > 0; }));
+  EXPECT_EQ(used_slots, wide.nodes.size() - 1 + leaves);
+  // Fewer, fuller nodes than the 4-wide collapse of the same tree (the same
+  // count of slots: every binary leaf plus one per non-root wide node).
+  const std::size_t four = bvh_detail::collapse_to_wide(nodes).nodes.size();
+  EXPECT_LT(wide.nodes.size(), four);
+  EXPECT_GT(static_cast<double>(used_slots) / wide.nodes.size(), static_cast<double>(four - 1 + leaves) / four);
+  // A refit copies moved binary boxes into the slots.
+  std::vector<BvhNode> moved(nodes.begin(), nodes.end());
+  for (BvhNode& n : moved) n.bounds.hi += glm::vec3(1.0f);
+  bvh_detail::refit_wide(wide, moved);
+  for (std::size_t w = 0; w < wide.nodes.size(); ++w)
+    for (int s = 0; s < 8; ++s)
+      if (wide.source[8 * w + s] != bvh_detail::kWideEmpty)
+        EXPECT_EQ(wide.nodes[w].bounds[5][s], moved[wide.source[8 * w + s]].bounds.hi.z);
+}
+
+TEST(BvhWide, EveryWidthAnswersLikeTheBinaryTree) {
+  const auto tris = soup(2000, 32);
+  BvhOptions binary_opts = quiet();
+  binary_opts.wide_traversal = false;
+  const Bvh binary(tris, binary_opts);
+  std::mt19937 rng(33);
+  for (int width : {0, 4, 8}) {
+    BvhOptions o = quiet();
+    o.wide_width = width;
+    const Bvh bvh(tris, o);
+    const double expect = width == 4 || !bvh_detail::cpu_has_wide8() ? 4.0 : 8.0;
+    EXPECT_EQ(bvh.build_stats().extra.at("wide_width"), expect) << width;
+    for (int i = 0; i < 20000; ++i) {
+      const glm::vec3 orig(2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f);
+      const Ray ray(orig, random_direction(rng));
+      for (bool ordered : {true, false}) {
+        QueryOptions q;
+        q.ordered = ordered;
+        const Hit a = binary.closest_hit(ray, q), b = bvh.closest_hit(ray, q);
+        ASSERT_EQ(a.prim, b.prim) << "width " << width << " ray " << i;
+        ASSERT_EQ(a.t, b.t);
+        ASSERT_EQ(binary.any_hit(ray, q), bvh.any_hit(ray, q));
+      }
+    }
+  }
+  BvhOptions bad = quiet();
+  bad.wide_width = 6;
+  EXPECT_THROW(Bvh(tris, bad), std::invalid_argument);
+}
+
 TEST(BvhWide, CollapseKeepsEveryLeafOnceWithItsBox) {
   for (int leaf : {1, 4}) {
     const auto tris = soup(3000, 20 + leaf);

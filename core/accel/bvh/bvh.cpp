@@ -5,25 +5,38 @@
 // is made once per ray:
 //  - traverse: the binary node array, also instantiated with Collect = true
 //    for statistics and traces (Collect = false carries no counters at all);
-//  - traverse_wide: the 4-wide copy (bvh_wide.h), the default fast path.
+//  - traverse_wide (bvh_wide_traverse.inl): the 8-wide (AVX2, where the CPU
+//    has it) or 4-wide (SSE) copy (bvh_wide.h), the default fast path.
 #include "core/accel/bvh/bvh.h"
-
-#include "core/accel/bvh/bvh_slab.h"
-#include "core/accel/bvh/bvh_triangle.h"
-#include "core/accel/bvh/bvh_wide.h"
-
-#include "core/analysis/epo.h"
-#include "core/analysis/sah.h"
 
 #include <bit>
 #include <chrono>
 #include <stdexcept>
 #include <string>
 
-namespace accelviz {
+#include "core/accel/bvh/bvh_slab.h"
+#include "core/accel/bvh/bvh_triangle.h"
+#include "core/accel/bvh/bvh_wide.h"
+#include "core/analysis/epo.h"
+#include "core/analysis/sah.h"
 
-Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const ProgressCallback& progress)
-    : opts_(opts) {
+namespace accelviz {
+namespace {
+
+/// Collapses `nodes` into `wide` with triangle blocks; returns its bytes.
+template <int W>
+std::size_t make_wide(std::span<const BvhNode> nodes, std::span<const Triangle> leaf_tris,
+                      bvh_detail::WideBvhT<W>& wide, BuildStats& stats) {
+  bvh_detail::collapse_to_wide(nodes, wide);
+  bvh_detail::build_tri4_blocks(wide, leaf_tris);
+  stats.extra["wide_nodes"] = static_cast<double>(wide.nodes.size());
+  return wide.nodes.size() * sizeof(bvh_detail::WideNodeT<W>) + wide.source.size() * sizeof(std::uint32_t) +
+         wide.tri_blocks.size() * sizeof(bvh_detail::TriBlock4);
+}
+
+}  // namespace
+
+Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const ProgressCallback& progress) : opts_(opts) {
   const auto t0 = std::chrono::steady_clock::now();
   validate(opts_);
   std::vector<Aabb> bounds(triangles.size());
@@ -41,11 +54,17 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
   for (std::size_t k = 0; k < prim_indices_.size(); ++k) leaf_tris_[k] = triangles[prim_indices_[k]];
   stats_.memory_bytes += leaf_tris_.size() * sizeof(Triangle);
   if (opts_.wide_traversal && !nodes_.empty()) {
-    wide_ = std::make_unique<bvh_detail::WideBvh>(bvh_detail::collapse_to_wide(nodes_));
-    bvh_detail::build_tri4_blocks(*wide_, leaf_tris_);
-    stats_.memory_bytes += wide_->nodes.size() * sizeof(bvh_detail::WideNode) + wide_->source.size() * sizeof(std::uint32_t) +
-                           wide_->tri_blocks.size() * sizeof(bvh_detail::TriBlock4);
-    stats_.extra["wide_nodes"] = static_cast<double>(wide_->nodes.size());
+    const int width = opts_.wide_width == 0                                   ? (bvh_detail::cpu_has_wide8() ? 8 : 4)
+                      : opts_.wide_width == 8 && !bvh_detail::cpu_has_wide8() ? 4
+                                                                              : opts_.wide_width;
+    if (width == 8) {
+      wide8_ = std::make_unique<bvh_detail::WideBvh8>();
+      stats_.memory_bytes += make_wide(nodes_, leaf_tris_, *wide8_, stats_);
+    } else {
+      wide_ = std::make_unique<bvh_detail::WideBvh>();
+      stats_.memory_bytes += make_wide(nodes_, leaf_tris_, *wide_, stats_);
+    }
+    stats_.extra["wide_width"] = width;
   }
   stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   update_quality_stats();
@@ -61,10 +80,9 @@ void Bvh::update_quality_stats() {
     // Not part of build_ms: it is a measurement of the tree, not a step of
     // making it; its own time is reported beside it.
     const auto t0 = std::chrono::steady_clock::now();
-    stats_.extra["epo"] = bvh_epo_leaf_order(nodes_, leaf_tris_, opts_.cost_traversal, opts_.cost_intersect,
-                                             opts_.threads);
-    stats_.extra["epo_ms"] =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    stats_.extra["epo"] =
+        bvh_epo_leaf_order(nodes_, leaf_tris_, opts_.cost_traversal, opts_.cost_intersect, opts_.threads);
+    stats_.extra["epo_ms"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
 }
 
@@ -89,15 +107,19 @@ void Bvh::refit(std::span<const Triangle> moved) {
     bvh_detail::refit_wide(*wide_, nodes_);
     bvh_detail::refit_tri4_blocks(leaf_tris_, wide_->tri_blocks);
   }
+  if (wide8_) {
+    bvh_detail::refit_wide(*wide8_, nodes_);
+    bvh_detail::refit_tri4_blocks(leaf_tris_, wide8_->tri_blocks);
+  }
   stats_.extra["refit_ms"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   update_quality_stats();
 }
 
 namespace {
 
-using bvh_detail::SlabRay;
 using bvh_detail::slab_test;
 using bvh_detail::slab_test_pair;
+using bvh_detail::SlabRay;
 
 struct BvhView {
   const BvhNode* nodes;
@@ -126,8 +148,9 @@ struct Collector {
     if (trace) trace->steps.push_back({VisitStep::Kind::node_culled, node, t0, t1});
   }
   void prim(std::uint32_t id, bool hit, float t) const {
-    if (trace) trace->steps.push_back({hit ? VisitStep::Kind::prim_hit : VisitStep::Kind::prim_miss, id,
-                                       hit ? t : kInfinity, kInfinity});
+    if (trace)
+      trace->steps.push_back(
+          {hit ? VisitStep::Kind::prim_hit : VisitStep::Kind::prim_miss, id, hit ? t : kInfinity, kInfinity});
   }
 };
 
@@ -215,10 +238,18 @@ Hit traverse(const BvhView& bvh, const Ray& ray, const Collector& c) {
       if constexpr (Collect) {
         c.stats->box_tests += 2;
         const float cull_t = c.xray ? ray.tmax : closest;
-        if (!h0) c.missed(i0, a0, a1);
-        else if (a0 > cull_t) { c.culled(i0, a0, a1); h0 = false; }
-        if (!h1) c.missed(i1, b0, b1);
-        else if (b0 > cull_t) { c.culled(i1, b0, b1); h1 = false; }
+        if (!h0)
+          c.missed(i0, a0, a1);
+        else if (a0 > cull_t) {
+          c.culled(i0, a0, a1);
+          h0 = false;
+        }
+        if (!h1)
+          c.missed(i1, b0, b1);
+        else if (b0 > cull_t) {
+          c.culled(i1, b0, b1);
+          h1 = false;
+        }
       }
       if constexpr (!Collect) {
         // Fast path with one data-dependent branch (any child hit?) instead
@@ -244,15 +275,18 @@ Hit traverse(const BvhView& bvh, const Ray& ray, const Collector& c) {
         ++sp;
         node = near;
         if constexpr (Collect) {
-          if (second_first) c.entered(near, b0, b1);
-          else c.entered(near, a0, a1);
+          if (second_first)
+            c.entered(near, b0, b1);
+          else
+            c.entered(near, a0, a1);
         }
         continue;
-      }
-      else if (h0 || h1) {
+      } else if (h0 || h1) {
         node = i0 + (h1 ? 1u : 0u);
-        if (h0) c.entered(i0, a0, a1);
-        else c.entered(i1, b0, b1);
+        if (h0)
+          c.entered(i0, a0, a1);
+        else
+          c.entered(i1, b0, b1);
         continue;
       }
     } else {
@@ -299,160 +333,63 @@ Hit traverse(const BvhView& bvh, const Ray& ray, const Collector& c) {
   }
 }
 
-/// Fast-path traversal of the 4-wide copy (no statistics). Same contract as
-/// traverse<AnyHit, Ordered, false, Test>: hits on the same triangles, ties
-/// kept by "first found at the smallest t".
-///  - Ordered: hit children sorted by entry distance, nearest taken, the
-///    others pushed farthest first; on pop a child whose entry lies beyond
-///    the closest hit is skipped.
-///  - Unordered: slot order.
-/// Stack: at most three entries per wide level, and a wide path is no longer
-/// than the binary one (kBvhMaxDepth).
-template <bool AnyHit, bool Ordered, TriangleTest Test>
-Hit traverse_wide(const bvh_detail::WideBvh& wide_bvh, const BvhView& bvh, const Ray& ray) {
-  using bvh_detail::WideNode;
-  const WideNode* wide = wide_bvh.nodes.data();
-  Hit best;
-  const bvh_detail::WideSlabRay wr4(ray);
-  const float tmin = ray.tmin;
-  float closest = ray.tmax;
-  InlineWatertightRay wr;
-  bool wr_ready = Test != TriangleTest::watertight;
-#ifdef ACCELVIZ_BVH_TRI4_SSE2
-  // Watertight leaves: four triangles per test (bvh_tri4.h).
-  constexpr bool kTri4 = Test == TriangleTest::watertight;
-  bvh_detail::Tri4Ray tr4(wr);
+#if defined(ACCELVIZ_BVH_WIDE8_AVX2)
+#define ACCELVIZ_BVH_WIDE8 1
 #endif
 
-  struct Entry {
-    std::uint32_t child, meta;
-    float t_entry;
-  };
-  Entry stack[3 * kBvhMaxDepth + 1];
-  unsigned sp = 0;
-  std::uint32_t child = 0, meta = 0;  // the wide root
-  for (;;) {
-    if (meta == 0) {
-      const WideNode& n = wide[child];
-      alignas(16) float te[4];
-      int mask = bvh_detail::wide_slab_test(n, wr4, tmin, closest, te);
-      if (mask != 0) {
-        if ((mask & (mask - 1)) == 0) {  // one child: no ordering, no push
-          const int s = std::countr_zero(static_cast<unsigned>(mask));
-          child = n.child[s];
-          meta = n.meta[s];
-          continue;
-        }
-        int slot[4], k = 0;
-        while (mask != 0) {
-          slot[k++] = std::countr_zero(static_cast<unsigned>(mask));
-          mask &= mask - 1;
-        }
-        // Any hit: any occluder ends the walk, so the sort buys little and
-        // costs a data-dependent shuffle per node: slot order (measured on
-        // shadow rays, docs/performance.md).
-        if constexpr (Ordered && !AnyHit) {
-          // Insertion sort by entry distance; equal distances keep slot order.
-          for (int i = 1; i < k; ++i) {
-            const int v = slot[i];
-            int j = i;
-            while (j > 0 && te[slot[j - 1]] > te[v]) {
-              slot[j] = slot[j - 1];
-              --j;
-            }
-            slot[j] = v;
-          }
-        }
-        for (int j = k - 1; j >= 1; --j) stack[sp++] = {n.child[slot[j]], n.meta[slot[j]], te[slot[j]]};
-        child = n.child[slot[0]];
-        meta = n.meta[slot[0]];
-        continue;
-      }
-    } else {
-      if (!wr_ready) {
-        wr = InlineWatertightRay(ray);
-        wr_ready = true;
-#ifdef ACCELVIZ_BVH_TRI4_SSE2
-        if constexpr (kTri4) tr4 = bvh_detail::Tri4Ray(wr);
-#endif
-      }
-#ifdef ACCELVIZ_BVH_TRI4_SSE2
-      if constexpr (kTri4) {
-        // Lanes in slot order are the leaf's triangles in order: the same
-        // sequence of tests and acceptances as the scalar loop below.
-        const bvh_detail::TriBlock4* blk = wide_bvh.tri_blocks.data() + child;
-        for (std::uint32_t left = meta; left > 0; ++blk) {
-          const int valid = left >= 4 ? 0xF : (1 << left) - 1;
-          left = left >= 4 ? left - 4 : 0;
-          bvh_detail::Tri4Result r;
-          bvh_detail::intersect_tri4(*blk, tr4, tmin, r);
-          int lanes = (r.candidate | r.special) & valid;
-          while (lanes != 0) {
-            const int l = std::countr_zero(static_cast<unsigned>(lanes));
-            lanes &= lanes - 1;
-            const std::uint32_t k = blk->pos[l];
-            Hit h;
-            bool hit;
-            if ((r.special >> l) & 1) {
-              hit = intersect_watertight(ray, wr.wr, bvh.tris[k], tmin, closest, h);
-            } else {
-              hit = bvh_detail::tri4_accept(r, l, closest);
-              h.t = r.t[l];
-              h.u = r.u[l];
-              h.v = r.v[l];
-            }
-            if constexpr (AnyHit) {
-              if (hit) {
-                best = h;
-                best.prim = k;
-                return best;
-              }
-            } else if (hit && h.t < best.t) {
-              best = h;
-              best.prim = k;
-              closest = h.t;
-            }
-          }
-        }
-      } else
-#endif
-      // A wide leaf slot names its first block; the leaf's triangles are
-      // consecutive in leaf order from the block's first position.
-      for (std::uint32_t k = wide_bvh.tri_blocks[child].pos[0], end = k + meta; k < end; ++k) {
-        Hit h;
-        const bool hit = test_triangle<Test>(ray, wr, bvh.tris[k], tmin, closest, h);
-        if constexpr (AnyHit) {
-          if (hit) {
-            best = h;
-            best.prim = k;
-            return best;
-          }
-        } else if (hit && h.t < best.t) {
-          best = h;
-          best.prim = k;
-          closest = h.t;
-        }
-      }
-    }
-    for (;;) {
-      if (sp == 0) return best;
-      const Entry e = stack[--sp];
-      if (!AnyHit && e.t_entry > closest) continue;
-      child = e.child;
-      meta = e.meta;
-      break;
-    }
-  }
+/// The 4-wide SSE traversal (bvh_wide_traverse.inl with W = 4).
+namespace wide4 {
+constexpr int kWidth = 4;
+using WideSlabRayW = bvh_detail::WideSlabRay;
+[[gnu::always_inline]] inline int wide_slab_test_w(const bvh_detail::WideNode& n, const WideSlabRayW& r, float tmin,
+                                                   float tmax, float* te) {
+  return bvh_detail::wide_slab_test(n, r, tmin, tmax, te);
 }
+#include "core/accel/bvh/bvh_wide_traverse.inl"
+}  // namespace wide4
+
+#ifdef ACCELVIZ_BVH_WIDE8
+/// The 8-wide traversal: the same source compiled for AVX2 (every function
+/// defined in this region gets the target), called only when the CPU has it.
+#pragma GCC push_options
+#pragma GCC target("avx2")
+namespace wide8 {
+constexpr int kWidth = 8;
+using WideSlabRayW = bvh_detail::WideSlabRay8;
+[[gnu::always_inline]] inline int wide_slab_test_w(const bvh_detail::WideNode8& n, const WideSlabRayW& r, float tmin,
+                                                   float tmax, float* te) {
+  return bvh_detail::wide_slab_test8(n, r, tmin, tmax, te);
+}
+#include "core/accel/bvh/bvh_wide_traverse.inl"
+}  // namespace wide8
+#pragma GCC pop_options
+#endif
 
 template <bool AnyHit>
 Hit dispatch_wide(const bvh_detail::WideBvh& wide, const BvhView& v, const Ray& ray, const QueryOptions& qo) {
+  using wide4::traverse_wide;
   const bool wt = qo.triangle_test == TriangleTest::watertight;
   if (qo.ordered)
     return wt ? traverse_wide<AnyHit, true, TriangleTest::watertight>(wide, v, ray)
               : traverse_wide<AnyHit, true, TriangleTest::moller_trumbore>(wide, v, ray);
   return wt ? traverse_wide<AnyHit, false, TriangleTest::watertight>(wide, v, ray)
             : traverse_wide<AnyHit, false, TriangleTest::moller_trumbore>(wide, v, ray);
+}
+
+template <bool AnyHit>
+Hit dispatch_wide8([[maybe_unused]] const bvh_detail::WideBvh8& wide, [[maybe_unused]] const BvhView& v,
+                   [[maybe_unused]] const Ray& ray, [[maybe_unused]] const QueryOptions& qo) {
+#ifdef ACCELVIZ_BVH_WIDE8
+  using wide8::traverse_wide;
+  const bool wt = qo.triangle_test == TriangleTest::watertight;
+  if (qo.ordered)
+    return wt ? traverse_wide<AnyHit, true, TriangleTest::watertight>(wide, v, ray)
+              : traverse_wide<AnyHit, true, TriangleTest::moller_trumbore>(wide, v, ray);
+  return wt ? traverse_wide<AnyHit, false, TriangleTest::watertight>(wide, v, ray)
+            : traverse_wide<AnyHit, false, TriangleTest::moller_trumbore>(wide, v, ray);
+#else
+  return Hit{};  // never built without AVX2 support (Bvh checks cpu_has_wide8)
+#endif
 }
 
 template <bool AnyHit, bool Collect>
@@ -471,8 +408,9 @@ Hit Bvh::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, Vi
   const BvhView v{nodes_.data(), leaf_tris_.data(), prim_indices_.data(), nodes_.size()};
   Hit h;
   if (stats == nullptr && trace == nullptr && !qo.back_to_front && !qo.xray) {
-    h = wide_ ? dispatch_wide<false>(*wide_, v, ray, qo)
-              : dispatch<false, false>(v, ray, qo, Collector{nullptr, nullptr});
+    h = wide8_  ? dispatch_wide8<false>(*wide8_, v, ray, qo)
+        : wide_ ? dispatch_wide<false>(*wide_, v, ray, qo)
+                : dispatch<false, false>(v, ray, qo, Collector{nullptr, nullptr});
   } else {
     RayStats local;
     h = dispatch<false, true>(v, ray, qo, Collector{stats ? stats : &local, trace, qo.back_to_front, qo.xray});
@@ -487,11 +425,11 @@ Hit Bvh::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, Vi
 bool Bvh::any_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats) const {
   const BvhView v{nodes_.data(), leaf_tris_.data(), prim_indices_.data(), nodes_.size()};
   if (stats == nullptr && !qo.back_to_front)
-    return wide_ ? dispatch_wide<true>(*wide_, v, ray, qo).valid()
-                 : dispatch<true, false>(v, ray, qo, Collector{nullptr, nullptr}).valid();
+    return wide8_  ? dispatch_wide8<true>(*wide8_, v, ray, qo).valid()
+           : wide_ ? dispatch_wide<true>(*wide_, v, ray, qo).valid()
+                   : dispatch<true, false>(v, ray, qo, Collector{nullptr, nullptr}).valid();
   RayStats local;
-  return dispatch<true, true>(v, ray, qo, Collector{stats ? stats : &local, nullptr, qo.back_to_front, false})
-      .valid();
+  return dispatch<true, true>(v, ray, qo, Collector{stats ? stats : &local, nullptr, qo.back_to_front, false}).valid();
 }
 
 }  // namespace accelviz

@@ -24,6 +24,7 @@ namespace accelviz {
 
 namespace bvh_detail {
 struct WideBvh;
+struct WideBvh8;
 }
 
 /// How a node's primitives are divided between its two children.
@@ -46,7 +47,8 @@ struct BvhOptions {
   float cost_intersect = 1.0f;   ///< C_isect: cost of one ray-primitive test (> 0, finite)
   unsigned threads = 0;          ///< build threads, 0 = all hardware threads; the node array is identical for any count
   bool compute_epo = true;       ///< Bvh only: compute the EPO metric into build_stats().extra["epo"] (costs a pass over the tree per triangle)
-  bool wide_traversal = true;    ///< Bvh only: uninstrumented queries walk a 4-wide collapse of the tree (faster); statistics and traces always walk the binary tree
+  bool wide_traversal = true;    ///< Bvh only: uninstrumented queries walk a wide collapse of the tree (faster); statistics and traces always walk the binary tree
+  int wide_width = 0;            ///< Bvh only: width of that collapse: 0 = 8 (AVX2) where the CPU has AVX2, else 4 (SSE); 4; or 8 (falls back to 4 without AVX2)
 };
 
 /// Throws std::invalid_argument naming the offending option when `opts` is out of range.
@@ -120,7 +122,8 @@ class Bvh final : public Accelerator {
   std::vector<BvhNode> nodes_;
   std::vector<std::uint32_t> prim_indices_;
   std::vector<Triangle> leaf_tris_;
-  std::unique_ptr<bvh_detail::WideBvh> wide_;  ///< 4-wide copy for the fast path (null when disabled or empty)
+  std::unique_ptr<bvh_detail::WideBvh> wide_;    ///< 4-wide copy for the fast path (null when not used)
+  std::unique_ptr<bvh_detail::WideBvh8> wide8_;  ///< 8-wide copy for the fast path (null when not used)
   BvhOptions opts_;
   BuildStats stats_;
 };

@@ -56,6 +56,8 @@ void validate(const BvhOptions& o) {
     fail("cost_traversal must be finite and > 0, got " + std::to_string(o.cost_traversal));
   if (!(o.cost_intersect > 0.0f) || !std::isfinite(o.cost_intersect))
     fail("cost_intersect must be finite and > 0, got " + std::to_string(o.cost_intersect));
+  if (o.wide_width != 0 && o.wide_width != 4 && o.wide_width != 8)
+    fail("wide_width must be 0 (auto), 4 or 8, got " + std::to_string(o.wide_width));
 }
 
 namespace bvh_detail {

@@ -21,6 +21,14 @@
 #define ACCELVIZ_BVH_SLAB_SSE2 1
 #endif
 
+// The 8-wide test needs AVX2 (VEX 256-bit) code in a binary built for plain
+// x86-64: GCC's target attribute compiles just those functions for AVX2, and
+// the BVH calls them only when the CPU says it has AVX2 (cpu_has_wide8).
+#if defined(ACCELVIZ_BVH_SLAB_SSE2) && defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#include <immintrin.h>
+#define ACCELVIZ_BVH_WIDE8_AVX2 1
+#endif
+
 #include <limits>
 
 namespace accelviz::bvh_detail {
@@ -142,6 +150,49 @@ struct WideSlabRay {
   return _mm_movemask_ps(_mm_andnot_ps(_mm_castsi128_ps(empty), _mm_cmple_ps(t0, t1)));
 }
 
+#ifdef ACCELVIZ_BVH_WIDE8_AVX2
+
+/// Per-ray constants of the eight-box test (WideSlabRay in 256-bit lanes).
+struct WideSlabRay8 {
+  __m256 origin[3], inv_dir[3];
+  int near_row[3], far_row[3];
+
+  [[gnu::target("avx2")]] explicit WideSlabRay8(const Ray& r) {
+    for (int a = 0; a < 3; ++a) {
+      origin[a] = _mm256_set1_ps(r.origin[a]);
+      inv_dir[a] = _mm256_set1_ps(r.inv_dir[a]);
+      const bool neg = r.inv_dir[a] < 0.0f;  // as intersect_slab: hi is near
+      near_row[a] = neg ? 3 + a : a;
+      far_row[a] = neg ? a : 3 + a;
+    }
+  }
+};
+
+/// Eight boxes of an 8-wide node at once: wide_slab_test's operations, in
+/// its order, on 256-bit registers (no FMA: AVX2 without -mfma), so each lane
+/// is bit for bit intersect_slab's result. _CMP_LE_OQ is cmpleps.
+[[gnu::target("avx2"), gnu::always_inline]] inline int wide_slab_test8(const WideNode8& node, const WideSlabRay8& r,
+                                                                       float tmin, float tmax, float* t_entry,
+                                                                       float* t_exit = nullptr) {
+  const __m256 scale = _mm256_set1_ps(kSlabExitScale);
+  __m256 t0 = _mm256_set1_ps(tmin), t1 = _mm256_set1_ps(tmax);
+  for (int a = 0; a < 3; ++a) {
+    const __m256 tn =
+        _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.bounds[r.near_row[a]]), r.origin[a]), r.inv_dir[a]);
+    const __m256 tf = _mm256_mul_ps(
+        _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.bounds[r.far_row[a]]), r.origin[a]), r.inv_dir[a]), scale);
+    t0 = _mm256_max_ps(tn, t0);
+    t1 = _mm256_min_ps(tf, t1);
+  }
+  _mm256_storeu_ps(t_entry, t0);
+  if (t_exit) _mm256_storeu_ps(t_exit, t1);
+  const __m256i empty = _mm256_cmpeq_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(node.meta)),
+                                           _mm256_set1_epi32(static_cast<int>(kWideEmpty)));
+  return _mm256_movemask_ps(_mm256_andnot_ps(_mm256_castsi256_ps(empty), _mm256_cmp_ps(t0, t1, _CMP_LE_OQ)));
+}
+
+#endif  // ACCELVIZ_BVH_WIDE8_AVX2
+
 #else
 
 struct SlabRay {
@@ -168,7 +219,7 @@ struct WideSlabRay {
 inline int wide_slab_test(const WideNode& node, const WideSlabRay& r, float tmin, float tmax, float* t_entry,
                           float* t_exit = nullptr) {
   float exits[4];
-  int mask = wide_slab_test_scalar(node, *r.ray, tmin, tmax, t_entry, t_exit ? t_exit : exits);
+  int mask = wide_slab_test_scalar<4>(node, *r.ray, tmin, tmax, t_entry, t_exit ? t_exit : exits);
   for (int s = 0; s < 4; ++s)
     if (node.meta[s] == kWideEmpty) mask &= ~(1 << s);
   return mask;

@@ -1,12 +1,14 @@
-// Collapse of a binary BVH into 4-wide nodes (see bvh_wide.h).
+// Collapse of a binary BVH into 4- or 8-wide nodes (see bvh_wide.h).
 #include "core/accel/bvh/bvh_wide.h"
 
+#include "core/accel/bvh/bvh_slab.h"
 #include "core/math/aabb.h"
 
 namespace accelviz::bvh_detail {
 namespace {
 
-void set_slot(WideNode& w, int slot, const Aabb& b) {
+template <int W>
+void set_slot(WideNodeT<W>& w, int slot, const Aabb& b) {
   w.bounds[0][slot] = b.lo.x;
   w.bounds[1][slot] = b.lo.y;
   w.bounds[2][slot] = b.lo.z;
@@ -15,9 +17,10 @@ void set_slot(WideNode& w, int slot, const Aabb& b) {
   w.bounds[5][slot] = b.hi.z;
 }
 
-WideNode empty_node() {
-  WideNode w;
-  for (int s = 0; s < 4; ++s) {
+template <int W>
+WideNodeT<W> empty_node() {
+  WideNodeT<W> w;
+  for (int s = 0; s < W; ++s) {
     set_slot(w, s, Aabb::empty());  // lo = +inf, hi = -inf: missed by every finite ray
     w.child[s] = 0;
     w.meta[s] = kWideEmpty;
@@ -27,32 +30,35 @@ WideNode empty_node() {
 
 }  // namespace
 
-WideBvh collapse_to_wide(std::span<const BvhNode> binary) {
-  WideBvh wide;
-  if (binary.empty()) return wide;
+template <int W>
+void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide) {
+  wide.nodes.clear();
+  wide.source.clear();
+  wide.tri_blocks.clear();
+  if (binary.empty()) return;
   wide.nodes.reserve(binary.size() / 2 + 1);
   wide.source.reserve(2 * binary.size() + 4);
 
   // Work list of (wide node to fill, binary node whose children it takes).
   std::vector<std::pair<std::uint32_t, std::uint32_t>> work;
-  wide.nodes.push_back(empty_node());
-  wide.source.insert(wide.source.end(), 4, kWideEmpty);
+  wide.nodes.push_back(empty_node<W>());
+  wide.source.insert(wide.source.end(), W, kWideEmpty);
   if (binary[0].count > 0) {
     // A single leaf: one slot.
     set_slot(wide.nodes[0], 0, binary[0].bounds);
     wide.nodes[0].child[0] = binary[0].index;
     wide.nodes[0].meta[0] = binary[0].count;
     wide.source[0] = 0;
-    return wide;
+    return;
   }
   work.push_back({0, 0});
   while (!work.empty()) {
     const auto [w, b] = work.back();
     work.pop_back();
-    // 1. Gather up to four binary nodes under b: open the largest inner one.
-    std::uint32_t slots[4] = {binary[b].index, binary[b].index + 1, 0, 0};
+    // 1. Gather up to W binary nodes under b: open the largest inner one.
+    std::uint32_t slots[W] = {binary[b].index, binary[b].index + 1};
     int n = 2;
-    while (n < 4) {
+    while (n < W) {
       int open = -1;
       float best = -1.0f;
       for (int s = 0; s < n; ++s) {
@@ -73,15 +79,15 @@ WideBvh collapse_to_wide(std::span<const BvhNode> binary) {
     // 2. Fill the slots; inner slots get new wide nodes, allocated together.
     for (int s = 0; s < n; ++s) {
       const BvhNode& c = binary[slots[s]];
-      wide.source[4 * w + s] = slots[s];
+      wide.source[W * w + s] = slots[s];
       set_slot(wide.nodes[w], s, c.bounds);
       if (c.count > 0) {
         wide.nodes[w].child[s] = c.index;
         wide.nodes[w].meta[s] = c.count;
       } else {
         const auto child = static_cast<std::uint32_t>(wide.nodes.size());
-        wide.nodes.push_back(empty_node());
-        wide.source.insert(wide.source.end(), 4, kWideEmpty);
+        wide.nodes.push_back(empty_node<W>());
+        wide.source.insert(wide.source.end(), W, kWideEmpty);
         wide.nodes[w].child[s] = child;
         wide.nodes[w].meta[s] = 0;
       }
@@ -90,29 +96,31 @@ WideBvh collapse_to_wide(std::span<const BvhNode> binary) {
     for (int s = n - 1; s >= 0; --s)
       if (wide.nodes[w].meta[s] == 0) work.push_back({wide.nodes[w].child[s], slots[s]});
   }
-  return wide;
 }
 
-void build_tri4_blocks(WideBvh& wide, std::span<const Triangle> leaf_tris) {
+template <int W>
+void build_tri4_blocks(WideBvhT<W>& wide, std::span<const Triangle> leaf_tris) {
   wide.tri_blocks.clear();
   wide.tri_blocks.reserve(leaf_tris.size() / 2 + 1);
-  for (WideNode& n : wide.nodes)
-    for (int s = 0; s < 4; ++s)
+  for (WideNodeT<W>& n : wide.nodes)
+    for (int s = 0; s < W; ++s)
       if (n.meta[s] != 0 && n.meta[s] != kWideEmpty)
         n.child[s] = append_tri4_blocks(leaf_tris, n.child[s], n.meta[s], wide.tri_blocks);
   wide.tri_blocks.shrink_to_fit();
 }
 
-void refit_wide(WideBvh& wide, std::span<const BvhNode> binary) {
+template <int W>
+void refit_wide(WideBvhT<W>& wide, std::span<const BvhNode> binary) {
   for (std::size_t w = 0; w < wide.nodes.size(); ++w)
-    for (int s = 0; s < 4; ++s)
-      if (wide.source[4 * w + s] != kWideEmpty) set_slot(wide.nodes[w], s, binary[wide.source[4 * w + s]].bounds);
+    for (int s = 0; s < W; ++s)
+      if (wide.source[W * w + s] != kWideEmpty) set_slot(wide.nodes[w], s, binary[wide.source[W * w + s]].bounds);
 }
 
-int wide_slab_test_scalar(const WideNode& node, const Ray& ray, float tmin, float tmax, float t_entry[4],
-                          float t_exit[4]) {
+template <int W>
+int wide_slab_test_scalar(const WideNodeT<W>& node, const Ray& ray, float tmin, float tmax, float t_entry[W],
+                          float t_exit[W]) {
   int mask = 0;
-  for (int s = 0; s < 4; ++s) {
+  for (int s = 0; s < W; ++s) {
     const Aabb box{{node.bounds[0][s], node.bounds[1][s], node.bounds[2][s]},
                    {node.bounds[3][s], node.bounds[4][s], node.bounds[5][s]}};
     SlabInterval iv;
@@ -122,5 +130,22 @@ int wide_slab_test_scalar(const WideNode& node, const Ray& ray, float tmin, floa
   }
   return mask;
 }
+
+bool cpu_has_wide8() {
+#if defined(ACCELVIZ_BVH_WIDE8_AVX2)
+  return __builtin_cpu_supports("avx2") != 0;
+#else
+  return false;
+#endif
+}
+
+template void collapse_to_wide<4>(std::span<const BvhNode>, WideBvhT<4>&);
+template void collapse_to_wide<8>(std::span<const BvhNode>, WideBvhT<8>&);
+template void build_tri4_blocks<4>(WideBvhT<4>&, std::span<const Triangle>);
+template void build_tri4_blocks<8>(WideBvhT<8>&, std::span<const Triangle>);
+template void refit_wide<4>(WideBvhT<4>&, std::span<const BvhNode>);
+template void refit_wide<8>(WideBvhT<8>&, std::span<const BvhNode>);
+template int wide_slab_test_scalar<4>(const WideNodeT<4>&, const Ray&, float, float, float*, float*);
+template int wide_slab_test_scalar<8>(const WideNodeT<8>&, const Ray&, float, float, float*, float*);
 
 }  // namespace accelviz::bvh_detail

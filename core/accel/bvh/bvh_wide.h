@@ -1,6 +1,7 @@
 #pragma once
-// A 4-wide copy of a binary BVH, used only by the uninstrumented (fast)
-// traversal.
+// A 4- or 8-wide copy of a binary BVH, used only by the uninstrumented (fast)
+// traversal: 8-wide with AVX2 where the CPU has it (checked at run time),
+// else 4-wide with SSE.
 //
 // Why: single-ray traversal of a binary BVH is latency-bound. Every step
 // loads a child pair, runs a slab test and takes a data-dependent branch;
@@ -8,7 +9,7 @@
 // that each node holds up to four children (Dammertz et al., "Shallow
 // Bounding Volume Hierarchies for Fast SIMD Ray Tracing of Incoherent Rays",
 // EGSR 2008; Wald et al. 2008; the layout Embree uses) halves the number of
-// sequential steps and tests four boxes with one set of SIMD instructions.
+// sequential steps and tests four (eight) boxes with one set of SIMD instructions.
 //
 // The binary node array stays the structure that is built, shown, counted
 // and refitted: the statistics/trace path traverses it, and every wide slot
@@ -23,45 +24,65 @@
 
 namespace accelviz::bvh_detail {
 
-/// 128 bytes: four child boxes in structure-of-arrays order, then the
-/// children. meta = 0: inner wide node `child`; 1..255: leaf of `meta`
-/// primitives starting at leaf position `child`; kWideEmpty: unused slot.
-struct alignas(64) WideNode {
-  float bounds[6][4];  ///< [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z][slot]
-  std::uint32_t child[4];
-  std::uint32_t meta[4];
+/// W child boxes in structure-of-arrays order, then the children (W = 4:
+/// 128 bytes, SSE; W = 8: 256 bytes, AVX2). meta = 0: inner wide node
+/// `child`; 1..255: leaf of `meta` primitives starting at leaf position
+/// `child`; kWideEmpty: unused slot.
+template <int W>
+struct alignas(64) WideNodeT {
+  float bounds[6][W];  ///< [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z][slot]
+  std::uint32_t child[W];
+  std::uint32_t meta[W];
 };
+using WideNode = WideNodeT<4>;
+using WideNode8 = WideNodeT<8>;
 static_assert(sizeof(WideNode) == 128);
+static_assert(sizeof(WideNode8) == 256);
 
 inline constexpr std::uint32_t kWideEmpty = 0xFFFFFFFFu;
 
-struct WideBvh {
-  std::vector<WideNode> nodes;        ///< root at 0; empty when the binary tree is
-  std::vector<std::uint32_t> source;  ///< 4 per wide node: the binary node each slot copies (kWideEmpty if unused)
+template <int W>
+struct WideBvhT {
+  std::vector<WideNodeT<W>> nodes;    ///< root at 0; empty when the binary tree is
+  std::vector<std::uint32_t> source;  ///< W per wide node: the binary node each slot copies (kWideEmpty if unused)
   /// The leaves' triangles as blocks of four (bvh_tri4.h), for the fast
   /// path: once build_tri4_blocks has run, a leaf slot's `child` is the
   /// index of its first block (ceil(meta / 4) consecutive blocks, in the
   /// order the slots are laid out), no longer its first leaf position.
   std::vector<TriBlock4> tri_blocks;
 };
+struct WideBvh : WideBvhT<4> {};
+struct WideBvh8 : WideBvhT<8> {};
 
 /// Fills wide.tri_blocks from the leaf-order triangles and points every
 /// leaf slot at its first block (collapse_to_wide's leaf slots name leaf
 /// positions; afterwards they name blocks).
-void build_tri4_blocks(WideBvh& wide, std::span<const Triangle> leaf_tris);
+template <int W>
+void build_tri4_blocks(WideBvhT<W>& wide, std::span<const Triangle> leaf_tris);
 
 /// Collapses a binary node array: each wide node takes a binary inner node's
 /// children and keeps opening the child with the largest surface area until
-/// it has four (or only leaves are left). Deterministic; wide children are
+/// it has W (or only leaves are left). Deterministic; wide children are
 /// stored after their parent.
-WideBvh collapse_to_wide(std::span<const BvhNode> binary);
+template <int W>
+void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide);
+inline WideBvh collapse_to_wide(std::span<const BvhNode> binary) {
+  WideBvh w;
+  collapse_to_wide<4>(binary, w);
+  return w;
+}
 
 /// Copies the binary boxes into the wide nodes again (after a refit).
-void refit_wide(WideBvh& wide, std::span<const BvhNode> binary);
+template <int W>
+void refit_wide(WideBvhT<W>& wide, std::span<const BvhNode> binary);
 
-/// Scalar twin of the four-box test: core/math/aabb.h's robust slab test per
+/// Scalar twin of the W-box test: core/math/aabb.h's robust slab test per
 /// slot. Bit i of the result: slot i hit; t_entry[i]/t_exit[i] its interval.
-int wide_slab_test_scalar(const WideNode& node, const Ray& ray, float tmin, float tmax, float t_entry[4],
-                          float t_exit[4]);
+template <int W>
+int wide_slab_test_scalar(const WideNodeT<W>& node, const Ray& ray, float tmin, float tmax, float t_entry[W],
+                          float t_exit[W]);
+
+/// True when this CPU runs the 8-wide AVX2 traversal (and this build has it).
+bool cpu_has_wide8();
 
 }  // namespace accelviz::bvh_detail

@@ -1,0 +1,152 @@
+// The fast-path traversal of the wide BVH, included twice by bvh.cpp: once
+// for the 4-wide SSE nodes and once, compiled for AVX2, for the 8-wide nodes.
+// The includer defines, in the enclosing namespace: kWidth (4 or 8),
+// WideSlabRayW and wide_slab_test_w (the box test of that width).
+// No includes here: the file is pasted inside a namespace.
+
+/// Fast-path traversal of the W-wide copy (no statistics). Same contract as
+/// traverse<AnyHit, Ordered, false, Test>: hits on the same triangles, ties
+/// kept by "first found at the smallest t".
+///  - Ordered: hit children sorted by entry distance, nearest taken, the
+///    others pushed farthest first; on pop a child whose entry lies beyond
+///    the closest hit is skipped.
+///  - Unordered: slot order.
+/// Stack: at most W - 1 entries per wide level, and a wide path is no longer
+/// than the binary one (kBvhMaxDepth).
+template <bool AnyHit, bool Ordered, TriangleTest Test>
+Hit traverse_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& bvh, const Ray& ray) {
+  using WideNode = bvh_detail::WideNodeT<kWidth>;
+  const WideNode* wide = wide_bvh.nodes.data();
+  Hit best;
+  const WideSlabRayW wrw(ray);
+  const float tmin = ray.tmin;
+  float closest = ray.tmax;
+  InlineWatertightRay wr;
+  bool wr_ready = Test != TriangleTest::watertight;
+#ifdef ACCELVIZ_BVH_TRI4_SSE2
+  // Watertight leaves: four triangles per test (bvh_tri4.h).
+  constexpr bool kTri4 = Test == TriangleTest::watertight;
+  bvh_detail::Tri4Ray tr4(wr);
+#endif
+
+  struct Entry {
+    std::uint32_t child, meta;
+    float t_entry;
+  };
+  Entry stack[(kWidth - 1) * kBvhMaxDepth + 1];
+  unsigned sp = 0;
+  std::uint32_t child = 0, meta = 0;  // the wide root
+  for (;;) {
+    if (meta == 0) {
+      const WideNode& n = wide[child];
+      alignas(32) float te[kWidth];
+      int mask = wide_slab_test_w(n, wrw, tmin, closest, te);
+      if (mask != 0) {
+        if ((mask & (mask - 1)) == 0) {  // one child: no ordering, no push
+          const int s = std::countr_zero(static_cast<unsigned>(mask));
+          child = n.child[s];
+          meta = n.meta[s];
+          continue;
+        }
+        int slot[kWidth], k = 0;
+        while (mask != 0) {
+          slot[k++] = std::countr_zero(static_cast<unsigned>(mask));
+          mask &= mask - 1;
+        }
+        // Any hit: any occluder ends the walk, so the sort buys little and
+        // costs a data-dependent shuffle per node: slot order (measured on
+        // shadow rays, docs/performance.md).
+        if constexpr (Ordered && !AnyHit) {
+          // Insertion sort by entry distance; equal distances keep slot order.
+          for (int i = 1; i < k; ++i) {
+            const int v = slot[i];
+            int j = i;
+            while (j > 0 && te[slot[j - 1]] > te[v]) {
+              slot[j] = slot[j - 1];
+              --j;
+            }
+            slot[j] = v;
+          }
+        }
+        for (int j = k - 1; j >= 1; --j) stack[sp++] = {n.child[slot[j]], n.meta[slot[j]], te[slot[j]]};
+        child = n.child[slot[0]];
+        meta = n.meta[slot[0]];
+        continue;
+      }
+    } else {
+      if (!wr_ready) {
+        wr = InlineWatertightRay(ray);
+        wr_ready = true;
+#ifdef ACCELVIZ_BVH_TRI4_SSE2
+        if constexpr (kTri4) tr4 = bvh_detail::Tri4Ray(wr);
+#endif
+      }
+#ifdef ACCELVIZ_BVH_TRI4_SSE2
+      if constexpr (kTri4) {
+        // Lanes in slot order are the leaf's triangles in order: the same
+        // sequence of tests and acceptances as the scalar loop below.
+        const bvh_detail::TriBlock4* blk = wide_bvh.tri_blocks.data() + child;
+        for (std::uint32_t left = meta; left > 0; ++blk) {
+          const int valid = left >= 4 ? 0xF : (1 << left) - 1;
+          left = left >= 4 ? left - 4 : 0;
+          bvh_detail::Tri4Result r;
+          bvh_detail::intersect_tri4(*blk, tr4, tmin, r);
+          int lanes = (r.candidate | r.special) & valid;
+          while (lanes != 0) {
+            const int l = std::countr_zero(static_cast<unsigned>(lanes));
+            lanes &= lanes - 1;
+            const std::uint32_t k = blk->pos[l];
+            Hit h;
+            bool hit;
+            if ((r.special >> l) & 1) {
+              hit = intersect_watertight(ray, wr.wr, bvh.tris[k], tmin, closest, h);
+            } else {
+              hit = bvh_detail::tri4_accept(r, l, closest);
+              h.t = r.t[l];
+              h.u = r.u[l];
+              h.v = r.v[l];
+            }
+            if constexpr (AnyHit) {
+              if (hit) {
+                best = h;
+                best.prim = k;
+                return best;
+              }
+            } else if (hit && h.t < best.t) {
+              best = h;
+              best.prim = k;
+              closest = h.t;
+            }
+          }
+        }
+      } else
+#endif
+      // A wide leaf slot names its first block; the leaf's triangles are
+      // consecutive in leaf order from the block's first position.
+      for (std::uint32_t k = wide_bvh.tri_blocks[child].pos[0], end = k + meta; k < end; ++k) {
+        Hit h;
+        const bool hit = test_triangle<Test>(ray, wr, bvh.tris[k], tmin, closest, h);
+        if constexpr (AnyHit) {
+          if (hit) {
+            best = h;
+            best.prim = k;
+            return best;
+          }
+        } else if (hit && h.t < best.t) {
+          best = h;
+          best.prim = k;
+          closest = h.t;
+        }
+      }
+    }
+    for (;;) {
+      if (sp == 0) return best;
+      const Entry e = stack[--sp];
+      if (!AnyHit && e.t_entry > closest) continue;
+      child = e.child;
+      meta = e.meta;
+      break;
+    }
+  }
+}
+
