@@ -216,7 +216,7 @@ void InsightViews::draw(AppState& app, const panels::PanelLayout& layout) {
   // Tree.
   if (const auto pick =
           panels::tree_panel(app.current() ? &app.current()->nodes : nullptr, shown ? &shown->visits : nullptr,
-                             selected_node(app), scroll_tree_, layout)) {
+                             selected_node(app), scroll_tree_, layout, app.config().view.colormap)) {
     select_node(app, *pick);
     insight_state_.region.reset();
   }

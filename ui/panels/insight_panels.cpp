@@ -396,8 +396,16 @@ bool on_path(const StructureNodes& nodes, std::uint32_t id, std::uint32_t select
   return selected == id;
 }
 
-void tree_rows(const StructureNodes& nodes, const std::vector<std::uint64_t>* visits, std::uint32_t id,
-               std::uint32_t selected, std::optional<std::uint32_t>& clicked, bool& scroll, int budget_depth) {
+/// How rows show visits: the boxes' colour ramp (ui/app/hot_nodes.h) over the
+/// tree's largest count, as a swatch before the row.
+struct RowColors {
+  ColorMap map;
+  std::uint64_t max_visits;
+};
+
+void tree_rows(const StructureNodes& nodes, const std::vector<std::uint64_t>* visits, const RowColors& rc,
+               std::uint32_t id, std::uint32_t selected, std::optional<std::uint32_t>& clicked, bool& scroll,
+               int budget_depth) {
   const StructureNode* n = nodes.node(id);
   if (!n) return;
   char label[160];
@@ -413,6 +421,14 @@ void tree_rows(const StructureNodes& nodes, const std::vector<std::uint64_t>* vi
   if (id == selected) flags |= ImGuiTreeNodeFlags_Selected;
   if (!n->leaf && id != selected && on_path(nodes, id, selected)) ImGui::SetNextItemOpen(true, ImGuiCond_Always);
   ImGui::PushID(static_cast<int>(id));
+  if (visits) {
+    // The same colour the node's box gets when boxes are coloured by visits.
+    const glm::vec3 c = colormap(rc.map, visit_ramp(vis, rc.max_visits));
+    ImGui::ColorButton("##visits", ImVec4(c.x, c.y, c.z, 1.0f),
+                       ImGuiColorEditFlags_NoTooltip | ImGuiColorEditFlags_NoDragDrop,
+                       ImVec2(ImGui::GetTextLineHeight(), ImGui::GetTextLineHeight()));
+    ImGui::SameLine();
+  }
   const bool open = ImGui::TreeNodeEx("n", flags, "%s", label);
   if (ImGui::IsItemClicked() && !ImGui::IsItemToggledOpen()) clicked = id;
   if (id == selected && scroll) {
@@ -422,7 +438,7 @@ void tree_rows(const StructureNodes& nodes, const std::vector<std::uint64_t>* vi
   if (open && !n->leaf) {
     if (budget_depth > 0)
       for (const std::uint32_t c : nodes.children(id))
-        tree_rows(nodes, visits, c, selected, clicked, scroll, budget_depth - 1);
+        tree_rows(nodes, visits, rc, c, selected, clicked, scroll, budget_depth - 1);
     ImGui::TreePop();
   }
   ImGui::PopID();
@@ -431,7 +447,8 @@ void tree_rows(const StructureNodes& nodes, const std::vector<std::uint64_t>* vi
 }  // namespace
 
 std::optional<std::uint32_t> tree_panel(const StructureNodes* nodes, const std::vector<std::uint64_t>* visits,
-                                        std::uint32_t selected, bool& scroll_to_selected, const PanelLayout& layout) {
+                                        std::uint32_t selected, bool& scroll_to_selected, const PanelLayout& layout,
+                                        ColorMap map) {
   std::optional<std::uint32_t> clicked;
   place_at(layout, 330.0f, 180.0f, 420.0f, 420.0f);
   if (!ImGui::Begin("Tree")) {
@@ -443,7 +460,11 @@ std::optional<std::uint32_t> tree_panel(const StructureNodes* nodes, const std::
   } else {
     ImGui::TextDisabled("%s, %llu nodes; click a row to select its subtree in the 3D view", nodes->kind().c_str(),
                         static_cast<unsigned long long>(nodes->size()));
-    tree_rows(*nodes, visits, 0, selected, clicked, scroll_to_selected, 128);
+    RowColors rc{map, 0};
+    if (visits)
+      for (const std::uint64_t v : *visits) rc.max_visits = std::max(rc.max_visits, v);
+    if (visits) ImGui::TextDisabled("swatch: visits on the boxes' colour ramp (hottest node = top colour)");
+    tree_rows(*nodes, visits, rc, 0, selected, clicked, scroll_to_selected, 128);
   }
   ImGui::End();
   return clicked;

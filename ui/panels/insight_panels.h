@@ -59,11 +59,13 @@ bool explainer_panel(ExplainerState& state, const SplitExplanation* e, std::uint
                      const PanelLayout& layout);
 
 // ---- Tree view ------------------------------------------------------------------------------
-/// Collapsible tree of `nodes` (count, depth, SAH share, visits when known);
-/// the path to `selected` is opened (and scrolled to when `scroll_to_selected`
+/// Collapsible tree of `nodes` (count, depth, SAH share, visits when known,
+/// with a swatch of the colour `map` gives the node's box by visits); the
+/// path to `selected` is opened (and scrolled to when `scroll_to_selected`
 /// is set; it is cleared once done). Returns a node the user clicked.
 std::optional<std::uint32_t> tree_panel(const StructureNodes* nodes, const std::vector<std::uint64_t>* visits,
-                                        std::uint32_t selected, bool& scroll_to_selected, const PanelLayout& layout);
+                                        std::uint32_t selected, bool& scroll_to_selected, const PanelLayout& layout,
+                                        ColorMap map = ColorMap::viridis);
 
 // ---- Scenarios ------------------------------------------------------------------------------
 struct ScenarioPanelState {
