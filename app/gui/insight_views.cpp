@@ -16,6 +16,19 @@ std::uint32_t selected_node(const AppState& app) {
   return n > 0 ? static_cast<std::uint32_t>(n) : 0u;
 }
 
+/// A (pinned) against B (the current choice) on the current scene and camera,
+/// at the panel's width and the view's aspect. Needs a pin and a current build.
+ABRequest ab_request(const AppState& app, const panels::ABPanelState& ab) {
+  ABRequest r;
+  r.scene = app.current()->scene;
+  r.a = *ab.pinned;
+  r.b = app.config().structure;
+  r.camera = app.camera();
+  r.width = ab.width;
+  r.height = app.view_width() > 0 ? std::max(16, ab.width * app.view_height() / app.view_width()) : ab.height;
+  return r;
+}
+
 void select_node(AppState& app, std::uint32_t id) {
   ViewSettings& v = app.config().view;
   v.show_boxes = true;
@@ -167,13 +180,7 @@ void InsightViews::draw(AppState& app, const panels::PanelLayout& layout) {
     app.set_message("pinned " + describe_choice(*ab_.pinned) + " as A");
   }
   if (aa.compare && ab_.pinned && app.current()) {
-    ABRequest r;
-    r.scene = app.current()->scene;
-    r.a = *ab_.pinned;
-    r.b = app.config().structure;
-    r.camera = app.camera();
-    r.width = ab_.width;
-    r.height = app.view_width() > 0 ? std::max(16, ab_.width * app.view_height() / app.view_width()) : ab_.height;
+    ABRequest r = ab_request(app, ab_);
     r.metric = ab_.metric == 1 ? HeatMetric::prims : ab_.metric == 2 ? HeatMetric::cost : HeatMetric::nodes;
     ab_job_.request([r](const std::atomic<bool>& cancel) { return run_ab(r, cancel); });
   }
@@ -362,13 +369,7 @@ ScriptHost::Status InsightViews::execute(AppState& app, const ScriptCommand& c) 
       if (!ab_.pinned) throw std::runtime_error("dump-ab: nothing pinned as A (use pin-a first)");
       if (!script_ab_requested_) {
         if (!app.settled() || !app.current()) return ScriptHost::Status::again;
-        ABRequest r;
-        r.scene = app.current()->scene;
-        r.a = *ab_.pinned;
-        r.b = app.config().structure;
-        r.camera = app.camera();
-        r.width = ab_.width;
-        r.height = app.view_width() > 0 ? std::max(16, ab_.width * app.view_height() / app.view_width()) : ab_.height;
+        const ABRequest r = ab_request(app, ab_);
         ab_dump_job_.request([r](const std::atomic<bool>& cancel) {
           // Both metrics the lecture compares, each over the same view.
           nlohmann::json out = {

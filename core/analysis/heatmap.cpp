@@ -1,9 +1,5 @@
 #include "core/analysis/heatmap.h"
 
-#include "core/query/batch.h"
-#include "core/query/camera.h"
-#include "core/query/ray_sets.h"
-
 #include <stb_image.h>
 #include <stb_image_write.h>
 
@@ -18,28 +14,42 @@
 #include <memory>
 #include <stdexcept>
 
+#include "core/query/batch.h"
+#include "core/query/camera.h"
+#include "core/query/ray_sets.h"
+
 namespace accelviz {
 
 // ---- metrics -------------------------------------------------------------------
 
 std::string_view metric_name(HeatMetric m) {
   switch (m) {
-    case HeatMetric::nodes: return "nodes";
-    case HeatMetric::prims: return "prims";
-    case HeatMetric::cost: return "cost";
-    case HeatMetric::shaded: return "shaded";
-    case HeatMetric::depth: return "depth";
+    case HeatMetric::nodes:
+      return "nodes";
+    case HeatMetric::prims:
+      return "prims";
+    case HeatMetric::cost:
+      return "cost";
+    case HeatMetric::shaded:
+      return "shaded";
+    case HeatMetric::depth:
+      return "depth";
   }
   return "nodes";
 }
 
 std::string_view metric_label(HeatMetric m) {
   switch (m) {
-    case HeatMetric::nodes: return "nodes visited per ray";
-    case HeatMetric::prims: return "primitive tests per ray";
-    case HeatMetric::cost: return "cost per ray (ctrav nodes + cisect prims)";
-    case HeatMetric::shaded: return "shaded";
-    case HeatMetric::depth: return "hit distance";
+    case HeatMetric::nodes:
+      return "nodes visited per ray";
+    case HeatMetric::prims:
+      return "primitive tests per ray";
+    case HeatMetric::cost:
+      return "cost per ray (ctrav nodes + cisect prims)";
+    case HeatMetric::shaded:
+      return "shaded";
+    case HeatMetric::depth:
+      return "hit distance";
   }
   return "";
 }
@@ -54,12 +64,13 @@ bool metric_needs_stats(HeatMetric m) {
   return m == HeatMetric::nodes || m == HeatMetric::prims || m == HeatMetric::cost;
 }
 
-float metric_value(HeatMetric m, const Ray& ray, const Hit& hit, const RayStats& stats, float c_trav,
-                   float c_isect) {
+float metric_value(HeatMetric m, const Ray& ray, const Hit& hit, const RayStats& stats, float c_trav, float c_isect) {
   constexpr float kNoValue = std::numeric_limits<float>::quiet_NaN();
   switch (m) {
-    case HeatMetric::nodes: return static_cast<float>(stats.nodes_visited);
-    case HeatMetric::prims: return static_cast<float>(stats.prim_tests);
+    case HeatMetric::nodes:
+      return static_cast<float>(stats.nodes_visited);
+    case HeatMetric::prims:
+      return static_cast<float>(stats.prim_tests);
     case HeatMetric::cost:
       return c_trav * static_cast<float>(stats.nodes_visited) + c_isect * static_cast<float>(stats.prim_tests);
     case HeatMetric::shaded: {
@@ -69,7 +80,8 @@ float metric_value(HeatMetric m, const Ray& ray, const Hit& hit, const RayStats&
       const float len = glm::length(ray.direction);
       return len > 0.0f ? std::min(1.0f, std::abs(glm::dot(hit.ng, ray.direction)) / len) : 0.0f;
     }
-    case HeatMetric::depth: return hit.valid() ? hit.t : kNoValue;
+    case HeatMetric::depth:
+      return hit.valid() ? hit.t : kNoValue;
   }
   return kNoValue;
 }
@@ -92,6 +104,12 @@ MetricImage render_metric(const Accelerator& accel, const Camera& camera, const 
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   if (!done) throw BuildCancelled();
 
+  return metric_image_from_hits(rays, hits, stats, opts, ms, figures);
+}
+
+MetricImage metric_image_from_hits(std::span<const Ray> rays, std::span<const Hit> hits,
+                                   std::span<const RayStats> stats, const HeatmapOptions& opts, double trace_ms,
+                                   HeatmapFigures* figures) {
   MetricImage img;
   img.width = opts.width;
   img.height = opts.height;
@@ -101,8 +119,8 @@ MetricImage render_metric(const Accelerator& accel, const Camera& camera, const 
   double sum = 0.0, max = 0.0;
   std::uint64_t counted = 0, hit_count = 0;
   for (std::size_t i = 0; i < rays.size(); ++i) {
-    const float v = metric_value(opts.metric, rays[i], hits[i], stats.empty() ? none : stats[i], opts.c_trav,
-                                 opts.c_isect);
+    const float v =
+        metric_value(opts.metric, rays[i], hits[i], stats.empty() ? none : stats[i], opts.c_trav, opts.c_isect);
     img.values[i] = v;
     if (hits[i].valid()) ++hit_count;
     if (std::isfinite(v)) {
@@ -116,8 +134,8 @@ MetricImage render_metric(const Accelerator& accel, const Camera& camera, const 
     figures->hits = hit_count;
     figures->mean = counted ? sum / static_cast<double>(counted) : 0.0;
     figures->max = max;
-    figures->render_ms = ms;
-    figures->rays_per_s = ms > 0.0 ? static_cast<double>(rays.size()) / (ms * 1e-3) : 0.0;
+    figures->render_ms = trace_ms;
+    figures->rays_per_s = trace_ms > 0.0 ? static_cast<double>(rays.size()) / (trace_ms * 1e-3) : 0.0;
   }
   return img;
 }
@@ -263,7 +281,8 @@ void draw_text(RgbImage& img, int x, int y, std::string_view text, glm::u8vec3 c
     if (const Glyph* g = find_glyph(c)) {
       for (int row = 0; row < kGlyphH; ++row)
         for (int col = 0; col < kGlyphW; ++col)
-          if (g->rows[row] & (1u << (kGlyphW - 1 - col))) fill_rect(img, x + col * scale, y + row * scale, scale, scale, color);
+          if (g->rows[row] & (1u << (kGlyphW - 1 - col)))
+            fill_rect(img, x + col * scale, y + row * scale, scale, scale, color);
     }
     x += kAdvance * scale;
   }
@@ -384,8 +403,8 @@ void write_png(const std::string& path, const RgbImage& img, bool overwrite) {
     throw std::runtime_error(path + ": cannot create: " + std::strerror(errno));
   }
   WriteContext ctx{f.get(), true};
-  const int encoded = stbi_write_png_to_func(write_to_file, &ctx, img.width, img.height, 3, img.pixels.data(),
-                                             img.width * 3);
+  const int encoded =
+      stbi_write_png_to_func(write_to_file, &ctx, img.width, img.height, 3, img.pixels.data(), img.width * 3);
   const bool closed = std::fclose(f.release()) == 0;
   if (!encoded || !ctx.ok || !closed) {
     const int err = errno;

@@ -3,17 +3,17 @@
 // all threads with per-ray statistics, turned into a value per pixel, then
 // into an RGB image through a colour map with a legend bar, written as PNG.
 // The CPU twin of the GUI's heatmap view, and what `accelviz render` writes.
-#include "core/accel/accel.h"
-#include "core/analysis/colormap.h"
-#include "core/scene/scene.h"
-
-#include <glm/glm.hpp>
-
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "core/accel/accel.h"
+#include "core/analysis/colormap.h"
+#include "core/scene/scene.h"
 
 namespace accelviz {
 
@@ -25,20 +25,20 @@ enum class HeatMetric {
   depth,   ///< distance to the closest hit; misses have no value
 };
 
-std::string_view metric_name(HeatMetric m);                 ///< "nodes", "prims", ...
-std::string_view metric_label(HeatMetric m);                ///< legend title, e.g. "nodes visited per ray"
+std::string_view metric_name(HeatMetric m);   ///< "nodes", "prims", ...
+std::string_view metric_label(HeatMetric m);  ///< legend title, e.g. "nodes visited per ray"
 std::optional<HeatMetric> parse_metric(std::string_view name);
 /// Whether the metric needs per-ray counters (a slower, instrumented pass).
 bool metric_needs_stats(HeatMetric m);
 
 struct HeatmapOptions {
   HeatMetric metric = HeatMetric::nodes;
-  int width = 800;          ///< image size in pixels (the legend is added outside it)
+  int width = 800;  ///< image size in pixels (the legend is added outside it)
   int height = 600;
-  unsigned threads = 0;     ///< 0: all hardware threads
-  QueryOptions query;       ///< triangle test, ordered traversal
-  float c_trav = 1.0f;      ///< cost metric: cost of a node visit
-  float c_isect = 1.0f;     ///< cost metric: cost of a primitive test
+  unsigned threads = 0;       ///< 0: all hardware threads
+  QueryOptions query;         ///< triangle test, ordered traversal
+  float c_trav = 1.0f;        ///< cost metric: cost of a node visit
+  float c_isect = 1.0f;       ///< cost metric: cost of a primitive test
   ProgressCallback progress;  ///< optional; false cancels (render_metric then throws BuildCancelled)
 };
 
@@ -64,6 +64,14 @@ struct HeatmapFigures {
 
 /// The value a pixel gets from its ray, hit and counters.
 float metric_value(HeatMetric m, const Ray& ray, const Hit& hit, const RayStats& stats, float c_trav, float c_isect);
+
+/// The metric image (and `figures`, when given) of traced primary rays:
+/// per pixel metric_value of its ray, hit and statistics (`stats` may be
+/// empty when the metric needs none), the mean and maximum over finite
+/// values, and rays/s from `trace_ms`. Shared by the CPU and GPU paths.
+MetricImage metric_image_from_hits(std::span<const Ray> rays, std::span<const Hit> hits,
+                                   std::span<const RayStats> stats, const HeatmapOptions& opts, double trace_ms,
+                                   HeatmapFigures* figures);
 
 /// Traces one primary ray per pixel and returns the metric image.
 MetricImage render_metric(const Accelerator& accel, const Camera& camera, const HeatmapOptions& opts,

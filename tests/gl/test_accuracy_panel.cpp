@@ -3,31 +3,21 @@
 // snapshot, and scripted mouse input. Checks that the panel draws every
 // state, that clicking on its charts applies a measured setting (and only
 // that), and that the Run and Cancel buttons report their actions.
-#include "core/query/camera.h"
-#include "core/scene/load.h"
-#include "ui/panels/panels.h"
-
 #include <gtest/gtest.h>
 #include <imgui.h>
 
 #include <memory>
 #include <set>
 
+#include "core/query/camera.h"
+#include "core/scene/load.h"
+#include "tests/gl/imgui_headless.h"
+#include "ui/panels/panels.h"
+
 namespace accelviz {
 namespace {
 
-struct HeadlessImGui {
-  HeadlessImGui() {
-    ImGui::CreateContext();
-    ImGuiIO& io = ImGui::GetIO();
-    io.DisplaySize = ImVec2(1280, 800);
-    io.IniFilename = nullptr;
-    io.MouseDoubleClickTime = 0.0f;  // scanned clicks never pair into a double click (collapse)
-    unsigned char* px = nullptr;
-    int w = 0, h = 0;
-    io.Fonts->GetTexDataAsRGBA32(&px, &w, &h);
-  }
-  ~HeadlessImGui() { ImGui::DestroyContext(); }
+struct HeadlessImGui : test::HeadlessImGuiContext {
   // A press frame and a release frame at `at` (charts act on the press, buttons on the release).
   panels::AccuracyAction click(panels::AccuracyPanelState& st, const SweepSnapshot* snap, bool busy, ImVec2 at) {
     panels::AccuracyAction a = frame(st, snap, busy, at, true);
@@ -43,11 +33,7 @@ struct HeadlessImGui {
   // One frame with the mouse at `at`, the left button down or not.
   panels::AccuracyAction frame(panels::AccuracyPanelState& st, const SweepSnapshot* snap, bool busy, ImVec2 at,
                                bool down) {
-    ImGuiIO& io = ImGui::GetIO();
-    io.DeltaTime = 1.0f / 60.0f;
-    io.MousePos = at;
-    io.MouseDown[0] = down;
-    ImGui::NewFrame();
+    begin_frame(at, down);
     const panels::AccuracyAction a = panels::accuracy_panel(st, snap, busy, "bvh", panels::PanelLayout{});
     ImGui::Render();
     return a;

@@ -10,28 +10,16 @@
 
 #include "core/accel/factory.h"
 #include "core/scene/load.h"
+#include "tests/gl/imgui_headless.h"
 #include "ui/panels/insight_panels.h"
 
 namespace accelviz {
 namespace {
 
-struct InsightPanelHarness {
-  InsightPanelHarness() {
-    ImGui::CreateContext();
-    ImGuiIO& io = ImGui::GetIO();
-    io.DisplaySize = ImVec2(1280, 1600);
-    io.IniFilename = nullptr;
-    unsigned char* px = nullptr;
-    int w = 0, h = 0;
-    io.Fonts->GetTexDataAsRGBA32(&px, &w, &h);
-  }
-  ~InsightPanelHarness() { ImGui::DestroyContext(); }
+struct InsightPanelHarness : test::HeadlessImGuiContext {
+  InsightPanelHarness() : HeadlessImGuiContext(ImVec2(1280, 1600)) {}
   void frame(panels::InsightPanelState& st, const ViewInsight* v, const RegionTouch* region, ImVec2 at, bool down) {
-    ImGuiIO& io = ImGui::GetIO();
-    io.DeltaTime = 1.0f / 60.0f;
-    io.MousePos = at;
-    io.MouseDown[0] = down;
-    ImGui::NewFrame();
+    begin_frame(at, down);
     // Open and tall enough to show the record image (the panel starts collapsed).
     ImGui::SetWindowCollapsed("Predicted vs measured", false);
     ImGui::SetWindowPos("Predicted vs measured", ImVec2(10, 10));

@@ -10,30 +10,16 @@
 
 #include "core/analysis/robustness_lab.h"
 #include "core/scene/load.h"
+#include "tests/gl/imgui_headless.h"
 #include "ui/panels/panels.h"
 
 namespace accelviz {
 namespace {
 
-struct HeadlessImGui {
-  HeadlessImGui() {
-    ImGui::CreateContext();
-    ImGuiIO& io = ImGui::GetIO();
-    io.DisplaySize = ImVec2(1280, 800);
-    io.IniFilename = nullptr;
-    io.MouseDoubleClickTime = 0.0f;
-    unsigned char* px = nullptr;
-    int w = 0, h = 0;
-    io.Fonts->GetTexDataAsRGBA32(&px, &w, &h);
-  }
-  ~HeadlessImGui() { ImGui::DestroyContext(); }
+struct HeadlessImGui : test::HeadlessImGuiContext {
   panels::RobustnessAction frame(panels::RobustnessPanelState& st, const RobustnessSnapshot* snap, bool busy, ImVec2 at,
                                  bool down) {
-    ImGuiIO& io = ImGui::GetIO();
-    io.DeltaTime = 1.0f / 60.0f;
-    io.MousePos = at;
-    io.MouseDown[0] = down;
-    ImGui::NewFrame();
+    begin_frame(at, down);
     const panels::RobustnessAction a = panels::robustness_panel(st, snap, busy, "kdtree", panels::PanelLayout{});
     ImGui::Render();
     return a;

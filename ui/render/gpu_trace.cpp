@@ -150,31 +150,7 @@ MetricImage gpu_render_metric(GpuBvhTracer& tracer, const Camera& camera, const 
   // The rays again on the CPU, for the metrics that need the direction (shaded).
   const std::vector<Ray> rays = primary_rays(camera, opts.width, opts.height);
 
-  MetricImage img;
-  img.width = opts.width;
-  img.height = opts.height;
-  img.metric = opts.metric;
-  img.values.resize(rays.size());
-  double sum = 0.0, max = 0.0;
-  std::uint64_t counted = 0, hit_count = 0;
-  for (std::size_t i = 0; i < rays.size(); ++i) {
-    const float v = metric_value(opts.metric, rays[i], r.hits[i], r.stats[i], opts.c_trav, opts.c_isect);
-    img.values[i] = v;
-    if (r.hits[i].valid()) ++hit_count;
-    if (std::isfinite(v)) {
-      sum += v;
-      max = counted == 0 ? v : std::max<double>(max, v);
-      ++counted;
-    }
-  }
-  if (figures) {
-    figures->rays = rays.size();
-    figures->hits = hit_count;
-    figures->mean = counted ? sum / static_cast<double>(counted) : 0.0;
-    figures->max = max;
-    figures->render_ms = r.trace_ms;
-    figures->rays_per_s = r.trace_ms > 0.0 ? static_cast<double>(rays.size()) / (r.trace_ms * 1e-3) : 0.0;
-  }
+  MetricImage img = metric_image_from_hits(rays, r.hits, r.stats, opts, r.trace_ms, figures);
   if (raw) *raw = std::move(r);
   return img;
 }
