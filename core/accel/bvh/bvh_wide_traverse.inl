@@ -34,6 +34,22 @@ Hit traverse_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& b
     float t_entry;
   };
   Entry stack[(kWidth - 1) * kBvhMaxDepth + 1];
+  // A triangle test's outcome for leaf position k: any hit ends the walk
+  // (returns true); closest hit keeps the first found at the smallest t.
+  const auto take = [&](bool hit, const Hit& h, std::uint32_t k) {
+    if (!hit) return false;
+    if constexpr (AnyHit) {
+      best = h;
+      best.prim = k;
+      return true;
+    }
+    if (h.t < best.t) {
+      best = h;
+      best.prim = k;
+      closest = h.t;
+    }
+    return false;
+  };
   unsigned sp = 0;
   std::uint32_t child = 0, meta = 0;  // the wide root
   for (;;) {
@@ -106,38 +122,18 @@ Hit traverse_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& b
               h.u = r.u[l];
               h.v = r.v[l];
             }
-            if constexpr (AnyHit) {
-              if (hit) {
-                best = h;
-                best.prim = k;
-                return best;
-              }
-            } else if (hit && h.t < best.t) {
-              best = h;
-              best.prim = k;
-              closest = h.t;
-            }
+            if (take(hit, h, k)) return best;
           }
         }
       } else
 #endif
-      // A wide leaf slot names its first block; the leaf's triangles are
-      // consecutive in leaf order from the block's first position.
-      for (std::uint32_t k = wide_bvh.tri_blocks[child].pos[0], end = k + meta; k < end; ++k) {
-        Hit h;
-        const bool hit = test_triangle<Test>(ray, wr, bvh.tris[k], tmin, closest, h);
-        if constexpr (AnyHit) {
-          if (hit) {
-            best = h;
-            best.prim = k;
-            return best;
-          }
-        } else if (hit && h.t < best.t) {
-          best = h;
-          best.prim = k;
-          closest = h.t;
+        // A wide leaf slot names its first block; the leaf's triangles are
+        // consecutive in leaf order from the block's first position.
+        for (std::uint32_t k = wide_bvh.tri_blocks[child].pos[0], end = k + meta; k < end; ++k) {
+          Hit h;
+          const bool hit = test_triangle<Test>(ray, wr, bvh.tris[k], tmin, closest, h);
+          if (take(hit, h, k)) return best;
         }
-      }
     }
     for (;;) {
       if (sp == 0) return best;
@@ -149,4 +145,3 @@ Hit traverse_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& b
     }
   }
 }
-
