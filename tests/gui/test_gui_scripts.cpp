@@ -3,27 +3,25 @@
 // loop, and the test checks what it wrote: screenshots pixel by pixel, the
 // picked ray against a brute-force trace computed here, the stats of each
 // structure, and that bad input is reported while the app carries on.
+#include <fcntl.h>
 #include <gtest/gtest.h>
-
-#include "core/accel/brute_force.h"
-#include "core/analysis/heatmap.h"
-#include "core/query/camera.h"
-#include "core/scene/load.h"
-
-#include <nlohmann/json.hpp>
+#include <poll.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 
-#include <fcntl.h>
-#include <poll.h>
-#include <sys/wait.h>
-#include <unistd.h>
+#include "core/accel/brute_force.h"
+#include "core/analysis/heatmap.h"
+#include "core/query/camera.h"
+#include "core/scene/load.h"
 
 namespace fs = std::filesystem;
 using namespace accelviz;
@@ -417,6 +415,57 @@ TEST_F(GuiScript, InsightScenariosAndPredictedVsMeasured) {
   EXPECT_EQ(in["explainer"]["decision"], "split");
 }
 
+// The other lecture scenarios, each at two slider positions: the figures
+// move the way each caption says.
+TEST_F(GuiScript, EveryScenarioSliderMovesItsFiguresTheDocumentedWay) {
+  struct Case {
+    const char* id;
+    float low, high;
+  };
+  const Case cases[] = {{"teapot-stadium", 10, 30},
+                        {"same-centroid", 200, 1000},
+                        {"same-bounds", 200, 1000},
+                        {"grass", 1000, 4000},
+                        {"growth", 4000, 8000}};
+  std::string script = std::string("open ") + kTeapot + "\nsize 640 480\nwait\n";
+  for (const Case& c : cases)
+    for (const bool high : {false, true}) {
+      const std::string name = std::string(c.id) + (high ? "-high" : "-low") + ".json";
+      script += "scenario " + std::string(c.id) + " " + std::to_string(high ? c.high : c.low) + "\n" +
+                "dump-scenario " + path(name).string() + "\n";
+    }
+  script += "quit\n";
+  const RunResult r = run(script);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto row = [](const nlohmann::json& j, const std::string& structure, bool last = false) {
+    nlohmann::json found;
+    for (const auto& x : j["rows"])
+      if (x["structure"] == structure) {
+        found = x;
+        if (!last) break;
+      }
+    EXPECT_FALSE(found.is_null()) << structure;
+    return found;
+  };
+  const auto low = [&](const char* id) { return read_json(path(std::string(id) + "-low.json")); };
+  const auto high = [&](const char* id) { return read_json(path(std::string(id) + "-high.json")); };
+  // Teapot in a stadium: as the stadium grows the grid's primitive tests per ray climb.
+  EXPECT_GT(row(high("teapot-stadium"), "grid")["prims_per_ray"].get<double>(),
+            row(low("teapot-stadium"), "grid")["prims_per_ray"].get<double>());
+  // One centroid / one box for all: cost per ray grows with N (nothing separates the primitives).
+  for (const char* id : {"same-centroid", "same-bounds"})
+    EXPECT_GT(row(high(id), "bvh")["cost_per_ray"].get<double>(), row(low(id), "bvh")["cost_per_ray"].get<double>())
+        << id;
+  // Grass: the slider is the field's size; all three structures measured on it.
+  for (const char* st : {"grid", "bvh", "kdtree"})
+    EXPECT_GT(row(high("grass"), st)["triangles"].get<double>(), row(low("grass"), st)["triangles"].get<double>())
+        << st;
+  // Growth: from N/64 to N a grid's nodes per ray grow (about N^(1/3)); the largest N follows the slider.
+  const nlohmann::json g = high("growth");
+  EXPECT_GT(row(g, "grid", true)["nodes_per_ray"].get<double>(), row(g, "grid")["nodes_per_ray"].get<double>());
+  EXPECT_GT(row(g, "bvh", true)["triangles"].get<double>(), row(low("growth"), "bvh", true)["triangles"].get<double>());
+}
+
 // The Dynamics panel plays builtin:dynamic off the UI thread: `play 3` waits
 // for three stepped frames, whose figures come from a SceneAnimator over the
 // scene's two-level structure. A static OBJ without lights reports shadow
@@ -453,10 +502,10 @@ TEST_F(GuiScript, DynamicsPanelPlaysFramesAndEffectsFollowTheScene) {
 
   const fs::path obj = path("tri.obj");
   std::ofstream(obj) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n";
-  const RunResult s = run("open " + obj.string() + "\nwait\ndump-dynamics " + path("static.json").string() +
-                          "\ndump-stats " + path("static_stats.json").string() +
-                          "\nforce-effect shadow-rays\nwait\ndump-dynamics " + path("forced.json").string() +
-                          "\ndump-stats " + path("forced_stats.json").string() + "\nquit\n");
+  const RunResult s =
+      run("open " + obj.string() + "\nwait\ndump-dynamics " + path("static.json").string() + "\ndump-stats " +
+          path("static_stats.json").string() + "\nforce-effect shadow-rays\nwait\ndump-dynamics " +
+          path("forced.json").string() + "\ndump-stats " + path("forced_stats.json").string() + "\nquit\n");
   ASSERT_EQ(s.code, 0) << s.err;
   for (const char* file : {"static.json", "forced.json"}) {
     const nlohmann::json st = read_json(path(file));
