@@ -261,8 +261,9 @@ TEST(BvhWide, EightWideCollapseKeepsEveryLeafOnceAndRefitsWithTheBinaryTree) {
   bvh_detail::refit_wide(wide, moved);
   for (std::size_t w = 0; w < wide.nodes.size(); ++w)
     for (int s = 0; s < 8; ++s)
-      if (wide.source[8 * w + s] != bvh_detail::kWideEmpty)
+      if (wide.source[8 * w + s] != bvh_detail::kWideEmpty) {
         EXPECT_EQ(wide.nodes[w].bounds[5][s], moved[wide.source[8 * w + s]].bounds.hi.z);
+      }
 }
 
 TEST(BvhWide, EveryWidthAnswersLikeTheBinaryTree) {
