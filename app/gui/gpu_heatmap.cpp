@@ -34,8 +34,6 @@ std::shared_ptr<const HeatmapFrame> GpuHeatmap::trace(const HeatmapRequest& r, s
 
   const std::size_t n = frame->image.values.size();
   frame->pixels.resize(n);
-  HeatmapSummary& s = frame->summary;
-  double sum_nodes = 0.0, sum_prims = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     PixelFigures& p = frame->pixels[i];
     p.value = frame->image.values[i];
@@ -43,21 +41,8 @@ std::shared_ptr<const HeatmapFrame> GpuHeatmap::trace(const HeatmapRequest& r, s
     p.prims = raw.stats[i].prim_tests;
     p.prim = raw.hits[i].prim;
     p.t = raw.hits[i].t;
-    sum_nodes += p.nodes;
-    sum_prims += p.prims;
-    s.max_nodes = std::max(s.max_nodes, p.nodes);
-    s.max_prims = std::max(s.max_prims, p.prims);
   }
-  s.rays = fig.rays;
-  s.hits = fig.hits;
-  if (n > 0) {
-    s.mean_nodes = sum_nodes / static_cast<double>(n);
-    s.mean_prims = sum_prims / static_cast<double>(n);
-  }
-  s.mean_value = fig.mean;
-  s.max_value = fig.max;
-  s.render_ms = fig.render_ms;
-  s.rays_per_s = fig.rays_per_s;
+  frame->summary = summarise_pixels(frame->pixels, fig.render_ms);
   return frame;
 }
 

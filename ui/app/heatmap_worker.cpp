@@ -78,6 +78,12 @@ HeatmapSummary summarise(const Accumulator& a, double render_ms) {
 
 }  // namespace
 
+HeatmapSummary summarise_pixels(std::span<const PixelFigures> pixels, double render_ms) {
+  Accumulator a;
+  for (const PixelFigures& p : pixels) a.add(p);
+  return summarise(a, render_ms);
+}
+
 bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::function<bool()>& keep_going,
                        const std::function<void(std::shared_ptr<const HeatmapFrame>)>& publish) {
   const int w = r.width, h = r.height;

@@ -11,6 +11,7 @@
 // the top, the same convention as `accelviz render` and the GL camera.
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "core/accel/accel.h"
@@ -84,6 +85,10 @@ struct HeatmapFrame {
 /// worker's engine, exposed for tests.
 bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::function<bool()>& keep_going,
                        const std::function<void(std::shared_ptr<const HeatmapFrame>)>& publish);
+
+/// The summary of fully traced pixels (every pixel counted once), as the
+/// worker computes it for its frames; used by the GPU path too.
+HeatmapSummary summarise_pixels(std::span<const PixelFigures> pixels, double render_ms);
 
 class HeatmapWorker {
  public:
