@@ -249,8 +249,9 @@ Command add_render_command(CLI::App& parent, const GlobalOptions& global) {
       ->capture_default_str();
   sub->add_option("--metric,-m", o->metric,
                   "Per-pixel metric: nodes (nodes visited), prims (triangle tests), cost (ctrav*nodes + "
-                  "cisect*prims), shaded (headlight shading), depth (hit distance)")
-      ->check(CLI::IsMember({"nodes", "prims", "cost", "shaded", "depth"}))
+                  "cisect*prims), shaded (headlight shading), depth (hit distance), instances (instances "
+                  "visited, two-level structure)")
+      ->check(CLI::IsMember({"nodes", "prims", "cost", "shaded", "depth", "instances"}))
       ->capture_default_str();
   sub->add_option("--camera", o->camera,
                   "View: ex,ey,ez,tx,ty,tz[,fovdeg] (eye, target, vertical fov in degrees, default 45) or gltf:N "

@@ -119,7 +119,7 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
   const ImageSize size = parse_size(job.size);
   const HeatMetric metric = parse_metric(job.metric).value();
   if (!metric_needs_stats(metric))
-    throw UsageError("--compare: needs a cost metric (nodes, prims or cost), not --metric " + job.metric);
+    throw UsageError("--compare: needs a cost metric (nodes, prims, cost or instances), not --metric " + job.metric);
   Progress progress(global.quiet);
   progress.begin("loading " + job.scene);
   const Scene scene = load_scene_noting_warnings(job.scene, global.quiet);

@@ -30,6 +30,7 @@ struct RayStats {
   std::uint32_t repeated_prim_tests = 0;  ///< tests of a primitive already tested by this ray
   std::uint32_t empty_cells = 0;     ///< empty cells/voxels stepped (grids)
   std::uint32_t leaves_skipped = 0;  ///< any-hit (BVH): leaves the ray crosses that the early exit never reached
+  std::uint32_t instances_visited = 0;  ///< two-level: instances whose BLAS the ray entered (0 for single-level)
 
   RayStats& operator+=(const RayStats& o) {
     nodes_visited += o.nodes_visited;
@@ -40,6 +41,7 @@ struct RayStats {
     repeated_prim_tests += o.repeated_prim_tests;
     empty_cells += o.empty_cells;
     leaves_skipped += o.leaves_skipped;
+    instances_visited += o.instances_visited;
     return *this;
   }
 };

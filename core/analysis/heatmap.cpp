@@ -34,6 +34,8 @@ std::string_view metric_name(HeatMetric m) {
       return "shaded";
     case HeatMetric::depth:
       return "depth";
+    case HeatMetric::instances:
+      return "instances";
   }
   return "nodes";
 }
@@ -50,18 +52,21 @@ std::string_view metric_label(HeatMetric m) {
       return "shaded";
     case HeatMetric::depth:
       return "hit distance";
+    case HeatMetric::instances:
+      return "instances visited per ray";
   }
   return "";
 }
 
 std::optional<HeatMetric> parse_metric(std::string_view name) {
-  for (HeatMetric m : {HeatMetric::nodes, HeatMetric::prims, HeatMetric::cost, HeatMetric::shaded, HeatMetric::depth})
+  for (HeatMetric m : {HeatMetric::nodes, HeatMetric::prims, HeatMetric::cost, HeatMetric::shaded, HeatMetric::depth,
+                       HeatMetric::instances})
     if (metric_name(m) == name) return m;
   return std::nullopt;
 }
 
 bool metric_needs_stats(HeatMetric m) {
-  return m == HeatMetric::nodes || m == HeatMetric::prims || m == HeatMetric::cost;
+  return m == HeatMetric::nodes || m == HeatMetric::prims || m == HeatMetric::cost || m == HeatMetric::instances;
 }
 
 float metric_value(HeatMetric m, const Ray& ray, const Hit& hit, const RayStats& stats, float c_trav, float c_isect) {
@@ -82,6 +87,8 @@ float metric_value(HeatMetric m, const Ray& ray, const Hit& hit, const RayStats&
     }
     case HeatMetric::depth:
       return hit.valid() ? hit.t : kNoValue;
+    case HeatMetric::instances:
+      return static_cast<float>(stats.instances_visited);
   }
   return kNoValue;
 }

@@ -18,11 +18,12 @@
 namespace accelviz {
 
 enum class HeatMetric {
-  nodes,   ///< RayStats::nodes_visited
-  prims,   ///< RayStats::prim_tests
-  cost,    ///< c_trav · nodes_visited + c_isect · prim_tests (the SAH's cost model, per ray)
-  shaded,  ///< headlight shading |N·L| of the closest hit, grey background: a picture of the scene
-  depth,   ///< distance to the closest hit; misses have no value
+  nodes,      ///< RayStats::nodes_visited
+  prims,      ///< RayStats::prim_tests
+  cost,       ///< c_trav · nodes_visited + c_isect · prim_tests (the SAH's cost model, per ray)
+  shaded,     ///< headlight shading |N·L| of the closest hit, grey background: a picture of the scene
+  depth,      ///< distance to the closest hit; misses have no value
+  instances,  ///< RayStats::instances_visited: instances whose BLAS the ray entered (two-level; 0 elsewhere)
 };
 
 std::string_view metric_name(HeatMetric m);   ///< "nodes", "prims", ...

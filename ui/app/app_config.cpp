@@ -280,12 +280,13 @@ const std::vector<Entry>& entries() {
         "heatmap", "off|full|blend", "per-pixel metric: off, replacing the mesh, or blended over it",
         {{"off", HeatmapDisplay::off}, {"full", HeatmapDisplay::full_screen}, {"blend", HeatmapDisplay::blend}},
         [](AppConfig& c) -> HeatmapDisplay& { return c.view.heatmap; }));
-    t.push_back(enum_option<HeatMetric>("metric", "nodes|prims|cost|shaded|depth", "heatmap metric",
+    t.push_back(enum_option<HeatMetric>("metric", "nodes|prims|cost|shaded|depth|instances", "heatmap metric",
                                         {{"nodes", HeatMetric::nodes},
                                          {"prims", HeatMetric::prims},
                                          {"cost", HeatMetric::cost},
                                          {"shaded", HeatMetric::shaded},
-                                         {"depth", HeatMetric::depth}},
+                                         {"depth", HeatMetric::depth},
+                                         {"instances", HeatMetric::instances}},
                                         [](AppConfig& c) -> HeatMetric& { return c.view.metric; }));
     t.push_back(bool_option("heatmap-gpu",
                             "trace the heatmap on the GPU (compute shader, BVH only; otherwise on the CPU)",

@@ -366,3 +366,5 @@ ScreenshotInfo AppState::screenshot_info(float scale_min, float scale_max) const
 }
 
 }  // namespace accelviz
+                 {"mean_instances", s.mean_instances},
+                 {"max_instances", s.max_instances},

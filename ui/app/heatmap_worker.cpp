@@ -14,8 +14,8 @@ namespace {
 
 struct Accumulator {
   std::uint64_t rays = 0, hits = 0, valued = 0;
-  double sum_nodes = 0.0, sum_prims = 0.0, sum_value = 0.0, max_value = 0.0;
-  std::uint32_t max_nodes = 0, max_prims = 0;
+  double sum_nodes = 0.0, sum_prims = 0.0, sum_instances = 0.0, sum_value = 0.0, max_value = 0.0;
+  std::uint32_t max_nodes = 0, max_prims = 0, max_instances = 0;
   std::uint64_t shadow_rays = 0, shadowed = 0;
   double shadow_nodes = 0.0, shadow_prims = 0.0;
 
@@ -28,8 +28,10 @@ struct Accumulator {
     if (p.prim != kInvalidId) ++hits;
     sum_nodes += p.nodes;
     sum_prims += p.prims;
+    sum_instances += p.instances;
     max_nodes = std::max(max_nodes, p.nodes);
     max_prims = std::max(max_prims, p.prims);
+    max_instances = std::max(max_instances, p.instances);
     if (!std::isnan(p.value)) {
       ++valued;
       sum_value += p.value;
@@ -46,10 +48,12 @@ struct Accumulator {
     valued += o.valued;
     sum_nodes += o.sum_nodes;
     sum_prims += o.sum_prims;
+    sum_instances += o.sum_instances;
     sum_value += o.sum_value;
     max_value = std::max(max_value, o.max_value);
     max_nodes = std::max(max_nodes, o.max_nodes);
     max_prims = std::max(max_prims, o.max_prims);
+    max_instances = std::max(max_instances, o.max_instances);
   }
 };
 
@@ -60,7 +64,9 @@ HeatmapSummary summarise(const Accumulator& a, double render_ms) {
   if (a.rays > 0) {
     s.mean_nodes = a.sum_nodes / static_cast<double>(a.rays);
     s.mean_prims = a.sum_prims / static_cast<double>(a.rays);
+    s.mean_instances = a.sum_instances / static_cast<double>(a.rays);
   }
+  s.max_instances = a.max_instances;
   s.max_nodes = a.max_nodes;
   s.max_prims = a.max_prims;
   if (a.valued > 0) s.mean_value = a.sum_value / static_cast<double>(a.valued);
@@ -128,6 +134,7 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
           p.value = metric_value(r.metric, ray, hit, stats, r.c_trav, r.c_isect);
           p.nodes = stats.nodes_visited;
           p.prims = stats.prim_tests;
+          p.instances = stats.instances_visited;
           p.prim = hit.prim;
           p.t = hit.t;
           p.shadow_rays = p.shadow_nodes = p.shadow_prims = p.shadowed = 0;

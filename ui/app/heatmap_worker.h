@@ -76,6 +76,7 @@ struct HeatmapFrame {
   HeatmapRequest request;  ///< what it shows (structure, camera, size, metric)
 
   const PixelFigures& at(int x, int y) const { return pixels[static_cast<std::size_t>(y) * image.width + x]; }
+  std::uint32_t instances = 0;       ///< RayStats::instances_visited (two-level; 0 elsewhere)
 };
 
 /// Traces request `r` level by level, synchronously, calling `publish`
@@ -90,6 +91,8 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
 /// worker computes it for its frames; used by the GPU path too.
 HeatmapSummary summarise_pixels(std::span<const PixelFigures> pixels, double render_ms);
 
+  double mean_instances = 0.0;  ///< instances visited per pixel (two-level; 0 elsewhere)
+  std::uint32_t max_instances = 0;
 class HeatmapWorker {
  public:
   HeatmapWorker();

@@ -306,6 +306,8 @@ void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const Pa
           view->complete ? "" : (" (1 in " + std::to_string(view->stride * view->stride) + ")").c_str());
       row("nodes / pixel", "mean %.2f, max %u", s.mean_nodes, s.max_nodes);
       row("prim tests / pixel", "mean %.2f, max %u", s.mean_prims, s.max_prims);
+      if (view->request.structure && view->request.structure->accel && view->request.structure->accel->name() == "tlas")
+        row("instances / pixel", "mean %.2f, max %u", s.mean_instances, s.max_instances);
       row("hits", "%" PRIu64 " of %" PRIu64, s.hits, s.rays);
       row("heatmap ms", "%.1f", s.render_ms);
       row("rays / s", "%.3g", s.rays_per_s);
@@ -392,7 +394,7 @@ bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout
     changed = true;
   }
   int metric = static_cast<int>(v.metric);
-  if (combo("Metric", metric, {"nodes visited", "primitive tests", "cost", "shaded", "depth"})) {
+  if (combo("Metric", metric, {"nodes visited", "primitive tests", "cost", "shaded", "depth", "instances visited"})) {
     v.metric = static_cast<HeatMetric>(metric);
     changed = true;
   }
@@ -655,3 +657,4 @@ void pixel_tooltip(int x, int y, const PixelFigures& p, HeatMetric metric, bool 
 }
 
 }  // namespace accelviz::panels
+  if (p.instances > 0) ImGui::Text("instances visited %u", p.instances);

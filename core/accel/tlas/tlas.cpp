@@ -297,6 +297,7 @@ static Hit traverse_two_level(const Tlas& t, std::span<const BvhNode> nodes, std
           best.instance = id;
           return best;
         }
+      if (c.rs) ++c.rs->instances_visited;
       } else {
         VisitTrace lt;
         Hit h = blas.closest_hit(local, qo, lsp, c.trace ? &lt : nullptr);
