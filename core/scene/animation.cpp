@@ -76,6 +76,133 @@ glm::vec4 sample_channel(const AnimationChannel& c, float t) {
   return value(k);
 }
 
+std::vector<float> sample_weights(const AnimationChannel& c, float t) {
+  using I = AnimationChannel::Interpolation;
+  const std::size_t keys = c.times.size();
+  const std::size_t per_key = c.interpolation == I::cubic_spline ? 3 : 1;
+  if (keys == 0) throw std::invalid_argument("animation channel without keys");
+  if (c.values.empty() || c.values.size() % (keys * per_key) != 0)
+    throw std::invalid_argument("weights channel: " + std::to_string(c.values.size()) + " values for " +
+                                std::to_string(keys) + " keys (expected a positive multiple of " +
+                                std::to_string(keys * per_key) + ")");
+  const std::size_t n = c.values.size() / (keys * per_key);  // morph targets
+  // Key k's block: [in-tangents n][values n][out-tangents n] for cubic spline, [values n] otherwise.
+  const auto at = [&](std::size_t k, std::size_t part, std::size_t j) {
+    return c.values[(k * per_key + part) * n + j].x;
+  };
+  const std::size_t vpart = per_key == 3 ? 1 : 0;
+  std::vector<float> out(n);
+  if (keys == 1 || t <= c.times.front() || t >= c.times.back()) {
+    const std::size_t k = keys == 1 || t <= c.times.front() ? 0 : keys - 1;
+    for (std::size_t j = 0; j < n; ++j) out[j] = at(k, vpart, j);
+    return out;
+  }
+  const std::size_t k =
+      static_cast<std::size_t>(std::upper_bound(c.times.begin(), c.times.end(), t) - c.times.begin()) - 1;
+  const float t0 = c.times[k], t1 = c.times[k + 1];
+  const float td = t1 - t0;
+  const float s = td > 0.0f ? (t - t0) / td : 0.0f;
+  for (std::size_t j = 0; j < n; ++j) {
+    switch (c.interpolation) {
+      case I::step:
+        out[j] = at(k, vpart, j);
+        break;
+      case I::linear:
+        out[j] = at(k, 0, j) + s * (at(k + 1, 0, j) - at(k, 0, j));
+        break;
+      case I::cubic_spline: {
+        // glTF 2.0 Appendix C, per weight, as for TRS.
+        const float p0 = at(k, 1, j), p1 = at(k + 1, 1, j);
+        const float b0 = at(k, 2, j), a1 = at(k + 1, 0, j);
+        const float s2 = s * s, s3 = s2 * s;
+        out[j] =
+            (2 * s3 - 3 * s2 + 1) * p0 + td * (s3 - 2 * s2 + s) * b0 + (-2 * s3 + 3 * s2) * p1 + td * (s3 - s2) * a1;
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+namespace {
+
+/// The first weights channel whose node references MESH (null: none).
+const AnimationChannel* weights_channel_of(const Scene& scene, std::uint32_t mesh) {
+  for (const Animation& a : scene.animations)
+    for (const AnimationChannel& c : a.channels)
+      if (c.path == AnimationChannel::Path::weights && !c.times.empty() && c.node >= 0 &&
+          static_cast<std::size_t>(c.node) < scene.nodes.size() && scene.nodes[c.node].mesh == static_cast<int>(mesh))
+        return &c;
+  return nullptr;
+}
+
+/// Positions moved by deformer D at time T (the grass sway; see MeshDeformer).
+std::vector<glm::vec3> sway(std::span<const glm::vec3> positions, const MeshDeformer& d, float t) {
+  const float w0 = 2.0f * 3.14159265358979f * d.frequency * t;
+  std::vector<glm::vec3> moved(positions.size());
+  for (std::size_t i = 0; i < moved.size(); ++i) {
+    const glm::vec3& p = positions[i];
+    const float h = d.height > 0.0f ? std::max(0.0f, p.y) / d.height : 0.0f;
+    const float amp = d.amplitude * h * h;
+    const float w = w0 + 0.7f * p.x + 0.5f * p.z;
+    moved[i] = p + glm::vec3(amp * std::sin(w), 0.0f, 0.5f * amp * std::cos(w));
+  }
+  return moved;
+}
+
+/// MESH's triangles over MOVED vertices, skipping those whose rest vertices
+/// are not finite (as the BLAS was built).
+std::vector<Triangle> triangles_over(const Mesh& mesh, const std::vector<glm::vec3>& moved) {
+  const auto finite3 = [](const glm::vec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+  };
+  std::vector<Triangle> out;
+  out.reserve(mesh.indices.size());
+  for (const glm::uvec3& idx : mesh.indices) {
+    const glm::vec3 &a = mesh.positions[idx.x], &b = mesh.positions[idx.y], &c = mesh.positions[idx.z];
+    if (!finite3(a) || !finite3(b) || !finite3(c)) continue;
+    out.push_back({moved[idx.x], moved[idx.y], moved[idx.z]});
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> deforming_meshes(const Scene& scene) {
+  std::vector<std::uint32_t> out;
+  for (const MeshDeformer& d : scene.deformers)
+    if (d.mesh < scene.meshes.size()) out.push_back(d.mesh);
+  for (std::uint32_t m = 0; m < scene.meshes.size(); ++m)
+    if (!scene.meshes[m].morph_deltas.empty() && weights_channel_of(scene, m)) out.push_back(m);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+std::vector<float> mesh_morph_weights(const Scene& scene, std::uint32_t mesh, float t) {
+  if (mesh >= scene.meshes.size()) return {};
+  const Mesh& m = scene.meshes[mesh];
+  std::vector<float> w = m.morph_weights;
+  if (const AnimationChannel* c = weights_channel_of(scene, mesh)) w = sample_weights(*c, t);
+  w.resize(m.morph_deltas.size(), 0.0f);
+  return w;
+}
+
+std::vector<glm::vec3> posed_positions(const Scene& scene, std::uint32_t mesh, float t) {
+  if (mesh >= scene.meshes.size()) return {};
+  const Mesh& m = scene.meshes[mesh];
+  std::vector<glm::vec3> p =
+      m.morph_deltas.empty() ? m.positions : morphed_positions(m, mesh_morph_weights(scene, mesh, t));
+  for (const MeshDeformer& d : scene.deformers)
+    if (d.mesh == mesh) p = sway(p, d, t);
+  return p;
+}
+
+std::vector<Triangle> posed_triangles(const Scene& scene, std::uint32_t mesh, float t) {
+  if (mesh >= scene.meshes.size()) return {};
+  return triangles_over(scene.meshes[mesh], posed_positions(scene, mesh, t));
+}
+
 float animation_duration(const Scene& scene) {
   float d = 0.0f;
   for (const Animation& a : scene.animations)
@@ -85,7 +212,7 @@ float animation_duration(const Scene& scene) {
 }
 
 bool scene_animates(const Scene& scene) {
-  if (!scene.deformers.empty()) return true;
+  if (!scene.deformers.empty() || !deforming_meshes(scene).empty()) return true;
   for (const Animation& a : scene.animations)
     for (const AnimationChannel& c : a.channels)
       if (c.node >= 0 && c.path != AnimationChannel::Path::weights && !c.times.empty()) return true;
@@ -143,31 +270,11 @@ std::vector<glm::mat4> node_world_transforms(std::span<const Node> nodes) {
 }
 
 std::vector<glm::vec3> deformed_positions(const Mesh& mesh, const MeshDeformer& d, float t) {
-  const float w0 = 2.0f * 3.14159265358979f * d.frequency * t;
-  std::vector<glm::vec3> moved(mesh.positions.size());
-  for (std::size_t i = 0; i < moved.size(); ++i) {
-    const glm::vec3& p = mesh.positions[i];
-    const float h = d.height > 0.0f ? std::max(0.0f, p.y) / d.height : 0.0f;
-    const float sway = d.amplitude * h * h;
-    const float w = w0 + 0.7f * p.x + 0.5f * p.z;
-    moved[i] = p + glm::vec3(sway * std::sin(w), 0.0f, 0.5f * sway * std::cos(w));
-  }
-  return moved;
+  return sway(mesh.positions, d, t);
 }
 
 std::vector<Triangle> deformed_triangles(const Mesh& mesh, const MeshDeformer& d, float t) {
-  const auto finite3 = [](const glm::vec3& v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-  };
-  const std::vector<glm::vec3> moved = deformed_positions(mesh, d, t);
-  std::vector<Triangle> out;
-  out.reserve(mesh.indices.size());
-  for (const glm::uvec3& idx : mesh.indices) {
-    const glm::vec3 &a = mesh.positions[idx.x], &b = mesh.positions[idx.y], &c = mesh.positions[idx.z];
-    if (!finite3(a) || !finite3(b) || !finite3(c)) continue;  // as the BLAS was built
-    out.push_back({moved[idx.x], moved[idx.y], moved[idx.z]});
-  }
-  return out;
+  return triangles_over(mesh, deformed_positions(mesh, d, t));
 }
 
 Scene posed_scene(const Scene& scene, float t) {
@@ -181,14 +288,18 @@ Scene posed_scene(const Scene& scene, float t) {
     for (Instance& inst : out.instances)
       if (inst.node < world.size()) inst.transform = world[inst.node];
   }
-  for (const MeshDeformer& d : scene.deformers)
-    if (d.mesh < out.meshes.size()) out.meshes[d.mesh].positions = deformed_positions(scene.meshes[d.mesh], d, t);
+  for (const std::uint32_t m : deforming_meshes(scene)) out.meshes[m].positions = posed_positions(scene, m, t);
   if (!scene.triangles.empty()) out.flatten();
   return out;
 }
 
 SceneAnimator::SceneAnimator(const Scene& scene, Tlas& tlas, const AnimatorOptions& opts)
-    : scene_(scene), tlas_(tlas), opts_(opts), nodes_(scene.nodes), duration_(animation_duration(scene)) {
+    : scene_(scene),
+      tlas_(tlas),
+      opts_(opts),
+      nodes_(scene.nodes),
+      duration_(animation_duration(scene)),
+      deforming_(deforming_meshes(scene)) {
   if (tlas.instances().size() != scene.instances.size())
     throw std::invalid_argument("animator: the two-level structure has " + std::to_string(tlas.instances().size()) +
                                 " instances, the scene " + std::to_string(scene.instances.size()));
@@ -217,11 +328,11 @@ FrameStats SceneAnimator::step(float t) {
       fs.tlas_rebuilt = true;
     }
   }
-  // Deforming meshes: refit, or rebuild past the ratio.
-  for (const MeshDeformer& d : scene_.deformers) {
-    const int b = d.mesh < scene_.meshes.size() ? tlas_.blas_of_mesh(d.mesh) : -1;
+  // Deforming meshes (deformers, morph targets): refit, or rebuild past the ratio.
+  for (const std::uint32_t mesh : deforming_) {
+    const int b = tlas_.blas_of_mesh(mesh);
     if (b < 0) continue;
-    const std::vector<Triangle> tris = deformed_triangles(scene_.meshes[d.mesh], d, t);
+    const std::vector<Triangle> tris = posed_triangles(scene_, mesh, t);
     const auto t0 = Clock::now();
     Bvh fresh(tris, tlas_.blas(b).options());
     fs.rebuild_ms += ms_since(t0);

@@ -25,14 +25,43 @@ namespace accelviz {
 glm::vec4 sample_channel(const AnimationChannel& channel, float t);
 
 /// Last key time over all channels of all animations (0: nothing animates).
+/// Morph weights of a `weights` CHANNEL at time T: one value per morph
+/// target (the channel's outputs per key divided by its keys), interpolated
+/// like sample_channel (linear, step, cubic spline with in/out tangents;
+/// clamped to the first and last key). Throws std::invalid_argument for a
+/// channel without keys or with a value count that is not a positive
+/// multiple of its keys (times 3 for cubic spline).
+std::vector<float> sample_weights(const AnimationChannel& channel, float t);
+
+/// Meshes whose shape changes over time, ascending: those a MeshDeformer
+/// moves and those with morph targets whose weights a channel drives (the
+/// channel's node references the mesh).
+std::vector<std::uint32_t> deforming_meshes(const Scene& scene);
+
+/// Morph weights of MESH at time T: the first `weights` channel (animations
+/// in order) whose node references the mesh, sampled at T, else the mesh's
+/// default weights. One BLAS per mesh: every instance shares this shape.
+/// Sized to the mesh's target count (empty: no targets).
+std::vector<float> mesh_morph_weights(const Scene& scene, std::uint32_t mesh, float t);
+
+/// Object-space vertex positions of MESH at time T: morph targets under
+/// mesh_morph_weights, then the mesh's deformers on top.
+std::vector<glm::vec3> posed_positions(const Scene& scene, std::uint32_t mesh, float t);
+
+/// Object-space triangles of MESH at time T (posed_positions), in index
+/// order, skipping the triangles a BLAS skips (non-finite rest vertices).
+std::vector<Triangle> posed_triangles(const Scene& scene, std::uint32_t mesh, float t);
+
 float animation_duration(const Scene& scene);
 
-/// True when the scene has animation channels or mesh deformers.
+/// True when the scene has node TRS channels, mesh deformers, or morph
+/// weights channels that drive a mesh with morph targets.
 bool scene_animates(const Scene& scene);
 
 /// Sets the TRS of every node a channel of ANIM drives to its value at T and
 /// recomputes those nodes' local matrices (T * R * S). Marks them in
-/// `changed` (resized to nodes.size()). Weight channels are ignored.
+/// `changed` (resized to nodes.size()). Weight channels are not node
+/// motion: they shape meshes (mesh_morph_weights, posed_positions).
 void apply_animation(const Animation& anim, float t, std::vector<Node>& nodes, std::vector<bool>& changed);
 
 /// The local matrix T * R * S of a node's translation, rotation and scale.
@@ -49,8 +78,8 @@ std::vector<Triangle> deformed_triangles(const Mesh& mesh, const MeshDeformer& d
 
 /// SCENE as it stands at time T (wrapped into the animation's duration, as
 /// SceneAnimator::step does): nodes driven by channels take their sampled
-/// TRS, every instance its node's world transform, deformed meshes their
-/// moved vertices; the world triangle list is flattened again when SCENE's
+/// TRS, every instance its node's world transform, deformed and morphing meshes their
+/// moved vertices (deformers and morph targets); the world triangle list is flattened again when SCENE's
 /// was (an instanced scene left unflattened stays so). At T = 0 of a scene
 /// whose rest pose is its first key this is SCENE's geometry.
 Scene posed_scene(const Scene& scene, float t);
@@ -84,7 +113,9 @@ class SceneAnimator {
   SceneAnimator(const Scene& scene, Tlas& tlas, const AnimatorOptions& opts = {});
 
   /// Moves everything to time T (seconds, wrapped into the animation's
-  /// duration) and updates the structure.
+  /// duration) and updates the structure: instance transforms and the TLAS
+  /// when nodes moved, and every deforming mesh's BLAS (deforming_meshes():
+  /// procedural deformers and morph targets) by refit, or rebuild past the ratio.
   FrameStats step(float t);
 
   /// Instance transforms as of the last step.
@@ -98,6 +129,7 @@ class SceneAnimator {
   std::vector<glm::mat4> transforms_;
   std::uint32_t frame_ = 0;
   float duration_ = 0.0f;
+  std::vector<std::uint32_t> deforming_;  ///< deforming_meshes(scene)
 };
 
 }  // namespace accelviz

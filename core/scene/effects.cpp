@@ -45,8 +45,9 @@ SceneEffects decide_effects(const Scene& scene, const EffectForces& forces) {
   if (fx.per_frame_updates.on) {
     std::string what;
     if (channels > 0) what = count(channels, "animation channel") + " (rigid: instance transforms + TLAS)";
-    if (!scene.deformers.empty())
-      what += (what.empty() ? "" : ", ") + count(scene.deformers.size(), "deforming mesh") + " (BLAS refit or rebuild)";
+    const std::size_t deforming = deforming_meshes(scene).size();
+    if (deforming > 0)
+      what += (what.empty() ? "" : ", ") + count(deforming, "deforming mesh") + " (BLAS refit or rebuild)";
     fx.per_frame_updates.reason = what;
   } else {
     fx.per_frame_updates.reason = "nothing animates: the structure is built once";

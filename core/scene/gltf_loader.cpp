@@ -465,7 +465,24 @@ class GltfConverter {
       const tinygltf::Mesh& gm = model_.meshes[m];
       Mesh mesh;
       mesh.name = gm.name;
-      bool morph_warned = false;
+      const std::string mesh_where = "mesh " + std::to_string(m);
+      // Morph targets (POSITION deltas only): kept unless one is stored in a
+      // way we do not read, then the base shape is used, as before.
+      bool morphs = false;
+      for (const tinygltf::Primitive& prim : gm.primitives)
+        morphs = morphs || !prim.targets.empty();
+      if (morphs) {
+        for (const tinygltf::Primitive& prim : gm.primitives)
+          for (const auto& target : prim.targets) {
+            const auto it = target.find("POSITION");
+            if (it != target.end() && it->second >= 0 && std::size_t(it->second) < model_.accessors.size() &&
+                model_.accessors[std::size_t(it->second)].sparse.isSparse && morphs) {
+              warn(mesh_where + " has a sparse morph target; its morph targets are ignored (base shape used)");
+              morphs = false;
+            }
+          }
+      }
+      std::size_t targets = 0;
       for (std::size_t p = 0; p < gm.primitives.size(); ++p) {
         const tinygltf::Primitive& prim = gm.primitives[p];
         const std::string where = "mesh " + std::to_string(m) + " primitive " + std::to_string(p);
@@ -481,14 +498,63 @@ class GltfConverter {
           warn(where + " has no POSITION attribute; skipped");
           continue;
         }
-        if (!prim.targets.empty() && !morph_warned) {
-          warn("mesh " + std::to_string(m) + " has morph targets; the base shape is used");
-          morph_warned = true;
-        }
+        const std::size_t first_vertex = mesh.positions.size();
         append_primitive(mesh, prim, mode, pos->second, where);
+        if (morphs && !prim.targets.empty()) append_morph_targets(mesh, prim, first_vertex, targets, where);
       }
+      if (morphs && targets > 0) finish_morph_targets(mesh, gm, mesh_where);
       scene_.meshes.push_back(std::move(mesh));
     }
+  }
+
+  /// POSITION deltas of PRIM's morph targets, for the vertices it appended
+  /// from FIRST_VERTEX on. Every primitive of a mesh must have the same
+  /// number of targets (glTF 2.0 §3.7.2.2); a target without POSITION moves nothing.
+  void append_morph_targets(Mesh& mesh, const tinygltf::Primitive& prim, std::size_t first_vertex,
+                            std::size_t& targets, const std::string& where) {
+    if (targets == 0) {
+      targets = prim.targets.size();
+      mesh.morph_deltas.resize(targets);
+    } else if (prim.targets.size() != targets) {
+      fail(where + " has " + std::to_string(prim.targets.size()) + " morph targets, an earlier primitive of its mesh " +
+           std::to_string(targets));
+    }
+    const std::size_t count = mesh.positions.size() - first_vertex;
+    for (std::size_t t = 0; t < targets; ++t) {
+      std::vector<glm::vec3>& deltas = mesh.morph_deltas[t];
+      deltas.resize(mesh.positions.size(), glm::vec3(0.0f));
+      const auto it = prim.targets[t].find("POSITION");
+      if (it == prim.targets[t].end()) continue;
+      const std::vector<glm::vec3> d =
+          read_positions(it->second, "POSITION of morph target " + std::to_string(t) + " of " + where);
+      if (d.size() != count)
+        fail(where + ": morph target " + std::to_string(t) + " has " + std::to_string(d.size()) +
+             " POSITION deltas for " + std::to_string(count) + " vertices");
+      for (std::size_t i = 0; i < count; ++i) {
+        if (!std::isfinite(d[i].x) || !std::isfinite(d[i].y) || !std::isfinite(d[i].z))
+          fail(where + ": morph target " + std::to_string(t) + " has a non-finite delta at vertex " + std::to_string(i));
+        deltas[first_vertex + i] = d[i];
+      }
+    }
+  }
+
+  /// Pads the deltas of primitives without targets, takes the default
+  /// weights (mesh.weights) and sets the rest pose to base + their deltas.
+  void finish_morph_targets(Mesh& mesh, const tinygltf::Mesh& gm, const std::string& where) {
+    for (std::vector<glm::vec3>& d : mesh.morph_deltas) d.resize(mesh.positions.size(), glm::vec3(0.0f));
+    const std::size_t targets = mesh.morph_deltas.size();
+    mesh.morph_weights.assign(targets, 0.0f);
+    if (!gm.weights.empty()) {
+      if (gm.weights.size() != targets)
+        fail(where + " has " + std::to_string(gm.weights.size()) + " default weights for " + std::to_string(targets) +
+             " morph targets");
+      for (std::size_t t = 0; t < targets; ++t) {
+        if (!std::isfinite(gm.weights[t])) fail(where + " has a non-finite default weight " + std::to_string(t));
+        mesh.morph_weights[t] = static_cast<float>(gm.weights[t]);
+      }
+    }
+    mesh.morph_base = mesh.positions;
+    mesh.positions = morphed_positions(mesh, mesh.morph_weights);
   }
 
   void append_primitive(Mesh& mesh, const tinygltf::Primitive& prim, int mode, int position_accessor,
@@ -559,6 +625,7 @@ class GltfConverter {
         fail(name + " refers to camera " + std::to_string(g.camera) + ", but the file has " +
              std::to_string(model_.cameras.size()) + " cameras");
       node.mesh = g.mesh < 0 ? -1 : g.mesh;
+      if (!g.weights.empty()) node_morph_weights(i, g);
       if (g.skin >= 0) warn(name + " is skinned; its mesh is used in the bind pose");
 
       if (!g.matrix.empty()) {
@@ -610,6 +677,37 @@ class GltfConverter {
         node_light_.back() = light;
       }
     }
+  }
+
+  /// A node's own morph weights replace its mesh's defaults in the rest
+  /// pose. One BLAS per mesh: all instances of a mesh share one shape, so
+  /// the first node that gives weights wins (a differing later one is warned about).
+  void node_morph_weights(std::size_t i, const tinygltf::Node& g) {
+    const std::string name = "node " + std::to_string(i);
+    if (g.mesh < 0) {
+      warn(name + " has morph weights but no mesh; ignored");
+      return;
+    }
+    Mesh& mesh = scene_.meshes[std::size_t(g.mesh)];
+    if (mesh.morph_deltas.empty()) return;  // no targets read (or none usable): nothing to weigh
+    if (g.weights.size() != mesh.morph_deltas.size())
+      fail(name + " has " + std::to_string(g.weights.size()) + " morph weights for the " +
+           std::to_string(mesh.morph_deltas.size()) + " morph targets of mesh " + std::to_string(g.mesh));
+    std::vector<float> w(g.weights.size());
+    for (std::size_t t = 0; t < w.size(); ++t) {
+      if (!std::isfinite(g.weights[t])) fail(name + " has a non-finite morph weight " + std::to_string(t));
+      w[t] = static_cast<float>(g.weights[t]);
+    }
+    if (morph_weights_set_.size() < scene_.meshes.size()) morph_weights_set_.resize(scene_.meshes.size(), false);
+    if (morph_weights_set_[std::size_t(g.mesh)]) {
+      if (w != mesh.morph_weights)
+        warn(name + ": morph weights differ from another node's of mesh " + std::to_string(g.mesh) +
+             "; the first node's are used for every instance");
+      return;
+    }
+    morph_weights_set_[std::size_t(g.mesh)] = true;
+    mesh.morph_weights = std::move(w);
+    mesh.positions = morphed_positions(mesh, mesh.morph_weights);
   }
 
   /// `local` stays authoritative; TRS is filled for display when the matrix
@@ -860,10 +958,28 @@ class GltfConverter {
           fail(where + " has unknown interpolation '" + gs.interpolation + "'");
         }
         read_keyframes(ch, gs, where);
+        if (ch.path == AnimationChannel::Path::weights) check_weights_channel(ch, where);
         anim.channels.push_back(std::move(ch));
       }
       scene_.animations.push_back(std::move(anim));
     }
+  }
+
+  /// A weights channel shapes the mesh of its node: one output per morph
+  /// target per key. A node without a morphing mesh makes it a no-op (warned).
+  void check_weights_channel(const AnimationChannel& ch, const std::string& where) {
+    const int mesh = scene_.nodes[std::size_t(ch.node)].mesh;
+    if (mesh < 0 || scene_.meshes[std::size_t(mesh)].morph_deltas.empty()) {
+      warn(where + " animates morph weights of node " + std::to_string(ch.node) +
+           ", which has no mesh with morph targets; ignored");
+      return;
+    }
+    const std::size_t targets = scene_.meshes[std::size_t(mesh)].morph_deltas.size();
+    const std::size_t per_key = ch.interpolation == AnimationChannel::Interpolation::cubic_spline ? 3 : 1;
+    if (ch.values.size() != ch.times.size() * per_key * targets)
+      fail(where + ": output has " + std::to_string(ch.values.size()) + " weights for " +
+           std::to_string(ch.times.size()) + " keyframes of the " + std::to_string(targets) + " morph targets of mesh " +
+           std::to_string(mesh) + (per_key == 3 ? " (cubic spline: 3 per target per keyframe)" : ""));
   }
 
   void read_keyframes(AnimationChannel& ch, const tinygltf::AnimationSampler& gs, const std::string& where) {
@@ -937,6 +1053,7 @@ class GltfConverter {
   Scene& scene_;
   std::vector<glm::mat4> local_;
   std::vector<int> node_light_;
+  std::vector<bool> morph_weights_set_;  ///< per mesh: a node's weights became its rest pose
 };
 
 // --- Step 1: reading the file ----------------------------------------------

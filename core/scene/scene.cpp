@@ -1,9 +1,24 @@
 #include "core/scene/scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
 namespace accelviz {
+
+std::vector<glm::vec3> morphed_positions(const Mesh& mesh, const std::vector<float>& weights) {
+  if (mesh.morph_deltas.empty()) return mesh.positions;
+  std::vector<glm::vec3> out = mesh.morph_base.empty() ? mesh.positions : mesh.morph_base;
+  const std::size_t targets = std::min(weights.size(), mesh.morph_deltas.size());
+  for (std::size_t t = 0; t < targets; ++t) {
+    const float w = weights[t];
+    if (w == 0.0f) continue;
+    const std::vector<glm::vec3>& d = mesh.morph_deltas[t];
+    const std::size_t n = std::min(d.size(), out.size());
+    for (std::size_t i = 0; i < n; ++i) out[i] += w * d[i];
+  }
+  return out;
+}
 
 Aabb Scene::bounds() const {
   Aabb b;

@@ -26,9 +26,22 @@ class SceneError : public std::runtime_error {
 /// Object-space triangle mesh (one glTF mesh, all its triangle primitives merged).
 struct Mesh {
   std::string name;
-  std::vector<glm::vec3> positions;
-  std::vector<glm::uvec3> indices;  ///< validated: every index < positions.size()
+  std::vector<glm::vec3> positions;  ///< the rest pose: morph_base + the default weights' deltas, if any
+  std::vector<glm::uvec3> indices;   ///< validated: every index < positions.size()
+  /// glTF morph targets (POSITION only): per target one delta per vertex
+  /// (zeros where a primitive's target has no POSITION). Empty: no targets.
+  std::vector<std::vector<glm::vec3>> morph_deltas;
+  /// Default weights, one per target (glTF mesh.weights, or a node's weights; zeros when absent).
+  std::vector<float> morph_weights;
+  /// Vertex positions before any morph (empty without targets): a pose with
+  /// weights w is morph_base + sum_i w_i * morph_deltas[i] (animation.h morphed_positions).
+  std::vector<glm::vec3> morph_base;
 };
+
+/// MESH's vertex positions under morph WEIGHTS: morph_base + sum_i
+/// weights[i] * morph_deltas[i], accumulated in target order (missing weights
+/// count as 0, extra ones are ignored). A mesh without targets: its positions.
+std::vector<glm::vec3> morphed_positions(const Mesh& mesh, const std::vector<float>& weights);
 
 /// A node of the scene graph. Local transform as TRS (matrix nodes are decomposed
 /// only for display; `local` is authoritative).

@@ -93,6 +93,7 @@ constexpr NamedKind kCommands[] = {
     {"select-region", ScriptCommand::Kind::select_region},
     {"pin-a", ScriptCommand::Kind::pin_a},
     {"dump-ab", ScriptCommand::Kind::dump_ab},
+    {"frames", ScriptCommand::Kind::frames},
 };
 
 }  // namespace
@@ -128,7 +129,7 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
       fail("unknown command '" + std::string(word) +
            "' (valid: open, structure, set, camera, size, wait, click, step, screenshot, dump-ray, dump-stats, quit, "
            "scenario, dump-scenario, "
-           "dump-insight, force-effect, play, dump-dynamics, select-region, pin-a, dump-ab)");
+           "dump-insight, force-effect, play, dump-dynamics, select-region, pin-a, dump-ab, frames)");
 
     ScriptCommand c;
     c.kind = it->kind;
@@ -237,6 +238,9 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
       }
       case ScriptCommand::Kind::play:
         if (!parse_int(rest, c.x) || c.x < 1 || c.x > 100000) fail("play: expected FRAMES (an integer in 1..100000)");
+        break;
+      case ScriptCommand::Kind::frames:
+        if (!parse_int(rest, c.x) || c.x < 1 || c.x > 100000) fail("frames: expected N (an integer in 1..100000)");
         break;
       case ScriptCommand::Kind::scenario: {
         std::string_view value;

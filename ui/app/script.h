@@ -34,6 +34,7 @@ struct ScriptCommand {
     select_region,  ///< x, y, x2, y2: a rectangle of the 3D view (pixels); selects the insight record's pixels under it
     pin_a,          ///< pins the current structure and query options as A (A/B compare)
     dump_ab,        ///< arg: path; compares A with the current choice (B) on this view, writes the totals as JSON
+    frames,         ///< x: frames; lets that many frames draw before the next command (no waiting on work)
   };
   Kind kind = Kind::wait;
   int line = 0;        ///< 1-based line in the script file
@@ -41,7 +42,7 @@ struct ScriptCommand {
   std::string arg;     ///< open: scene; structure: name; set: key; camera: spec; step: N|next|prev|first|last;
                        ///< screenshot/dump-*: path
   std::string value;   ///< set: value
-  int x = 0, y = 0;    ///< size: width, height; click: pixel; select-region: first corner
+  int x = 0, y = 0;    ///< size: width, height; click: pixel; select-region: first corner; frames: count
   int x2 = 0, y2 = 0;  ///< select-region: second corner
 };
 
