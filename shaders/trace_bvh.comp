@@ -1,6 +1,9 @@
 #version 450 core
 // The heatmap's primary rays traced on the GPU over the binary BVH's flat
-// node array (ui/render/gpu_trace.cpp drives it). One invocation per pixel;
+// node array (ui/render/gpu_trace.cpp drives it). One invocation per pixel
+// of the row band [u_row0, u_row_end) (the whole image in one dispatch, or
+// band by band across the GUI's frames; a pixel's result does not depend on
+// its band);
 // it reproduces, operation for operation, what the CPU's instrumented
 // traversal counts (core/accel/bvh/bvh.cpp, traverse<closest, Ordered,
 // Collect = true, Test>):
@@ -47,6 +50,8 @@ layout(std430, binding = 2) writeonly buffer Out { PixelOut pixels[]; };
 
 uniform int u_width;
 uniform int u_height;
+uniform int u_row0;     // first row of this dispatch's band
+uniform int u_row_end;  // one past its last row (<= u_height)
 uniform uint u_node_count;
 uniform vec3 u_position;
 uniform vec3 u_forward;
@@ -252,8 +257,8 @@ bool test_triangle(uint k, float tmin, float tmax, out float t_out) {
 // ---- traversal -------------------------------------------------------------------
 
 void main() {
-  int px = int(gl_GlobalInvocationID.x), py = int(gl_GlobalInvocationID.y);
-  if (px >= u_width || py >= u_height) return;
+  int px = int(gl_GlobalInvocationID.x), py = u_row0 + int(gl_GlobalInvocationID.y);
+  if (px >= u_width || py >= u_row_end || py >= u_height) return;
   make_primary_ray(px, py);
 
   uint visited = 0u, box_tests = 0u, prim_tests = 0u, culled = 0u, missed = 0u;

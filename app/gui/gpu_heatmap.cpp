@@ -1,36 +1,84 @@
 #include "app/gui/gpu_heatmap.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
 #include "core/accel/bvh/bvh.h"
 
 namespace accelviz {
+namespace {
 
-std::shared_ptr<const HeatmapFrame> GpuHeatmap::trace(const HeatmapRequest& r, std::uint64_t id) {
+constexpr int kBandRows = 8;  // one row of trace_bvh.comp's 8x8 work groups
+
+}  // namespace
+
+void GpuHeatmap::start(const HeatmapRequest& r, std::uint64_t id) {
+  running_ = false;
+  progress_ = {};
   const Bvh* bvh = r.structure ? dynamic_cast<const Bvh*>(r.structure->accel.get()) : nullptr;
   if (!bvh) throw std::invalid_argument("only the bvh structure is traced on the GPU");
   if (!tracer_) tracer_ = std::make_unique<GpuBvhTracer>();
   if (uploaded_ != r.structure) {
+    uploaded_.reset();
     tracer_->upload(*bvh);
     uploaded_ = r.structure;
   }
-  HeatmapOptions ho;
-  ho.metric = r.metric;
-  ho.width = r.width;
-  ho.height = r.height;
-  ho.query = r.query;
-  ho.c_trav = r.c_trav;
-  ho.c_isect = r.c_isect;
+  tracer_->begin(r.camera, r.width, r.height, r.query);
+  request_ = r;
+  id_ = id;
+  running_ = true;
+  progress_.rows = r.height;
+  // ms_per_pixel_ and last_rows_ carry over: the previous view's cost sizes
+  // this one's first band (a camera being dragged restarts every frame).
+}
+
+std::shared_ptr<const HeatmapFrame> GpuHeatmap::step(double budget_ms) {
+  if (!running_) return nullptr;
+  try {
+    double spent = 0.0;
+    do {
+      // Size the band to what is left of the budget at the last band's cost
+      // per pixel, at most twice the last band (the cost varies over the
+      // image), whole work-group rows when more than one; 8 rows when the
+      // cost is unknown or the budget is 0.
+      int rows = kBandRows;
+      if (budget_ms > 0.0 && ms_per_pixel_ > 0.0 && last_rows_ > 0) {
+        const double left = budget_ms - spent;
+        const double fit = left / (ms_per_pixel_ * static_cast<double>(request_.width));
+        rows = static_cast<int>(std::clamp(fit, 1.0, static_cast<double>(std::max(kBandRows, 2 * last_rows_))));
+        if (rows > kBandRows) rows -= rows % kBandRows;
+      }
+      const int before = tracer_->rows_done();
+      const double ms = tracer_->trace_rows(rows);
+      const int traced = tracer_->rows_done() - before;
+      spent += ms;
+      last_rows_ = traced;
+      if (traced > 0) ms_per_pixel_ = ms / (static_cast<double>(traced) * request_.width);
+      progress_.rows_done = tracer_->rows_done();
+      progress_.trace_ms += ms;
+      ++progress_.bands;
+    } while (!tracer_->finished() && budget_ms > 0.0 && spent < budget_ms);
+    if (!tracer_->finished()) return nullptr;
+    return finish();
+  } catch (...) {
+    running_ = false;
+    throw;
+  }
+}
+
+std::shared_ptr<const HeatmapFrame> GpuHeatmap::finish() {
+  running_ = false;
+  const GpuTraceResult raw = tracer_->result();
+  const HeatmapOptions ho = heatmap_options(request_);
   HeatmapFigures fig;
-  GpuTraceResult raw;
   auto frame = std::make_shared<HeatmapFrame>();
-  frame->image = gpu_render_metric(*tracer_, r.camera, ho, &fig, &raw);
-  frame->id = id;
+  frame->image = gpu_metric_image(raw, request_.camera, ho, &fig);
+  frame->id = id_;
   frame->stride = 1;
   frame->complete = true;
-  frame->request = r;
+  frame->request = request_;
 
   const std::size_t n = frame->image.values.size();
   frame->pixels.resize(n);
@@ -44,6 +92,13 @@ std::shared_ptr<const HeatmapFrame> GpuHeatmap::trace(const HeatmapRequest& r, s
   }
   frame->summary = summarise_pixels(frame->pixels, fig.render_ms);
   return frame;
+}
+
+std::shared_ptr<const HeatmapFrame> GpuHeatmap::trace(const HeatmapRequest& r, std::uint64_t id) {
+  start(r, id);
+  std::shared_ptr<const HeatmapFrame> f;
+  while (!f && running_) f = step(1e9);
+  return f;
 }
 
 }  // namespace accelviz

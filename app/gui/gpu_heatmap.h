@@ -1,28 +1,45 @@
 #pragma once
 // The GUI's GPU heatmap: the View panel's "Trace on: GPU" traces the current
 // view's primary rays with ui/render's GpuBvhTracer (shaders/trace_bvh.comp)
-// on the window's GL context, synchronously, and hands AppState a complete
-// HeatmapFrame like the CPU worker's last level (same counts per pixel).
+// on the window's GL context, in row bands across frames (GpuHeatmapJob:
+// each frame dispatches bands until its time budget is spent, so the window
+// keeps drawing and a new view cancels the trace), and hands AppState the
+// complete HeatmapFrame once the last band is done (same counts per pixel as
+// the CPU worker's last level; no partial image is shown).
 // Called on the GUI thread with the window's context current.
 #include <cstdint>
 #include <memory>
 
-#include "ui/app/heatmap_worker.h"
+#include "ui/app/gpu_heatmap_job.h"
 #include "ui/render/gpu_trace.h"
 
 namespace accelviz {
 
-class GpuHeatmap {
+class GpuHeatmap final : public GpuHeatmapJob {
  public:
-  /// Traces `r` (its structure must be a BVH) and returns the frame. Throws
-  /// ShaderError/GlError (shader or GL trouble) or std::invalid_argument
-  /// (not a BVH); the GPU objects are made on first use, the BVH uploaded
-  /// when the structure changed.
+  /// Throws ShaderError/GlError (shader or GL trouble) or
+  /// std::invalid_argument (not a BVH, bad size); the GPU objects are made
+  /// on first use, the BVH uploaded when the structure changed.
+  void start(const HeatmapRequest& r, std::uint64_t id) override;
+  std::shared_ptr<const HeatmapFrame> step(double budget_ms) override;
+  void cancel() override { running_ = false; }
+  bool busy() const override { return running_; }
+  Progress progress() const override { return progress_; }
+
+  /// The whole request in one go (start, then bands until done).
   std::shared_ptr<const HeatmapFrame> trace(const HeatmapRequest& r, std::uint64_t id);
 
  private:
+  std::shared_ptr<const HeatmapFrame> finish();
+
   std::unique_ptr<GpuBvhTracer> tracer_;
   std::shared_ptr<const BuiltStructure> uploaded_;  ///< held: a freed structure's address may come back
+  HeatmapRequest request_;
+  std::uint64_t id_ = 0;
+  bool running_ = false;
+  Progress progress_;
+  double ms_per_pixel_ = 0.0;  ///< the last band's cost, to size the next (0: unknown)
+  int last_rows_ = 0;
 };
 
 }  // namespace accelviz

@@ -113,7 +113,9 @@ class Gui final : public ScriptHost {
   std::shared_ptr<const LoadedScene> dynamics_scene_;    ///< the scene the player was reset for
   std::shared_ptr<const BuiltStructure> dynamics_rest_;  ///< the build the shown frames are made for
   Clock::time_point dynamics_clock_ = Clock::now();
-  std::optional<std::uint64_t> play_target_;  ///< script `play`: the frame count to reach
+  std::optional<std::uint64_t> play_target_;    ///< script `play`: the frame count to reach
+  std::uint64_t frames_drawn_ = 0;              ///< frames swapped so far (dump-stats `frames`)
+  std::optional<std::uint64_t> frames_target_;  ///< script `frames`: the frame count to reach
   std::vector<std::string> dropped_;
   std::vector<KeyPress> keys_;
 
@@ -156,9 +158,8 @@ Gui::Gui(const GuiOptions& options, AppSettings settings, std::optional<ScriptRu
       options_.use_settings ? std::optional<std::filesystem::path>(imgui_ini_file(config_dir_)) : std::nullopt);
   view_ = std::make_unique<SceneView>();
   gpu_heatmap_ = std::make_unique<GpuHeatmap>();
-  // Called from app_.update() on this thread, with the window's context current.
-  app_.set_gpu_heatmap_tracer(
-      [this](const HeatmapRequest& r, std::uint64_t id) { return gpu_heatmap_->trace(r, id); });
+  // Stepped from app_.update() on this thread, with the window's context current.
+  app_.set_gpu_heatmap_tracer(gpu_heatmap_.get());
   if (!settings_error.empty()) app_.set_error(settings_error);
 }
 
@@ -167,6 +168,8 @@ Gui::~Gui() {
   g_keys = nullptr;
   // Renderer and ImGui objects need the window's context current when they die.
   if (window_) window_->make_current();
+  app_.set_gpu_heatmap_tracer(nullptr);
+  gpu_heatmap_.reset();
   view_.reset();
   imgui_.reset();
 }
@@ -316,6 +319,11 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
   vi.range_max = range.y;
   vi.heatmap_on_gpu = app_.heatmap_on_gpu();
   vi.gpu_note = app_.gpu_heatmap_note();
+  const auto gpu_trace = app_.gpu_heatmap_progress();
+  if (gpu_trace) {
+    vi.gpu_rows_done = gpu_trace->rows_done;
+    vi.gpu_rows = gpu_trace->rows;
+  }
   panels::view_panel(app_.config().view, vi, layout, &app_.config().structure.query);
 
   const auto& insp = app_.inspection();
@@ -327,7 +335,13 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
                                layout))
     take_screenshot();
   panels::help_panel(show_help_, layout);
-  panels::status_bar(app_.message(), app_.error(), bp, app_.heatmap_busy(), layout);
+  std::string heatmap_status;
+  if (gpu_trace)
+    heatmap_status = "tracing heatmap on the GPU: " +
+                     std::to_string(gpu_trace->rows > 0 ? 100 * gpu_trace->rows_done / gpu_trace->rows : 0) + "%";
+  else if (app_.heatmap_busy())
+    heatmap_status = "refining heatmap";
+  panels::status_bar(app_.message(), app_.error(), bp, heatmap_status, layout);
 
   const std::shared_ptr<const SweepSnapshot> sweep = sweeps_.latest();
   const panels::AccuracyAction aa =
@@ -538,8 +552,16 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       fail_if(write_file_atomic(c.arg, inspection_json(*insp, app_.replay_step()).dump(2) + "\n"));
       return Status::done;
     }
-    case K::dump_stats:
-      fail_if(write_file_atomic(c.arg, app_.stats_json().dump(2) + "\n"));
+    case K::dump_stats: {
+      nlohmann::json doc = app_.stats_json();
+      doc["frames"] = frames_drawn_;
+      fail_if(write_file_atomic(c.arg, doc.dump(2) + "\n"));
+      return Status::done;
+    }
+    case K::frames:
+      if (!frames_target_) frames_target_ = frames_drawn_ + static_cast<std::uint64_t>(c.x);
+      if (frames_drawn_ < *frames_target_) return Status::again;
+      frames_target_.reset();
       return Status::done;
     case K::quit:
       quit_ = true;
@@ -710,6 +732,7 @@ int Gui::run() {
     view_->renderer().present(fbw, fbh);
     imgui_->render();
     window_->swap_buffers();
+    ++frames_drawn_;
     if (options_.use_settings)
       if (const std::string e = imgui_->save_layout(); !e.empty()) app_.set_error(e);
   }

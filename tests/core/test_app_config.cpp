@@ -62,6 +62,7 @@ const std::map<std::string, std::string> kOtherValues = {
     {"colormap", "turbo"},
     {"opacity", "0.3"},
     {"scale", "2,40"},
+    {"heatmap-gpu-ms", "4"},
     {"legend", "off"},
     {"ray-path", "off"},
     {"msaa", "1"},

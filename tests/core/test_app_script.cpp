@@ -146,6 +146,21 @@ TEST(AppScript, InsightRegionAndABCommands) {
   }
 }
 
+// `frames N` lets N frames draw (the GPU heatmap test watches a trace
+// progress across frames with it).
+TEST(AppScript, FramesCommandTakesACount) {
+  const auto cmds = parse_script("frames 3\nframes 100000\n", "s.txt");
+  ASSERT_EQ(cmds.size(), 2u);
+  EXPECT_EQ(cmds[0].kind, K::frames);
+  EXPECT_EQ(cmds[0].x, 3);
+  EXPECT_EQ(cmds[1].x, 100000);
+  EXPECT_EQ(command_name(K::frames), "frames");
+  for (const char* text : {"frames\n", "frames 0\n", "frames -2\n", "frames 100001\n", "frames two\n"}) {
+    const std::string e = parse_error(text);
+    EXPECT_EQ(e.rfind("s.txt:1: frames: expected N (an integer in 1..100000)", 0), 0u) << text << "\ngot: " << e;
+  }
+}
+
 TEST(AppScript, MissingFileIsAnError) {
   try {
     load_script("/nonexistent/dir/script.txt");

@@ -7,6 +7,7 @@
 // compute is slow and this also runs under ASan.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <memory>
@@ -205,6 +206,71 @@ TEST_F(GpuTrace, MetricImagesAndColourisedPicturesEqualTheCpus) {
     const RgbImage a = colorize(cpu, ColorizeOptions{}), b = colorize(gpu, ColorizeOptions{});
     EXPECT_EQ(a.pixels, b.pixels) << metric_name(m);
   }
+}
+
+// The GUI spreads an image over frames in row bands (begin, trace_rows,
+// result): after each band exactly the rows traced so far hold the one-shot
+// trace's figures, bit for bit, and every later row is still untraced (the
+// dispatch wrote only its band). Band sizes are uneven and the height is not
+// a multiple of the 8-row work group; a second begin() (the view changed
+// mid-trace) starts from an untraced image again.
+TEST_F(GpuTrace, BandedTraceEqualsTheOneShotTraceBandByBand) {
+  const Scene scene = load_scene("builtin:teapot-stadium?size=2000");
+  const Bvh bvh(scene.triangles);
+  tracer_->upload(bvh);
+  const int w = 40, h = 29;
+  const Camera cam = frame_bounds(scene.bounds(), static_cast<float>(w) / h);
+  const GpuTraceResult whole = tracer_->trace(cam, w, h, QueryOptions{});
+  std::uint64_t whole_hits = 0;
+  for (const Hit& hit : whole.hits) whole_hits += hit.valid() ? 1 : 0;
+  ASSERT_GT(whole_hits, 0u);
+
+  // A restart mid-trace: one band of another view, then the real one.
+  tracer_->begin(look_at({0.0f, 5.0f, 9.0f}, {0.0f, 0.0f, 0.0f}, 0.8f), w, h, QueryOptions{});
+  tracer_->trace_rows(20);  // rows 5..19 below must read untraced again
+  tracer_->begin(cam, w, h, QueryOptions{});
+  EXPECT_EQ(tracer_->rows_done(), 0);
+  EXPECT_EQ(tracer_->rows_total(), h);
+  int expect_done = 0, bands = 0;
+  double band_ms = 0.0;
+  for (const int rows : {5, 8, 1, 13, 100}) {
+    ASSERT_FALSE(tracer_->finished());
+    band_ms += tracer_->trace_rows(rows);
+    ++bands;
+    expect_done = std::min(h, expect_done + rows);
+    ASSERT_EQ(tracer_->rows_done(), expect_done);
+    const GpuTraceResult r = tracer_->result();
+    ASSERT_EQ(r.stats.size(), whole.stats.size());
+    std::size_t wrong_traced = 0, wrong_untraced = 0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * w + x;
+        const RayStats &a = r.stats[i], &b = whole.stats[i];
+        if (y < expect_done) {
+          const bool same = a.nodes_visited == b.nodes_visited && a.box_tests == b.box_tests &&
+                            a.prim_tests == b.prim_tests && a.nodes_culled == b.nodes_culled &&
+                            a.nodes_missed == b.nodes_missed && r.hits[i].prim == whole.hits[i].prim &&
+                            std::bit_cast<std::uint32_t>(r.hits[i].t) == std::bit_cast<std::uint32_t>(whole.hits[i].t);
+          wrong_traced += same ? 0 : 1;
+        } else {
+          const bool untraced = a.nodes_visited == GpuBvhTracer::kUntraced && a.box_tests == GpuBvhTracer::kUntraced &&
+                                a.prim_tests == GpuBvhTracer::kUntraced && !r.hits[i].valid();
+          wrong_untraced += untraced ? 0 : 1;
+        }
+      }
+    EXPECT_EQ(wrong_traced, 0u) << "band " << bands << ": rows [0, " << expect_done << ") differ from one shot";
+    EXPECT_EQ(wrong_untraced, 0u) << "band " << bands << ": rows [" << expect_done << ", " << h
+                                  << ") were written by a band that does not cover them";
+    EXPECT_DOUBLE_EQ(r.trace_ms, band_ms);
+    if (tracer_->finished()) break;
+  }
+  EXPECT_TRUE(tracer_->finished());
+  EXPECT_EQ(bands, 5);                     // 5 + 8 + 1 + 13 = 27 rows, then the last 2
+  EXPECT_EQ(tracer_->trace_rows(8), 0.0);  // nothing left: no dispatch
+  EXPECT_THROW(tracer_->trace_rows(0), std::invalid_argument);
+  GpuBvhTracer fresh;
+  EXPECT_THROW(fresh.trace_rows(8), std::logic_error);
+  EXPECT_THROW(fresh.result(), std::logic_error);
 }
 
 TEST_F(GpuTrace, RejectsBadInputAndNamesUnsupportedStructures) {

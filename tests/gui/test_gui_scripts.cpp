@@ -622,3 +622,39 @@ TEST_F(GuiScript, HeatmapTracedOnTheGpuCountsWhatTheCpuCounts) {
   EXPECT_EQ(grid["gpu_note"], "only the bvh structure is traced on the GPU");
   EXPECT_EQ(grid["complete"], true);
 }
+// The GPU heatmap never freezes the window: with heatmap-gpu-ms 0 the
+// compute shader traces one 8-row band per frame, so while the 160x120 image
+// is in progress the window keeps drawing (the frame counter advances), the
+// progress (rows done) grows, the previous CPU image stays up, and only the
+// finished image is shown, with the CPU's counts.
+TEST_F(GuiScript, GpuHeatmapTracesInBandsWhileTheWindowKeepsDrawing) {
+  const std::string script = std::string("open ") + kTeapot + "\nsize 160 120\ncamera " + kCamera +
+                             "\nset heatmap full\nset heatmap-gpu-ms 0\nwait\ndump-stats " + path("cpu.json").string() +
+                             "\nset heatmap-gpu on\nframes 3\ndump-stats " + path("p1.json").string() +
+                             "\nframes 3\ndump-stats " + path("p2.json").string() + "\nwait\ndump-stats " +
+                             path("done.json").string() + "\nquit\n";
+  const RunResult r = run(script);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json cpu = read_json(path("cpu.json")), p1 = read_json(path("p1.json")),
+                       p2 = read_json(path("p2.json")), done = read_json(path("done.json"));
+  ASSERT_TRUE(p1["gpu_trace"].is_object()) << p1["gpu_trace"] << " " << p1["view"]["gpu_note"];
+  ASSERT_TRUE(p2["gpu_trace"].is_object()) << p2["gpu_trace"];
+  const int rows1 = p1["gpu_trace"]["rows_done"], rows2 = p2["gpu_trace"]["rows_done"];
+  EXPECT_EQ(p1["gpu_trace"]["rows"], 120);
+  EXPECT_GT(rows1, 0);
+  EXPECT_LT(rows2, 120);
+  EXPECT_GT(rows2, rows1);  // progress between the dumps
+  EXPECT_EQ(rows2 - rows1, 8 * (p2["gpu_trace"]["bands"].get<int>() - p1["gpu_trace"]["bands"].get<int>()));
+  EXPECT_GE(p2["frames"].get<int>(), p1["frames"].get<int>() + 3);  // frames drawn mid-trace
+  EXPECT_GT(done["frames"].get<int>(), p2["frames"].get<int>());
+  // Mid-trace the CPU's image is still the one shown; then the GPU's, complete.
+  EXPECT_EQ(p2["view"]["device"], "cpu");
+  EXPECT_TRUE(done["gpu_trace"].is_null()) << done["gpu_trace"];
+  const nlohmann::json& v = done["view"];
+  EXPECT_EQ(v["device"], "gpu") << v["gpu_note"];
+  EXPECT_EQ(v["complete"], true);
+  EXPECT_EQ(v["rays"], 160 * 120);
+  for (const char* k : {"hits", "mean_nodes", "max_nodes", "mean_prims", "max_prims", "mean_value", "max_value"})
+    EXPECT_EQ(v[k], cpu["view"][k]) << k;
+}
+

@@ -300,6 +300,9 @@ const std::vector<Entry>& entries() {
     t.push_back({{"scale", "auto|MIN,MAX", "heatmap range: the image's [0, max] or locked"},
                  [](const AppConfig& c) {
                    return c.view.auto_scale ? std::string("auto")
+    t.push_back(float_option("heatmap-gpu-ms", "0..1000",
+                             "GPU heatmap: ms of tracing per frame, in row bands (0: one 8-row band a frame)", 0, 1000,
+                             false, [](AppConfig& c) -> float& { return c.view.heatmap_gpu_ms; }));
                                             : format_number(c.view.scale_min) + "," + format_number(c.view.scale_max);
                  },
                  [](AppConfig& c, std::string_view v) -> std::string {
@@ -425,6 +428,18 @@ std::string screenshot_caption(const AppConfig& config) {
     s += ", back-to-front";
   if (config.structure.query.xray) s += ", x-ray";
   if (config.view.heatmap != HeatmapDisplay::off) {
+HeatmapOptions view_heatmap_options(const AppConfig& config, int width, int height) {
+  HeatmapOptions o;
+  o.metric = config.view.metric;
+  o.width = width;
+  o.height = height;
+  o.threads = config.structure.options.threads;
+  o.query = config.structure.query;
+  o.c_trav = config.structure.options.bvh.cost_traversal;
+  o.c_isect = config.structure.options.bvh.cost_intersect;
+  return o;
+}
+
     s += ", heatmap " + std::string(metric_name(config.view.metric)) + " " +
          std::string(colormap_name(config.view.colormap)) + " scale " + option_value(config, "scale");
     if (config.view.heatmap == HeatmapDisplay::blend) s += " blend " + option_value(config, "opacity");

@@ -46,7 +46,8 @@ struct ViewSettings {
 
   HeatmapDisplay heatmap = HeatmapDisplay::off;
   HeatMetric metric = HeatMetric::nodes;
-  bool heatmap_gpu = false;  ///< trace the heatmap on the GPU (compute shader; BVH only, else the CPU worker)
+  bool heatmap_gpu = false;      ///< trace the heatmap on the GPU (compute shader; BVH only, else the CPU worker)
+  float heatmap_gpu_ms = 12.0f;  ///< GPU heatmap: tracing per frame, in row bands (0: one 8-row band a frame)
   ColorMap colormap = ColorMap::viridis;
   float opacity = 0.6f;    ///< blend: heatmap alpha over the mesh
   bool auto_scale = true;  ///< [0, image max]; else [scale_min, scale_max]
@@ -110,3 +111,9 @@ std::string screenshot_caption(const AppConfig& config);
 std::string format_number(double v);
 
 }  // namespace accelviz
+/// The current view's heatmap as core's options at W×H: the View's metric,
+/// the structure choice's query options and threads, and the cost metric's
+/// weights (the BVH's C_trav/C_isect, as `render --ctrav/--cisect`). The
+/// heatmap request, its restart key and the GPU trace all start from it.
+HeatmapOptions view_heatmap_options(const AppConfig& config, int width, int height);
+

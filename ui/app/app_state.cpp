@@ -73,16 +73,16 @@ AppState::HeatmapKey AppState::heatmap_key(int w, int h) const {
   k.forward = cam.forward;
   k.up = cam.up;
   k.yfov = cam.yfov;
-  k.width = w;
-  k.height = h;
-  k.metric = config().view.metric;
-  k.test = config().structure.query.triangle_test;
-  k.ordered = config().structure.query.ordered;
-  k.back_to_front = config().structure.query.back_to_front;
-  k.xray = config().structure.query.xray;
-  // The cost metric weighs with the BVH's C_trav/C_isect, as `render --ctrav/--cisect` does.
-  k.c_trav = config().structure.options.bvh.cost_traversal;
-  k.c_isect = config().structure.options.bvh.cost_intersect;
+  const HeatmapOptions o = view_heatmap_options(config(), w, h);
+  k.width = o.width;
+  k.height = o.height;
+  k.metric = o.metric;
+  k.test = o.query.triangle_test;
+  k.ordered = o.query.ordered;
+  k.back_to_front = o.query.back_to_front;
+  k.xray = o.query.xray;
+  k.c_trav = o.c_trav;
+  k.c_isect = o.c_isect;
   k.shadows = current_ && shadow_rays_wanted(current_->scene->scene, config().effects);
   k.gpu = config().view.heatmap_gpu;
   return k;
@@ -99,6 +99,12 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
       (reload_ || wanted_scene_ != requested_scene_ || !requested_ || !same_build(*requested_, wanted))) {
     request_id_ = builds_.request({wanted_scene_, wanted, reload_});
     if (scene_loading_) scene_request_id_ = request_id_;
+  // The previous frame's time outside the GPU heatmap's step (sizes its budget).
+  const auto now = std::chrono::steady_clock::now();
+  const double frame_other_ms =
+      last_update_ ? std::chrono::duration<double, std::milli>(now - *last_update_).count() - last_gpu_step_ms_ : 0.0;
+  last_update_ = now;
+  double step_ms = 0.0;
     requested_scene_ = wanted_scene_;
     requested_ = wanted;
     reload_ = false;
@@ -149,21 +155,12 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
   if (current_ && view_w_ > 0 && view_h_ > 0) {
     const HeatmapKey key = heatmap_key(view_w_, view_h_);
     if (!heatmap_requested_ || !(*heatmap_requested_ == key)) {
-      HeatmapRequest r;
-      r.structure = current_;
-      r.camera = camera();
-      r.width = view_w_;
-      r.height = view_h_;
-      r.metric = key.metric;
-      r.query = config().structure.query;
-      r.c_trav = key.c_trav;
-      r.c_isect = key.c_isect;
-      r.threads = settings_.config.structure.options.threads;
+      HeatmapRequest r = heatmap_request(view_heatmap_options(config(), view_w_, view_h_), current_, camera());
       r.shadow_lights = shadow_lights(current_->scene->scene, key.shadows);
       heatmap_on_gpu_ = false;
       gpu_note_.clear();
       if (key.gpu) {
-        if (!gpu_tracer_)
+        if (!gpu_job_)
           gpu_note_ = "no GPU tracer in this session";
         else if (current_->choice.name != "bvh")
           gpu_note_ = "only the bvh structure is traced on the GPU";
@@ -173,9 +170,12 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
             HeatmapRequest primary = r;
             primary.shadow_lights.clear();
             heatmaps_.cancel();
-            heatmap_ = gpu_tracer_(primary, ++gpu_frame_id_);
+            gpu_job_->start(primary, ++gpu_frame_id_);
             heatmap_on_gpu_ = true;
-            u.heatmap_changed = true;
+      gpu_frame_shown_ = false;
+      gpu_fallback_.reset();
+            gpu_fallback_ = r;
+      if (gpu_job_) gpu_job_->cancel();
           } catch (const std::exception& e) {
             gpu_note_ = e.what();
           }
@@ -190,7 +190,7 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
                         q.back_to_front != inspected_query_.back_to_front || q.xray != inspected_query_.xray))
       recast();
   }
-  if (auto latest = heatmaps_.latest(); !heatmap_on_gpu_ && latest != heatmap_) {
+  if (auto latest = heatmaps_.latest(); !heatmap_on_gpu_ && latest && latest != heatmap_) {
     heatmap_ = std::move(latest);
     u.heatmap_changed = true;
   }
@@ -198,6 +198,33 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
 }
 
 bool AppState::show_frame(std::shared_ptr<const BuiltStructure> frame, const LoadedScene* rest_scene) {
+    // The GPU trace's bands for this frame (the window stays responsive;
+    // the old heatmap stays up until the new one is complete).
+    if (heatmap_on_gpu_ && gpu_job_ && gpu_job_->busy()) {
+      try {
+        // heatmap-gpu-ms, or as long as the rest of the last frame took
+        // (capped at 100 ms) when that is longer: on a slow GL (llvmpipe
+        // draws a frame in tens of ms) the trace then gets about half the
+        // time instead of a sliver, and the window still draws at about half
+        // its rate. 0 stays "one band a frame".
+        double budget = static_cast<double>(config().view.heatmap_gpu_ms);
+        if (budget > 0.0 && frame_other_ms > 0.0) budget = std::max(budget, std::min(frame_other_ms, 100.0));
+        const auto t_step = std::chrono::steady_clock::now();
+        auto f = gpu_job_->step(budget);
+        step_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_step).count();
+        if (f) {
+          heatmap_ = std::move(f);
+          gpu_frame_shown_ = true;
+          shown_on_gpu_ = true;
+          u.heatmap_changed = true;
+        }
+      } catch (const std::exception& e) {
+        gpu_note_ = e.what();
+        heatmap_on_gpu_ = false;
+        if (gpu_fallback_) heatmaps_.request(std::move(*gpu_fallback_));
+        gpu_fallback_.reset();
+      }
+    }
   if (!frame || !rest_ || rest_->scene.get() != rest_scene || frame->choice.name != rest_->choice.name ||
       !same_build(frame->choice, rest_->choice))
     return false;
@@ -206,8 +233,10 @@ bool AppState::show_frame(std::shared_ptr<const BuiltStructure> frame, const Loa
     recast();
   }
   return true;
+    shown_on_gpu_ = false;
 }
 
+  last_gpu_step_ms_ = step_ms;
 void AppState::show_rest() {
   if (current_ == rest_) return;
   current_ = rest_;
@@ -222,7 +251,13 @@ bool AppState::settled() const {
     return false;
   if (!current_ || view_w_ <= 0 || view_h_ <= 0) return true;
   if (!heatmap_requested_ || !(*heatmap_requested_ == heatmap_key(view_w_, view_h_))) return false;
-  return heatmap_ && (heatmap_on_gpu_ || heatmap_->id == heatmaps_.latest_request()) && heatmap_->complete;
+  if (heatmap_on_gpu_) return gpu_frame_shown_;
+  return heatmap_ && heatmap_->id == heatmaps_.latest_request() && heatmap_->complete;
+}
+
+std::optional<GpuHeatmapJob::Progress> AppState::gpu_heatmap_progress() const {
+  if (!heatmap_on_gpu_ || !gpu_job_ || !gpu_job_->busy()) return std::nullopt;
+  return gpu_job_->progress();
 }
 
 void AppState::reset_camera() {
@@ -339,7 +374,7 @@ nlohmann::json AppState::stats_json() const {
                  {"mean_shadow_prims", s.mean_shadow_prims},
                  {"render_ms", s.render_ms},
                  {"rays_per_s", s.rays_per_s},
-                 {"device", heatmap_on_gpu_ ? "gpu" : "cpu"},
+                 {"device", shown_on_gpu_ ? "gpu" : "cpu"},
                  {"gpu_note", gpu_note_}};
   }
   return j;
@@ -358,6 +393,10 @@ ScreenshotInfo AppState::screenshot_info(float scale_min, float scale_max) const
   if (current_) {
     info.config.structure.name = current_->choice.name;
     info.config.structure.options = current_->choice.options;
+  // The GPU trace of the current view while it runs (null otherwise).
+  j["gpu_trace"] = nullptr;
+  if (const auto p = gpu_heatmap_progress())
+    j["gpu_trace"] = {{"rows_done", p->rows_done}, {"rows", p->rows}, {"bands", p->bands}, {"trace_ms", p->trace_ms}};
   }
   info.scale_min = scale_min;
   info.scale_max = scale_max;

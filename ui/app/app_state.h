@@ -6,6 +6,7 @@
 // scripts drive the same calls, so a scripted run exercises the product.
 #include "ui/app/app_config.h"
 #include "ui/app/build_worker.h"
+#include "ui/app/gpu_heatmap_job.h"
 #include "ui/app/heatmap_worker.h"
 #include "ui/app/orbit_camera.h"
 #include "ui/app/ray_inspection.h"
@@ -14,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <chrono>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -77,19 +79,21 @@ class AppState {
   bool loading_scene() const { return scene_loading_; }
   const std::shared_ptr<const HeatmapFrame>& heatmap() const { return heatmap_; }
   BuildWorker::Status build_status() const { return builds_.status(); }
-  bool heatmap_busy() const { return heatmaps_.busy(); }
+  /// The CPU worker or the GPU job is tracing the current view.
+  bool heatmap_busy() const { return heatmaps_.busy() || gpu_heatmap_progress().has_value(); }
 
-  /// Traces a heatmap request on the GPU, synchronously, returning the whole
-  /// frame (the GUI installs one over its GL context: app/gui/gpu_heatmap.h).
-  /// It throws to report why it cannot.
-  using GpuHeatmapTracer = std::function<std::shared_ptr<const HeatmapFrame>(const HeatmapRequest&, std::uint64_t)>;
-  /// With a tracer set and the View's heatmap-gpu on, the heatmap of a BVH
-  /// view is traced by it instead of the CPU worker.
-  void set_gpu_heatmap_tracer(GpuHeatmapTracer tracer) { gpu_tracer_ = std::move(tracer); }
+  /// With a GPU job set (the GUI installs one over its GL context:
+  /// app/gui/gpu_heatmap.h) and the View's heatmap-gpu on, the heatmap of a
+  /// BVH view is traced by it instead of the CPU worker: update() steps it
+  /// once per frame within heatmap-gpu-ms and shows its frame once complete.
+  /// Not owned; null removes it.
+  void set_gpu_heatmap_tracer(GpuHeatmapJob* job) { gpu_job_ = job; }
   /// Why heatmap-gpu is on but the CPU traced the heatmap ("" otherwise).
   const std::string& gpu_heatmap_note() const { return gpu_note_; }
   /// The heatmap shown was traced on the GPU.
-  bool heatmap_on_gpu() const { return heatmap_on_gpu_; }
+  bool heatmap_on_gpu() const { return shown_on_gpu_; }
+  /// The GPU trace of the current view in progress, if one is running.
+  std::optional<GpuHeatmapJob::Progress> gpu_heatmap_progress() const;
   /// No build queued or running and the heatmap of the current view
   /// complete (what the script's `wait` waits for).
   bool settled() const;
@@ -171,14 +175,23 @@ class AppState {
   std::shared_ptr<const BuiltStructure> rest_;  ///< the last build (current_ unless a frame is shown)
   std::shared_ptr<const HeatmapFrame> heatmap_;
   std::optional<HeatmapKey> heatmap_requested_;
-  GpuHeatmapTracer gpu_tracer_;
+  GpuHeatmapJob* gpu_job_ = nullptr;
   std::string gpu_note_;
   bool heatmap_on_gpu_ = false;
   std::uint64_t gpu_frame_id_ = 0;
 
   ViewCamera camera_;
+  // The current view is traced by gpu_job_; its frame is complete and shown;
+  // heatmap_ came from gpu_job_.
   int view_w_ = 0, view_h_ = 0;
+  bool gpu_frame_shown_ = false;
+  bool shown_on_gpu_ = false;
+  // The full request, for the CPU should the GPU fail mid-trace.
+  std::optional<HeatmapRequest> gpu_fallback_;
 
+  // When update() last ran and how long its GPU step took (sizes the next budget).
+  std::optional<std::chrono::steady_clock::time_point> last_update_;
+  double last_gpu_step_ms_ = 0.0;
   std::optional<RayInspection> inspection_;
   QueryOptions inspected_query_;  ///< the query options inspection_ was cast with
   std::size_t replay_step_ = 0;

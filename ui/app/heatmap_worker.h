@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "core/accel/accel.h"
@@ -37,6 +38,38 @@ struct HeatmapRequest {
   /// Their work is counted apart from the primary ray's (PixelFigures::shadow_*).
   std::vector<Light> shadow_lights;
 };
+
+/// Core's options for tracing `r` (metric, size, threads, query options,
+/// cost weights; no progress callback): the GPU heatmap's, and what a
+/// request's frame was traced with.
+inline HeatmapOptions heatmap_options(const HeatmapRequest& r) {
+  HeatmapOptions o;
+  o.metric = r.metric;
+  o.width = r.width;
+  o.height = r.height;
+  o.threads = r.threads;
+  o.query = r.query;
+  o.c_trav = r.c_trav;
+  o.c_isect = r.c_isect;
+  return o;
+}
+
+/// A request tracing `structure` from `camera` with options `o` (the
+/// inverse of heatmap_options; no shadow lights, default coarsest level).
+inline HeatmapRequest heatmap_request(const HeatmapOptions& o, std::shared_ptr<const BuiltStructure> structure,
+                                      const Camera& camera) {
+  HeatmapRequest r;
+  r.structure = std::move(structure);
+  r.camera = camera;
+  r.width = o.width;
+  r.height = o.height;
+  r.metric = o.metric;
+  r.query = o.query;
+  r.c_trav = o.c_trav;
+  r.c_isect = o.c_isect;
+  r.threads = o.threads;
+  return r;
+}
 
 /// What one pixel's ray found (the hover tooltip shows these).
 struct PixelFigures {

@@ -405,6 +405,9 @@ bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout
   }
   if (v.heatmap_gpu && !info.gpu_note.empty())
     ImGui::TextDisabled("GPU unavailable (%s): traced on the CPU", info.gpu_note.c_str());
+  else if (v.heatmap_gpu && info.gpu_rows_done >= 0)
+    ImGui::TextDisabled("compute shader: row %d of %d (the previous image stays until done)", info.gpu_rows_done,
+                        info.gpu_rows);
   else if (v.heatmap_gpu && info.heatmap_on_gpu)
     ImGui::TextDisabled("compute shader: primary rays, same counts as the CPU");
   int map = static_cast<int>(v.colormap);
@@ -614,8 +617,8 @@ void help_panel(bool& open, const PanelLayout& layout) {
   ImGui::End();
 }
 
-void status_bar(const std::string& message, const std::string& error, const BuildProgress& progress, bool heatmap_busy,
-                const PanelLayout& layout) {
+void status_bar(const std::string& message, const std::string& error, const BuildProgress& progress,
+                const std::string& heatmap_status, const PanelLayout& layout) {
   const float h = ImGui::GetFrameHeightWithSpacing() + 4.0f * layout.scale;
   ImGui::SetNextWindowPos(ImVec2(0.0f, layout.height - h));
   ImGui::SetNextWindowSize(ImVec2(layout.width, h));
@@ -633,9 +636,9 @@ void status_bar(const std::string& message, const std::string& error, const Buil
       ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.35f, 1.0f), "%s", error.c_str());
     else
       ImGui::TextUnformatted(message.c_str());
-    if (heatmap_busy) {
+    if (!heatmap_status.empty()) {
       ImGui::SameLine();
-      ImGui::TextDisabled("  (refining heatmap)");
+      ImGui::TextDisabled("  (%s)", heatmap_status.c_str());
     }
   }
   ImGui::End();

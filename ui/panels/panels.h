@@ -66,6 +66,8 @@ struct ViewInfo {
   float range_min = 0.0f, range_max = 1.0f;  ///< the heatmap range in use
   bool heatmap_on_gpu = false;                ///< the heatmap shown was traced on the GPU
   std::string gpu_note;                       ///< why "Trace on: GPU" fell back to the CPU ("" when it did not)
+  int gpu_rows_done = -1;                     ///< the GPU trace in progress: rows done (-1: none running)
+  int gpu_rows = 0;                           ///< and rows in all
 };
 /// Every renderer layer: mesh, wireframe, node boxes (selection, colouring),
 /// heatmap (display, metric, colour map, scale, opacity, legend), ray path,
@@ -88,9 +90,10 @@ bool screenshot_panel(std::string& folder, const std::string& default_folder, co
                       const PanelLayout& layout);
 /// Every shortcut (ui/app/shortcuts.h).
 void help_panel(bool& open, const PanelLayout& layout);
-/// One line at the bottom: the error (red) or message, and the build's progress.
-void status_bar(const std::string& message, const std::string& error, const BuildProgress& progress, bool heatmap_busy,
-                const PanelLayout& layout);
+/// One line at the bottom: the error (red) or message, the build's progress,
+/// and `heatmap_status` greyed after it ("" when the heatmap is done).
+void status_bar(const std::string& message, const std::string& error, const BuildProgress& progress,
+                const std::string& heatmap_status, const PanelLayout& layout);
 /// The figures of one heatmap pixel, as a tooltip at the mouse.
 void pixel_tooltip(int x, int y, const PixelFigures& p, HeatMetric metric, bool exact);
 

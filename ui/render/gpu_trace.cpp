@@ -1,5 +1,6 @@
 #include "ui/render/gpu_trace.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -69,8 +70,16 @@ void GpuBvhTracer::upload(const Bvh& bvh) {
 }
 
 GpuTraceResult GpuBvhTracer::trace(const Camera& camera, int width, int height, const QueryOptions& query) {
+  begin(camera, width, height, query);
+  trace_rows(height);
+  return result();
+}
+
+void GpuBvhTracer::begin(const Camera& camera, int width, int height, const QueryOptions& query) {
   if (width <= 0 || height <= 0) throw std::invalid_argument("GPU trace: image size must be positive");
   if (!uploaded_) throw std::logic_error("GPU trace: no BVH uploaded");
+  width_ = height_ = rows_done_ = 0;
+  band_ms_ = 0.0;
   const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   const std::size_t bytes = n * sizeof(GpuPixel);
   if (!out_ || out_bytes_ < bytes) {
@@ -78,6 +87,11 @@ GpuTraceResult GpuBvhTracer::trace(const Camera& camera, int width, int height, 
     glNamedBufferStorage(out_.id(), static_cast<GLsizeiptr>(bytes), nullptr, GL_MAP_READ_BIT);
     out_bytes_ = bytes;
   }
+  // Every pixel untraced until its band runs (all bits set: counters
+  // kUntraced, prim kInvalidId, t a NaN).
+  const std::uint32_t untraced = kUntraced;
+  glClearNamedBufferSubData(out_.id(), GL_R32UI, 0, static_cast<GLsizeiptr>(bytes), GL_RED_INTEGER, GL_UNSIGNED_INT,
+                            &untraced);
 
   // The per-camera constants of core's camera_ray, computed by the same C++.
   const float aspect = camera_aspect(camera, width, height);
@@ -98,28 +112,48 @@ GpuTraceResult GpuBvhTracer::trace(const Camera& camera, int width, int height, 
   program_.set("u_back_to_front", query.back_to_front ? 1 : 0);
   program_.set("u_xray", query.xray ? 1 : 0);
   program_.set("u_watertight", query.triangle_test == TriangleTest::watertight ? 1 : 0);
+  check_gl_errors("GPU trace setup");
+  width_ = width;
+  height_ = height;
+}
 
-  GpuTraceResult r;
-  r.width = width;
-  r.height = height;
+double GpuBvhTracer::trace_rows(int rows) {
+  if (height_ <= 0) throw std::logic_error("GPU trace: trace_rows before begin");
+  if (rows < 1) throw std::invalid_argument("GPU trace: a band needs at least one row");
+  const int y0 = rows_done_;
+  const int y1 = std::min(height_, y0 + std::min(rows, height_));
+  if (y0 >= y1) return 0.0;
+  program_.set("u_row0", y0);
+  program_.set("u_row_end", y1);
   program_.use();
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, nodes_.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, tris_.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, out_.id());
-  glFinish();  // nothing queued before counts against the trace
+  glFinish();  // nothing queued before counts against the band
   const auto t0 = std::chrono::steady_clock::now();
-  glDispatchCompute(static_cast<GLuint>((width + kGroup - 1) / kGroup),
-                    static_cast<GLuint>((height + kGroup - 1) / kGroup), 1);
+  glDispatchCompute(static_cast<GLuint>((width_ + kGroup - 1) / kGroup),
+                    static_cast<GLuint>((y1 - y0 + kGroup - 1) / kGroup), 1);
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_CLIENT_MAPPED_BUFFER_BARRIER_BIT);
   glFinish();
-  r.trace_ms = ms_since(t0);
-  check_gl_errors("GPU trace dispatch");
-
-  const auto t1 = std::chrono::steady_clock::now();
-  std::vector<GpuPixel> px(n);
-  glGetNamedBufferSubData(out_.id(), 0, static_cast<GLsizeiptr>(bytes), px.data());
+  const double ms = ms_since(t0);
   for (GLuint b = 0; b < 3; ++b) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b, 0);
   glUseProgram(0);
+  check_gl_errors("GPU trace dispatch");
+  rows_done_ = y1;
+  band_ms_ += ms;
+  return ms;
+}
+
+GpuTraceResult GpuBvhTracer::result() const {
+  if (height_ <= 0) throw std::logic_error("GPU trace: result before begin");
+  const std::size_t n = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
+  GpuTraceResult r;
+  r.width = width_;
+  r.height = height_;
+  r.trace_ms = band_ms_;
+  const auto t1 = std::chrono::steady_clock::now();
+  std::vector<GpuPixel> px(n);
+  glGetNamedBufferSubData(out_.id(), 0, static_cast<GLsizeiptr>(n * sizeof(GpuPixel)), px.data());
   check_gl_errors("GPU trace readback");
 
   r.stats.resize(n);
@@ -143,14 +177,22 @@ GpuTraceResult GpuBvhTracer::trace(const Camera& camera, int width, int height, 
   return r;
 }
 
+MetricImage gpu_metric_image(const GpuTraceResult& r, const Camera& camera, const HeatmapOptions& opts,
+                             HeatmapFigures* figures) {
+  if (r.width != opts.width || r.height != opts.height)
+    throw std::invalid_argument("heatmap: the GPU trace is " + std::to_string(r.width) + "x" +
+                                std::to_string(r.height) + ", the options ask for " + std::to_string(opts.width) + "x" +
+                                std::to_string(opts.height));
+  // The rays again on the CPU, for the metrics that need the direction (shaded).
+  const std::vector<Ray> rays = primary_rays(camera, opts.width, opts.height);
+  return metric_image_from_hits(rays, r.hits, r.stats, opts, r.trace_ms, figures);
+}
+
 MetricImage gpu_render_metric(GpuBvhTracer& tracer, const Camera& camera, const HeatmapOptions& opts,
                               HeatmapFigures* figures, GpuTraceResult* raw) {
   if (opts.width <= 0 || opts.height <= 0) throw std::invalid_argument("heatmap: image size must be positive");
   GpuTraceResult r = tracer.trace(camera, opts.width, opts.height, opts.query);
-  // The rays again on the CPU, for the metrics that need the direction (shaded).
-  const std::vector<Ray> rays = primary_rays(camera, opts.width, opts.height);
-
-  MetricImage img = metric_image_from_hits(rays, r.hits, r.stats, opts, r.trace_ms, figures);
+  MetricImage img = gpu_metric_image(r, camera, opts, figures);
   if (raw) *raw = std::move(r);
   return img;
 }

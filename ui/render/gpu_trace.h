@@ -60,8 +60,27 @@ class GpuBvhTracer {
   /// Traces one primary ray per pixel (core's primary_ray) of a W×H image.
   /// Honours the triangle test, ordered, back_to_front and xray of `query`.
   /// Throws std::invalid_argument for a non-positive size, std::logic_error
-  /// before upload().
+  /// before upload(). The same as begin(), trace_rows(height), result().
   GpuTraceResult trace(const Camera& camera, int width, int height, const QueryOptions& query);
+
+  // ---- in row bands (the GUI spreads one image over its frames) ----------
+  /// Starts a banded trace of a W×H image: fixes the camera, size and query
+  /// and marks every pixel untraced (all counters kUntraced, a miss). Throws
+  /// like trace(). A pixel traced in any band gets exactly trace()'s figures.
+  void begin(const Camera& camera, int width, int height, const QueryOptions& query);
+  /// Dispatches the next band, rows [rows_done(), rows_done() + rows)
+  /// clipped to the image, and waits for it (glFinish). Returns the band's
+  /// wall ms (also added to result().trace_ms). Throws std::logic_error
+  /// without begin(), std::invalid_argument for rows < 1, GlError.
+  double trace_rows(int rows);
+  int rows_done() const { return rows_done_; }
+  int rows_total() const { return height_; }
+  bool finished() const { return height_ > 0 && rows_done_ >= height_; }
+  /// Reads the whole image back as it stands (untraced rows as begin() left
+  /// them); trace_ms is the sum of the bands so far.
+  GpuTraceResult result() const;
+  /// What begin() writes into every counter of an untraced pixel.
+  static constexpr std::uint32_t kUntraced = 0xFFFFFFFFu;
 
  private:
   ShaderProgram program_;
@@ -73,7 +92,15 @@ class GpuBvhTracer {
   std::vector<std::uint32_t> prim_ids_;  ///< leaf order -> scene order
   std::vector<glm::vec3> normals_;       ///< triangle_normal per leaf-order triangle
   bool uploaded_ = false;
+  int width_ = 0, height_ = 0;  ///< of the banded trace begun last
+  int rows_done_ = 0;
+  double band_ms_ = 0.0;  ///< its bands' wall ms so far
 };
+
+/// The metric image of a finished GPU trace (metric_image_from_hits over
+/// core's primary rays of `camera`); render_ms is r.trace_ms.
+MetricImage gpu_metric_image(const GpuTraceResult& r, const Camera& camera, const HeatmapOptions& opts,
+                             HeatmapFigures* figures = nullptr);
 
 /// render_metric on the GPU: the same MetricImage (and figures; render_ms is
 /// the GPU trace time) as core's render_metric(bvh, camera, opts) gives,
