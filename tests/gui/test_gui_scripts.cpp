@@ -598,30 +598,6 @@ TEST_F(GuiScript, ABFromAScriptAndTheHeatmapsXray) {
   EXPECT_GT(xab["prims"]["total_b"].get<double>(), xab["prims"]["total_a"].get<double>());
 }
 
-// View panel "Trace on: GPU" (`set heatmap-gpu on`): the BVH's heatmap is
-// traced by the compute shader on the window's context (llvmpipe here) with
-// the CPU worker's counts; another structure falls back to the CPU and says why.
-TEST_F(GuiScript, HeatmapTracedOnTheGpuCountsWhatTheCpuCounts) {
-  const std::string script = std::string("open ") + kTeapot + "\nsize 160 120\ncamera " + kCamera +
-                             "\nset heatmap full\nwait\ndump-stats " + path("cpu.json").string() +
-                             "\nset heatmap-gpu on\nwait\ndump-stats " + path("gpu.json").string() +
-                             "\nstructure grid\nwait\ndump-stats " + path("grid.json").string() + "\nquit\n";
-  const RunResult r = run(script);
-  ASSERT_EQ(r.code, 0) << r.err;
-  const nlohmann::json cpu = read_json(path("cpu.json"))["view"], gpu = read_json(path("gpu.json"))["view"];
-  EXPECT_EQ(cpu["device"], "cpu");
-  EXPECT_EQ(gpu["device"], "gpu") << gpu["gpu_note"];
-  EXPECT_EQ(gpu["complete"], true);
-  EXPECT_EQ(gpu["rays"], 160 * 120);
-  EXPECT_GT(gpu["hits"].get<std::uint64_t>(), 0u);
-  for (const char* k : {"hits", "mean_nodes", "max_nodes", "mean_prims", "max_prims", "mean_value", "max_value"})
-    EXPECT_EQ(gpu[k], cpu[k]) << k;
-  const nlohmann::json grid = read_json(path("grid.json"))["view"];
-  EXPECT_EQ(grid["structure"], "grid");
-  EXPECT_EQ(grid["device"], "cpu");
-  EXPECT_EQ(grid["gpu_note"], "only the bvh structure is traced on the GPU");
-  EXPECT_EQ(grid["complete"], true);
-}
 // The GPU heatmap never freezes the window: with heatmap-gpu-ms 0 the
 // compute shader traces one 8-row band per frame, so while the 160x120 image
 // is in progress the window keeps drawing (the frame counter advances), the
@@ -658,3 +634,27 @@ TEST_F(GuiScript, GpuHeatmapTracesInBandsWhileTheWindowKeepsDrawing) {
     EXPECT_EQ(v[k], cpu["view"][k]) << k;
 }
 
+// View panel "Trace on: GPU" (`set heatmap-gpu on`): the BVH's heatmap is
+// traced by the compute shader on the window's context (llvmpipe here) with
+// the CPU worker's counts; another structure falls back to the CPU and says why.
+TEST_F(GuiScript, HeatmapTracedOnTheGpuCountsWhatTheCpuCounts) {
+  const std::string script = std::string("open ") + kTeapot + "\nsize 160 120\ncamera " + kCamera +
+                             "\nset heatmap full\nwait\ndump-stats " + path("cpu.json").string() +
+                             "\nset heatmap-gpu on\nwait\ndump-stats " + path("gpu.json").string() +
+                             "\nstructure grid\nwait\ndump-stats " + path("grid.json").string() + "\nquit\n";
+  const RunResult r = run(script);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json cpu = read_json(path("cpu.json"))["view"], gpu = read_json(path("gpu.json"))["view"];
+  EXPECT_EQ(cpu["device"], "cpu");
+  EXPECT_EQ(gpu["device"], "gpu") << gpu["gpu_note"];
+  EXPECT_EQ(gpu["complete"], true);
+  EXPECT_EQ(gpu["rays"], 160 * 120);
+  EXPECT_GT(gpu["hits"].get<std::uint64_t>(), 0u);
+  for (const char* k : {"hits", "mean_nodes", "max_nodes", "mean_prims", "max_prims", "mean_value", "max_value"})
+    EXPECT_EQ(gpu[k], cpu[k]) << k;
+  const nlohmann::json grid = read_json(path("grid.json"))["view"];
+  EXPECT_EQ(grid["structure"], "grid");
+  EXPECT_EQ(grid["device"], "cpu");
+  EXPECT_EQ(grid["gpu_note"], "only the bvh structure is traced on the GPU");
+  EXPECT_EQ(grid["complete"], true);
+}

@@ -291,6 +291,9 @@ const std::vector<Entry>& entries() {
     t.push_back(bool_option("heatmap-gpu",
                             "trace the heatmap on the GPU (compute shader, BVH only; otherwise on the CPU)",
                             [](AppConfig& c) -> bool& { return c.view.heatmap_gpu; }));
+    t.push_back(float_option("heatmap-gpu-ms", "0..1000",
+                             "GPU heatmap: ms of tracing per frame, in row bands (0: one 8-row band a frame)", 0, 1000,
+                             false, [](AppConfig& c) -> float& { return c.view.heatmap_gpu_ms; }));
     t.push_back(enum_option<ColorMap>(
         "colormap", "viridis|inferno|turbo", "heatmap colour map",
         {{"viridis", ColorMap::viridis}, {"inferno", ColorMap::inferno}, {"turbo", ColorMap::turbo}},
@@ -300,9 +303,6 @@ const std::vector<Entry>& entries() {
     t.push_back({{"scale", "auto|MIN,MAX", "heatmap range: the image's [0, max] or locked"},
                  [](const AppConfig& c) {
                    return c.view.auto_scale ? std::string("auto")
-    t.push_back(float_option("heatmap-gpu-ms", "0..1000",
-                             "GPU heatmap: ms of tracing per frame, in row bands (0: one 8-row band a frame)", 0, 1000,
-                             false, [](AppConfig& c) -> float& { return c.view.heatmap_gpu_ms; }));
                                             : format_number(c.view.scale_min) + "," + format_number(c.view.scale_max);
                  },
                  [](AppConfig& c, std::string_view v) -> std::string {
@@ -419,15 +419,6 @@ std::string describe_structure(const StructureChoice& choice) {
   return s;
 }
 
-std::string screenshot_caption(const AppConfig& config) {
-  std::string s = describe_structure(config.structure);
-  s += ", " + option_value(config, "triangle-test");
-  if (!config.structure.query.ordered)
-    s += ", unordered";
-  else if (config.structure.query.back_to_front)
-    s += ", back-to-front";
-  if (config.structure.query.xray) s += ", x-ray";
-  if (config.view.heatmap != HeatmapDisplay::off) {
 HeatmapOptions view_heatmap_options(const AppConfig& config, int width, int height) {
   HeatmapOptions o;
   o.metric = config.view.metric;
@@ -440,6 +431,15 @@ HeatmapOptions view_heatmap_options(const AppConfig& config, int width, int heig
   return o;
 }
 
+std::string screenshot_caption(const AppConfig& config) {
+  std::string s = describe_structure(config.structure);
+  s += ", " + option_value(config, "triangle-test");
+  if (!config.structure.query.ordered)
+    s += ", unordered";
+  else if (config.structure.query.back_to_front)
+    s += ", back-to-front";
+  if (config.structure.query.xray) s += ", x-ray";
+  if (config.view.heatmap != HeatmapDisplay::off) {
     s += ", heatmap " + std::string(metric_name(config.view.metric)) + " " +
          std::string(colormap_name(config.view.colormap)) + " scale " + option_value(config, "scale");
     if (config.view.heatmap == HeatmapDisplay::blend) s += " blend " + option_value(config, "opacity");

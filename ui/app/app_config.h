@@ -106,14 +106,14 @@ std::string describe_structure(const StructureChoice& choice);
 /// ordering, and what the heatmap shows (metric, colour map, scale).
 std::string screenshot_caption(const AppConfig& config);
 
-/// Text of a number as the option table writes it: shortest form that reads
-/// back to the same float ("1", "0.25", "1e-05").
-std::string format_number(double v);
-
-}  // namespace accelviz
 /// The current view's heatmap as core's options at W×H: the View's metric,
 /// the structure choice's query options and threads, and the cost metric's
 /// weights (the BVH's C_trav/C_isect, as `render --ctrav/--cisect`). The
 /// heatmap request, its restart key and the GPU trace all start from it.
 HeatmapOptions view_heatmap_options(const AppConfig& config, int width, int height);
 
+/// Text of a number as the option table writes it: shortest form that reads
+/// back to the same float ("1", "0.25", "1e-05").
+std::string format_number(double v);
+
+}  // namespace accelviz

@@ -90,6 +90,12 @@ AppState::HeatmapKey AppState::heatmap_key(int w, int h) const {
 
 AppState::FrameUpdate AppState::update(int view_width, int view_height) {
   FrameUpdate u;
+  // The previous frame's time outside the GPU heatmap's step (sizes its budget).
+  const auto now = std::chrono::steady_clock::now();
+  const double frame_other_ms =
+      last_update_ ? std::chrono::duration<double, std::milli>(now - *last_update_).count() - last_gpu_step_ms_ : 0.0;
+  last_update_ = now;
+  double step_ms = 0.0;
   view_w_ = view_width;
   view_h_ = view_height;
 
@@ -99,12 +105,6 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
       (reload_ || wanted_scene_ != requested_scene_ || !requested_ || !same_build(*requested_, wanted))) {
     request_id_ = builds_.request({wanted_scene_, wanted, reload_});
     if (scene_loading_) scene_request_id_ = request_id_;
-  // The previous frame's time outside the GPU heatmap's step (sizes its budget).
-  const auto now = std::chrono::steady_clock::now();
-  const double frame_other_ms =
-      last_update_ ? std::chrono::duration<double, std::milli>(now - *last_update_).count() - last_gpu_step_ms_ : 0.0;
-  last_update_ = now;
-  double step_ms = 0.0;
     requested_scene_ = wanted_scene_;
     requested_ = wanted;
     reload_ = false;
@@ -158,7 +158,10 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
       HeatmapRequest r = heatmap_request(view_heatmap_options(config(), view_w_, view_h_), current_, camera());
       r.shadow_lights = shadow_lights(current_->scene->scene, key.shadows);
       heatmap_on_gpu_ = false;
+      gpu_frame_shown_ = false;
+      gpu_fallback_.reset();
       gpu_note_.clear();
+      if (gpu_job_) gpu_job_->cancel();
       if (key.gpu) {
         if (!gpu_job_)
           gpu_note_ = "no GPU tracer in this session";
@@ -172,10 +175,7 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
             heatmaps_.cancel();
             gpu_job_->start(primary, ++gpu_frame_id_);
             heatmap_on_gpu_ = true;
-      gpu_frame_shown_ = false;
-      gpu_fallback_.reset();
             gpu_fallback_ = r;
-      if (gpu_job_) gpu_job_->cancel();
           } catch (const std::exception& e) {
             gpu_note_ = e.what();
           }
@@ -184,20 +184,6 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
       if (!heatmap_on_gpu_) heatmaps_.request(std::move(r));
       heatmap_requested_ = key;
     }
-    // Query options changed: the inspected ray is re-cast with them.
-    const QueryOptions& q = config().structure.query;
-    if (inspection_ && (q.triangle_test != inspected_query_.triangle_test || q.ordered != inspected_query_.ordered ||
-                        q.back_to_front != inspected_query_.back_to_front || q.xray != inspected_query_.xray))
-      recast();
-  }
-  if (auto latest = heatmaps_.latest(); !heatmap_on_gpu_ && latest && latest != heatmap_) {
-    heatmap_ = std::move(latest);
-    u.heatmap_changed = true;
-  }
-  return u;
-}
-
-bool AppState::show_frame(std::shared_ptr<const BuiltStructure> frame, const LoadedScene* rest_scene) {
     // The GPU trace's bands for this frame (the window stays responsive;
     // the old heatmap stays up until the new one is complete).
     if (heatmap_on_gpu_ && gpu_job_ && gpu_job_->busy()) {
@@ -225,6 +211,22 @@ bool AppState::show_frame(std::shared_ptr<const BuiltStructure> frame, const Loa
         gpu_fallback_.reset();
       }
     }
+    // Query options changed: the inspected ray is re-cast with them.
+    const QueryOptions& q = config().structure.query;
+    if (inspection_ && (q.triangle_test != inspected_query_.triangle_test || q.ordered != inspected_query_.ordered ||
+                        q.back_to_front != inspected_query_.back_to_front || q.xray != inspected_query_.xray))
+      recast();
+  }
+  if (auto latest = heatmaps_.latest(); !heatmap_on_gpu_ && latest && latest != heatmap_) {
+    heatmap_ = std::move(latest);
+    shown_on_gpu_ = false;
+    u.heatmap_changed = true;
+  }
+  last_gpu_step_ms_ = step_ms;
+  return u;
+}
+
+bool AppState::show_frame(std::shared_ptr<const BuiltStructure> frame, const LoadedScene* rest_scene) {
   if (!frame || !rest_ || rest_->scene.get() != rest_scene || frame->choice.name != rest_->choice.name ||
       !same_build(frame->choice, rest_->choice))
     return false;
@@ -233,10 +235,8 @@ bool AppState::show_frame(std::shared_ptr<const BuiltStructure> frame, const Loa
     recast();
   }
   return true;
-    shown_on_gpu_ = false;
 }
 
-  last_gpu_step_ms_ = step_ms;
 void AppState::show_rest() {
   if (current_ == rest_) return;
   current_ = rest_;
@@ -377,6 +377,10 @@ nlohmann::json AppState::stats_json() const {
                  {"device", shown_on_gpu_ ? "gpu" : "cpu"},
                  {"gpu_note", gpu_note_}};
   }
+  // The GPU trace of the current view while it runs (null otherwise).
+  j["gpu_trace"] = nullptr;
+  if (const auto p = gpu_heatmap_progress())
+    j["gpu_trace"] = {{"rows_done", p->rows_done}, {"rows", p->rows}, {"bands", p->bands}, {"trace_ms", p->trace_ms}};
   return j;
 }
 
@@ -393,10 +397,6 @@ ScreenshotInfo AppState::screenshot_info(float scale_min, float scale_max) const
   if (current_) {
     info.config.structure.name = current_->choice.name;
     info.config.structure.options = current_->choice.options;
-  // The GPU trace of the current view while it runs (null otherwise).
-  j["gpu_trace"] = nullptr;
-  if (const auto p = gpu_heatmap_progress())
-    j["gpu_trace"] = {{"rows_done", p->rows_done}, {"rows", p->rows}, {"bands", p->bands}, {"trace_ms", p->trace_ms}};
   }
   info.scale_min = scale_min;
   info.scale_max = scale_max;

@@ -177,21 +177,21 @@ class AppState {
   std::optional<HeatmapKey> heatmap_requested_;
   GpuHeatmapJob* gpu_job_ = nullptr;
   std::string gpu_note_;
-  bool heatmap_on_gpu_ = false;
-  std::uint64_t gpu_frame_id_ = 0;
-
-  ViewCamera camera_;
   // The current view is traced by gpu_job_; its frame is complete and shown;
   // heatmap_ came from gpu_job_.
-  int view_w_ = 0, view_h_ = 0;
+  bool heatmap_on_gpu_ = false;
   bool gpu_frame_shown_ = false;
   bool shown_on_gpu_ = false;
   // The full request, for the CPU should the GPU fail mid-trace.
   std::optional<HeatmapRequest> gpu_fallback_;
-
+  std::uint64_t gpu_frame_id_ = 0;
   // When update() last ran and how long its GPU step took (sizes the next budget).
   std::optional<std::chrono::steady_clock::time_point> last_update_;
   double last_gpu_step_ms_ = 0.0;
+
+  ViewCamera camera_;
+  int view_w_ = 0, view_h_ = 0;
+
   std::optional<RayInspection> inspection_;
   QueryOptions inspected_query_;  ///< the query options inspection_ was cast with
   std::size_t replay_step_ = 0;
