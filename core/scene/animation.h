@@ -24,7 +24,6 @@ namespace accelviz {
 /// keys or with a value count that does not match its interpolation.
 glm::vec4 sample_channel(const AnimationChannel& channel, float t);
 
-/// Last key time over all channels of all animations (0: nothing animates).
 /// Morph weights of a `weights` CHANNEL at time T: one value per morph
 /// target (the channel's outputs per key divided by its keys), interpolated
 /// like sample_channel (linear, step, cubic spline with in/out tangents;
@@ -52,6 +51,7 @@ std::vector<glm::vec3> posed_positions(const Scene& scene, std::uint32_t mesh, f
 /// order, skipping the triangles a BLAS skips (non-finite rest vertices).
 std::vector<Triangle> posed_triangles(const Scene& scene, std::uint32_t mesh, float t);
 
+/// Last key time over all channels of all animations (0: nothing animates).
 float animation_duration(const Scene& scene);
 
 /// True when the scene has node TRS channels, mesh deformers, or morph

@@ -366,6 +366,8 @@ nlohmann::json AppState::stats_json() const {
                  {"max_nodes", s.max_nodes},
                  {"mean_prims", s.mean_prims},
                  {"max_prims", s.max_prims},
+                 {"mean_instances", s.mean_instances},
+                 {"max_instances", s.max_instances},
                  {"mean_value", s.mean_value},
                  {"max_value", s.max_value},
                  {"shadow_rays", s.shadow_rays},
@@ -405,5 +407,3 @@ ScreenshotInfo AppState::screenshot_info(float scale_min, float scale_max) const
 }
 
 }  // namespace accelviz
-                 {"mean_instances", s.mean_instances},
-                 {"max_instances", s.max_instances},

@@ -76,6 +76,7 @@ struct PixelFigures {
   float value = 0.0f;                ///< the metric (NaN: no value)
   std::uint32_t nodes = 0;           ///< RayStats::nodes_visited
   std::uint32_t prims = 0;           ///< RayStats::prim_tests
+  std::uint32_t instances = 0;       ///< RayStats::instances_visited (two-level; 0 elsewhere)
   std::uint32_t prim = 0xFFFFFFFFu;  ///< hit primitive (kInvalidId: miss)
   float t = 0.0f;                    ///< hit distance (inf: miss)
   std::uint32_t shadow_rays = 0;     ///< any-hit rays traced from the hit toward the lights
@@ -90,6 +91,8 @@ struct HeatmapSummary {
   std::uint64_t hits = 0;
   double mean_nodes = 0.0, mean_prims = 0.0;
   std::uint32_t max_nodes = 0, max_prims = 0;
+  double mean_instances = 0.0;  ///< instances visited per pixel (two-level; 0 elsewhere)
+  std::uint32_t max_instances = 0;
   double mean_value = 0.0, max_value = 0.0;  ///< of the metric, over pixels with a value
   double render_ms = 0.0;                    ///< tracing time of all levels so far (instrumented)
   double rays_per_s = 0.0;
@@ -109,7 +112,6 @@ struct HeatmapFrame {
   HeatmapRequest request;  ///< what it shows (structure, camera, size, metric)
 
   const PixelFigures& at(int x, int y) const { return pixels[static_cast<std::size_t>(y) * image.width + x]; }
-  std::uint32_t instances = 0;       ///< RayStats::instances_visited (two-level; 0 elsewhere)
 };
 
 /// Traces request `r` level by level, synchronously, calling `publish`
@@ -124,8 +126,6 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
 /// worker computes it for its frames; used by the GPU path too.
 HeatmapSummary summarise_pixels(std::span<const PixelFigures> pixels, double render_ms);
 
-  double mean_instances = 0.0;  ///< instances visited per pixel (two-level; 0 elsewhere)
-  std::uint32_t max_instances = 0;
 class HeatmapWorker {
  public:
   HeatmapWorker();

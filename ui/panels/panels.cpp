@@ -652,6 +652,7 @@ void pixel_tooltip(int x, int y, const PixelFigures& p, HeatMetric metric, bool 
   else
     ImGui::Text("%s: %.4g", std::string(metric_name(metric)).c_str(), p.value);
   ImGui::Text("nodes visited %u, prim tests %u", p.nodes, p.prims);
+  if (p.instances > 0) ImGui::Text("instances visited %u", p.instances);
   if (p.prim != kInvalidId)
     ImGui::Text("hit prim %u at t = %.5g", p.prim, p.t);
   else
@@ -660,4 +661,3 @@ void pixel_tooltip(int x, int y, const PixelFigures& p, HeatMetric metric, bool 
 }
 
 }  // namespace accelviz::panels
-  if (p.instances > 0) ImGui::Text("instances visited %u", p.instances);

@@ -285,6 +285,7 @@ static Hit traverse_two_level(const Tlas& t, std::span<const BvhNode> nodes, std
       RayStats ls;
       RayStats* lsp = c.any() ? &ls : nullptr;
       if (c.ts) ++c.ts->instances_visited;
+      if (c.rs) ++c.rs->instances_visited;
       if constexpr (AnyHit) {
         const bool h = blas.any_hit(local, qo, lsp);
         if (c.rs) *c.rs += ls;
@@ -297,7 +298,6 @@ static Hit traverse_two_level(const Tlas& t, std::span<const BvhNode> nodes, std
           best.instance = id;
           return best;
         }
-      if (c.rs) ++c.rs->instances_visited;
       } else {
         VisitTrace lt;
         Hit h = blas.closest_hit(local, qo, lsp, c.trace ? &lt : nullptr);
