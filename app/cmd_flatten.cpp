@@ -54,7 +54,8 @@ nlohmann::json figures_json(const TwoLevelFigures& f) {
           {"hits", f.hits},
           {"mean_nodes", f.mean_nodes},
           {"mean_prims", f.mean_prims},
-          {"mean_instances", f.mean_instances}};
+          {"mean_instances", f.mean_instances},
+          {"trace_ms", f.trace_ms}};
 }
 
 int run_flatten(const FlattenOptions& o, const GlobalOptions& global) {

@@ -11,6 +11,7 @@
 #include "core/scene/load.h"
 #include "ui/app/app_state.h"
 #include "ui/app/dynamics.h"
+#include "ui/app/flatten_worker.h"
 #include "ui/app/script.h"
 #include "ui/app/sweep_worker.h"
 #include "ui/app/settings.h"
@@ -85,6 +86,12 @@ class Gui final : public ScriptHost {
   const SceneEffects* effects();
   /// The Dynamics panel: the timeline and per-frame figures while per-frame updates are on.
   void draw_dynamics(const panels::PanelLayout& layout);
+  /// The Flatten what-if panel while the structure is tlas; takes a finished commit.
+  void draw_flatten(const panels::PanelLayout& layout);
+  /// Asks the flatten worker to predict or commit IDS on the shown scene and view.
+  std::uint64_t request_flatten(FlattenRequest::Kind kind, std::vector<std::uint32_t> ids);
+  /// A finished commit (once): its merged scene is opened and built.
+  void take_flatten_commit();
   void take_screenshot();
   SavedScreenshot write_frame(const std::optional<std::filesystem::path>& explicit_path);
   void report_errors();
@@ -107,6 +114,11 @@ class Gui final : public ScriptHost {
   panels::RobustnessPanelState robustness_panel_;
   DynamicsWorker dynamics_;  ///< steps the shown scene's animation off the UI thread
   DynamicsPlayer player_;
+  FlattenWorker flatten_;  ///< the Flatten what-if's predictions and commits, off the UI thread
+  panels::FlattenPanelState flatten_panel_;
+  std::shared_ptr<const LoadedScene> flatten_scene_;  ///< the scene the selection is of (held: addresses come back)
+  std::uint64_t flatten_taken_ = 0;                   ///< the last commit result acted on
+  std::optional<std::uint64_t> flatten_wait_;         ///< script flatten / flatten-commit: the job waited for
   std::optional<SceneEffects> effects_;
   std::shared_ptr<const LoadedScene> effects_scene_;  ///< held: a freed scene's address may come back
   EffectForces effects_forces_;
@@ -293,6 +305,7 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
     if (!err.empty()) app_.set_error(err);
   }
   draw_dynamics(layout);
+  draw_flatten(layout);
 
   const BuildWorker::Status st = app_.build_status();
   panels::BuildProgress bp;
@@ -475,6 +488,51 @@ void Gui::take_screenshot() {
   }
 }
 
+void Gui::take_flatten_commit() {
+  const std::shared_ptr<const FlattenResult> r = flatten_.latest();
+  if (!r || r->id <= flatten_taken_ || r->kind != FlattenRequest::Kind::commit) return;
+  flatten_taken_ = r->id;
+  if (!r->error.empty())
+    app_.set_error(r->error);
+  else if (r->committed)
+    app_.open_loaded_scene(r->committed);
+}
+
+std::uint64_t Gui::request_flatten(FlattenRequest::Kind kind, std::vector<std::uint32_t> ids) {
+  FlattenRequest r;
+  r.kind = kind;
+  r.scene = app_.rest()->scene;
+  r.instances = std::move(ids);
+  r.camera = app_.camera();
+  r.width = flatten_panel_.width;
+  r.height = flatten_panel_.height;
+  r.options.blas = app_.config().structure.options.bvh;  // as the factory builds "tlas"
+  r.options.blas.compute_epo = false;
+  if (r.options.blas.threads == 0) r.options.blas.threads = app_.config().structure.options.threads;
+  r.options.tlas = r.options.blas;
+  return flatten_.request(std::move(r));
+}
+
+void Gui::draw_flatten(const panels::PanelLayout& layout) {
+  take_flatten_commit();
+  const std::shared_ptr<const BuiltStructure>& rest = app_.rest();
+  if (!rest || !rest->accel || rest->accel->name() != "tlas") return;
+  if (flatten_scene_ != rest->scene) {  // another scene: the selection starts over
+    flatten_scene_ = rest->scene;
+    flatten_panel_.scene_identity = flatten_scene_.get();
+    panels::set_flatten_selection(flatten_panel_, {});
+  }
+  std::optional<std::uint32_t> clicked;
+  if (const auto& insp = app_.inspection(); insp && insp->hit.valid() && insp->hit.instance != kInvalidId)
+    clicked = insp->hit.instance;
+  const std::shared_ptr<const FlattenResult> result = flatten_.latest();
+  const panels::FlattenAction a = panels::flatten_panel(flatten_panel_, &flatten_scene_->scene, result.get(),
+                                                        flatten_.busy(), flatten_.fraction(), clicked, layout);
+  if (a.cancel) flatten_.cancel();
+  if (a.preview) request_flatten(FlattenRequest::Kind::preview, flatten_panel_.selected);
+  if (a.commit) request_flatten(FlattenRequest::Kind::commit, flatten_panel_.selected);
+}
+
 ScriptHost::Status Gui::execute(const ScriptCommand& c) {
   using K = ScriptCommand::Kind;
   auto fail_if = [](const std::string& error) {
@@ -566,6 +624,51 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
     case K::quit:
       quit_ = true;
       return Status::done;
+    case K::flatten: {
+      if (app_.loading_scene() || !app_.rest()) return Status::again;
+      if (!flatten_wait_) {
+        const std::string name = app_.rest()->accel->name();
+        if (name != "tlas") throw std::runtime_error("flatten: the structure is " + name + "; the what-if needs tlas");
+        std::vector<std::uint32_t> ids = parse_instance_ids(c.arg, app_.rest()->scene->scene.instances.size());
+        flatten_scene_ = app_.rest()->scene;
+        flatten_panel_.scene_identity = flatten_scene_.get();
+        panels::set_flatten_selection(flatten_panel_, ids);
+        flatten_wait_ = request_flatten(FlattenRequest::Kind::preview, std::move(ids));
+      }
+      const std::shared_ptr<const FlattenResult> r = flatten_.latest();
+      if (!r || r->id < *flatten_wait_) return Status::again;
+      flatten_wait_.reset();
+      if (!r->error.empty()) throw std::runtime_error(r->error);
+      return Status::done;
+    }
+    case K::flatten_commit: {
+      if (!flatten_wait_) {
+        const std::shared_ptr<const FlattenResult> r = flatten_.latest();
+        if (!r || !r->figures || !app_.rest() || r->scene != app_.rest()->scene.get())
+          throw std::runtime_error("flatten-commit: no prediction of the shown scene (run flatten IDS first)");
+        flatten_wait_ = request_flatten(FlattenRequest::Kind::commit, r->instances);
+      }
+      const std::shared_ptr<const FlattenResult> r = flatten_.latest();
+      if (!r || r->id < *flatten_wait_) return Status::again;
+      take_flatten_commit();
+      if (!r->error.empty()) {
+        flatten_wait_.reset();
+        throw std::runtime_error(r->error);
+      }
+      // Done once the merged scene is shown and its build and heatmap are in.
+      if (app_.loading_scene() || app_.scene_spec() != r->committed->spec || !app_.settled()) return Status::again;
+      flatten_wait_.reset();
+      return Status::done;
+    }
+    case K::dump_flatten: {
+      const std::shared_ptr<const FlattenResult> r = flatten_.latest();
+      if (!r || (!r->figures && r->error.empty()))
+        throw std::runtime_error("dump-flatten: no flatten prediction yet (run flatten IDS first)");
+      const std::string spec =
+          flatten_scene_ && r->scene == flatten_scene_.get() ? flatten_scene_->spec : std::string();
+      fail_if(write_file_atomic(c.arg, flatten_result_json(*r, spec).dump(2) + "\n"));
+      return Status::done;
+    }
     case K::force_effect:
       fail_if(force_effect(app_.config(), c.arg, c.value == "on"));
       return Status::done;

@@ -2,6 +2,7 @@
 // (core/accel/tlas/flatten_what_if.h) on hand-made two- and three-instance scenes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <vector>
 
 #include "core/accel/tlas/flatten_what_if.h"
@@ -101,7 +102,9 @@ Scene three_quads() {
 TEST(FlattenWhatIf, MergingTwoOfThreeInstancesKeepsTheWorldGeometry) {
   const Scene s = tlas_what_if_test::three_quads();
   const std::vector<std::uint32_t> sel = {0, 2};
-  const Scene flat = flatten_instances(s, sel);
+  const FlattenedScene flattened = flatten_instances(s, sel);
+  const Scene& flat = flattened.scene;
+  EXPECT_EQ(flattened.merged_triangles, 4u);
   ASSERT_EQ(flat.instances.size(), 2u);  // instance 1 kept, then the merged one
   EXPECT_EQ(flat.instances[0].transform, s.instances[1].transform);
   EXPECT_EQ(flat.meshes[flat.instances[1].mesh].indices.size(), 4u);
@@ -123,6 +126,8 @@ TEST(FlattenWhatIf, MergingTwoOfThreeInstancesKeepsTheWorldGeometry) {
   EXPECT_GT(w.two_level.sah_cost, 0.0);
   EXPECT_GT(w.flattened.sah_cost, 0.0);
   EXPECT_GT(w.two_level.mean_instances, 0.0);
+  EXPECT_GT(w.two_level.trace_ms, 0.0);
+  EXPECT_GT(w.flattened.trace_ms, 0.0);
   // Two instances merged: fewer instance entries per ray.
   EXPECT_LT(w.flattened.mean_instances, w.two_level.mean_instances);
 
@@ -136,6 +141,24 @@ TEST(FlattenWhatIf, MergingTwoOfThreeInstancesKeepsTheWorldGeometry) {
       EXPECT_NEAR(ha.t, hb.t, 1e-5f) << x;
     }
   }
+}
+
+TEST(FlattenWhatIf, ProgressRisesToOneAndFalseCancels) {
+  const Scene s = tlas_what_if_test::three_quads();
+  const std::vector<std::uint32_t> sel = {1};
+  const Camera cam = look_at({1.5f, 0.5f, 4.0f}, {1.5f, 0.5f, 0.0f}, 1.0f);
+  std::vector<double> seen;
+  flatten_what_if(s, sel, cam, 8, 6, {}, [&](double f) {
+    seen.push_back(f);
+    return true;
+  });
+  ASSERT_GT(seen.size(), 12u);  // a row of each trace at least
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_DOUBLE_EQ(seen.back(), 1.0);
+  EXPECT_GE(seen.front(), 0.0);
+  int calls = 0;
+  EXPECT_THROW(flatten_what_if(s, sel, cam, 8, 6, {}, [&](double) { return ++calls < 5; }), BuildCancelled);
+  EXPECT_GE(calls, 5);
 }
 
 TEST(FlattenWhatIf, BadSelectionsAreRefused) {

@@ -658,3 +658,31 @@ TEST_F(GuiScript, HeatmapTracedOnTheGpuCountsWhatTheCpuCounts) {
   EXPECT_EQ(grid["gpu_note"], "only the bvh structure is traced on the GPU");
   EXPECT_EQ(grid["complete"], true);
 }
+
+// Two-level views and the flatten what-if in the window: the `instances`
+// metric counts instances per pixel, `flatten` predicts merging four trees
+// and `flatten-commit` rebuilds the merged scene (three fewer instances).
+TEST_F(GuiScript, InstancesMetricAndFlattenWhatIfCommit) {
+  const RunResult r = run("open builtin:forest?size=1000&seed=4\nstructure tlas\nsize 320 240\nset metric instances\n"
+                          "wait\ndump-stats " +
+                          path("before.json").string() + "\nflatten 0-3\ndump-flatten " + path("what.json").string() +
+                          "\nflatten-commit\ndump-stats " + path("after.json").string() + "\nquit\n");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json before = read_json(path("before.json"));
+  EXPECT_EQ(before["view"]["metric"], "instances");
+  EXPECT_GT(before["view"]["mean_instances"].get<double>(), 0.0);
+  EXPECT_NEAR(before["view"]["mean_value"].get<double>(), before["view"]["mean_instances"].get<double>(), 1e-9);
+  const double instances = before["build"]["extra"]["instances"].get<double>();
+  const nlohmann::json what = read_json(path("what.json"));
+  EXPECT_EQ(what["instances"], "0-3");
+  EXPECT_EQ(what["merged_instances"].get<int>(), 4);
+  EXPECT_GT(what["merged_triangles"].get<int>(), 0);
+  EXPECT_EQ(what["two_level"]["instances"].get<double>(), instances);
+  EXPECT_EQ(what["flattened"]["instances"].get<double>(), instances - 3);
+  EXPECT_EQ(what["flattened"]["hits"], what["two_level"]["hits"]);
+  EXPECT_GT(what["two_level"]["trace_ms"].get<double>(), 0.0);
+  const nlohmann::json after = read_json(path("after.json"));
+  EXPECT_NE(after["scene"].get<std::string>().find("[flattened 4 instances]"), std::string::npos) << after["scene"];
+  EXPECT_EQ(after["build"]["extra"]["instances"].get<double>(), instances - 3);
+  EXPECT_EQ(after["triangles"], before["triangles"]);
+}

@@ -25,6 +25,15 @@ void AppState::open_scene(const std::string& spec) {
   set_message("loading " + spec);
 }
 
+void AppState::open_loaded_scene(std::shared_ptr<const LoadedScene> scene) {
+  if (!scene) return;
+  wanted_scene_ = scene->spec;
+  preloaded_ = std::move(scene);
+  reload_ = true;
+  scene_loading_ = true;
+  set_message("opening " + wanted_scene_);
+}
+
 std::string AppState::set_option(std::string_view key, std::string_view value) {
   const std::string e = apply_option(settings_.config, key, value);
   if (!e.empty()) set_error(e);
@@ -103,7 +112,10 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
   const StructureChoice& wanted = config().structure;
   if (!wanted_scene_.empty() &&
       (reload_ || wanted_scene_ != requested_scene_ || !requested_ || !same_build(*requested_, wanted))) {
-    request_id_ = builds_.request({wanted_scene_, wanted, reload_});
+    BuildRequest r{wanted_scene_, wanted, reload_, {}};
+    if (preloaded_ && preloaded_->spec == wanted_scene_) r.preloaded = preloaded_;
+    preloaded_.reset();
+    request_id_ = builds_.request(std::move(r));
     if (scene_loading_) scene_request_id_ = request_id_;
     requested_scene_ = wanted_scene_;
     requested_ = wanted;
@@ -125,8 +137,10 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
         u.scene_changed = true;
         camera_ = ViewCamera::scene_default(scene, aspect_of(view_w_, view_h_));
         clear_inspection();
-        settings_.last_scene = current_->scene->spec;
-        add_recent(settings_, current_->scene->spec);
+        if (!current_->scene->in_memory) {
+          settings_.last_scene = current_->scene->spec;
+          add_recent(settings_, current_->scene->spec);
+        }
         std::string m =
             "opened " + current_->scene->spec + " (" + std::to_string(scene.triangles.size()) + " triangles)";
         if (!scene.report.warnings.empty())

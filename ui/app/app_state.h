@@ -37,6 +37,9 @@ class AppState {
   /// Loads `spec` (again, if it is the current scene) and builds the chosen
   /// structure over it in the background; the current scene stays until then.
   void open_scene(const std::string& spec);
+  /// Shows SCENE (made in the app: a committed flatten) as a new scene: the
+  /// chosen structure is built over it in the background, like open_scene().
+  void open_loaded_scene(std::shared_ptr<const LoadedScene> scene);
   /// `set KEY VALUE`: "" or the one-line error (also shown on the status line).
   std::string set_option(std::string_view key, std::string_view value);
   /// Cancels the build in progress (the current structure stays).
@@ -166,6 +169,7 @@ class AppState {
   std::string wanted_scene_;
   bool reload_ = false;
   bool scene_loading_ = false;
+  std::shared_ptr<const LoadedScene> preloaded_;  ///< open_loaded_scene's scene, until requested
   std::uint64_t scene_request_id_ = 0;        ///< the build request that loads the wanted scene
   std::string requested_scene_;               ///< of the last build request
   std::optional<StructureChoice> requested_;  ///< of the last build request

@@ -101,7 +101,10 @@ BuildOutcome BuildWorker::execute(std::uint64_t id, const BuildRequest& r) {
   out.id = id;
   try {
     std::shared_ptr<const LoadedScene> scene = scene_;
-    if (!scene || scene->spec != r.scene || r.reload) {
+    if (r.preloaded) {
+      scene = r.preloaded;
+      scene_ = scene;
+    } else if (!scene || scene->spec != r.scene || r.reload) {
       set_stage("loading " + r.scene);
       const auto t0 = std::chrono::steady_clock::now();
       auto loaded = std::make_shared<LoadedScene>();

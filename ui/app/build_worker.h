@@ -28,6 +28,9 @@ struct LoadedScene {
   std::string spec;  ///< as given to load_scene
   Scene scene;
   double load_ms = 0.0;
+  /// Made in the app (a committed flatten), not loaded: `spec` names it but
+  /// cannot be loaded again, so it is not remembered as the last or a recent scene.
+  bool in_memory = false;
 };
 
 /// A finished build: the structure, the scene whose triangles it refers to
@@ -44,6 +47,8 @@ struct BuildRequest {
   std::string scene;  ///< scene spec; loaded unless it is the one loaded last (or `reload`)
   StructureChoice structure;
   bool reload = false;  ///< load the scene again even if it is the current one (File > Open of the same file)
+  /// When set, this scene (spec == `scene`) is used instead of loading one.
+  std::shared_ptr<const LoadedScene> preloaded;
 };
 
 struct BuildOutcome {

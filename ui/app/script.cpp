@@ -10,6 +10,7 @@
 #include "core/accel/factory.h"
 #include "ui/app/app_config.h"
 #include "ui/app/dynamics.h"
+#include "ui/app/flatten_worker.h"
 #include "ui/app/scenarios.h"
 
 namespace accelviz {
@@ -94,6 +95,9 @@ constexpr NamedKind kCommands[] = {
     {"pin-a", ScriptCommand::Kind::pin_a},
     {"dump-ab", ScriptCommand::Kind::dump_ab},
     {"frames", ScriptCommand::Kind::frames},
+    {"flatten", ScriptCommand::Kind::flatten},
+    {"flatten-commit", ScriptCommand::Kind::flatten_commit},
+    {"dump-flatten", ScriptCommand::Kind::dump_flatten},
 };
 
 }  // namespace
@@ -129,7 +133,8 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
       fail("unknown command '" + std::string(word) +
            "' (valid: open, structure, set, camera, size, wait, click, step, screenshot, dump-ray, dump-stats, quit, "
            "scenario, dump-scenario, "
-           "dump-insight, force-effect, play, dump-dynamics, select-region, pin-a, dump-ab, frames)");
+           "dump-insight, force-effect, play, dump-dynamics, select-region, pin-a, dump-ab, frames, flatten, "
+           "flatten-commit, dump-flatten)");
 
     ScriptCommand c;
     c.kind = it->kind;
@@ -151,6 +156,7 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
       case ScriptCommand::Kind::dump_insight:
       case ScriptCommand::Kind::dump_dynamics:
       case ScriptCommand::Kind::dump_ab:
+      case ScriptCommand::Kind::dump_flatten:
         // The rest of the line, so paths may hold spaces.
         need_rest(c.kind == ScriptCommand::Kind::open ? "a scene (file or builtin:NAME)" : "a file path");
         c.arg = std::string(rest);
@@ -222,7 +228,18 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
       case ScriptCommand::Kind::wait:
       case ScriptCommand::Kind::quit:
       case ScriptCommand::Kind::pin_a:
+      case ScriptCommand::Kind::flatten_commit:
         no_rest();
+        break;
+      case ScriptCommand::Kind::flatten:
+        // The ids are checked against the scene's instance count when it runs.
+        need_rest("instance ids, e.g. 0,2,5-9 or all");
+        c.arg = std::string(rest);
+        try {
+          check_instance_ids(c.arg);
+        } catch (const std::invalid_argument& e) {
+          fail("flatten: " + std::string(e.what()));
+        }
         break;
       case ScriptCommand::Kind::force_effect: {
         std::string_view value;

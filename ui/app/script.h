@@ -35,6 +35,9 @@ struct ScriptCommand {
     pin_a,          ///< pins the current structure and query options as A (A/B compare)
     dump_ab,        ///< arg: path; compares A with the current choice (B) on this view, writes the totals as JSON
     frames,         ///< x: frames; lets that many frames draw before the next command (no waiting on work)
+    flatten,        ///< arg: instance ids ("0,2,5-9", "all"); predicts the flatten what-if on this view, waits
+    flatten_commit,  ///< commits the last prediction (its instances merged) and waits for the merged scene's build
+    dump_flatten,    ///< arg: path; the last prediction's figures as JSON
   };
   Kind kind = Kind::wait;
   int line = 0;        ///< 1-based line in the script file

@@ -7,6 +7,7 @@
 #include "ui/app/app_config.h"
 #include "ui/app/build_worker.h"
 #include "ui/app/dynamics.h"
+#include "ui/app/flatten_worker.h"
 #include "ui/app/heatmap_worker.h"
 #include "ui/app/ray_inspection.h"
 #include "ui/app/robustness_worker.h"
@@ -148,5 +149,29 @@ std::optional<std::pair<std::string, bool>> scene_effects_section(const SceneEff
 /// plotted over time (TLAS rebuild ms, refit ms, rebuild ms, SAH refitted
 /// vs rebuilt).
 void dynamics_panel(DynamicsPlayer& player, const DynamicsSnapshot* snap, bool busy, const PanelLayout& layout);
+
+// ---- Flatten what-if (flatten_panel.cpp) ----------------------------------------------
+struct FlattenPanelState {
+  std::string ids;                      ///< the selection as typed ("0,2,5-9", "all")
+  std::vector<std::uint32_t> selected;  ///< parsed, sorted, distinct
+  std::string error;                    ///< the text's parse error
+  int width = 160, height = 120;        ///< primary rays of the current view traced for the prediction
+  const LoadedScene* scene_identity = nullptr;  ///< the scene the selection is of (results of others are hidden)
+  bool collapsed_at_start = true;
+};
+struct FlattenAction {
+  bool preview = false;  ///< measure the selection (restarting one in progress)
+  bool commit = false;   ///< rebuild with the previewed selection merged
+  bool cancel = false;
+};
+/// Sets the selection (ids sorted and distinct) and its text.
+void set_flatten_selection(FlattenPanelState& state, std::vector<std::uint32_t> ids);
+/// Instances field, "add clicked instance", a checkbox list, Predict/Cancel
+/// with progress, the predicted figures (two-level vs flattened: nodes,
+/// triangle tests, instances per ray, trace ms, memory, SAH, build ms) and
+/// Commit, enabled once the shown prediction is of the current selection.
+FlattenAction flatten_panel(FlattenPanelState& state, const Scene* scene, const FlattenResult* result, bool busy,
+                            double fraction, std::optional<std::uint32_t> clicked_instance,
+                            const PanelLayout& layout);
 
 }  // namespace accelviz::panels

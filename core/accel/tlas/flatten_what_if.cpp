@@ -1,6 +1,8 @@
 // The flatten what-if (see flatten_what_if.h).
 #include "core/accel/tlas/flatten_what_if.h"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -9,7 +11,7 @@
 
 namespace accelviz {
 
-Scene flatten_instances(const Scene& scene, std::span<const std::uint32_t> selected) {
+FlattenedScene flatten_instances(const Scene& scene, std::span<const std::uint32_t> selected) {
   std::vector<char> merged(scene.instances.size(), 0);
   for (std::uint32_t id : selected) {
     if (id >= scene.instances.size())
@@ -18,7 +20,9 @@ Scene flatten_instances(const Scene& scene, std::span<const std::uint32_t> selec
     if (merged[id]) throw std::invalid_argument("flatten: instance " + std::to_string(id) + " listed twice");
     merged[id] = 1;
   }
-  Scene out = scene;
+  FlattenedScene result;
+  result.scene = scene;
+  Scene& out = result.scene;
   out.instances.clear();
   Mesh big;
   big.name = "flattened";
@@ -45,6 +49,7 @@ Scene flatten_instances(const Scene& scene, std::span<const std::uint32_t> selec
       big.indices.push_back({base, base + 1, base + 2});
     }
   }
+  result.merged_triangles = big.indices.size();
   if (!big.indices.empty()) {
     Node n;
     n.name = "flattened";
@@ -61,13 +66,24 @@ Scene flatten_instances(const Scene& scene, std::span<const std::uint32_t> selec
     out.flatten();
   else
     out.triangles.clear();
-  return out;
+  return result;
 }
 
 namespace {
 
-TwoLevelFigures measure(const Scene& scene, const Camera& camera, int width, int height, const TlasOptions& opts) {
-  const Tlas t(scene, opts);
+using Clock = std::chrono::steady_clock;
+
+/// PROGRESS mapped onto [lo, lo + span]; empty when PROGRESS is.
+ProgressCallback sub_progress(const ProgressCallback& progress, double lo, double span) {
+  if (!progress) return {};
+  return [progress, lo, span](double f) { return progress(lo + span * f); };
+}
+
+/// Builds and traces one side; the build takes the first BUILD_SHARE of [0, 1] of PROGRESS.
+TwoLevelFigures measure(const Scene& scene, const Camera& camera, int width, int height, const TlasOptions& opts,
+                        const ProgressCallback& progress) {
+  constexpr double kBuildShare = 0.4;
+  const Tlas t(scene, opts, sub_progress(progress, 0.0, kBuildShare));
   TwoLevelFigures f;
   const BuildStats& b = t.build_stats();
   f.sah_cost = b.sah_cost;
@@ -77,7 +93,9 @@ TwoLevelFigures measure(const Scene& scene, const Camera& camera, int width, int
   f.blas = t.blas_count();
   double nodes = 0.0, prims = 0.0, inst = 0.0;
   const QueryOptions qo;
-  for (int y = 0; y < height; ++y)
+  const auto t0 = Clock::now();
+  for (int y = 0; y < height; ++y) {
+    if (progress && !progress(kBuildShare + (1.0 - kBuildShare) * y / std::max(1, height))) throw BuildCancelled();
     for (int x = 0; x < width; ++x) {
       TwoLevelRayStats s;
       const Hit h = t.closest_hit_two_level(primary_ray(camera, x, y, width, height), qo, &s);
@@ -87,6 +105,8 @@ TwoLevelFigures measure(const Scene& scene, const Camera& camera, int width, int
       prims += s.prim_tests;
       inst += s.instances_visited;
     }
+  }
+  f.trace_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   if (f.rays > 0) {
     f.mean_nodes = nodes / static_cast<double>(f.rays);
     f.mean_prims = prims / static_cast<double>(f.rays);
@@ -98,15 +118,14 @@ TwoLevelFigures measure(const Scene& scene, const Camera& camera, int width, int
 }  // namespace
 
 FlattenWhatIf flatten_what_if(const Scene& scene, std::span<const std::uint32_t> selected, const Camera& camera,
-                              int width, int height, const TlasOptions& opts) {
+                              int width, int height, const TlasOptions& opts, const ProgressCallback& progress) {
   FlattenWhatIf w;
-  const Scene flat = flatten_instances(scene, selected);
+  const FlattenedScene flat = flatten_instances(scene, selected);
   w.merged_instances = selected.size();
-  if (!flat.instances.empty() && flat.instances.back().node + 1 == flat.nodes.size() &&
-      flat.nodes.back().name == "flattened" && !selected.empty())
-    w.merged_triangles = flat.meshes[flat.instances.back().mesh].indices.size();
-  w.two_level = measure(scene, camera, width, height, opts);
-  w.flattened = measure(flat, camera, width, height, opts);
+  w.merged_triangles = flat.merged_triangles;
+  w.two_level = measure(scene, camera, width, height, opts, sub_progress(progress, 0.0, 0.5));
+  w.flattened = measure(flat.scene, camera, width, height, opts, sub_progress(progress, 0.5, 0.5));
+  if (progress) progress(1.0);
   return w;
 }
 

@@ -22,6 +22,7 @@ struct TwoLevelFigures {
   double mean_prims = 0.0;      ///< per primary ray: triangle tests
   double mean_instances = 0.0;  ///< per primary ray: instances entered
   std::uint64_t rays = 0, hits = 0;
+  double trace_ms = 0.0;  ///< wall time of tracing the rays (closest hit, counters on, one thread)
 };
 
 struct FlattenWhatIf {
@@ -31,18 +32,27 @@ struct FlattenWhatIf {
   std::uint64_t merged_triangles = 0;  ///< world triangles of the merged BLAS
 };
 
+struct FlattenedScene {
+  Scene scene;
+  std::uint64_t merged_triangles = 0;  ///< world triangles in the merged mesh (0: nothing merged)
+};
+
 /// SCENE with the instances listed in SELECTED (indices into
 /// scene.instances; duplicates and out-of-range ids are refused with
 /// std::invalid_argument) merged into one new mesh of their world
 /// triangles, placed once under the identity transform; the other instances
 /// keep their meshes and transforms. Instance order: the kept ones first,
-/// then the merged one. The result is flattened when SCENE was.
-Scene flatten_instances(const Scene& scene, std::span<const std::uint32_t> selected);
+/// then the merged one (absent when the selected instances have no finite
+/// triangle). The result is flattened when SCENE was.
+FlattenedScene flatten_instances(const Scene& scene, std::span<const std::uint32_t> selected);
 
 /// Builds the two-level structure of SCENE and of flatten_instances(SCENE,
 /// SELECTED) with OPTS and traces the WIDTH x HEIGHT primary rays of CAMERA
-/// through both (closest hit, counters on).
+/// through both (closest hit, counters on). PROGRESS (optional) gets the
+/// fraction done over both builds and traces; when it returns false the
+/// what-if stops and throws BuildCancelled.
 FlattenWhatIf flatten_what_if(const Scene& scene, std::span<const std::uint32_t> selected, const Camera& camera,
-                              int width, int height, const TlasOptions& opts = {});
+                              int width, int height, const TlasOptions& opts = {},
+                              const ProgressCallback& progress = {});
 
 }  // namespace accelviz
