@@ -179,7 +179,8 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   progress.begin("loading " + o.scene);
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
   progress.end(std::to_string(scene.triangles.size()) + " triangles");
-  const StructureOptions so = o.structure_opts.to_options(o.threads, /*compute_epo=*/!o.no_epo);
+  StructureOptions so = o.structure_opts.to_options(o.threads, /*compute_epo=*/!o.no_epo);
+  so.scene = &scene;  // "tlas" builds its two levels from the scene's meshes and instances
 
   // ---- ray sets, from the first structure's primary hits ----
   const Camera camera = camera_for(o.camera, scene, size);

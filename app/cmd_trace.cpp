@@ -38,7 +38,8 @@ int run_trace(const TraceOptions& o, const GlobalOptions& global) {
   progress.end(std::to_string(scene.triangles.size()) + " triangles");
 
   progress.begin("building " + o.structure);
-  const StructureOptions so = o.structure_opts.to_options(o.threads, /*compute_epo=*/false);
+  StructureOptions so = o.structure_opts.to_options(o.threads, /*compute_epo=*/false);
+  so.scene = &scene;  // "tlas" builds its two levels from the scene's meshes and instances
   const std::unique_ptr<Accelerator> accel = build_accelerator(o.structure, scene.triangles, so, progress.callback());
   const double build_ms = accel->build_stats().build_ms;
   progress.end(std::to_string(static_cast<long long>(build_ms)) + " ms");

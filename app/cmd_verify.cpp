@@ -34,10 +34,15 @@ int run_verify(const VerifyOptions& o, const GlobalOptions& global) {
   progress.begin("loading " + o.scene);
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
   progress.end(std::to_string(scene.triangles.size()) + " triangles");
+  if (scene.triangles.empty() && !scene.instances.empty())
+    throw std::runtime_error(o.scene +
+                             ": instanced and too large to flatten; verify needs the flattened triangles for its "
+                             "brute-force reference");
 
   progress.begin("verifying " + std::to_string(structures.size()) + " structures");
   const std::vector<Ray> rays = verify_rays(scene.triangles, o.rays, o.seed);
-  const VerifyResult r = verify_structures(scene.triangles, rays, structures, o.threads);
+  // "tlas": two levels from the scene's instances, checked against the flattened brute force.
+  const VerifyResult r = verify_structures(scene.triangles, rays, structures, o.threads, &scene);
   progress.end(std::to_string(static_cast<long long>(r.total_ms)) + " ms");
 
   if (!global.quiet)
@@ -83,7 +88,7 @@ Command add_verify_command(CLI::App& parent, const GlobalOptions& global) {
   sub->add_option("--rays,-n", o->rays, "Number of rays")->check(CLI::Range(std::size_t{1}, std::size_t{1} << 32))->capture_default_str();
   sub->add_option("--structure,-s", o->structure,
                   "all, or a comma list of brute, bvh (every splitter), bvh-binned, bvh-exact, bvh-median, kdtree, "
-                  "grid, octree, embree")
+                  "grid, octree, tlas (two-level over the scene's instances; not in all), embree")
       ->capture_default_str();
   sub->add_option("--seed", o->seed, "Seed of the ray generator")->capture_default_str();
   sub->add_option("--threads,-j", o->threads, "Threads (0: all hardware threads)")->capture_default_str();

@@ -28,8 +28,11 @@ std::unique_ptr<Accelerator> build_accelerator(std::string_view name, std::span<
     to.blas = opts.bvh;
     if (to.blas.threads == 0) to.blas.threads = opts.threads;
     to.tlas = to.blas;
+    // The scene's own meshes and instances when `triangles` is its flattened
+    // list (a scene without instances, e.g. hand-made triangles, is one instance).
     const bool same = opts.scene != nullptr && triangles.data() == opts.scene->triangles.data() &&
-                      triangles.size() == opts.scene->triangles.size() && !triangles.empty();
+                      triangles.size() == opts.scene->triangles.size() && !triangles.empty() &&
+                      !opts.scene->instances.empty();
     if (same || unflattened) return std::make_unique<Tlas>(*opts.scene, to, progress);
     return std::make_unique<Tlas>(triangles, to, progress);
   }

@@ -56,11 +56,13 @@ std::vector<VerifyStructure> parse_verify_structures(const std::string& list, un
     } else if (n == "brute" || n == "brute-bbox" || n == "kdtree" || n == "grid" || n == "octree" || n == "embree") {
       if (n == "embree" && !kHaveEmbree) throw std::invalid_argument("--structure embree: this build has no Embree backend");
       add(n, n);
+    } else if (n == "tlas") {
+      add("tlas", "tlas");  // two levels from the scene's instances when verify_structures gets the scene
     } else if (n == "voxels") {
       throw std::invalid_argument("--structure voxels: voxel hits are voxels, not triangles; it cannot be verified against triangles");
     } else {
       throw std::invalid_argument("--structure: unknown '" + n +
-                                  "' (all, brute, brute-bbox, bvh, bvh-binned, bvh-exact, bvh-median, kdtree, grid, octree" +
+                                  "' (all, brute, brute-bbox, bvh, bvh-binned, bvh-exact, bvh-median, kdtree, grid, octree, tlas" +
                                   (kHaveEmbree ? ", embree)" : ")"));
     }
   }
@@ -169,7 +171,9 @@ std::vector<Ray> verify_rays(std::span<const Triangle> triangles, std::size_t co
 }
 
 VerifyResult verify_structures(std::span<const Triangle> triangles, std::span<const Ray> rays,
-                               const std::vector<VerifyStructure>& structures, unsigned threads) {
+                               const std::vector<VerifyStructure>& structures, unsigned threads, const Scene* scene) {
+  if (scene && (scene->triangles.data() != triangles.data() || scene->triangles.size() != triangles.size()))
+    throw std::invalid_argument("verify: the scene given is not the one whose triangles are traced");
   using Clock = std::chrono::steady_clock;
   const auto t_start = Clock::now();
   VerifyResult res;
@@ -188,7 +192,9 @@ VerifyResult verify_structures(std::span<const Triangle> triangles, std::span<co
   const QueryOptions q;  // watertight, ordered: the product's defaults
   std::mutex mutex;
   for (const VerifyStructure& s : structures) {
-    const std::unique_ptr<Accelerator> accel = build_accelerator(s.factory_name, triangles, s.options);
+    StructureOptions so = s.options;
+    so.scene = scene;  // "tlas": the scene's own instances (hits use the flattened ids the reference uses)
+    const std::unique_ptr<Accelerator> accel = build_accelerator(s.factory_name, triangles, so);
     const unsigned nt = resolve_threads(threads);
     std::vector<VerifyCounts> per_thread(nt);
     parallel_for(rays.size(), threads, 256, [&](std::size_t b, std::size_t e, unsigned ti) {

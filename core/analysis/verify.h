@@ -61,8 +61,14 @@ struct VerifyResult {
 };
 
 /// Traces `rays` on every structure in closest and any-hit mode and compares
-/// with the reference, over `threads` threads (0: all).
+/// with the reference, over `threads` threads (0: all). With `scene` (whose
+/// flattened triangle list `triangles` must be), "tlas" builds its two levels
+/// from the scene's meshes and instances and is compared with the brute force
+/// over the flattened triangles; without it, "tlas" is one instance over
+/// `triangles`. Throws std::invalid_argument when `scene`'s triangles are not
+/// `triangles`.
 VerifyResult verify_structures(std::span<const Triangle> triangles, std::span<const Ray> rays,
-                               const std::vector<VerifyStructure>& structures, unsigned threads);
+                               const std::vector<VerifyStructure>& structures, unsigned threads,
+                               const Scene* scene = nullptr);
 
 }  // namespace accelviz

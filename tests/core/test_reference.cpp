@@ -149,6 +149,11 @@ TEST(Verify, StructureListParsing) {
   EXPECT_EQ(parse_verify_structures("kdtree,grid,kdtree", 1).size(), 2u);
   EXPECT_THROW(parse_verify_structures("voxels", 1), std::invalid_argument);
   EXPECT_THROW(parse_verify_structures("nope", 1), std::invalid_argument);
+  // tlas is verified when asked for (two levels from the scene given), not in "all".
+  const auto tl = parse_verify_structures("tlas,brute", 1);
+  ASSERT_EQ(tl.size(), 2u);
+  EXPECT_EQ(tl[0].factory_name, "tlas");
+  for (const auto& s : all) EXPECT_NE(s.factory_name, "tlas");
 }
 
 TEST(Verify, RaysAreDeterministic) {
