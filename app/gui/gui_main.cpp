@@ -8,6 +8,7 @@
 #include "app/gui/gpu_heatmap.h"
 #include "app/gui/insight_views.h"
 #include "app/gui/scene_view.h"
+#include "core/accel/tlas/tlas.h"
 #include "core/scene/load.h"
 #include "ui/app/app_state.h"
 #include "ui/app/dynamics.h"
@@ -324,6 +325,10 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
     vi.node_kind = b->nodes.kind();
     vi.max_depth = b->nodes.max_depth();
     vi.node_count = b->nodes.size();
+    if (const auto* tlas = dynamic_cast<const Tlas*>(b->accel.get())) {
+      vi.blas_max_depth = blas_max_depth(*tlas);
+      vi.instances = tlas->instances().size();
+    }
   }
   vi.boxes_drawn = view_->boxes_drawn();
   vi.boxes_truncated = view_->boxes_truncated();
@@ -613,6 +618,10 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
     case K::dump_stats: {
       nlohmann::json doc = app_.stats_json();
       doc["frames"] = frames_drawn_;
+      view_->sync(app_);  // the overlay as the settings stand now
+      doc["boxes"] = {{"drawn", view_->boxes_drawn()},
+                      {"truncated", view_->boxes_truncated()},
+                      {"instance_colors", view_->instance_colored()}};
       fail_if(write_file_atomic(c.arg, doc.dump(2) + "\n"));
       return Status::done;
     }
@@ -713,7 +722,10 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
                             {"refit_ms", f.refit_ms},
                             {"rebuild_ms", f.rebuild_ms},
                             {"sah_refit", f.sah_refit},
-                            {"sah_rebuilt", f.sah_rebuilt}});
+                            {"sah_rebuilt", f.sah_rebuilt},
+                            {"overlap_area", f.overlap.area_ratio},
+                            {"overlap_volume", f.overlap.volume_ratio},
+                            {"overlap_pairs", f.overlap.overlapping_pairs}});
         doc["dynamics"] = {{"frames_stepped", snap->frames}, {"setup_ms", snap->setup_ms}, {"duration", snap->duration},
                            {"animates", snap->animates},     {"error", snap->error},       {"history", frames}};
         doc["dynamics"]["shown_frame"] = nullptr;
@@ -722,6 +734,9 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
           doc["dynamics"]["shown_frame"] = {
               {"time", snap->frame_time},
               {"build_ms", snap->frame_build_ms},
+              {"animator_tree", snap->frame_is_animator_tree},
+              {"node_count", app_.current()->accel->build_stats().node_count},
+              {"sah_cost", app_.current()->accel->build_stats().sah_cost},
               {"root_lo", root ? std::vector<float>{root->lo.x, root->lo.y, root->lo.z} : std::vector<float>{}},
               {"root_hi", root ? std::vector<float>{root->hi.x, root->hi.y, root->hi.z} : std::vector<float>{}}};
         }

@@ -3,10 +3,16 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/accel/tlas/tlas.h"
 #include "ui/app/hot_nodes.h"
+#include "ui/app/instance_colors.h"
 #include "ui/render/box_selection.h"
 
 namespace accelviz {
+
+namespace {
+constexpr std::uint32_t kNoInstance = 0xFFFFFFFFu;  ///< NodeBox::instance of a box that is no instance's
+}  // namespace
 
 bool SceneView::sync(const AppState& app) {
   bool changed = false;
@@ -16,6 +22,14 @@ bool SceneView::sync(const AppState& app) {
     renderer_.set_triangles(built ? std::span<const Triangle>(built->scene->scene.triangles)
                                   : std::span<const Triangle>());
     scene_ = scene;
+    colored_ = false;  // set_triangles dropped the colours
+    changed = true;
+  }
+  // Per-instance colours: a two-level structure's view, when asked for.
+  const bool colored = built && app.config().view.instance_colors && built->nodes.kind() == "tlas";
+  if (colored != colored_) {
+    renderer_.set_triangle_colors(colored ? triangle_instance_colors(built->scene->scene) : std::vector<glm::vec3>());
+    colored_ = colored;
     changed = true;
   }
   if (app.heatmap() && app.heatmap().get() != heatmap_frame_) {
@@ -42,7 +56,13 @@ void SceneView::upload_boxes(const AppState& app) {
   const ViewInsight* insight =
       box_insight_.insight && box_insight_.insight->built.get() == built ? box_insight_.insight.get() : nullptr;
   const RegionTouch* region = insight ? box_insight_.region.get() : nullptr;
-  const bool by_visits = insight && box_insight_.color_by_visits;
+  // A two-level structure's bottom level: its BLAS boxes in world space.
+  const Tlas* blas_of = built && built->nodes.kind() == "tlas" && v.box_level == BoxLevel::blas
+                            ? dynamic_cast<const Tlas*>(built->accel.get())
+                            : nullptr;
+  // Hot-node visits are counted per node of the structure's table (the top
+  // level for `tlas`), so they colour that level only.
+  const bool by_visits = insight && box_insight_.color_by_visits && !blas_of;
   // Primitives the selected region's rays tested, on the surface.
   if (static_cast<const void*>(region) != region_uploaded_) {
     region_uploaded_ = region;
@@ -54,12 +74,14 @@ void SceneView::upload_boxes(const AppState& app) {
     }
     renderer_.set_highlighted_primitives(prims);
   }
-  const std::string key =
-      std::to_string(reinterpret_cast<std::uintptr_t>(insight)) + "/" + std::to_string(by_visits) + "/" +
-      std::to_string(reinterpret_cast<std::uintptr_t>(region)) + "/" +
-      std::to_string(reinterpret_cast<std::uintptr_t>(built)) + "/" + std::to_string(static_cast<int>(v.box_mode)) +
-      "/" + std::to_string(v.box_depth) + "/" + std::to_string(v.box_depth_last) + "/" + std::to_string(v.box_node) +
-      "/" + std::to_string(static_cast<int>(v.box_color)) + "/" + std::to_string(static_cast<int>(v.colormap));
+  const std::string key = std::to_string(reinterpret_cast<std::uintptr_t>(insight)) + "/" + std::to_string(by_visits) +
+                          "/" + std::to_string(reinterpret_cast<std::uintptr_t>(region)) + "/" +
+                          std::to_string(reinterpret_cast<std::uintptr_t>(built)) + "/" +
+                          std::to_string(static_cast<int>(v.box_mode)) + "/" + std::to_string(v.box_depth) + "/" +
+                          std::to_string(v.box_depth_last) + "/" + std::to_string(v.box_node) + "/" +
+                          std::to_string(static_cast<int>(v.box_color)) + "/" +
+                          std::to_string(static_cast<int>(v.colormap)) + "/" + std::to_string(blas_of != nullptr) +
+                          "/" + std::to_string(v.box_instance) + "/" + std::to_string(v.instance_colors);
   if (key == box_key_) return;
   box_key_ = key;
   boxes_drawn_ = 0;
@@ -85,6 +107,8 @@ void SceneView::upload_boxes(const AppState& app) {
       else if (const auto b = built->nodes.box(id))
         s.boxes.push_back({*b, id, 1, true, 0.0f});
     }
+  } else if (blas_of) {
+    s = select_blas_boxes(*blas_of, sel, kMaxBoxes, v.box_instance);
   } else {
     s = built->nodes.select(sel, kMaxBoxes);
   }
@@ -106,6 +130,8 @@ void SceneView::upload_boxes(const AppState& app) {
       c.color = hot[i];
     } else if (region) {
       c.color = glm::vec4(1.0f, 0.55f, 0.1f, 1.0f);
+    } else if (v.instance_colors && b.instance != kNoInstance) {
+      c.color = glm::vec4(instance_color(b.instance), 1.0f);  // the colour its triangles have
     } else if (v.box_color == BoxColorBy::depth) {
       c.color = glm::vec4(qualitative_color(b.depth), 1.0f);
     } else {

@@ -43,6 +43,8 @@ class SceneView {
   bool has_heatmap() const { return has_heatmap_; }
 
   std::uint64_t boxes_drawn() const { return boxes_drawn_; }
+  /// The mesh is drawn in per-instance colours (instance-colors on, a tlas shown).
+  bool instance_colored() const { return colored_; }
   bool boxes_truncated() const { return boxes_truncated_; }
 
   /// Most boxes drawn at once (llvmpipe draws ~1e5 instanced boxes per frame comfortably).
@@ -60,6 +62,7 @@ class SceneView {
   const void* region_uploaded_ = nullptr;
   std::string ray_key_;
   int colormap_ = -1;
+  bool colored_ = false;  ///< per-instance triangle colours uploaded
   bool has_heatmap_ = false;
   std::uint64_t boxes_drawn_ = 0;
   bool boxes_truncated_ = false;

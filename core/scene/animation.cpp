@@ -350,6 +350,11 @@ FrameStats SceneAnimator::step(float t) {
       ++fs.rebuilds;
     }
   }
+  if (fs.tlas_rebuilt || !overlap_known_) {
+    overlap_ = instance_overlap(tlas_);
+    overlap_known_ = true;
+  }
+  fs.overlap = overlap_;
   return fs;
 }
 

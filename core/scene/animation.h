@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/accel/tlas/tlas.h"
+#include "core/accel/tlas/tlas_overlap.h"
 #include "core/scene/scene.h"
 
 namespace accelviz {
@@ -103,6 +104,11 @@ struct FrameStats {
   double rebuild_ms = 0.0;   ///< fresh BLAS builds (made every frame a mesh deforms, to compare SAH)
   double sah_refit = 0.0;    ///< refitted deforming BLAS (sum over deforming meshes)
   double sah_rebuilt = 0.0;  ///< fresh build on the same vertices (sum)
+  /// Instance overlap (tlas_overlap.h) of the instances' world boxes after
+  /// this frame's update: measured when the TLAS was rebuilt (and on the
+  /// first frame), carried over unchanged when nothing moved. Not part of
+  /// any of the timings above.
+  InstanceOverlap overlap;
 };
 
 /// Drives a Tlas built from SCENE through time. Only what moves is touched:
@@ -129,6 +135,8 @@ class SceneAnimator {
   std::vector<glm::mat4> transforms_;
   std::uint32_t frame_ = 0;
   float duration_ = 0.0f;
+  InstanceOverlap overlap_;  ///< as of the last TLAS rebuild
+  bool overlap_known_ = false;
   std::vector<std::uint32_t> deforming_;  ///< deforming_meshes(scene)
 };
 

@@ -44,6 +44,9 @@ for r in rows[1:]:
     assert r["moved_instances"] == boxes, r
     assert r["refits"] == 1 and r["tlas_rebuilt"], r
     assert r["sah_refit"] > 0 and r["sah_rebuilt"] > 0, r
+# Instance overlap per frame: measured on each frame's moved instances.
+assert all(r["overlap_area"] > 0 and r["overlap_pairs"] > 0 for r in rows), rows
+assert len({r["overlap_area"] for r in rows}) > 1, [r["overlap_area"] for r in rows]
 print("animate ok")
 PY
 # A static scene: zero-cost frames and a note.

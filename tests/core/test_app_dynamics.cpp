@@ -4,15 +4,22 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <glm/gtc/matrix_transform.hpp>
+#include <set>
 #include <thread>
+#include <tuple>
 
+#include "core/accel/tlas/tlas.h"
+#include "core/accel/tlas/tlas_overlap.h"
 #include "core/scene/animation.h"
 #include "core/scene/effects.h"
 #include "core/scene/load.h"
 #include "ui/app/app_state.h"
 #include "ui/app/dynamics.h"
+#include "ui/app/instance_colors.h"
 #include "ui/app/script.h"
 #include "ui/app/settings.h"
 
@@ -366,6 +373,277 @@ TEST(AppEffectSettings, ForcesAreSavedAndRestored) {
       EXPECT_NE(std::string(e.what()).find(problem), std::string::npos) << e.what();
     }
   }
+}
+
+// ---- issue 10 views: per-frame overlap, the animator's own tree, TLAS/BLAS boxes, instance colours ----
+
+namespace app_dynamics_views {
+
+// The animator's structure options for a `tlas` choice, as the worker and
+// the factory build them (a fresh Tlas over a pose must use the same).
+TlasOptions tlas_options_of(const StructureChoice& c) {
+  TlasOptions to;
+  to.blas = c.options.bvh;
+  if (to.blas.threads == 0) to.blas.threads = c.options.threads;
+  to.blas.compute_epo = false;
+  to.tlas = to.blas;
+  return to;
+}
+
+// A tiny instanced scene: one 2x2x2-triangle mesh (a strip of 8), placed
+// three times, the middle one rotated and scaled.
+Scene three_instances() {
+  Scene s;
+  Mesh m;
+  m.name = "strip";
+  for (int i = 0; i <= 4; ++i) {
+    m.positions.push_back({static_cast<float>(i), 0.0f, 0.0f});
+    m.positions.push_back({static_cast<float>(i), 1.0f, 0.2f * static_cast<float>(i)});
+  }
+  for (std::uint32_t i = 0; i < 4; ++i) {
+    m.indices.push_back({2 * i, 2 * i + 2, 2 * i + 1});
+    m.indices.push_back({2 * i + 1, 2 * i + 2, 2 * i + 3});
+  }
+  s.meshes.push_back(m);
+  const glm::mat4 places[3] = {
+      glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 0.0f, 0.0f)),
+      glm::scale(
+          glm::rotate(glm::translate(glm::mat4(1.0f), glm::vec3(10.0f, 0.0f, 0.0f)), 0.7f, glm::vec3(0.0f, 1.0f, 0.0f)),
+          glm::vec3(1.0f, 2.0f, 1.0f)),
+      glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 5.0f, 3.0f)),
+  };
+  for (std::uint32_t i = 0; i < 3; ++i) {
+    Node n;
+    n.local = places[i];
+    n.mesh = 0;
+    s.nodes.push_back(n);
+    s.roots.push_back(static_cast<int>(i));
+    Instance inst;
+    inst.mesh = 0;
+    inst.node = i;
+    inst.transform = places[i];
+    s.instances.push_back(inst);
+  }
+  s.flatten();
+  return s;
+}
+
+}  // namespace app_dynamics_views
+
+TEST(AppDynamicsViews, InstanceOverlapIsMeasuredPerFrameOnThatFramesInstances) {
+  using namespace app_dynamics_views;
+  const auto scene = loaded("builtin:dynamic?size=1200");
+  DynamicsWorker w;
+  const float times[] = {0.0f, 0.5f, 1.1f, 1.9f};
+  for (const float t : times) {
+    w.request({scene, t});
+    wait_done(w);
+  }
+  const auto snap = w.latest();
+  ASSERT_TRUE(snap);
+  ASSERT_EQ(snap->error, "");
+  ASSERT_EQ(snap->history.size(), 4u);
+  std::set<double> distinct;
+  for (std::size_t i = 0; i < 4; ++i) {
+    const FrameStats& f = snap->history[i];
+    // The same figure from a two-level structure built afresh over the
+    // scene posed at that time (the worker's animator uses the defaults).
+    const Scene posed = posed_scene(scene->scene, f.time);
+    const Tlas fresh(posed, tlas_options_of(StructureChoice{}));
+    const InstanceOverlap want = instance_overlap(fresh);
+    EXPECT_EQ(f.overlap.instances, want.instances) << i;
+    EXPECT_EQ(f.overlap.overlapping_pairs, want.overlapping_pairs) << i;
+    EXPECT_NEAR(f.overlap.area_ratio, want.area_ratio, 1e-9 * (1.0 + want.area_ratio)) << i;
+    EXPECT_NEAR(f.overlap.volume_ratio, want.volume_ratio, 1e-9 * (1.0 + want.volume_ratio)) << i;
+    EXPECT_GT(f.overlap.area_ratio, 0.0) << i;
+    distinct.insert(f.overlap.area_ratio);
+  }
+  EXPECT_GE(distinct.size(), 3u) << "the overlap should change as the boxes fly";
+}
+
+TEST(AppDynamicsViews, TheShownTlasFrameIsTheAnimatorsOwnTree) {
+  using namespace app_dynamics_views;
+  const auto scene = loaded("builtin:dynamic?size=1200");
+  StructureChoice choice;
+  choice.name = "tlas";
+  choice.options.bvh.max_leaf_size = 2;  // not the default: the animator must take the view's options
+  // The reference: an animator of our own, stepped through the same times.
+  Tlas ref(scene->scene, tlas_options_of(choice));
+  SceneAnimator animator(scene->scene, ref, AnimatorOptions{});
+  DynamicsWorker w;
+  std::shared_ptr<const BuiltStructure> first;
+  double first_sah = 0.0;
+  std::vector<Aabb> first_tlas_boxes;
+  for (const float t : {0.3f, 1.4f, 2.6f}) {
+    DynamicsRequest r{scene, t};
+    r.structure = choice;
+    w.request(r);
+    const auto snap = wait_done(w);
+    ASSERT_TRUE(snap && snap->frame);
+    ASSERT_EQ(snap->error, "");
+    const FrameStats f = animator.step(t);
+    EXPECT_TRUE(snap->frame_is_animator_tree);
+    const auto* shown = dynamic_cast<const Tlas*>(snap->frame->accel.get());
+    ASSERT_NE(shown, nullptr);
+    // Node count and SAH of the shown tree equal the animator's at this frame.
+    EXPECT_EQ(shown->build_stats().node_count, ref.build_stats().node_count) << t;
+    EXPECT_DOUBLE_EQ(shown->build_stats().sah_cost, ref.build_stats().sah_cost) << t;
+    EXPECT_EQ(snap->frame->nodes.size(), StructureNodes::of(ref).size()) << t;
+    // The grass BLAS is the refitted one the plots measure (not a fresh build).
+    const FrameStats& g = snap->history.back();
+    ASSERT_EQ(g.refits, 1u);
+    ASSERT_EQ(f.refits, 1u);
+    const int grass = shown->blas_of_mesh(scene->scene.deformers[0].mesh);
+    ASSERT_GE(grass, 0);
+    const double shown_grass = shown->blas(static_cast<std::size_t>(grass)).build_stats().sah_cost;
+    EXPECT_DOUBLE_EQ(g.sah_refit, f.sah_refit) << t;
+    if (g.rebuilds == 0) {
+      EXPECT_DOUBLE_EQ(shown_grass, g.sah_refit) << t;
+      EXPECT_NE(shown_grass, g.sah_rebuilt) << t << ": the refitted tree, not a rebuild";
+    } else {
+      EXPECT_DOUBLE_EQ(shown_grass, g.sah_rebuilt) << t;
+    }
+    if (!first) {
+      first = snap->frame;
+      first_sah = shown->build_stats().sah_cost;
+      const auto* ft = dynamic_cast<const Tlas*>(first->accel.get());
+      for (const BvhNode& n : ft->tlas_nodes()) first_tlas_boxes.push_back(n.bounds);
+    }
+  }
+  // The first frame stays as it was while the animator moved on (snapshots
+  // share BLASes copy-on-write).
+  const auto* ft = dynamic_cast<const Tlas*>(first->accel.get());
+  EXPECT_DOUBLE_EQ(ft->build_stats().sah_cost, first_sah);
+  ASSERT_EQ(ft->tlas_nodes().size(), first_tlas_boxes.size());
+  for (std::size_t i = 0; i < first_tlas_boxes.size(); ++i) {
+    EXPECT_EQ(ft->tlas_nodes()[i].bounds.lo, first_tlas_boxes[i].lo);
+    EXPECT_EQ(ft->tlas_nodes()[i].bounds.hi, first_tlas_boxes[i].hi);
+  }
+  const int grass = ft->blas_of_mesh(scene->scene.deformers[0].mesh);
+  EXPECT_NE(&ft->blas(static_cast<std::size_t>(grass)), &ref.blas(static_cast<std::size_t>(grass)));
+}
+
+TEST(AppDynamicsViews, TlasSnapshotsKeepTheirBlasWhenTheOriginalIsRefitted) {
+  const Scene s = make_builtin("builtin:dynamic?size=600");
+  Tlas t(s);
+  const std::uint32_t mesh = s.deformers[0].mesh;
+  const std::size_t b = static_cast<std::size_t>(t.blas_of_mesh(mesh));
+  const std::shared_ptr<const Tlas> snap = t.snapshot();
+  const Bvh* shared = &snap->blas(b);
+  EXPECT_EQ(shared, &t.blas(b));  // shared until one side changes
+  const std::vector<Aabb> before = [&] {
+    std::vector<Aabb> v;
+    for (const BvhNode& n : snap->blas(b).nodes()) v.push_back(n.bounds);
+    return v;
+  }();
+  t.refit_blas(b, deformed_triangles(s.meshes[mesh], s.deformers[0], 0.8f));
+  EXPECT_NE(&t.blas(b), shared);
+  EXPECT_EQ(&snap->blas(b), shared);
+  bool moved = false;
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    EXPECT_EQ(snap->blas(b).nodes()[i].bounds.lo, before[i].lo);
+    moved |= !(t.blas(b).nodes()[i].bounds.hi == before[i].hi);
+  }
+  EXPECT_TRUE(moved);
+  // Unshared, a refit works in place.
+  const Bvh* own = &t.blas(b);
+  t.refit_blas(b, deformed_triangles(s.meshes[mesh], s.deformers[0], 1.2f));
+  EXPECT_EQ(&t.blas(b), own);
+}
+
+TEST(AppDynamicsViews, TlasAndBlasBoxSetsDifferWithTheExpectedCounts) {
+  using namespace app_dynamics_views;
+  const Scene s = three_instances();
+  TlasOptions to;
+  to.blas.max_leaf_size = 1;  // 8 triangles: 8 leaves, 15 nodes per BLAS
+  to.blas.leaf_size_cap = 1;
+  to.tlas = to.blas;
+  const Tlas t(s, to);
+  ASSERT_EQ(t.blas_count(), 1u);
+  const std::size_t blas_nodes = t.blas(0).nodes().size();
+  ASSERT_EQ(blas_nodes, 15u);
+  const StructureNodes top = StructureNodes::of(t);
+
+  // Leaves: the top level's are the three instance boxes, each naming its instance.
+  NodeSelection leaves;
+  leaves.mode = BoxMode::leaves;
+  const auto tl = top.select(leaves, 1000);
+  ASSERT_EQ(tl.boxes.size(), 3u);
+  std::set<std::uint32_t> named;
+  for (const NodeBox& b : tl.boxes) named.insert(b.instance);
+  EXPECT_EQ(named, (std::set<std::uint32_t>{0, 1, 2}));
+  // ...the bottom level's, every instance's eight BLAS leaves in world space.
+  const auto bl = select_blas_boxes(t, leaves, 1000);
+  ASSERT_EQ(bl.boxes.size(), 24u);
+  EXPECT_EQ(bl.matched, 24u);
+  EXPECT_FALSE(bl.truncated);
+  for (std::size_t i = 0; i < bl.boxes.size(); ++i) {
+    const NodeBox& b = bl.boxes[i];
+    ASSERT_EQ(b.instance, i / 8);
+    EXPECT_TRUE(b.leaf);
+    // A leaf holds one triangle: its world box holds that world triangle
+    // (one of the instance's flattened triangles), and is exactly the
+    // triangle's box under a translation (instances 0 and 2; the rotated
+    // instance 1 gets the box of the rotated object box's corners).
+    bool inside = false, equal = false;
+    const Instance& inst = s.instances[b.instance];
+    for (std::uint32_t k = inst.first_triangle; k < inst.first_triangle + inst.triangle_count; ++k) {
+      const Aabb w = s.triangles[k].bounds();
+      if (glm::all(glm::lessThanEqual(b.bounds.lo, w.lo + 1e-4f)) &&
+          glm::all(glm::greaterThanEqual(b.bounds.hi, w.hi - 1e-4f)))
+        inside = true;
+      if (glm::all(glm::lessThan(glm::abs(w.lo - b.bounds.lo), glm::vec3(1e-4f))) &&
+          glm::all(glm::lessThan(glm::abs(w.hi - b.bounds.hi), glm::vec3(1e-4f))))
+        equal = true;
+    }
+    EXPECT_TRUE(inside) << "box " << i;
+    if (b.instance != 1) {
+      EXPECT_TRUE(equal) << "box " << i;
+    }
+  }
+  // Depth 0: one TLAS root against three BLAS roots (each instance's world box).
+  NodeSelection root;
+  const auto t0 = top.select(root, 1000);
+  const auto b0 = select_blas_boxes(t, root, 1000);
+  ASSERT_EQ(t0.boxes.size(), 1u);
+  ASSERT_EQ(b0.boxes.size(), 3u);
+  for (const NodeBox& b : b0.boxes) {
+    const Aabb& w = t.instances()[b.instance].world_bounds;  // padded by a few ulps
+    EXPECT_TRUE(w.contains(b.bounds)) << b.instance;
+    EXPECT_NEAR(w.surface_area(), b.bounds.surface_area(), 1e-3f * w.surface_area()) << b.instance;
+  }
+  // One instance only; an instance out of range selects nothing.
+  const auto one = select_blas_boxes(t, leaves, 1000, 1);
+  ASSERT_EQ(one.boxes.size(), 8u);
+  for (const NodeBox& b : one.boxes) EXPECT_EQ(b.instance, 1u);
+  EXPECT_TRUE(select_blas_boxes(t, leaves, 1000, 3).boxes.empty());
+  // The box limit: whole instances only (two of three fit in 20), all counted.
+  const auto cut = select_blas_boxes(t, leaves, 20);
+  EXPECT_EQ(cut.boxes.size(), 16u);
+  EXPECT_TRUE(cut.truncated);
+  EXPECT_EQ(cut.matched, 24u);
+  // ...and a first instance larger than the limit is cut at it.
+  EXPECT_EQ(select_blas_boxes(t, leaves, 5).boxes.size(), 5u);
+  EXPECT_EQ(blas_max_depth(t), t.blas(0).build_stats().max_depth);
+}
+
+TEST(AppDynamicsViews, InstanceColoursAreStableDistinctAndFollowTheTriangleRanges) {
+  using namespace app_dynamics_views;
+  std::set<std::tuple<int, int, int>> seen;
+  for (std::uint32_t id = 0; id < 200; ++id) {
+    const glm::vec3 c = instance_color(id);
+    EXPECT_EQ(c, instance_color(id));                                              // stable
+    EXPECT_GE(std::max({c.x, c.y, c.z}), 0.74f) << id;                             // bright
+    EXPECT_GT(std::max({c.x, c.y, c.z}) - std::min({c.x, c.y, c.z}), 0.3f) << id;  // never grey
+    seen.insert({static_cast<int>(c.x * 255), static_cast<int>(c.y * 255), static_cast<int>(c.z * 255)});
+  }
+  EXPECT_EQ(seen.size(), 200u);
+  const Scene s = three_instances();
+  const std::vector<glm::vec3> tri = triangle_instance_colors(s);
+  ASSERT_EQ(tri.size(), s.triangles.size());
+  for (std::uint32_t i = 0; i < 3; ++i)
+    for (std::uint32_t k = 0; k < s.instances[i].triangle_count; ++k)
+      EXPECT_EQ(tri[s.instances[i].first_triangle + k], instance_color(i));
 }
 
 }  // namespace unity_test_app_dynamics

@@ -6,6 +6,8 @@
 #include "ui/render/camera_view.h"
 
 #include <cmath>
+#include <stdexcept>
+#include <vector>
 
 namespace accelviz::test {
 namespace {
@@ -94,6 +96,37 @@ TEST_F(MeshPassTest, WireframeDrawsTheTriangleEdges) {
   EXPECT_GT(channel_diff(pixel_at(img, inside), red), 100);
   view.show_wireframe = false;
   EXPECT_FALSE(draw(view).pixels == img.pixels);
+}
+
+// Per-instance colours of a two-level view (Renderer::set_triangle_colors):
+// each triangle shaded in its own colour, the same headlight as the flat colour.
+TEST_F(MeshPassTest, PerTriangleColoursShadeEachTriangleInItsOwnColour) {
+  std::vector<Triangle> wall;
+  add_quad_xy(wall, -3.0f, -3.0f, 0.0f, 3.0f, 0.0f);  // left half: triangles 0, 1
+  add_quad_xy(wall, 0.0f, -3.0f, 3.0f, 3.0f, 0.0f);   // right half: triangles 2, 3
+  renderer_->set_triangles(wall);
+  const glm::vec3 left(0.9f, 0.2f, 0.1f), right(0.1f, 0.3f, 0.9f);
+  renderer_->set_triangle_colors(std::vector<glm::vec3>{left, left, right, right});
+  RenderView view;
+  view.camera = Camera{};
+  view.mesh_color = {0.5f, 0.5f, 0.5f};
+  const glm::vec3 n(0.0f, 0.0f, 1.0f);
+  const auto want_at = [&](int x, int y, const glm::vec3& c) {
+    return to_rgba8(headlight(c, n, pixel_on_plane(view.camera, x, y, n, 0.0f), view.camera.position));
+  };
+  Rgba8Image img = draw(view);
+  EXPECT_LE(channel_diff(img.at(40, 48), want_at(40, 48, left)), kTolerance) << describe(img.at(40, 48));
+  EXPECT_LE(channel_diff(img.at(88, 48), want_at(88, 48, right)), kTolerance) << describe(img.at(88, 48));
+  // A colour count that is not the triangle count is refused; the colours stay.
+  EXPECT_THROW(renderer_->set_triangle_colors(std::vector<glm::vec3>{left}), std::invalid_argument);
+  // Cleared: the flat mesh colour again; new triangles drop the colours too.
+  renderer_->set_triangle_colors({});
+  img = draw(view);
+  EXPECT_LE(channel_diff(img.at(40, 48), want_at(40, 48, view.mesh_color)), kTolerance) << describe(img.at(40, 48));
+  renderer_->set_triangle_colors(std::vector<glm::vec3>{left, left, right, right});
+  renderer_->set_triangles(wall);
+  img = draw(view);
+  EXPECT_LE(channel_diff(img.at(88, 48), want_at(88, 48, view.mesh_color)), kTolerance) << describe(img.at(88, 48));
 }
 
 TEST_F(MeshPassTest, FullScreenHeatmapKeepsTheMeshDepthForOverlays) {

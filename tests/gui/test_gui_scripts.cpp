@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
@@ -464,6 +465,59 @@ TEST_F(GuiScript, EveryScenarioSliderMovesItsFiguresTheDocumentedWay) {
   const nlohmann::json g = high("growth");
   EXPECT_GT(row(g, "grid", true)["nodes_per_ray"].get<double>(), row(g, "grid")["nodes_per_ray"].get<double>());
   EXPECT_GT(row(g, "bvh", true)["triangles"].get<double>(), row(low("growth"), "bvh", true)["triangles"].get<double>());
+}
+
+// The two-level views of issue 10, in the real window: the node boxes at the
+// top level (TLAS nodes, instance boxes) and the bottom level (every
+// instance's BLAS in world space, or one instance's), per-instance colours,
+// and a played frame that is the animator's own tree with its instance
+// overlap per frame.
+TEST_F(GuiScript, TwoLevelBoxLevelsInstanceColoursAndPlayedFrames) {
+  const RunResult r =
+      run("open builtin:dynamic?size=1200\nstructure tlas\nsize 320 240\nset box-mode leaves\nwait\nscreenshot " +
+          path("top.png").string() + "\ndump-stats " + path("top.json").string() +
+          "\nset box-level blas\nset instance-colors on\nwait\nscreenshot " + path("blas.png").string() +
+          "\ndump-stats " + path("blas.json").string() + "\nset box-instance 0\nwait\ndump-stats " +
+          path("one.json").string() + "\nplay 2\nwait\ndump-dynamics " + path("dyn.json").string() + "\nscreenshot " +
+          path("played.png").string() + "\nquit\n");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json top = read_json(path("top.json"));
+  const nlohmann::json blas = read_json(path("blas.json"));
+  const nlohmann::json one = read_json(path("one.json"));
+  ASSERT_EQ(top["structure"], "tlas") << top.dump();
+  // Leaves: one box per instance at the top level; every instance's BLAS
+  // leaves at the bottom level; one instance's alone fewer still.
+  const auto instances = top["build"]["extra"]["instances"].get<double>();
+  EXPECT_EQ(top["boxes"]["drawn"].get<double>(), instances);
+  EXPECT_GT(blas["boxes"]["drawn"].get<std::uint64_t>(), top["boxes"]["drawn"].get<std::uint64_t>());
+  EXPECT_GT(one["boxes"]["drawn"].get<std::uint64_t>(), 0u);
+  EXPECT_LT(one["boxes"]["drawn"].get<std::uint64_t>(), blas["boxes"]["drawn"].get<std::uint64_t>());
+  EXPECT_FALSE(top["boxes"]["instance_colors"].get<bool>());
+  EXPECT_TRUE(blas["boxes"]["instance_colors"].get<bool>());
+  // Instance colours fill the mesh with saturated colour where it was grey
+  // (only the box lines were coloured before).
+  const auto saturated = [](const RgbImage& img) {
+    int n = 0;
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) {
+        const glm::u8vec3 c = img.at(x, y);
+        n += std::max({c.x, c.y, c.z}) - std::min({c.x, c.y, c.z}) > 60;
+      }
+    return n;
+  };
+  EXPECT_GT(saturated(read_png(path("blas.png").string())), 2 * saturated(read_png(path("top.png").string())));
+  // The played frames: the animator's own tree, the overlap measured on each.
+  const nlohmann::json d = read_json(path("dyn.json"));
+  ASSERT_TRUE(d["dynamics"].is_object()) << d.dump();
+  const auto& shown = d["dynamics"]["shown_frame"];
+  ASSERT_TRUE(shown.is_object()) << d.dump();
+  EXPECT_TRUE(shown["animator_tree"].get<bool>());
+  EXPECT_GT(shown["node_count"].get<double>(), 0.0);
+  for (const auto& f : d["dynamics"]["history"]) {
+    EXPECT_GT(f["overlap_area"].get<double>(), 0.0) << f.dump();
+    EXPECT_GT(f["overlap_pairs"].get<double>(), 0.0) << f.dump();
+  }
+  EXPECT_TRUE(fs::exists(path("played.png")));
 }
 
 // The Dynamics panel plays builtin:dynamic off the UI thread: `play 3` waits

@@ -276,6 +276,15 @@ const std::vector<Entry>& entries() {
                                         [](AppConfig& c) -> BoxColorBy& { return c.view.box_color; }));
     t.push_back(bool_option("boxes-through-mesh", "boxes are not hidden by the mesh",
                             [](AppConfig& c) -> bool& { return c.view.boxes_through_mesh; }));
+    t.push_back(enum_option<BoxLevel>("box-level", "tlas|blas",
+                                      "two-level: top-level node boxes, or every instance's BLAS boxes in world space",
+                                      {{"tlas", BoxLevel::tlas}, {"blas", BoxLevel::blas}},
+                                      [](AppConfig& c) -> BoxLevel& { return c.view.box_level; }));
+    t.push_back(int_option("box-instance", "-1..2^31", "two-level, blas level: only this instance's boxes (-1: all)",
+                           -1, std::numeric_limits<int>::max(),
+                           [](AppConfig& c) -> int& { return c.view.box_instance; }));
+    t.push_back(bool_option("instance-colors", "two-level: each instance in its own colour (hashed from its id)",
+                            [](AppConfig& c) -> bool& { return c.view.instance_colors; }));
     t.push_back(enum_option<HeatmapDisplay>(
         "heatmap", "off|full|blend", "per-pixel metric: off, replacing the mesh, or blended over it",
         {{"off", HeatmapDisplay::off}, {"full", HeatmapDisplay::full_screen}, {"blend", HeatmapDisplay::blend}},

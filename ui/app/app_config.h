@@ -29,6 +29,11 @@ struct StructureChoice {
 enum class HeatmapDisplay { off, full_screen, blend };
 enum class BoxMode { depth, depth_range, leaves, subtree };
 enum class BoxColorBy { depth, sah_share };
+/// Which level of a two-level structure (`tlas`) the node boxes show.
+enum class BoxLevel {
+  tlas,  ///< the top-level nodes (and each instance's world box as their leaves)
+  blas,  ///< the bottom-level nodes of each instance, carried to world space
+};
 
 /// The renderer's layers as the user sets them (the GUI maps this onto
 /// ui/render's RenderView; kept separate so this file needs no GL header).
@@ -43,6 +48,11 @@ struct ViewSettings {
   int box_node = 0;        ///< subtree mode: its root node (the "selected node")
   BoxColorBy box_color = BoxColorBy::depth;
   bool boxes_through_mesh = false;
+  BoxLevel box_level = BoxLevel::tlas;  ///< tlas only: top-level or bottom-level boxes
+  int box_instance = -1;                ///< tlas, blas level: only this instance's BLAS boxes (-1: every instance)
+  /// tlas only: each instance's triangles (and its boxes) in its own colour,
+  /// hashed from the instance id.
+  bool instance_colors = false;
 
   HeatmapDisplay heatmap = HeatmapDisplay::off;
   HeatMetric metric = HeatMetric::nodes;

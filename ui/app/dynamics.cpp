@@ -37,6 +37,9 @@ nlohmann::json effects_json(const SceneEffects& effects) {
 
 struct DynamicsWorker::State {
   std::shared_ptr<const LoadedScene> scene;
+  /// The `tlas` choice the animator's structure was built with (none: the
+  /// defaults, when the view shows another structure).
+  std::optional<StructureChoice> tlas_choice;
   std::unique_ptr<Tlas> tlas;
   std::unique_ptr<SceneAnimator> animator;
   std::shared_ptr<DynamicsSnapshot> snap;  ///< copied before each publish
@@ -46,6 +49,22 @@ namespace {
 using Published = std::shared_ptr<const DynamicsSnapshot>;
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+/// The view shows the two-level structure: the animator's own tree is the frame.
+bool shows_tlas(const DynamicsRequest& r) {
+  return r.structure && r.structure->name == "tlas";
+}
+/// The animator's structure options: the view's `tlas` choice, as the
+/// factory (core/accel/factory.cpp) builds it, or the defaults.
+TlasOptions animator_tlas_options(const std::optional<StructureChoice>& choice) {
+  TlasOptions to;
+  if (choice) {
+    to.blas = choice->options.bvh;
+    if (to.blas.threads == 0) to.blas.threads = choice->options.threads;
+  }
+  to.blas.compute_epo = false;
+  to.tlas = to.blas;
+  return to;
 }
 }  // namespace
 
@@ -59,11 +78,17 @@ DynamicsWorker::DynamicsWorker()
               publish(nullptr);
               return;
             }
-            if (s.scene != r.scene) {
-              // A new scene: set up its own two-level structure (the app's
-              // structure is whatever the user chose; the animator needs a Tlas).
+            // A new scene, or the view's two-level structure with other
+            // options than the animator's: set the animator up afresh.
+            const bool new_options = shows_tlas(r) && (!s.tlas_choice || !same_build(*s.tlas_choice, *r.structure));
+            if (s.scene != r.scene || new_options) {
+              // The animator's own two-level structure: the view's when it
+              // shows `tlas` (its frames are then this very tree), else one
+              // with default options (the app's structure is whatever the
+              // user chose; the animator needs a Tlas).
               s.animator.reset();
               s.tlas.reset();
+              s.tlas_choice = shows_tlas(r) ? r.structure : std::nullopt;
               s.scene = r.scene;
               s.snap = std::make_shared<DynamicsSnapshot>();
               s.snap->scene = r.scene.get();
@@ -73,10 +98,8 @@ DynamicsWorker::DynamicsWorker()
               {  // also when nothing animates but the user forced per-frame updates on
                 const auto t0 = std::chrono::steady_clock::now();
                 try {
-                  TlasOptions to;
-                  to.blas.compute_epo = false;
-                  to.tlas = to.blas;
-                  s.tlas = std::make_unique<Tlas>(r.scene->scene, to, [&](double) { return keep_going(); });
+                  s.tlas = std::make_unique<Tlas>(r.scene->scene, animator_tlas_options(s.tlas_choice),
+                                                  [&](double) { return keep_going(); });
                   AnimatorOptions ao;
                   ao.rebuild_ratio = r.rebuild_ratio;
                   s.animator = std::make_unique<SceneAnimator>(r.scene->scene, *s.tlas, ao);
@@ -100,18 +123,29 @@ DynamicsWorker::DynamicsWorker()
               s.snap->error = std::string("dynamics: ") + e.what();
             }
             if (r.structure && s.snap->error.empty() && !s.snap->history.empty()) {
-              // The frame for display: the scene posed at this time and the
-              // chosen structure built over it (the app's build, as the
-              // build worker makes it, but for this pose).
+              // The frame for display: the scene posed at this time (what is
+              // drawn, and what primitive ids name) and the structure over
+              // it. For `tlas` that is the animator's own tree as this step
+              // left it (refitted or rebuilt per its policy), frozen by a
+              // snapshot, so the view shows what the plots measure; any
+              // other structure is built over the pose as the build worker
+              // would build it.
               const auto t0 = std::chrono::steady_clock::now();
               try {
                 auto posed = std::make_shared<LoadedScene>();
                 posed->spec = r.scene->spec;
                 posed->scene = posed_scene(r.scene->scene, s.snap->history.back().time);
-                StructureChoice choice = *r.structure;
-                choice.options.scene = &posed->scene;
-                std::shared_ptr<const Accelerator> accel = build_accelerator(
-                    choice.name, posed->scene.triangles, choice.options, [&](double) { return keep_going(); });
+                std::shared_ptr<const Accelerator> accel;
+                const bool own = shows_tlas(r) && s.tlas;
+                if (own) {
+                  accel = s.tlas->snapshot();
+                } else {
+                  StructureChoice choice = *r.structure;
+                  choice.options.scene = &posed->scene;
+                  accel = build_accelerator(choice.name, posed->scene.triangles, choice.options,
+                                            [&](double) { return keep_going(); });
+                }
+                s.snap->frame_is_animator_tree = own;
                 auto built = std::make_shared<BuiltStructure>();
                 built->nodes = StructureNodes::of(*accel);
                 built->accel = std::move(accel);

@@ -13,9 +13,13 @@
 //  - DynamicsPlayer: play/pause, scrub, speed: which time the worker is asked
 //    to step to next.
 // With a structure choice in the request, each frame also carries the
-// scene posed at that time (posed_scene()) and the chosen structure built
-// over it: AppState::show_frame() makes it the one the 3D view, the heatmap
-// and the ray inspector use (see docs/dynamics.md).
+// scene posed at that time (posed_scene()) and the structure over it:
+// AppState::show_frame() makes it the one the 3D view, the heatmap and the
+// ray inspector use (see docs/dynamics.md). When the choice is `tlas`, the
+// animator's structure is built with that choice's options and the frame's
+// structure IS the animator's tree after the step (Tlas::snapshot: refitted
+// or rebuilt per the rebuild ratio), so the view shows what the plots
+// measure; any other structure is built over the pose.
 #include <cstdint>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -65,7 +69,10 @@ struct DynamicsSnapshot {
   /// structure in the requests).
   std::shared_ptr<const BuiltStructure> frame;
   float frame_time = 0.0f;
-  double frame_build_ms = 0.0;  ///< posing + building that frame's structure
+  double frame_build_ms = 0.0;  ///< posing + building (or, for tlas, snapshotting) that frame's structure
+  /// frame's structure is the animator's own tree (the request's structure
+  /// is `tlas`), not a build over the posed scene.
+  bool frame_is_animator_tree = false;
 };
 
 class DynamicsWorker {

@@ -1,6 +1,7 @@
 #include "ui/app/structure_nodes.h"
 
 #include <algorithm>
+#include <limits>
 
 #include "core/accel/bvh/bvh.h"
 #include "core/accel/grid/grid.h"
@@ -73,6 +74,7 @@ StructureNodes StructureNodes::of(const Accelerator& accel) {
         leaf.depth = t.nodes_[i].depth + 1;
         leaf.leaf = true;
         leaf.prims = static_cast<std::uint32_t>(tlas->blas(inst.blas).leaf_triangles().size());
+        leaf.instance = order[k];
         t.nodes_.push_back(leaf);
       }
     }
@@ -284,7 +286,7 @@ StructureNodes::Selection StructureNodes::select(const NodeSelection& sel, std::
   }
   auto to_box = [&](std::uint32_t i) {
     const StructureNode& n = nodes_[i];
-    return NodeBox{n.bounds, i, n.depth, n.leaf, n.sah_share};
+    return NodeBox{n.bounds, i, n.depth, n.leaf, n.sah_share, n.instance};
   };
   if (sel.mode == BoxMode::subtree) {
     if (sel.node >= nodes_.size()) return out;
@@ -330,6 +332,61 @@ StructureNodes::Selection StructureNodes::select(const NodeSelection& sel, std::
     for (auto it = kids.rbegin(); it != kids.rend(); ++it) stack.push_back(*it);
   }
   return out;
+}
+
+namespace {
+
+/// The box of BOX's eight corners under M.
+Aabb world_box(const Aabb& box, const glm::mat4& m) {
+  Aabb out;
+  if (box.is_empty()) return out;
+  for (int i = 0; i < 8; ++i) {
+    const glm::vec3 c((i & 1) ? box.hi.x : box.lo.x, (i & 2) ? box.hi.y : box.lo.y, (i & 4) ? box.hi.z : box.lo.z);
+    out.extend(glm::vec3(m * glm::vec4(c, 1.0f)));
+  }
+  return out;
+}
+
+}  // namespace
+
+StructureNodes::Selection select_blas_boxes(const Tlas& tlas, const NodeSelection& sel, std::size_t limit,
+                                            int instance) {
+  StructureNodes::Selection out;
+  const auto instances = tlas.instances();
+  if (instance >= 0 && static_cast<std::size_t>(instance) >= instances.size()) return out;
+  const std::size_t first = instance >= 0 ? static_cast<std::size_t>(instance) : 0;
+  const std::size_t last = instance >= 0 ? first + 1 : instances.size();
+  // Each BLAS's selection once, in object space (instances share BLASes).
+  std::vector<std::optional<std::vector<NodeBox>>> per_blas(tlas.blas_count());
+  for (std::size_t i = first; i < last; ++i) {
+    const TlasInstance& inst = instances[i];
+    auto& picked = per_blas[inst.blas];
+    if (!picked)
+      picked = StructureNodes::of(tlas.blas(inst.blas)).select(sel, std::numeric_limits<std::size_t>::max()).boxes;
+    out.matched += picked->size();
+    if (out.truncated) continue;
+    if (out.boxes.size() + picked->size() > limit && !out.boxes.empty()) {
+      out.truncated = true;  // whole instances only
+      continue;
+    }
+    for (const NodeBox& b : *picked) {
+      if (out.boxes.size() >= limit) {
+        out.truncated = true;
+        break;
+      }
+      NodeBox w = b;
+      w.bounds = world_box(b.bounds, inst.to_world);
+      w.instance = static_cast<std::uint32_t>(i);
+      out.boxes.push_back(w);
+    }
+  }
+  return out;
+}
+
+std::uint32_t blas_max_depth(const Tlas& tlas) {
+  std::uint32_t d = 0;
+  for (std::size_t b = 0; b < tlas.blas_count(); ++b) d = std::max(d, tlas.blas(b).build_stats().max_depth);
+  return d;
 }
 
 }  // namespace accelviz

@@ -23,7 +23,8 @@ struct StructureNode {
   std::uint32_t parent = 0xFFFFFFFFu;  ///< none for the root
   std::uint32_t prims = 0;             ///< leaves: primitives referenced
   bool leaf = false;
-  float sah_share = 0.0f;  ///< this node's part of the SAH cost, all nodes summing to 1
+  float sah_share = 0.0f;                ///< this node's part of the SAH cost, all nodes summing to 1
+  std::uint32_t instance = 0xFFFFFFFFu;  ///< two-level: the instance whose world box this leaf is (none otherwise)
 };
 
 /// Which nodes to show (ViewSettings' box_* fields).
@@ -40,6 +41,7 @@ struct NodeBox {
   std::uint32_t depth = 0;
   bool leaf = false;
   float sah_share = 0.0f;
+  std::uint32_t instance = 0xFFFFFFFFu;  ///< two-level: the instance the box belongs to (none otherwise)
 };
 
 class StructureNodes {
@@ -91,5 +93,23 @@ class StructureNodes {
   };
   std::optional<GridCells> grid_;
 };
+
+class Tlas;
+
+/// The bottom-level boxes of a two-level structure in world space: for
+/// every instance (or only instance INSTANCE when it is >= 0), the nodes SEL
+/// names in its BLAS (depths counted from the BLAS root; subtree: a BLAS
+/// node id), each box's eight corners carried to world space by the
+/// instance's transform (the box of those corners). Every box keeps its
+/// BLAS node id, depth and SAH share and names its instance. Instances are
+/// taken in id order and whole: when the next instance's boxes would pass
+/// LIMIT, the list stops there (`truncated`; the first instance alone is cut
+/// at LIMIT); `matched` counts every instance's. An INSTANCE out of range
+/// selects nothing.
+StructureNodes::Selection select_blas_boxes(const Tlas& tlas, const NodeSelection& sel, std::size_t limit,
+                                            int instance = -1);
+
+/// The deepest BLAS node depth of a two-level structure (the blas level's depth range).
+std::uint32_t blas_max_depth(const Tlas& tlas);
 
 }  // namespace accelviz

@@ -83,13 +83,14 @@ void dynamics_panel(DynamicsPlayer& player, const DynamicsSnapshot* snap, bool b
     ImGui::Text("last frame: t=%.3f s, %u instances moved, %u refits, %u rebuilds", static_cast<double>(f.time),
                 f.moved_instances, f.refits, f.rebuilds);
   }
-  std::vector<float> tlas, refit, rebuild, sah_r, sah_b;
+  std::vector<float> tlas, refit, rebuild, sah_r, sah_b, overlap;
   for (const FrameStats& f : snap->history) {
     tlas.push_back(static_cast<float>(f.tlas_rebuild_ms));
     refit.push_back(static_cast<float>(f.refit_ms));
     rebuild.push_back(static_cast<float>(f.rebuild_ms));
     sah_r.push_back(static_cast<float>(f.sah_refit));
     sah_b.push_back(static_cast<float>(f.sah_rebuilt));
+    overlap.push_back(static_cast<float>(f.overlap.area_ratio));
   }
   const float h = 48.0f * s;
   auto top = [](const std::vector<float>& v) {
@@ -107,7 +108,21 @@ void dynamics_panel(DynamicsPlayer& player, const DynamicsSnapshot* snap, bool b
   }
   plot("SAH refitted", sah_r, lo, hi, h);
   plot("SAH rebuilt", sah_b, lo, hi, h);
-  if (snap->frame)
+  // Instance overlap (core/accel/tlas/tlas_overlap.h): the sum of pairwise
+  // intersection areas of the instances' world boxes over the root's area.
+  plot("Instance overlap", overlap, 0.0f, top(overlap), h);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("sum over instance pairs of the area of their boxes' intersection / the TLAS root's area");
+  if (!snap->history.empty()) {
+    const InstanceOverlap& o = snap->history.back().overlap;
+    ImGui::Text("overlap: %.4g (area), %.4g (volume), %llu overlapping pairs of %llu instances", o.area_ratio,
+                o.volume_ratio, static_cast<unsigned long long>(o.overlapping_pairs),
+                static_cast<unsigned long long>(o.instances));
+  }
+  if (snap->frame && snap->frame_is_animator_tree)
+    ImGui::Text("view: frame t=%.3f s, the animator's own tree (as refitted/rebuilt above; posed in %.1f ms)",
+                static_cast<double>(snap->frame_time), snap->frame_build_ms);
+  else if (snap->frame)
     ImGui::Text("view: frame t=%.3f s (%s rebuilt over the posed scene in %.1f ms)",
                 static_cast<double>(snap->frame_time), snap->frame->choice.name.c_str(), snap->frame_build_ms);
   ImGui::TextDisabled("The 3D view, heatmap and ray inspector show the latest frame stepped.");

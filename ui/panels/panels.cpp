@@ -345,12 +345,32 @@ bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout
     ImGui::SameLine();
     ImGui::TextDisabled("(this structure has none)");
   }
+  const bool two_level = info.node_kind == "tlas";
+  if (two_level) {  // which level's boxes, and per-instance colours
+    int level = static_cast<int>(v.box_level);
+    if (combo("Level", level, {"top (TLAS nodes, instance boxes)", "bottom (each instance's BLAS)"})) {
+      v.box_level = static_cast<BoxLevel>(level);
+      changed = true;
+    }
+    if (v.box_level == BoxLevel::blas) {
+      int inst = v.box_instance;
+      if (ImGui::InputInt("Instance", &inst)) {
+        v.box_instance = std::clamp(
+            inst, -1,
+            static_cast<int>(std::min<std::uint64_t>(info.instances > 0 ? info.instances - 1 : 0, 0x7FFFFFFF)));
+        changed = true;
+      }
+      ImGui::TextDisabled("-1: every instance (whole instances up to the box limit)");
+    }
+    changed |= checkbox("Instance colours", v.instance_colors, "each instance's triangles and boxes in its own colour");
+  }
   int mode = static_cast<int>(v.box_mode);
   if (combo("Show", mode, {"one depth", "depth range", "leaves", "selected subtree"})) {
     v.box_mode = static_cast<BoxMode>(mode);
     changed = true;
   }
-  const int max_depth = static_cast<int>(info.max_depth);
+  const int max_depth =
+      static_cast<int>(two_level && v.box_level == BoxLevel::blas ? info.blas_max_depth : info.max_depth);
   switch (v.box_mode) {
     case BoxMode::depth:
       changed |= slider_int("Depth", v.box_depth, 0, std::max(max_depth, 1));

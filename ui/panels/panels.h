@@ -64,7 +64,9 @@ struct ViewInfo {
   std::uint64_t node_count = 0;
   std::uint64_t boxes_drawn = 0;
   bool boxes_truncated = false;
-  float range_min = 0.0f, range_max = 1.0f;  ///< the heatmap range in use
+  std::uint32_t blas_max_depth = 0;           ///< tlas: the deepest BLAS node (the blas level's depth range)
+  std::uint64_t instances = 0;                ///< tlas: instances (the blas level's instance choice)
+  float range_min = 0.0f, range_max = 1.0f;   ///< the heatmap range in use
   bool heatmap_on_gpu = false;                ///< the heatmap shown was traced on the GPU
   std::string gpu_note;                       ///< why "Trace on: GPU" fell back to the CPU ("" when it did not)
   int gpu_rows_done = -1;                     ///< the GPU trace in progress: rows done (-1: none running)

@@ -9,6 +9,7 @@
 #include "ui/render/camera_view.h"
 
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <span>
 
 namespace accelviz {
@@ -19,6 +20,12 @@ class MeshPass {
   /// Replaces the mesh: three vertices per triangle, each with the triangle's
   /// geometric normal (no index buffer, so a primitive id p is vertices 3p..3p+2).
   void upload(std::span<const Triangle> triangles);
+  /// One colour per triangle for the shaded mesh instead of the flat mesh
+  /// colour (per-instance colours of a two-level view); empty: back to the
+  /// flat colour. Throws std::invalid_argument unless there is exactly one
+  /// colour per uploaded triangle. upload() clears them.
+  void upload_colors(std::span<const glm::vec3> per_triangle);
+  bool has_colors() const { return has_colors_; }
   std::size_t triangle_count() const { return triangle_count_; }
   const Aabb& bounds() const { return bounds_; }
 
@@ -35,10 +42,13 @@ class MeshPass {
                        const glm::vec4& color) const;
 
  private:
-  void bind(const ShaderProgram& program, const CameraMatrices& m, const glm::vec4& color, bool shaded) const;
+  void bind(const ShaderProgram& program, const CameraMatrices& m, const glm::vec4& color, bool shaded,
+            bool vertex_colors = false) const;
 
   GlObject vao_;
   GlObject vbo_;
+  GlObject colors_;  ///< RGBA8 per vertex, binding 1 (attribute 2 enabled only while has_colors_)
+  bool has_colors_ = false;
   std::size_t triangle_count_ = 0;
   Aabb bounds_;
 };

@@ -27,6 +27,10 @@ void Renderer::set_triangles(std::span<const Triangle> triangles) {
   mesh_.upload(triangles);
 }
 
+void Renderer::set_triangle_colors(std::span<const glm::vec3> colors) {
+  mesh_.upload_colors(colors);
+}
+
 void Renderer::set_boxes(std::span<const ColoredBox> boxes) {
   boxes_.upload(boxes);
 }

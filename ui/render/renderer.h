@@ -35,6 +35,10 @@ class Renderer {
   Renderer();
 
   void set_triangles(std::span<const Triangle> triangles);
+  /// One colour per triangle of the last set_triangles() for the shaded mesh
+  /// (per-instance colours); empty: the view's flat mesh colour. Throws
+  /// std::invalid_argument on a count mismatch. set_triangles() clears them.
+  void set_triangle_colors(std::span<const glm::vec3> colors);
   void set_boxes(std::span<const ColoredBox> boxes);
   void set_quads(std::span<const TranslucentQuad> quads);
   void set_ray_path(const RayPath& path);

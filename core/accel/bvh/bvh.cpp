@@ -71,6 +71,15 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
 }
 
 Bvh::~Bvh() = default;
+Bvh::Bvh(const Bvh& o)
+    : Accelerator(o),
+      nodes_(o.nodes_),
+      prim_indices_(o.prim_indices_),
+      leaf_tris_(o.leaf_tris_),
+      wide_(o.wide_ ? std::make_unique<bvh_detail::WideBvh>(*o.wide_) : nullptr),
+      wide8_(o.wide8_ ? std::make_unique<bvh_detail::WideBvh8>(*o.wide8_) : nullptr),
+      opts_(o.opts_),
+      stats_(o.stats_) {}
 Bvh::Bvh(Bvh&&) noexcept = default;
 Bvh& Bvh::operator=(Bvh&&) noexcept = default;
 

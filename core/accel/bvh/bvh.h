@@ -93,6 +93,9 @@ class Bvh final : public Accelerator {
  public:
   Bvh(std::span<const Triangle> triangles, const BvhOptions& opts = {}, const ProgressCallback& progress = {});
   ~Bvh() override;
+  /// A deep copy (nodes, leaf triangles, the wide copy): what a two-level
+  /// structure refits when the BLAS is shared with a snapshot (Tlas::snapshot).
+  Bvh(const Bvh& other);
   Bvh(Bvh&&) noexcept;
   Bvh& operator=(Bvh&&) noexcept;
 

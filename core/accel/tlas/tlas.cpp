@@ -105,7 +105,7 @@ Tlas::Tlas(std::span<const Triangle> triangles, const TlasOptions& opts, const P
   const auto t0 = Clock::now();
   validate(opts_.blas);
   validate(opts_.tlas);
-  blas_.push_back(std::make_unique<Bvh>(triangles, quiet(opts_.blas), progress));
+  blas_.push_back(std::make_shared<Bvh>(triangles, quiet(opts_.blas), progress));
   blas_mesh_.push_back(0);
   TlasInstance inst;
   set_instance_transform(inst, glm::mat4(1.0f));
@@ -117,6 +117,18 @@ Tlas::Tlas(std::span<const Triangle> triangles, const TlasOptions& opts, const P
 }
 
 Tlas::~Tlas() = default;
+
+std::shared_ptr<const Tlas> Tlas::snapshot() const {
+  return std::shared_ptr<const Tlas>(new Tlas(*this));
+}
+
+Bvh& Tlas::own_blas(std::size_t b) {
+  // Only the updating thread copies this structure (snapshot()), so a count
+  // of 1 cannot grow behind our back; a snapshot released elsewhere can only
+  // make the copy unnecessary, never unsafe.
+  if (blas_[b].use_count() > 1) blas_[b] = std::make_shared<Bvh>(*blas_[b]);
+  return *blas_[b];
+}
 
 void Tlas::build_blas_list(const Scene& scene, const ProgressCallback& progress) {
   std::vector<bool> used(scene.meshes.size(), false);
@@ -132,7 +144,7 @@ void Tlas::build_blas_list(const Scene& scene, const ProgressCallback& progress)
     const double span = total ? static_cast<double>(scene.meshes[m].indices.size()) / static_cast<double>(total) : 0.0;
     ProgressCallback sub;
     if (progress) sub = [&](double f) { return progress(lo + span * f); };
-    blas_.push_back(std::make_unique<Bvh>(tris, quiet(opts_.blas), sub));
+    blas_.push_back(std::make_shared<Bvh>(tris, quiet(opts_.blas), sub));
     blas_mesh_.push_back(static_cast<std::uint32_t>(m));
     done += scene.meshes[m].indices.size();
   }
@@ -353,8 +365,9 @@ TlasUpdateStats Tlas::update_transforms(std::span<const glm::mat4> to_world) {
 TlasUpdateStats Tlas::refit_blas(std::size_t b, std::span<const Triangle> tris) {
   if (b >= blas_.size()) throw std::invalid_argument("tlas: no BLAS " + std::to_string(b));
   TlasUpdateStats s;
+  Bvh& blas = own_blas(b);  // before the clock: the copy is not part of the refit
   const auto t0 = Clock::now();
-  blas_[b]->refit(tris);
+  blas.refit(tris);
   s.blas_refit_ms = ms_since(t0);
   for (TlasInstance& inst : instances_)
     if (inst.blas == b) update_world_bounds(inst);
@@ -369,7 +382,7 @@ TlasUpdateStats Tlas::replace_blas(std::size_t b, Bvh fresh) {
     throw std::invalid_argument("tlas: replacement BLAS " + std::to_string(b) + " has " +
                                 std::to_string(fresh.leaf_triangles().size()) + " triangles, built with " +
                                 std::to_string(blas_[b]->leaf_triangles().size()));
-  *blas_[b] = std::move(fresh);
+  blas_[b] = std::make_shared<Bvh>(std::move(fresh));
   for (TlasInstance& inst : instances_)
     if (inst.blas == b) update_world_bounds(inst);
   TlasUpdateStats s;
@@ -385,7 +398,7 @@ TlasUpdateStats Tlas::rebuild_blas(std::size_t b, std::span<const Triangle> tris
                                 " triangles, built with " + std::to_string(blas_[b]->leaf_triangles().size()));
   TlasUpdateStats s;
   const auto t0 = Clock::now();
-  *blas_[b] = Bvh(tris, quiet(opts_.blas));
+  blas_[b] = std::make_shared<Bvh>(tris, quiet(opts_.blas));
   s.blas_rebuild_ms = ms_since(t0);
   for (TlasInstance& inst : instances_)
     if (inst.blas == b) update_world_bounds(inst);

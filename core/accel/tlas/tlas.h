@@ -71,6 +71,15 @@ class Tlas final : public Accelerator {
   Tlas(std::span<const Triangle> triangles, const TlasOptions& opts = {}, const ProgressCallback& progress = {});
   ~Tlas() override;
 
+  /// A frozen copy of the structure as it stands: TLAS nodes, instances and
+  /// figures copied, every BLAS shared (not copied). Later updates of this
+  /// structure never change the copy: refit_blas refits a private copy of a
+  /// shared BLAS, replace_blas and rebuild_blas put a new one in its place.
+  /// How the GUI shows the animator's own per-frame tree while the animator
+  /// moves on (ui/app/dynamics.h). Not thread-safe against a concurrent
+  /// update of this structure: take it on the thread that updates.
+  std::shared_ptr<const Tlas> snapshot() const;
+
   std::string name() const override { return "tlas"; }
   Hit closest_hit(const Ray& ray, const QueryOptions& opts, RayStats* stats = nullptr,
                   VisitTrace* trace = nullptr) const override;
@@ -121,7 +130,11 @@ class Tlas final : public Accelerator {
   void update_memory_stats();
 
   TlasOptions opts_;
-  std::vector<std::unique_ptr<Bvh>> blas_;
+  Tlas(const Tlas&) = default;  ///< snapshot(): shares the BLASes
+  /// The BLAS about to be changed in place: copied first when a snapshot shares it.
+  Bvh& own_blas(std::size_t b);
+
+  std::vector<std::shared_ptr<Bvh>> blas_;
   std::vector<std::uint32_t> blas_mesh_;  ///< scene mesh of each BLAS
   std::vector<TlasInstance> instances_;
   std::vector<BvhNode> tlas_nodes_;

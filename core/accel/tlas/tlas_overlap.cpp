@@ -1,6 +1,8 @@
 // Instance overlap (see tlas_overlap.h).
 #include "core/accel/tlas/tlas_overlap.h"
 
+#include "core/accel/tlas/tlas.h"
+
 #include <algorithm>
 #include <vector>
 
@@ -48,6 +50,13 @@ InstanceOverlap instance_overlap(std::span<const Aabb> boxes) {
   if (out.root_area > 0.0) out.area_ratio = out.area_sum / out.root_area;
   if (out.root_volume > 0.0) out.volume_ratio = out.volume_sum / out.root_volume;
   return out;
+}
+
+InstanceOverlap instance_overlap(const Tlas& tlas) {
+  std::vector<Aabb> boxes;
+  boxes.reserve(tlas.instances().size());
+  for (const TlasInstance& inst : tlas.instances()) boxes.push_back(inst.world_bounds);
+  return instance_overlap(boxes);
 }
 
 }  // namespace accelviz

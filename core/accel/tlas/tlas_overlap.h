@@ -32,4 +32,9 @@ struct InstanceOverlap {
 /// O(n log n + pairs whose x-extents overlap).
 InstanceOverlap instance_overlap(std::span<const Aabb> boxes);
 
+class Tlas;
+/// The overlap of TLAS's instances as they stand now (their world boxes):
+/// what SceneAnimator::step measures per frame (FrameStats::overlap).
+InstanceOverlap instance_overlap(const Tlas& tlas);
+
 }  // namespace accelviz
