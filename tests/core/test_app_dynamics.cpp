@@ -627,6 +627,33 @@ TEST(AppDynamicsViews, TlasAndBlasBoxSetsDifferWithTheExpectedCounts) {
   EXPECT_EQ(blas_max_depth(t), t.blas(0).build_stats().max_depth);
 }
 
+TEST(AppDynamicsViews, FramingAtTheBlasLevelFramesTheChosenInstanceOrSubtree) {
+  using namespace app_dynamics_frames;
+  AppSettings settings;
+  settings.config.structure.name = "tlas";
+  AppState app(settings);
+  app.open_scene("builtin:dynamic?size=1200");
+  ASSERT_TRUE(pump_app(app, [&] { return app.settled() && app.current(); }));
+  const auto* tlas = dynamic_cast<const Tlas*>(app.current()->accel.get());
+  ASSERT_NE(tlas, nullptr);
+  ViewSettings& v = app.config().view;
+  v.box_level = BoxLevel::blas;
+  v.box_instance = 5;
+  app.frame_selection();  // depth mode: instance 5's world box
+  const Aabb inst = tlas->instances()[5].world_bounds;
+  EXPECT_LT(glm::length(app.view_camera().orbit.pivot - inst.center()), 1e-5f);
+  v.box_mode = BoxMode::subtree;
+  v.box_node = 1;  // the root's first child in instance 5's BLAS
+  app.frame_selection();
+  NodeSelection sel;
+  sel.mode = BoxMode::subtree;
+  sel.node = 1;
+  const auto boxes = select_blas_boxes(*tlas, sel, 1000, 5);
+  ASSERT_FALSE(boxes.boxes.empty());
+  EXPECT_LT(glm::length(app.view_camera().orbit.pivot - boxes.boxes[0].bounds.center()), 1e-5f);
+  EXPECT_GT(glm::length(app.view_camera().orbit.pivot - inst.center()), 0.0f);
+}
+
 TEST(AppDynamicsViews, InstanceColoursAreStableDistinctAndFollowTheTriangleRanges) {
   using namespace app_dynamics_views;
   std::set<std::tuple<int, int, int>> seen;

@@ -1,5 +1,6 @@
 #include "ui/app/app_state.h"
 
+#include "core/accel/tlas/tlas.h"
 #include "core/query/camera.h"
 #include "core/scene/effects.h"
 
@@ -283,8 +284,24 @@ void AppState::frame_selection() {
   if (!s) return;
   Aabb box = s->bounds();
   const ViewSettings& v = config().view;
-  if (v.show_boxes && v.box_mode == BoxMode::subtree)
+  const auto* tlas = dynamic_cast<const Tlas*>(current_->accel.get());
+  if (v.show_boxes && tlas && current_->nodes.kind() == "tlas" && v.box_level == BoxLevel::blas) {
+    // The bottom level: the selected BLAS subtree in every shown instance
+    // (or in the one instance chosen), else the chosen instance's world box.
+    if (v.box_mode == BoxMode::subtree) {
+      NodeSelection sel;
+      sel.mode = BoxMode::subtree;
+      sel.node = static_cast<std::uint32_t>(v.box_node);
+      Aabb u;
+      for (const NodeBox& b : select_blas_boxes(*tlas, sel, std::size_t{1} << 20, v.box_instance).boxes)
+        u.extend(b.bounds);
+      if (!u.is_empty()) box = u;
+    } else if (v.box_instance >= 0 && static_cast<std::size_t>(v.box_instance) < tlas->instances().size()) {
+      box = tlas->instances()[static_cast<std::size_t>(v.box_instance)].world_bounds;
+    }
+  } else if (v.show_boxes && v.box_mode == BoxMode::subtree) {
     if (const auto b = current_->nodes.box(static_cast<std::uint32_t>(v.box_node))) box = *b;
+  }
   camera_.unfix();
   camera_.orbit.frame(box, aspect_of(view_w_, view_h_));
 }
