@@ -95,7 +95,7 @@ Command add_animate_command(CLI::App& parent, const GlobalOptions& global) {
   return {sub, [o, &global] { return run_animate(*o, global); }};
 }
 
-const CommandRegistration reg{add_animate_command};
+const CommandRegistration register_animate{add_animate_command};
 
 }  // namespace
 

@@ -156,7 +156,7 @@ Command add_calibrate_command(CLI::App& parent, const GlobalOptions& global) {
   return {sub, [o, &global] { return run_calibrate(*o, global); }};
 }
 
-const CommandRegistration reg{add_calibrate_command};
+const CommandRegistration register_calibrate{add_calibrate_command};
 
 }  // namespace
 

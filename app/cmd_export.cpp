@@ -45,7 +45,7 @@ Command add_export_command(CLI::App& parent, const GlobalOptions& global) {
   return {sub, [o, &global] { return run_export(*o, global); }};
 }
 
-const CommandRegistration reg{add_export_command};
+const CommandRegistration register_export{add_export_command};
 
 }  // namespace
 

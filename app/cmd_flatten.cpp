@@ -115,7 +115,7 @@ Command add_flatten_command(CLI::App& parent, const GlobalOptions& global) {
   return {sub, [o, &global] { return run_flatten(*o, global); }};
 }
 
-const CommandRegistration reg{add_flatten_command};
+const CommandRegistration register_flatten{add_flatten_command};
 
 }  // namespace
 

@@ -170,7 +170,7 @@ Command add_refit_command(CLI::App& parent, const GlobalOptions& global) {
   return {sub, [o, &global] { return run_refit(*o, global); }};
 }
 
-const CommandRegistration reg{add_refit_command};
+const CommandRegistration register_refit{add_refit_command};
 
 }  // namespace
 

@@ -125,7 +125,7 @@ Command add_robustness_command(CLI::App& parent, const GlobalOptions& global) {
   return {sub, [o, &global] { return run_robustness(*o, global); }};
 }
 
-const CommandRegistration reg{add_robustness_command};
+const CommandRegistration register_robustness{add_robustness_command};
 
 }  // namespace
 

@@ -392,7 +392,7 @@ Command add_sweep_command(CLI::App& parent, const GlobalOptions& global) {
   return {sub, [o, &global] { return run_sweep_command(*o, global); }};
 }
 
-const CommandRegistration reg{add_sweep_command};
+const CommandRegistration register_sweep{add_sweep_command};
 
 }  // namespace
 

@@ -96,7 +96,7 @@ Command add_verify_command(CLI::App& parent, const GlobalOptions& global) {
   return {sub, [o, &global] { return run_verify(*o, global); }};
 }
 
-const CommandRegistration reg{add_verify_command};
+const CommandRegistration register_verify{add_verify_command};
 
 }  // namespace
 
