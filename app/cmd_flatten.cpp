@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "app/cli_common.h"
+#include "core/accel/tlas/flatten_json.h"
 #include "core/accel/tlas/flatten_what_if.h"
 
 namespace accelviz::cli {
@@ -44,20 +45,6 @@ std::vector<std::uint32_t> parse_ids(const std::string& text) {
   return ids;
 }
 
-nlohmann::json figures_json(const TwoLevelFigures& f) {
-  return {{"sah_cost", f.sah_cost},
-          {"memory_bytes", f.memory_bytes},
-          {"build_ms", f.build_ms},
-          {"instances", f.instances},
-          {"blas", f.blas},
-          {"rays", f.rays},
-          {"hits", f.hits},
-          {"mean_nodes", f.mean_nodes},
-          {"mean_prims", f.mean_prims},
-          {"mean_instances", f.mean_instances},
-          {"trace_ms", f.trace_ms}};
-}
-
 int run_flatten(const FlattenOptions& o, const GlobalOptions& global) {
   const ImageSize size = parse_size(o.size);
   std::vector<std::uint32_t> ids = parse_ids(o.instances);
@@ -81,11 +68,9 @@ int run_flatten(const FlattenOptions& o, const GlobalOptions& global) {
   }
   progress.end("done");
   if (o.json) {
-    print_json_line({{"scene", o.scene},
-                     {"merged_instances", w.merged_instances},
-                     {"merged_triangles", w.merged_triangles},
-                     {"two_level", figures_json(w.two_level)},
-                     {"flattened", figures_json(w.flattened)}});
+    nlohmann::json j = {{"scene", o.scene}};
+    j.update(flatten_what_if_json(w));
+    print_json_line(j);
     return 0;
   }
   std::printf("%s: %llu instances merged into one BLAS (%llu triangles), %dx%d primary rays\n", o.scene.c_str(),

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/scene/load.h"
+#include "tests/core/base64.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_gltf_loader {
@@ -26,21 +27,6 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr int kU8 = 5121, kU16 = 5123, kU32 = 5125, kFloat = 5126;
-
-std::string base64(const std::vector<unsigned char>& data) {
-  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (std::size_t i = 0; i < data.size(); i += 3) {
-    std::uint32_t v = std::uint32_t(data[i]) << 16;
-    if (i + 1 < data.size()) v |= std::uint32_t(data[i + 1]) << 8;
-    if (i + 2 < data.size()) v |= data[i + 2];
-    out += t[v >> 18];
-    out += t[(v >> 12) & 63];
-    out += i + 1 < data.size() ? t[(v >> 6) & 63] : '=';
-    out += i + 2 < data.size() ? t[v & 63] : '=';
-  }
-  return out;
-}
 
 void put_u32(std::string& s, std::uint32_t v) {
   for (int k = 0; k < 4; ++k) s += char((v >> (8 * k)) & 0xFF);
@@ -100,7 +86,7 @@ struct GltfBuilder {
     json d = doc;
     if (!bin.empty())
       d["buffers"] = json::array(
-          {json{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}});
+          {json{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + test::base64(bin)}}});
     return d.dump(1);
   }
   std::string glb_bytes() const {

@@ -17,6 +17,7 @@
 
 #include "core/query/ray_file.h"
 #include "core/scene/load.h"
+#include "tests/core/base64.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_malformed_files {
@@ -118,23 +119,8 @@ std::string glb(const Doc& d) {
   return u32(0x46546C67) + u32(2) + u32(static_cast<std::uint32_t>(12 + body.size())) + body;
 }
 
-std::string base64(const std::string& data) {
-  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (std::size_t i = 0; i < data.size(); i += 3) {
-    std::uint32_t v = std::uint32_t(static_cast<unsigned char>(data[i])) << 16;
-    if (i + 1 < data.size()) v |= std::uint32_t(static_cast<unsigned char>(data[i + 1])) << 8;
-    if (i + 2 < data.size()) v |= static_cast<unsigned char>(data[i + 2]);
-    out += t[v >> 18];
-    out += t[(v >> 12) & 63];
-    out += i + 1 < data.size() ? t[(v >> 6) & 63] : '=';
-    out += i + 2 < data.size() ? t[v & 63] : '=';
-  }
-  return out;
-}
-
 std::string gltf_text(Doc d) {
-  d.j["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64(d.bin);
+  d.j["buffers"][0]["uri"] = "data:application/octet-stream;base64," + test::base64(d.bin);
   return d.j.dump();
 }
 

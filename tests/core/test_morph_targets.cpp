@@ -16,6 +16,7 @@
 #include "core/scene/animation.h"
 #include "core/scene/effects.h"
 #include "core/scene/load.h"
+#include "tests/core/base64.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_morph_targets {
@@ -25,21 +26,6 @@ using nlohmann::json;
 namespace fs = std::filesystem;
 using P = AnimationChannel::Path;
 using I = AnimationChannel::Interpolation;
-
-std::string morph_base64(const std::vector<unsigned char>& data) {
-  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (std::size_t i = 0; i < data.size(); i += 3) {
-    std::uint32_t v = std::uint32_t(data[i]) << 16;
-    if (i + 1 < data.size()) v |= std::uint32_t(data[i + 1]) << 8;
-    if (i + 2 < data.size()) v |= data[i + 2];
-    out += t[v >> 18];
-    out += t[(v >> 12) & 63];
-    out += i + 1 < data.size() ? t[(v >> 6) & 63] : '=';
-    out += i + 2 < data.size() ? t[v & 63] : '=';
-  }
-  return out;
-}
 
 /// A glTF document in memory: one embedded buffer, float and u32 accessors.
 struct MorphGltf {
@@ -66,7 +52,7 @@ struct MorphGltf {
   std::string write(const fs::path& path) const {
     json d = doc;
     d["buffers"] = json::array(
-        {json{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + morph_base64(bin)}}});
+        {json{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + test::base64(bin)}}});
     std::ofstream(path) << d.dump(1);
     return path.string();
   }

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "core/accel/tlas/flatten_json.h"
+
 namespace accelviz {
 
 namespace {
@@ -100,24 +102,6 @@ std::string flattened_spec(const std::string& spec, std::size_t merged) {
   return spec + " [flattened " + std::to_string(merged) + " instance" + (merged == 1 ? "" : "s") + "]";
 }
 
-namespace {
-
-nlohmann::json two_level_json(const TwoLevelFigures& f) {
-  return {{"sah_cost", f.sah_cost},
-          {"memory_bytes", f.memory_bytes},
-          {"build_ms", f.build_ms},
-          {"instances", f.instances},
-          {"blas", f.blas},
-          {"rays", f.rays},
-          {"hits", f.hits},
-          {"mean_nodes", f.mean_nodes},
-          {"mean_prims", f.mean_prims},
-          {"mean_instances", f.mean_instances},
-          {"trace_ms", f.trace_ms}};
-}
-
-}  // namespace
-
 nlohmann::json flatten_result_json(const FlattenResult& r, const std::string& spec) {
   nlohmann::json j = {{"scene", spec},
                       {"instances", format_instance_ids(r.instances)},
@@ -126,10 +110,7 @@ nlohmann::json flatten_result_json(const FlattenResult& r, const std::string& sp
                       {"ms", r.ms}};
   if (!r.error.empty()) j["error"] = r.error;
   if (r.figures) {
-    j["merged_instances"] = r.figures->merged_instances;
-    j["merged_triangles"] = r.figures->merged_triangles;
-    j["two_level"] = two_level_json(r.figures->two_level);
-    j["flattened"] = two_level_json(r.figures->flattened);
+    j.update(flatten_what_if_json(*r.figures));
   }
   if (r.committed) j["committed"] = r.committed->spec;
   return j;
