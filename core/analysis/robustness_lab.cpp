@@ -40,11 +40,11 @@ glm::vec3 vertex_of(const Triangle& t, std::size_t i) {
 // The lab's own BVH traversal, templated on the two tests so that only they
 // differ between variants. Closest hit over [ray.tmin, ray.tmax].
 template <bool Padded>
-Hit lab_closest(const Bvh& bvh, const Ray& ray, TriangleTest test, const WatertightRay& wr) {
+Hit lab_closest(const Bvh& bvh, std::span<const Triangle> tris, const Ray& ray, TriangleTest test,
+                const WatertightRay& wr) {
   Hit best;
   const auto nodes = bvh.nodes();
   if (nodes.empty()) return best;
-  const auto tris = bvh.leaf_triangles();
   const auto ids = bvh.prim_indices();
   std::uint32_t stack[kBvhMaxDepth + 2];
   int sp = 0;
@@ -75,10 +75,10 @@ Hit lab_closest(const Bvh& bvh, const Ray& ray, TriangleTest test, const Waterti
 // Every primitive the variant hits in [t0, t1] (the closest surface point's
 // tolerance window), counted.
 template <bool Padded>
-int lab_count(const Bvh& bvh, const Ray& ray, TriangleTest test, const WatertightRay& wr, float t0, float t1) {
+int lab_count(const Bvh& bvh, std::span<const Triangle> tris, const Ray& ray, TriangleTest test,
+              const WatertightRay& wr, float t0, float t1) {
   const auto nodes = bvh.nodes();
   if (nodes.empty()) return 0;
-  const auto tris = bvh.leaf_triangles();
   std::uint32_t stack[kBvhMaxDepth + 2];
   int sp = 0, count = 0;
   stack[sp++] = 0;
@@ -225,6 +225,7 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
   BvhOptions bo;
   bo.threads = opts.threads;
   const Bvh bvh(triangles, bo);
+  const std::vector<Triangle> leaf_tris = bvh.copy_leaf_triangles();  // the lab's traversals index leaf positions
   std::unique_ptr<Accelerator> own;
   if (!opts.structure.empty()) {
     StructureOptions so;
@@ -291,7 +292,8 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
         hits[i] = own->closest_hit(ray, q);
       } else {
         const WatertightRay wr(ray.direction);
-        hits[i] = s.padded ? lab_closest<true>(bvh, ray, s.test, wr) : lab_closest<false>(bvh, ray, s.test, wr);
+        hits[i] = s.padded ? lab_closest<true>(bvh, leaf_tris, ray, s.test, wr)
+                           : lab_closest<false>(bvh, leaf_tris, ray, s.test, wr);
       }
       if ((i & 4095) == 4095) check();
     }
@@ -323,8 +325,8 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
       if (rh.valid() && ref_count[i] == 1) {
         const WatertightRay wr(lr.ray.direction);
         const float t0f = static_cast<float>(rh.t - rh.t_tolerance), t1f = static_cast<float>(rh.t + rh.t_tolerance);
-        const int n = s.padded ? lab_count<true>(bvh, lr.ray, s.test, wr, t0f, t1f)
-                               : lab_count<false>(bvh, lr.ray, s.test, wr, t0f, t1f);
+        const int n = s.padded ? lab_count<true>(bvh, leaf_tris, lr.ray, s.test, wr, t0f, t1f)
+                               : lab_count<false>(bvh, leaf_tris, lr.ray, s.test, wr, t0f, t1f);
         if (n >= 2) {
           ++v.double_hits;
           ++v.double_hits_by_family[fam];

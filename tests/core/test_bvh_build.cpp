@@ -46,6 +46,8 @@ void expect_valid_tree(const Bvh& bvh, std::span<const Triangle> tris, const Bvh
   const auto nodes = bvh.nodes();
   const auto ids = bvh.prim_indices();
   ASSERT_EQ(ids.size(), tris.size());
+  ASSERT_EQ(bvh.triangle_count(), tris.size());
+  const std::vector<Triangle> leaf_tris = bvh.copy_leaf_triangles();
   if (tris.empty()) {
     EXPECT_TRUE(nodes.empty());
     return;
@@ -69,8 +71,8 @@ void expect_valid_tree(const Bvh& bvh, std::span<const Triangle> tris, const Bvh
         ASSERT_LT(ids[k], tris.size());
         ++seen[ids[k]];
         b.extend(tris[ids[k]].bounds());
-        // The leaf-order copy matches the scene triangle.
-        EXPECT_EQ(std::memcmp(&bvh.leaf_triangles()[k], &tris[ids[k]], sizeof(Triangle)), 0);
+        // The leaf-order triangles (from the blocks) match the scene triangle.
+        EXPECT_EQ(std::memcmp(&leaf_tris[k], &tris[ids[k]], sizeof(Triangle)), 0);
       }
       EXPECT_TRUE(b.lo == n.bounds.lo && b.hi == n.bounds.hi) << "leaf " << i << " bounds not tight";
     } else {
@@ -165,10 +167,10 @@ TEST(BvhBuild, StatsMatchTheNodeArray) {
   EXPECT_EQ(st.leaf_count, leaves);
   EXPECT_EQ(st.max_depth, max_depth);
   EXPECT_NEAR(st.avg_leaf_depth, depth_sum / static_cast<double>(leaves), 1e-9);
-  // Nodes, indices, the leaf-order triangles, and the W-wide copy (W = 4:
-  // 128-byte nodes, W = 8: 256-byte nodes, plus the binary id each of its W
-  // slots copies; the leaves' triangles in 160-byte blocks of four,
-  // ceil(count / 4) per leaf).
+  // Nodes, indices, the triangles once as 160-byte blocks of four
+  // (ceil(count / 4) per leaf) with a 4-byte first-block index per binary
+  // node, and the W-wide copy (W = 4: 128-byte nodes, W = 8: 256-byte
+  // nodes, plus the binary id each of its W slots copies).
   const std::size_t wide = static_cast<std::size_t>(st.extra.at("wide_nodes"));
   const auto width = static_cast<std::size_t>(st.extra.at("wide_width"));
   ASSERT_TRUE(width == 4 || width == 8);
@@ -177,12 +179,18 @@ TEST(BvhBuild, StatsMatchTheNodeArray) {
   std::size_t blocks = 0;
   for (const BvhNode& n : bvh.nodes())
     if (n.count > 0) blocks += (n.count + 3) / 4;
-  EXPECT_EQ(st.memory_bytes, bvh.nodes().size() * 32 + tris.size() * 4 + tris.size() * sizeof(Triangle) +
-                                 wide * width * (32 + 4) + blocks * 160);
+  const std::size_t shared = bvh.nodes().size() * (32 + 4) + tris.size() * 4 + blocks * 160;
+  EXPECT_EQ(st.memory_bytes, shared + wide * width * (32 + 4));
+  // The breakdown in extra sums to the total.
+  double parts = 0.0;
+  for (const char* key : {"memory_binary_nodes", "memory_prim_indices", "memory_tri_blocks", "memory_leaf_block_index",
+                          "memory_wide_nodes", "memory_wide_source"})
+    parts += st.extra.at(key);
+  EXPECT_EQ(parts, static_cast<double>(st.memory_bytes));
+  EXPECT_EQ(st.extra.at("memory_tri_blocks"), static_cast<double>(blocks * 160));
   o.wide_traversal = false;
   const Bvh binary_only(tris, o);
-  EXPECT_EQ(binary_only.build_stats().memory_bytes,
-            bvh.nodes().size() * 32 + tris.size() * 4 + tris.size() * sizeof(Triangle));
+  EXPECT_EQ(binary_only.build_stats().memory_bytes, shared);
   EXPECT_EQ(binary_only.build_stats().extra.count("wide_nodes"), 0u);
   EXPECT_GE(st.build_ms, 0.0);
   EXPECT_GT(st.sah_cost, 0.0);

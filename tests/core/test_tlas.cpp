@@ -293,7 +293,7 @@ TEST(Tlas, BuildsEachUniqueMeshOnce) {
   EXPECT_EQ(tlas.instances().size(), s.instances.size());
   EXPECT_EQ(tlas.blas_of_mesh(2), -1);
   EXPECT_EQ(tlas.instanced_triangles(), s.triangles.size());
-  EXPECT_EQ(tlas.blas(tlas.blas_of_mesh(0)).leaf_triangles().size(), s.meshes[0].indices.size());
+  EXPECT_EQ(tlas.blas(tlas.blas_of_mesh(0)).triangle_count(), s.meshes[0].indices.size());
   EXPECT_LT(tlas.memory_two_level(), tlas.memory_flattened_estimate() / 10);
   EXPECT_GT(tlas.build_stats().sah_cost, 0.0);
   for (const TlasInstance& inst : tlas.instances()) {

@@ -73,7 +73,7 @@ StructureNodes StructureNodes::of(const Accelerator& accel) {
         leaf.parent = i;
         leaf.depth = t.nodes_[i].depth + 1;
         leaf.leaf = true;
-        leaf.prims = static_cast<std::uint32_t>(tlas->blas(inst.blas).leaf_triangles().size());
+        leaf.prims = static_cast<std::uint32_t>(tlas->blas(inst.blas).triangle_count());
         leaf.instance = order[k];
         t.nodes_.push_back(leaf);
       }

@@ -58,9 +58,9 @@ GpuBvhTracer::GpuBvhTracer() : program_(ShaderProgram::build({"trace_bvh.comp"})
 
 void GpuBvhTracer::upload(const Bvh& bvh) {
   const std::span<const BvhNode> nodes = bvh.nodes();
-  const std::span<const Triangle> tris = bvh.leaf_triangles();
+  const std::vector<Triangle> tris = bvh.copy_leaf_triangles();
   nodes_ = make_storage(nodes.data(), nodes.size_bytes(), "the BVH nodes");
-  tris_ = make_storage(tris.data(), tris.size_bytes(), "the triangles");
+  tris_ = make_storage(tris.data(), tris.size() * sizeof(Triangle), "the triangles");
   node_count_ = nodes.size();
   prim_ids_.assign(bvh.prim_indices().begin(), bvh.prim_indices().end());
   normals_.resize(tris.size());

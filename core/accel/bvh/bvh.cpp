@@ -11,6 +11,7 @@
 
 #include <bit>
 #include <chrono>
+#include <functional>
 #include <stdexcept>
 #include <string>
 
@@ -23,15 +24,23 @@
 namespace accelviz {
 namespace {
 
-/// Collapses `nodes` into `wide` with triangle blocks; returns its bytes.
+/// Collapses `nodes` into `wide`, leaf slots pointing at the triangle blocks; returns its bytes.
 template <int W>
-std::size_t make_wide(std::span<const BvhNode> nodes, std::span<const Triangle> leaf_tris,
-                      bvh_detail::WideBvhT<W>& wide, BuildStats& stats) {
+std::size_t make_wide(std::span<const BvhNode> nodes, const std::function<void(std::uint32_t)>& add_leaf,
+                      std::span<const std::uint32_t> leaf_block, bvh_detail::WideBvhT<W>& wide, BuildStats& stats) {
   bvh_detail::collapse_to_wide(nodes, wide);
-  bvh_detail::build_tri4_blocks(wide, leaf_tris);
+  // The triangle blocks in the order the fast path's leaf slots are laid out.
+  for (std::size_t w = 0; w < wide.nodes.size(); ++w)
+    for (int s = 0; s < W; ++s)
+      if (wide.nodes[w].meta[s] != 0 && wide.nodes[w].meta[s] != bvh_detail::kWideEmpty)
+        add_leaf(wide.source[W * w + s]);
+  bvh_detail::point_leaf_slots_at_blocks(wide, leaf_block);
+  const std::size_t node_bytes = wide.nodes.size() * sizeof(bvh_detail::WideNodeT<W>);
+  const std::size_t source_bytes = wide.source.size() * sizeof(std::uint32_t);
   stats.extra["wide_nodes"] = static_cast<double>(wide.nodes.size());
-  return wide.nodes.size() * sizeof(bvh_detail::WideNodeT<W>) + wide.source.size() * sizeof(std::uint32_t) +
-         wide.tri_blocks.size() * sizeof(bvh_detail::TriBlock4);
+  stats.extra["memory_wide_nodes"] = static_cast<double>(node_bytes);
+  stats.extra["memory_wide_source"] = static_cast<double>(source_bytes);
+  return node_bytes + source_bytes;
 }
 
 }  // namespace
@@ -49,25 +58,47 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
   nodes_ = std::move(topo.nodes);
   prim_indices_ = std::move(topo.prim_indices);
   stats_ = std::move(topo.stats);
-  // Triangles in leaf order: a leaf's triangles are contiguous in memory.
-  leaf_tris_.resize(prim_indices_.size());
-  for (std::size_t k = 0; k < prim_indices_.size(); ++k) leaf_tris_[k] = triangles[prim_indices_[k]];
-  stats_.memory_bytes += leaf_tris_.size() * sizeof(Triangle);
+  nodes_.shrink_to_fit();
+  prim_indices_.shrink_to_fit();
+  // The triangles as blocks of four, each leaf from a new block (its
+  // triangles contiguous, in leaf order), the blocks in the order the wide
+  // tree's leaf slots are laid out (else in node order).
+  std::size_t block_count = 0;
+  for (const BvhNode& n : nodes_) block_count += (n.count + 3) / 4;
+  blocks_.reserve(block_count);
+  leaf_block_.assign(nodes_.size(), 0);
+  const std::function<void(std::uint32_t)> add_leaf = [&](std::uint32_t i) {
+    const auto tri_at = [&](std::uint32_t k) -> const Triangle& { return triangles[prim_indices_[k]]; };
+    leaf_block_[i] = bvh_detail::append_tri4_blocks(tri_at, nodes_[i].index, nodes_[i].count, blocks_);
+  };
+  std::size_t wide_bytes = 0;
   if (opts_.wide_traversal && !nodes_.empty()) {
     const int width = opts_.wide_width == 0                                   ? (bvh_detail::cpu_has_wide8() ? 8 : 4)
                       : opts_.wide_width == 8 && !bvh_detail::cpu_has_wide8() ? 4
                                                                               : opts_.wide_width;
     if (width == 8) {
       wide8_ = std::make_unique<bvh_detail::WideBvh8>();
-      stats_.memory_bytes += make_wide(nodes_, leaf_tris_, *wide8_, stats_);
+      wide_bytes = make_wide(nodes_, add_leaf, leaf_block_, *wide8_, stats_);
     } else {
       wide_ = std::make_unique<bvh_detail::WideBvh>();
-      stats_.memory_bytes += make_wide(nodes_, leaf_tris_, *wide_, stats_);
+      wide_bytes = make_wide(nodes_, add_leaf, leaf_block_, *wide_, stats_);
     }
     stats_.extra["wide_width"] = width;
+  } else {
+    for (std::uint32_t i = 0; i < nodes_.size(); ++i)
+      if (nodes_[i].count > 0) add_leaf(i);
   }
+  const std::size_t node_bytes = nodes_.size() * sizeof(BvhNode);
+  const std::size_t index_bytes = prim_indices_.size() * sizeof(std::uint32_t);
+  const std::size_t block_bytes = blocks_.size() * sizeof(bvh_detail::TriBlock4);
+  const std::size_t leaf_block_bytes = leaf_block_.size() * sizeof(std::uint32_t);
+  stats_.extra["memory_binary_nodes"] = static_cast<double>(node_bytes);
+  stats_.extra["memory_prim_indices"] = static_cast<double>(index_bytes);
+  stats_.extra["memory_tri_blocks"] = static_cast<double>(block_bytes);
+  stats_.extra["memory_leaf_block_index"] = static_cast<double>(leaf_block_bytes);
+  stats_.memory_bytes = node_bytes + index_bytes + block_bytes + leaf_block_bytes + wide_bytes;
   stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  update_quality_stats();
+  update_quality_stats(triangles);
 }
 
 Bvh::~Bvh() = default;
@@ -75,7 +106,8 @@ Bvh::Bvh(const Bvh& o)
     : Accelerator(o),
       nodes_(o.nodes_),
       prim_indices_(o.prim_indices_),
-      leaf_tris_(o.leaf_tris_),
+      blocks_(o.blocks_),
+      leaf_block_(o.leaf_block_),
       wide_(o.wide_ ? std::make_unique<bvh_detail::WideBvh>(*o.wide_) : nullptr),
       wide8_(o.wide8_ ? std::make_unique<bvh_detail::WideBvh8>(*o.wide8_) : nullptr),
       opts_(o.opts_),
@@ -83,45 +115,47 @@ Bvh::Bvh(const Bvh& o)
 Bvh::Bvh(Bvh&&) noexcept = default;
 Bvh& Bvh::operator=(Bvh&&) noexcept = default;
 
-void Bvh::update_quality_stats() {
+void Bvh::update_quality_stats(std::span<const Triangle> triangles) {
   stats_.sah_cost = bvh_sah_cost(nodes_, opts_.cost_traversal, opts_.cost_intersect);
   if (opts_.compute_epo) {
     // Not part of build_ms: it is a measurement of the tree, not a step of
     // making it; its own time is reported beside it.
     const auto t0 = std::chrono::steady_clock::now();
     stats_.extra["epo"] =
-        bvh_epo_leaf_order(nodes_, leaf_tris_, opts_.cost_traversal, opts_.cost_intersect, opts_.threads);
+        bvh_epo(nodes_, prim_indices_, triangles, opts_.cost_traversal, opts_.cost_intersect, opts_.threads);
     stats_.extra["epo_ms"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
 }
 
 void Bvh::refit(std::span<const Triangle> moved) {
-  if (moved.size() != leaf_tris_.size())
-    throw std::invalid_argument("Bvh::refit: expected " + std::to_string(leaf_tris_.size()) + " triangles, got " +
+  if (moved.size() != prim_indices_.size())
+    throw std::invalid_argument("Bvh::refit: expected " + std::to_string(prim_indices_.size()) + " triangles, got " +
                                 std::to_string(moved.size()));
   const auto t0 = std::chrono::steady_clock::now();
-  for (std::size_t k = 0; k < prim_indices_.size(); ++k) leaf_tris_[k] = moved[prim_indices_[k]];
   // Children are stored after their parents: one reverse sweep is bottom-up.
   for (std::size_t i = nodes_.size(); i-- > 0;) {
     BvhNode& n = nodes_[i];
     Aabb b;
     if (n.count > 0) {
-      for (std::uint32_t k = n.index; k < n.index + n.count; ++k) b.extend(leaf_tris_[k].bounds());
+      for (std::uint32_t k = n.index; k < n.index + n.count; ++k) b.extend(moved[prim_indices_[k]].bounds());
     } else {
       b = Aabb::merge(nodes_[n.index].bounds, nodes_[n.index + 1].bounds);
     }
     n.bounds = b;
   }
-  if (wide_) {
-    bvh_detail::refit_wide(*wide_, nodes_);
-    bvh_detail::refit_tri4_blocks(leaf_tris_, wide_->tri_blocks);
-  }
-  if (wide8_) {
-    bvh_detail::refit_wide(*wide8_, nodes_);
-    bvh_detail::refit_tri4_blocks(leaf_tris_, wide8_->tri_blocks);
-  }
+  bvh_detail::refit_tri4_blocks([&](std::uint32_t k) -> const Triangle& { return moved[prim_indices_[k]]; }, blocks_);
+  if (wide_) bvh_detail::refit_wide(*wide_, nodes_);
+  if (wide8_) bvh_detail::refit_wide(*wide8_, nodes_);
   stats_.extra["refit_ms"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  update_quality_stats();
+  update_quality_stats(moved);
+}
+
+std::vector<Triangle> Bvh::copy_leaf_triangles() const {
+  std::vector<Triangle> out(prim_indices_.size());
+  for (const bvh_detail::TriBlock4& b : blocks_)
+    for (std::uint32_t l = 0; l < 4; ++l)
+      if (b.pos[l] != bvh_detail::kTri4Empty) out[b.pos[l]] = bvh_detail::tri4_triangle(b, l);
+  return out;
 }
 
 namespace {
@@ -132,7 +166,8 @@ using bvh_detail::SlabRay;
 
 struct BvhView {
   const BvhNode* nodes;
-  const Triangle* tris;
+  const bvh_detail::TriBlock4* blocks;  ///< the triangle blocks (bvh_tri4.h)
+  const std::uint32_t* leaf_block;      ///< per binary node: a leaf's first block
   const std::uint32_t* prim_ids;
   std::size_t node_count;
 };
@@ -299,11 +334,14 @@ Hit traverse(const BvhView& bvh, const Ray& ray, const Collector& c) {
         continue;
       }
     } else {
-      for (std::uint32_t k = n.index, end = n.index + n.count; k < end; ++k) {
+      const bvh_detail::TriBlock4* blk = bvh.blocks + bvh.leaf_block[node];
+      for (std::uint32_t j = 0; j < n.count; ++j) {
+        const std::uint32_t k = n.index + j;
+        const Triangle tri = bvh_detail::tri4_triangle(blk[j >> 2], j & 3);
         Hit h;
         // X-ray: every primitive is tested over the whole segment.
         const float prim_tmax = Collect && !AnyHit && c.xray ? ray.tmax : closest;
-        const bool hit = test_triangle<Test>(ray, wr, bvh.tris[k], tmin, prim_tmax, h);
+        const bool hit = test_triangle<Test>(ray, wr, tri, tmin, prim_tmax, h);
         if constexpr (Collect) {
           ++c.stats->prim_tests;
           c.prim(bvh.prim_ids[k], hit, h.t);
@@ -322,6 +360,7 @@ Hit traverse(const BvhView& bvh, const Ray& ray, const Collector& c) {
         } else if (hit && h.t < best.t) {  // first found wins ties, as in BruteForce
           best = h;
           best.prim = k;
+          best.ng = triangle_normal(tri);
           closest = h.t;
         }
       }
@@ -414,7 +453,7 @@ Hit dispatch(const BvhView& v, const Ray& ray, const QueryOptions& qo, const Col
 }  // namespace
 
 Hit Bvh::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, VisitTrace* trace) const {
-  const BvhView v{nodes_.data(), leaf_tris_.data(), prim_indices_.data(), nodes_.size()};
+  const BvhView v{nodes_.data(), blocks_.data(), leaf_block_.data(), prim_indices_.data(), nodes_.size()};
   Hit h;
   if (stats == nullptr && trace == nullptr && !qo.back_to_front && !qo.xray) {
     h = wide8_  ? dispatch_wide8<false>(*wide8_, v, ray, qo)
@@ -424,15 +463,12 @@ Hit Bvh::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, Vi
     RayStats local;
     h = dispatch<false, true>(v, ray, qo, Collector{stats ? stats : &local, trace, qo.back_to_front, qo.xray});
   }
-  if (h.valid()) {
-    h.ng = triangle_normal(leaf_tris_[h.prim]);
-    h.prim = prim_indices_[h.prim];
-  }
+  if (h.valid()) h.prim = prim_indices_[h.prim];  // the traversals set ng
   return h;
 }
 
 bool Bvh::any_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats) const {
-  const BvhView v{nodes_.data(), leaf_tris_.data(), prim_indices_.data(), nodes_.size()};
+  const BvhView v{nodes_.data(), blocks_.data(), leaf_block_.data(), prim_indices_.data(), nodes_.size()};
   if (stats == nullptr && !qo.back_to_front)
     return wide8_  ? dispatch_wide8<true>(*wide8_, v, ray, qo).valid()
            : wide_ ? dispatch_wide<true>(*wide_, v, ray, qo).valid()

@@ -25,6 +25,7 @@ namespace accelviz {
 namespace bvh_detail {
 struct WideBvh;
 struct WideBvh8;
+struct TriBlock4;
 }
 
 /// How a node's primitives are divided between its two children.
@@ -87,13 +88,15 @@ struct BvhTopology {
 BvhTopology build_bvh(std::span<const Aabb> bounds, std::span<const glm::vec3> centroids,
                       const BvhOptions& opts = {}, const ProgressCallback& progress = {});
 
-/// A BVH over triangles: build_bvh plus a leaf-ordered copy of the triangles
-/// for traversal, closest/any-hit queries and refitting.
+/// A BVH over triangles: build_bvh plus the triangles in leaf order, stored
+/// once as blocks of four (bvh_tri4.h; each binary leaf starts a block),
+/// which every traversal reads: the binary one (statistics, traces) through
+/// a per-node first-block index, the wide fast path through its leaf slots.
 class Bvh final : public Accelerator {
  public:
   Bvh(std::span<const Triangle> triangles, const BvhOptions& opts = {}, const ProgressCallback& progress = {});
   ~Bvh() override;
-  /// A deep copy (nodes, leaf triangles, the wide copy): what a two-level
+  /// A deep copy (nodes, triangle blocks, the wide copy): what a two-level
   /// structure refits when the BLAS is shared with a snapshot (Tlas::snapshot).
   Bvh(const Bvh& other);
   Bvh(Bvh&&) noexcept;
@@ -108,8 +111,11 @@ class Bvh final : public Accelerator {
   std::span<const BvhNode> nodes() const { return nodes_; }
   /// Leaf ranges index this array; its values are primitive ids in scene order.
   std::span<const std::uint32_t> prim_indices() const { return prim_indices_; }
-  /// Triangles in leaf order: leaf_triangles()[k] is scene triangle prim_indices()[k].
-  std::span<const Triangle> leaf_triangles() const { return leaf_tris_; }
+  /// Number of triangles the tree was built over.
+  std::size_t triangle_count() const { return prim_indices_.size(); }
+  /// A copy of the triangles in leaf order: [k] is scene triangle
+  /// prim_indices()[k] (O(triangles); the tree keeps them only as blocks).
+  std::vector<Triangle> copy_leaf_triangles() const;
   const BvhOptions& options() const { return opts_; }
 
   /// After the vertices moved (same triangle count, same order as at build):
@@ -120,11 +126,13 @@ class Bvh final : public Accelerator {
   void refit(std::span<const Triangle> moved_triangles);
 
  private:
-  void update_quality_stats();
+  /// sah_cost, and epo when enabled, over `triangles` in scene order.
+  void update_quality_stats(std::span<const Triangle> triangles);
 
   std::vector<BvhNode> nodes_;
   std::vector<std::uint32_t> prim_indices_;
-  std::vector<Triangle> leaf_tris_;
+  std::vector<bvh_detail::TriBlock4> blocks_;  ///< the triangles, four per block, each leaf from a new block
+  std::vector<std::uint32_t> leaf_block_;      ///< per binary node: a leaf's first block (unused for inner nodes)
   std::unique_ptr<bvh_detail::WideBvh> wide_;    ///< 4-wide copy for the fast path (null when not used)
   std::unique_ptr<bvh_detail::WideBvh8> wide8_;  ///< 8-wide copy for the fast path (null when not used)
   BvhOptions opts_;

@@ -36,17 +36,19 @@ static_assert(sizeof(TriBlock4) == 160);
 
 inline constexpr std::uint32_t kTri4Empty = 0xFFFFFFFFu;
 
-/// Blocks for leaf triangles [first, first + count) of `tris` (leaf order),
-/// appended to `out`; returns the index of the first block.
-inline std::uint32_t append_tri4_blocks(std::span<const Triangle> tris, std::uint32_t first, std::uint32_t count,
-                                        std::vector<TriBlock4>& out) {
+/// Blocks for leaf positions [first, first + count): `tri(k)` is the
+/// triangle at leaf position k. Appended to `out`; returns the index of the
+/// first block.
+template <class TriAt>
+std::uint32_t append_tri4_blocks(const TriAt& tri, std::uint32_t first, std::uint32_t count,
+                                 std::vector<TriBlock4>& out) {
   const auto start = static_cast<std::uint32_t>(out.size());
   for (std::uint32_t b = 0; b < count; b += 4) {
     TriBlock4 blk{};
     for (std::uint32_t l = 0; l < 4; ++l) {
       const bool used = b + l < count;
       // Padding lanes repeat the block's first triangle (finite values) and are masked out.
-      const Triangle& t = tris[first + b + (used ? l : 0)];
+      const Triangle& t = tri(first + b + (used ? l : 0));
       const glm::vec3* vs[3] = {&t.v0, &t.v1, &t.v2};
       for (int k = 0; k < 3; ++k)
         for (int a = 0; a < 3; ++a) blk.v[3 * k + a][l] = (&vs[k]->x)[a];
@@ -57,12 +59,20 @@ inline std::uint32_t append_tri4_blocks(std::span<const Triangle> tris, std::uin
   return start;
 }
 
-/// Copies the triangles at the blocks' positions again (after a refit).
-inline void refit_tri4_blocks(std::span<const Triangle> tris, std::vector<TriBlock4>& blocks) {
+/// The triangle in lane `l` of a block (the floats it was built from).
+[[gnu::always_inline]] inline Triangle tri4_triangle(const TriBlock4& b, std::uint32_t l) {
+  return Triangle{
+      {b.v[0][l], b.v[1][l], b.v[2][l]}, {b.v[3][l], b.v[4][l], b.v[5][l]}, {b.v[6][l], b.v[7][l], b.v[8][l]}};
+}
+
+/// Copies the triangles at the blocks' positions again (after a refit):
+/// `tri(k)` is the triangle now at leaf position k.
+template <class TriAt>
+void refit_tri4_blocks(const TriAt& tri, std::vector<TriBlock4>& blocks) {
   for (TriBlock4& blk : blocks)
     for (std::uint32_t l = 0; l < 4; ++l) {
       const std::uint32_t p = blk.pos[l] != kTri4Empty ? blk.pos[l] : blk.pos[0];
-      const Triangle& t = tris[p];
+      const Triangle& t = tri(p);
       const glm::vec3* vs[3] = {&t.v0, &t.v1, &t.v2};
       for (int k = 0; k < 3; ++k)
         for (int a = 0; a < 3; ++a) blk.v[3 * k + a][l] = (&vs[k]->x)[a];

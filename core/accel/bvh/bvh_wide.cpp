@@ -34,7 +34,6 @@ template <int W>
 void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide) {
   wide.nodes.clear();
   wide.source.clear();
-  wide.tri_blocks.clear();
   if (binary.empty()) return;
   wide.nodes.reserve(binary.size() / 2 + 1);
   wide.source.reserve(2 * binary.size() + 4);
@@ -96,17 +95,17 @@ void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide) {
     for (int s = n - 1; s >= 0; --s)
       if (wide.nodes[w].meta[s] == 0) work.push_back({wide.nodes[w].child[s], slots[s]});
   }
+  // The reserve above is sized for 2-wide; wider trees use a fraction of it.
+  wide.nodes.shrink_to_fit();
+  wide.source.shrink_to_fit();
 }
 
 template <int W>
-void build_tri4_blocks(WideBvhT<W>& wide, std::span<const Triangle> leaf_tris) {
-  wide.tri_blocks.clear();
-  wide.tri_blocks.reserve(leaf_tris.size() / 2 + 1);
-  for (WideNodeT<W>& n : wide.nodes)
+void point_leaf_slots_at_blocks(WideBvhT<W>& wide, std::span<const std::uint32_t> leaf_block) {
+  for (std::size_t w = 0; w < wide.nodes.size(); ++w)
     for (int s = 0; s < W; ++s)
-      if (n.meta[s] != 0 && n.meta[s] != kWideEmpty)
-        n.child[s] = append_tri4_blocks(leaf_tris, n.child[s], n.meta[s], wide.tri_blocks);
-  wide.tri_blocks.shrink_to_fit();
+      if (wide.nodes[w].meta[s] != 0 && wide.nodes[w].meta[s] != kWideEmpty)
+        wide.nodes[w].child[s] = leaf_block[wide.source[W * w + s]];
 }
 
 template <int W>
@@ -141,8 +140,8 @@ bool cpu_has_wide8() {
 
 template void collapse_to_wide<4>(std::span<const BvhNode>, WideBvhT<4>&);
 template void collapse_to_wide<8>(std::span<const BvhNode>, WideBvhT<8>&);
-template void build_tri4_blocks<4>(WideBvhT<4>&, std::span<const Triangle>);
-template void build_tri4_blocks<8>(WideBvhT<8>&, std::span<const Triangle>);
+template void point_leaf_slots_at_blocks<4>(WideBvhT<4>&, std::span<const std::uint32_t>);
+template void point_leaf_slots_at_blocks<8>(WideBvhT<8>&, std::span<const std::uint32_t>);
 template void refit_wide<4>(WideBvhT<4>&, std::span<const BvhNode>);
 template void refit_wide<8>(WideBvhT<8>&, std::span<const BvhNode>);
 template int wide_slab_test_scalar<4>(const WideNodeT<4>&, const Ray&, float, float, float*, float*);

@@ -27,7 +27,8 @@ namespace accelviz::bvh_detail {
 /// W child boxes in structure-of-arrays order, then the children (W = 4:
 /// 128 bytes, SSE; W = 8: 256 bytes, AVX2). meta = 0: inner wide node
 /// `child`; 1..255: leaf of `meta` primitives starting at leaf position
-/// `child`; kWideEmpty: unused slot.
+/// `child` (after point_leaf_slots_at_blocks: at triangle block `child`);
+/// kWideEmpty: unused slot.
 template <int W>
 struct alignas(64) WideNodeT {
   float bounds[6][W];  ///< [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z][slot]
@@ -45,20 +46,15 @@ template <int W>
 struct WideBvhT {
   std::vector<WideNodeT<W>> nodes;    ///< root at 0; empty when the binary tree is
   std::vector<std::uint32_t> source;  ///< W per wide node: the binary node each slot copies (kWideEmpty if unused)
-  /// The leaves' triangles as blocks of four (bvh_tri4.h), for the fast
-  /// path: once build_tri4_blocks has run, a leaf slot's `child` is the
-  /// index of its first block (ceil(meta / 4) consecutive blocks, in the
-  /// order the slots are laid out), no longer its first leaf position.
-  std::vector<TriBlock4> tri_blocks;
 };
 struct WideBvh : WideBvhT<4> {};
 struct WideBvh8 : WideBvhT<8> {};
 
-/// Fills wide.tri_blocks from the leaf-order triangles and points every
-/// leaf slot at its first block (collapse_to_wide's leaf slots name leaf
-/// positions; afterwards they name blocks).
+/// Points every leaf slot at the first triangle block of the binary leaf it
+/// copies (`leaf_block[binary node]`, class Bvh's leaf-order blocks of
+/// bvh_tri4.h); before, collapse_to_wide's leaf slots name leaf positions.
 template <int W>
-void build_tri4_blocks(WideBvhT<W>& wide, std::span<const Triangle> leaf_tris);
+void point_leaf_slots_at_blocks(WideBvhT<W>& wide, std::span<const std::uint32_t> leaf_block);
 
 /// Collapses a binary node array: each wide node takes a binary inner node's
 /// children and keeps opening the child with the largest surface area until

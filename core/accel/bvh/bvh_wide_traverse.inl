@@ -36,7 +36,8 @@ Hit traverse_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& b
   Entry stack[(kWidth - 1) * kBvhMaxDepth + 1];
   // A triangle test's outcome for leaf position k: any hit ends the walk
   // (returns true); closest hit keeps the first found at the smallest t.
-  const auto take = [&](bool hit, const Hit& h, std::uint32_t k) {
+  // `tri`: the triangle (for the closest hit's normal).
+  const auto take = [&](bool hit, const Hit& h, std::uint32_t k, const Triangle& tri) {
     if (!hit) return false;
     if constexpr (AnyHit) {
       best = h;
@@ -46,6 +47,7 @@ Hit traverse_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& b
     if (h.t < best.t) {
       best = h;
       best.prim = k;
+      best.ng = triangle_normal(tri);
       closest = h.t;
     }
     return false;
@@ -101,7 +103,7 @@ Hit traverse_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& b
       if constexpr (kTri4) {
         // Lanes in slot order are the leaf's triangles in order: the same
         // sequence of tests and acceptances as the scalar loop below.
-        const bvh_detail::TriBlock4* blk = wide_bvh.tri_blocks.data() + child;
+        const bvh_detail::TriBlock4* blk = bvh.blocks + child;
         for (std::uint32_t left = meta; left > 0; ++blk) {
           const int valid = left >= 4 ? 0xF : (1 << left) - 1;
           left = left >= 4 ? left - 4 : 0;
@@ -112,27 +114,30 @@ Hit traverse_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& b
             const int l = std::countr_zero(static_cast<unsigned>(lanes));
             lanes &= lanes - 1;
             const std::uint32_t k = blk->pos[l];
+            const Triangle tri = bvh_detail::tri4_triangle(*blk, static_cast<std::uint32_t>(l));
             Hit h;
             bool hit;
             if ((r.special >> l) & 1) {
-              hit = intersect_watertight(ray, wr.wr, bvh.tris[k], tmin, closest, h);
+              hit = intersect_watertight(ray, wr.wr, tri, tmin, closest, h);
             } else {
               hit = bvh_detail::tri4_accept(r, l, closest);
               h.t = r.t[l];
               h.u = r.u[l];
               h.v = r.v[l];
             }
-            if (take(hit, h, k)) return best;
+            if (take(hit, h, k, tri)) return best;
           }
         }
       } else
 #endif
         // A wide leaf slot names its first block; the leaf's triangles are
-        // consecutive in leaf order from the block's first position.
-        for (std::uint32_t k = wide_bvh.tri_blocks[child].pos[0], end = k + meta; k < end; ++k) {
+        // its blocks' lanes in order.
+        for (std::uint32_t j = 0; j < meta; ++j) {
+          const bvh_detail::TriBlock4& blk = bvh.blocks[child + (j >> 2)];
+          const Triangle tri = bvh_detail::tri4_triangle(blk, j & 3);
           Hit h;
-          const bool hit = test_triangle<Test>(ray, wr, bvh.tris[k], tmin, closest, h);
-          if (take(hit, h, k)) return best;
+          const bool hit = test_triangle<Test>(ray, wr, tri, tmin, closest, h);
+          if (take(hit, h, blk.pos[j & 3], tri)) return best;
         }
     }
     for (;;) {

@@ -67,7 +67,7 @@ Tlas::Tlas(const Scene& scene, const TlasOptions& opts, const ProgressCallback& 
   build_blas_list(scene, progress);
   // Instances, with the world primitive ids flattening gives (or would give).
   std::vector<std::uint64_t> kept(blas_.size());
-  for (std::size_t b = 0; b < blas_.size(); ++b) kept[b] = blas_[b]->leaf_triangles().size();
+  for (std::size_t b = 0; b < blas_.size(); ++b) kept[b] = blas_[b]->triangle_count();
   std::uint64_t next = 0;
   instances_.reserve(scene.instances.size());
   const bool flattened = !scene.triangles.empty();
@@ -238,7 +238,7 @@ void Tlas::update_memory_stats() {
   stats_.extra["memory_flattened_estimate"] = static_cast<double>(flat);
   stats_.extra["instanced_triangles"] = static_cast<double>(instanced_triangles_);
   std::uint64_t unique = 0;
-  for (const auto& b : blas_) unique += b->leaf_triangles().size();
+  for (const auto& b : blas_) unique += b->triangle_count();
   stats_.extra["unique_triangles"] = static_cast<double>(unique);
 }
 
@@ -378,10 +378,10 @@ TlasUpdateStats Tlas::refit_blas(std::size_t b, std::span<const Triangle> tris) 
 
 TlasUpdateStats Tlas::replace_blas(std::size_t b, Bvh fresh) {
   if (b >= blas_.size()) throw std::invalid_argument("tlas: no BLAS " + std::to_string(b));
-  if (fresh.leaf_triangles().size() != blas_[b]->leaf_triangles().size())
+  if (fresh.triangle_count() != blas_[b]->triangle_count())
     throw std::invalid_argument("tlas: replacement BLAS " + std::to_string(b) + " has " +
-                                std::to_string(fresh.leaf_triangles().size()) + " triangles, built with " +
-                                std::to_string(blas_[b]->leaf_triangles().size()));
+                                std::to_string(fresh.triangle_count()) + " triangles, built with " +
+                                std::to_string(blas_[b]->triangle_count()));
   blas_[b] = std::make_shared<Bvh>(std::move(fresh));
   for (TlasInstance& inst : instances_)
     if (inst.blas == b) update_world_bounds(inst);
@@ -393,9 +393,9 @@ TlasUpdateStats Tlas::replace_blas(std::size_t b, Bvh fresh) {
 
 TlasUpdateStats Tlas::rebuild_blas(std::size_t b, std::span<const Triangle> tris) {
   if (b >= blas_.size()) throw std::invalid_argument("tlas: no BLAS " + std::to_string(b));
-  if (tris.size() != blas_[b]->leaf_triangles().size())
+  if (tris.size() != blas_[b]->triangle_count())
     throw std::invalid_argument("tlas: rebuild of BLAS " + std::to_string(b) + " with " + std::to_string(tris.size()) +
-                                " triangles, built with " + std::to_string(blas_[b]->leaf_triangles().size()));
+                                " triangles, built with " + std::to_string(blas_[b]->triangle_count()));
   TlasUpdateStats s;
   const auto t0 = Clock::now();
   blas_[b] = std::make_shared<Bvh>(tris, quiet(opts_.blas));
