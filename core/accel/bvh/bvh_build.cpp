@@ -154,7 +154,7 @@ class Builder {
       std::thread worker([&] {
         try {
           SplitScratch own_scratch;
-          right_nodes.reserve(2 * (right.end - right.begin) / std::max(1, params_.max_leaf_size) + 1);
+          right_nodes.reserve(2 * (right.end - right.begin));
           right_nodes.resize(1);
           build(right, right_nodes, 0, own_scratch);
         } catch (...) {
@@ -279,7 +279,9 @@ BvhTopology build_bvh(std::span<const Aabb> bounds, std::span<const glm::vec3> c
                           : opts.splitter == BvhSplitter::lbvh      ? split_lbvh
                                                                     : split_median;
     Builder builder(params, split, prims, resolve_threads(opts.threads), progress);
-    topo.nodes.reserve(2 * n / static_cast<std::size_t>(opts.max_leaf_size) + 1);
+    // At most 2n - 1 nodes: reserving them all spares the regrowth copies
+    // (pages never written are never touched); shrink_to_fit trims after.
+    topo.nodes.reserve(2 * n);
     topo.nodes.resize(1);
     SplitScratch scratch;
     builder.build(NodeWork{0, static_cast<std::uint32_t>(n), root_bounds, root_centroids, 0}, topo.nodes, 0,

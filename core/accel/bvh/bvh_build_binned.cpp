@@ -7,11 +7,11 @@
 // once (counts and bounds), and the SAH is evaluated only at the B-1 bucket
 // boundaries of each axis with two sweeps over the buckets. Cost per node:
 // O(n + B), no sorting.
-#include "core/accel/bvh/bvh_build.h"
-
 #include <array>
 #include <limits>
 #include <utility>
+
+#include "core/accel/bvh/bvh_build.h"
 
 #if defined(__SSE2__) && !defined(ACCELVIZ_NO_SIMD)
 #include <emmintrin.h>
@@ -58,7 +58,8 @@ void bin_primitives(std::span<const BuildPrim> prims, const glm::vec3& origin, c
   alignas(16) int idx[4];
   for (const BuildPrim& p : prims) {
     const __m128 x = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(&p.centroid.x), o), kv);
-    _mm_store_si128(reinterpret_cast<__m128i*>(idx), _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(x, _mm_setzero_ps()), top)));
+    _mm_store_si128(reinterpret_cast<__m128i*>(idx),
+                    _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(x, _mm_setzero_ps()), top)));
     // lo.xyz (+ hi.x), and hi.xyz rotated out of (lo.z, hi.x, hi.y, hi.z):
     // both loads stay inside the 40-byte record.
     const __m128 lo = _mm_loadu_ps(&p.bounds.lo.x);
@@ -88,9 +89,124 @@ Aabb bucket_box(const Bins& bins, int axis, int b) {
 
 namespace {
 
+/// cost_of[a][b] = A_L·N_L + A_R·N_R of the plane between buckets b and b+1
+/// on axis a (half areas; meaningful only where both sides hold primitives).
+/// The SSE2 version sweeps the three axes at once, one lane each, with the
+/// scalar code's operations in the scalar code's order (Aabb::extend's
+/// min/max operand order, half_area's sum order), so both give the same bits.
+#if defined(__SSE2__) && !defined(ACCELVIZ_NO_SIMD)
+[[gnu::always_inline]] inline void transpose3(__m128 r0, __m128 r1, __m128 r2, __m128& x, __m128& y, __m128& z) {
+  // rows (x_a, y_a, z_a, -) for a = 0..2 -> columns (c_0, c_1, c_2, -)
+  const __m128 t0 = _mm_unpacklo_ps(r0, r1);  // x0 x1 y0 y1
+  const __m128 t1 = _mm_unpackhi_ps(r0, r1);  // z0 z1 -  -
+  const __m128 t2 = _mm_unpacklo_ps(r2, r2);  // x2 x2 y2 y2
+  const __m128 t3 = _mm_unpackhi_ps(r2, r2);  // z2 z2 -  -
+  x = _mm_movelh_ps(t0, t2);                  // x0 x1 x2 x2
+  y = _mm_movehl_ps(t2, t0);                  // y0 y1 y2 y2
+  z = _mm_movelh_ps(t1, t3);                  // z0 z1 z2 z2
+}
+
+/// Half areas of the three axes' accumulated boxes, one per lane (0 where empty).
+[[gnu::always_inline]] inline __m128 half_areas3(const __m128 lo[3], const __m128 hi[3]) {
+  __m128 lx, ly, lz, hx, hy, hz;
+  transpose3(lo[0], lo[1], lo[2], lx, ly, lz);
+  transpose3(hi[0], hi[1], hi[2], hx, hy, hz);
+  const __m128 empty = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(lx, hx), _mm_cmpgt_ps(ly, hy)), _mm_cmpgt_ps(lz, hz));
+  const __m128 ex = _mm_sub_ps(hx, lx), ey = _mm_sub_ps(hy, ly), ez = _mm_sub_ps(hz, lz);
+  const __m128 area = _mm_add_ps(_mm_add_ps(_mm_mul_ps(ex, ey), _mm_mul_ps(ey, ez)), _mm_mul_ps(ez, ex));
+  return _mm_andnot_ps(empty, area);
+}
+
+void sweep_costs(const Bins& bins, int nb, float (&cost_of)[3][kMaxBuckets]) {
+  alignas(16) float right_area[kMaxBuckets][4];
+  alignas(16) float right_count[kMaxBuckets][4];
+  __m128 lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = _mm_set1_ps(kInfinity);
+    hi[a] = _mm_set1_ps(-kInfinity);
+  }
+  __m128i cnt = _mm_setzero_si128();
+  for (int b = nb - 1; b > 0; --b) {
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = _mm_min_ps(_mm_load_ps(bins.lo[a][b]), lo[a]);  // glm::min(acc, box)
+      hi[a] = _mm_max_ps(_mm_load_ps(bins.hi[a][b]), hi[a]);  // glm::max(acc, box)
+    }
+    cnt = _mm_add_epi32(cnt, _mm_setr_epi32(static_cast<int>(bins.count[0][b]), static_cast<int>(bins.count[1][b]),
+                                            static_cast<int>(bins.count[2][b]), 0));
+    _mm_store_ps(right_area[b - 1], half_areas3(lo, hi));
+    _mm_store_ps(right_count[b - 1], _mm_cvtepi32_ps(cnt));
+  }
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = _mm_set1_ps(kInfinity);
+    hi[a] = _mm_set1_ps(-kInfinity);
+  }
+  cnt = _mm_setzero_si128();
+  alignas(16) float cost[4];
+  for (int b = 0; b < nb - 1; ++b) {
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = _mm_min_ps(_mm_load_ps(bins.lo[a][b]), lo[a]);
+      hi[a] = _mm_max_ps(_mm_load_ps(bins.hi[a][b]), hi[a]);
+    }
+    cnt = _mm_add_epi32(cnt, _mm_setr_epi32(static_cast<int>(bins.count[0][b]), static_cast<int>(bins.count[1][b]),
+                                            static_cast<int>(bins.count[2][b]), 0));
+    _mm_store_ps(cost, _mm_add_ps(_mm_mul_ps(half_areas3(lo, hi), _mm_cvtepi32_ps(cnt)),
+                                  _mm_mul_ps(_mm_load_ps(right_area[b]), _mm_load_ps(right_count[b]))));
+    for (int a = 0; a < 3; ++a) cost_of[a][b] = cost[a];
+  }
+}
+#else
+void sweep_costs(const Bins& bins, int nb, float (&cost_of)[3][kMaxBuckets]) {
+  for (int a = 0; a < 3; ++a) {
+    std::array<float, kMaxBuckets> right_area;
+    std::array<std::uint32_t, kMaxBuckets> right_count;
+    Aabb acc;
+    std::uint32_t cnt = 0;
+    for (int b = nb - 1; b > 0; --b) {
+      acc.extend(bucket_box(bins, a, b));
+      cnt += bins.count[a][b];
+      right_area[b - 1] = acc.half_area();
+      right_count[b - 1] = cnt;
+    }
+    acc = Aabb{};
+    cnt = 0;
+    for (int b = 0; b < nb - 1; ++b) {
+      acc.extend(bucket_box(bins, a, b));
+      cnt += bins.count[a][b];
+      cost_of[a][b] = acc.half_area() * static_cast<float>(cnt) + right_area[b] * static_cast<float>(right_count[b]);
+    }
+  }
+}
+#endif
+
+/// Centroid bounds gathered during the partition: Aabb::extend with the
+/// same min/max operand order, on SSE registers where available (lane 3
+/// reads the record's id and is dropped).
+#if defined(__SSE2__) && !defined(ACCELVIZ_NO_SIMD)
+struct CentroidBounds {
+  __m128 lo = _mm_set1_ps(kInfinity), hi = _mm_set1_ps(-kInfinity);
+  void extend(const BuildPrim& p) {
+    const __m128 c = _mm_loadu_ps(&p.centroid.x);
+    lo = _mm_min_ps(c, lo);  // glm::min(lo, c)
+    hi = _mm_max_ps(c, hi);  // glm::max(hi, c)
+  }
+  Aabb get() const {
+    alignas(16) float l[4], h[4];
+    _mm_store_ps(l, lo);
+    _mm_store_ps(h, hi);
+    return Aabb{{l[0], l[1], l[2]}, {h[0], h[1], h[2]}};
+  }
+};
+#else
+struct CentroidBounds {
+  Aabb box;
+  void extend(const BuildPrim& p) { box.extend(p.centroid); }
+  Aabb get() const { return box; }
+};
+#endif
+
 template <bool Record>
-bool search_impl(int nb, std::span<const BuildPrim> prims, const Aabb& centroid_bounds, Bins& bins,
-                 BinnedSahSearch& s, CandidateCosts* costs) {
+bool search_impl(int nb, std::span<const BuildPrim> prims, const Aabb& centroid_bounds, Bins& bins, BinnedSahSearch& s,
+                 CandidateCosts* costs) {
   const std::size_t n = prims.size();
   s = BinnedSahSearch{};
 
@@ -115,26 +231,15 @@ bool search_impl(int nb, std::span<const BuildPrim> prims, const Aabb& centroid_
   //    side's area and count, a left-to-right sweep completes the cost
   //    A_L·N_L + A_R·N_R (half areas; C_trav and 1/A_N are common to all
   //    candidates and enter only the leaf test).
+  float cost_of[3][kMaxBuckets];
+  sweep_costs(bins, nb, cost_of);
   for (int a = 0; a < 3; ++a) {
     if (!s.usable[a]) continue;
-    std::array<float, kMaxBuckets> right_area;
-    std::array<std::uint32_t, kMaxBuckets> right_count;
-    Aabb acc;
     std::uint32_t cnt = 0;
-    for (int b = nb - 1; b > 0; --b) {
-      acc.extend(bucket_box(bins, a, b));
-      cnt += bins.count[a][b];
-      right_area[b - 1] = acc.half_area();
-      right_count[b - 1] = cnt;
-    }
-    acc = Aabb{};
-    cnt = 0;
     for (int b = 0; b < nb - 1; ++b) {
-      acc.extend(bucket_box(bins, a, b));
       cnt += bins.count[a][b];
-      if (cnt == 0 || right_count[b] == 0) continue;
-      const float cost =
-          acc.half_area() * static_cast<float>(cnt) + right_area[b] * static_cast<float>(right_count[b]);
+      if (cnt == 0 || cnt == n) continue;  // one side empty
+      const float cost = cost_of[a][b];
       if constexpr (Record) (*costs)[a][b] = cost;
       if (better_split(cost, cnt, n, s.best_cost, s.best_left)) {
         s.best_cost = cost;
@@ -181,21 +286,21 @@ SplitOutcome split_binned_sah(const SplitParams& params, std::span<BuildPrim> pr
   const int a = best_axis;
   const float lo_a = lo[a], k_a = k[a];
   const auto goes_left = [&](const BuildPrim& p) { return bucket_of(p.centroid[a], lo_a, k_a, nb) <= best_bucket; };
-  Aabb cb_left, cb_right;
+  CentroidBounds cb_left, cb_right;
   std::size_t i = 0, j = n;
   for (;;) {
-    while (i < j && goes_left(prims[i])) cb_left.extend(prims[i++].centroid);
-    while (i < j && !goes_left(prims[j - 1])) cb_right.extend(prims[--j].centroid);
+    while (i < j && goes_left(prims[i])) cb_left.extend(prims[i++]);
+    while (i < j && !goes_left(prims[j - 1])) cb_right.extend(prims[--j]);
     if (i >= j) break;
     std::swap(prims[i], prims[j - 1]);
-    cb_left.extend(prims[i++].centroid);
-    cb_right.extend(prims[--j].centroid);
+    cb_left.extend(prims[i++]);
+    cb_right.extend(prims[--j]);
   }
   out.mid = i;
   out.bounds[0] = child_bounds[0];
   out.bounds[1] = child_bounds[1];
-  out.centroid_bounds[0] = cb_left;
-  out.centroid_bounds[1] = cb_right;
+  out.centroid_bounds[0] = cb_left.get();
+  out.centroid_bounds[1] = cb_right.get();
   return SplitOutcome::split;
 }
 
