@@ -334,21 +334,6 @@ StructureNodes::Selection StructureNodes::select(const NodeSelection& sel, std::
   return out;
 }
 
-namespace {
-
-/// The box of BOX's eight corners under M.
-Aabb world_box(const Aabb& box, const glm::mat4& m) {
-  Aabb out;
-  if (box.is_empty()) return out;
-  for (int i = 0; i < 8; ++i) {
-    const glm::vec3 c((i & 1) ? box.hi.x : box.lo.x, (i & 2) ? box.hi.y : box.lo.y, (i & 4) ? box.hi.z : box.lo.z);
-    out.extend(glm::vec3(m * glm::vec4(c, 1.0f)));
-  }
-  return out;
-}
-
-}  // namespace
-
 StructureNodes::Selection select_blas_boxes(const Tlas& tlas, const NodeSelection& sel, std::size_t limit,
                                             int instance) {
   StructureNodes::Selection out;
@@ -375,7 +360,7 @@ StructureNodes::Selection select_blas_boxes(const Tlas& tlas, const NodeSelectio
         break;
       }
       NodeBox w = b;
-      w.bounds = world_box(b.bounds, inst.to_world);
+      w.bounds = corners_box(b.bounds, inst.to_world);
       w.instance = static_cast<std::uint32_t>(i);
       out.boxes.push_back(w);
     }

@@ -2,15 +2,25 @@
 // traversal in instance space (see tlas.h).
 #include "core/accel/tlas/tlas.h"
 
-#include "core/accel/tlas/tlas_overlap.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
+#include "core/accel/tlas/tlas_overlap.h"
+
 namespace accelviz {
+
+Aabb corners_box(const Aabb& box, const glm::mat4& m) {
+  Aabb out;
+  if (box.is_empty()) return out;
+  for (int i = 0; i < 8; ++i) {
+    const glm::vec3 c((i & 1) ? box.hi.x : box.lo.x, (i & 2) ? box.hi.y : box.lo.y, (i & 4) ? box.hi.z : box.lo.z);
+    out.extend(glm::vec3(m * glm::vec4(c, 1.0f)));
+  }
+  return out;
+}
 
 namespace {
 
@@ -40,12 +50,8 @@ std::vector<Triangle> object_triangles(const Mesh& mesh) {
 /// magnitude: world triangles flattened vertex by vertex round differently
 /// from the box corners, and a ray carried into object space rounds too.
 Aabb transform_box(const Aabb& box, const glm::mat4& m) {
-  Aabb out;
-  if (box.is_empty()) return out;
-  for (int i = 0; i < 8; ++i) {
-    const glm::vec3 c((i & 1) ? box.hi.x : box.lo.x, (i & 2) ? box.hi.y : box.lo.y, (i & 4) ? box.hi.z : box.lo.z);
-    out.extend(glm::vec3(m * glm::vec4(c, 1.0f)));
-  }
+  Aabb out = corners_box(box, m);
+  if (out.is_empty()) return out;
   const glm::vec3 mag = glm::max(glm::abs(out.lo), glm::abs(out.hi));
   const float pad = 1e-5f * std::max({mag.x, mag.y, mag.z, out.extent().x, out.extent().y, out.extent().z});
   out.lo -= glm::vec3(pad);

@@ -39,6 +39,10 @@ struct TwoLevelRayStats {
   std::uint32_t prim_tests = 0;         ///< ray-triangle tests, summed over instances
 };
 
+/// The box of BOX's eight corners under the affine M (an empty box stays
+/// empty): an instance's or a BLAS node's box in world space.
+Aabb corners_box(const Aabb& box, const glm::mat4& m);
+
 /// One placement of a BLAS.
 struct TlasInstance {
   std::uint32_t blas = 0;           ///< index into the BLAS list
