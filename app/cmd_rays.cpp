@@ -48,6 +48,7 @@ int run_rays(const RaysOptions& o, const GlobalOptions& global) {
     StructureOptions so;
     so.threads = o.threads;
     so.bvh.compute_epo = false;
+    so.scene = &scene;  // "tlas" builds its two levels from the scene's meshes and instances
     const std::unique_ptr<Accelerator> accel = build_accelerator(o.structure, scene.triangles, so);
     std::vector<Hit> hits(rays.size());
     trace_closest(*accel, rays, hits, QueryOptions{}, o.threads);
