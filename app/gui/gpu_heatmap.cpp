@@ -25,11 +25,11 @@ void GpuHeatmap::start(const HeatmapRequest& r, std::uint64_t id) {
     tracer_->upload(*bvh);
     uploaded_ = r.structure;
   }
-  tracer_->begin(r.camera, r.width, r.height, r.query);
+  tracer_->begin(r.camera, r.options.width, r.options.height, r.options.query);
   request_ = r;
   id_ = id;
   running_ = true;
-  progress_.rows = r.height;
+  progress_.rows = r.options.height;
   // ms_per_pixel_ and last_rows_ carry over: the previous view's cost sizes
   // this one's first band (a camera being dragged restarts every frame).
 }
@@ -46,7 +46,7 @@ std::shared_ptr<const HeatmapFrame> GpuHeatmap::step(double budget_ms) {
       int rows = kBandRows;
       if (budget_ms > 0.0 && ms_per_pixel_ > 0.0 && last_rows_ > 0) {
         const double left = budget_ms - spent;
-        const double fit = left / (ms_per_pixel_ * static_cast<double>(request_.width));
+        const double fit = left / (ms_per_pixel_ * static_cast<double>(request_.options.width));
         rows = static_cast<int>(std::clamp(fit, 1.0, static_cast<double>(std::max(kBandRows, 2 * last_rows_))));
         if (rows > kBandRows) rows -= rows % kBandRows;
       }
@@ -55,7 +55,7 @@ std::shared_ptr<const HeatmapFrame> GpuHeatmap::step(double budget_ms) {
       const int traced = tracer_->rows_done() - before;
       spent += ms;
       last_rows_ = traced;
-      if (traced > 0) ms_per_pixel_ = ms / (static_cast<double>(traced) * request_.width);
+      if (traced > 0) ms_per_pixel_ = ms / (static_cast<double>(traced) * request_.options.width);
       progress_.rows_done = tracer_->rows_done();
       progress_.trace_ms += ms;
       ++progress_.bands;
@@ -71,10 +71,9 @@ std::shared_ptr<const HeatmapFrame> GpuHeatmap::step(double budget_ms) {
 std::shared_ptr<const HeatmapFrame> GpuHeatmap::finish() {
   running_ = false;
   const GpuTraceResult raw = tracer_->result();
-  const HeatmapOptions ho = heatmap_options(request_);
   HeatmapFigures fig;
   auto frame = std::make_shared<HeatmapFrame>();
-  frame->image = gpu_metric_image(raw, request_.camera, ho, &fig);
+  frame->image = gpu_metric_image(raw, request_.camera, request_.options, &fig);
   frame->id = id_;
   frame->stride = 1;
   frame->complete = true;

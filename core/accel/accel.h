@@ -99,6 +99,8 @@ struct QueryOptions {
   /// traversal as if no hit ended it (the cost hidden behind the first
   /// surface). Same hit. Either flag takes the instrumented path.
   bool xray = false;
+
+  bool operator==(const QueryOptions&) const = default;
 };
 
 class Accelerator {

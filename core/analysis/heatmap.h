@@ -43,6 +43,15 @@ struct HeatmapOptions {
   ProgressCallback progress;  ///< optional; false cancels (render_metric then throws BuildCancelled)
 };
 
+/// Whether `a` and `b` trace the same image: metric, size, query options and
+/// cost weights all equal. `threads` and `progress` are left out on purpose:
+/// they change neither the rays nor the values (and a std::function has no
+/// ==, so HeatmapOptions cannot have a defaulted operator==).
+inline bool same_heatmap_image(const HeatmapOptions& a, const HeatmapOptions& b) {
+  return a.metric == b.metric && a.width == b.width && a.height == b.height && a.query == b.query &&
+         a.c_trav == b.c_trav && a.c_isect == b.c_isect;
+}
+
 /// One float per pixel, row-major from the top-left. NaN means "no value"
 /// (a miss, for depth and shaded), drawn as background.
 struct MetricImage {

@@ -27,7 +27,7 @@ class FakeGpuJob final : public GpuHeatmapJob {
     id_ = id;
     running_ = true;
     progress_ = {};
-    progress_.rows = r.height;
+    progress_.rows = r.options.height;
     ++starts;
   }
   std::shared_ptr<const HeatmapFrame> step(double budget_ms) override {
@@ -45,9 +45,9 @@ class FakeGpuJob final : public GpuHeatmapJob {
     f->stride = 1;
     f->complete = true;
     f->request = request;
-    f->image.width = request.width;
-    f->image.height = request.height;
-    f->image.values.assign(static_cast<std::size_t>(request.width) * request.height, 1.0f);
+    f->image.width = request.options.width;
+    f->image.height = request.options.height;
+    f->image.values.assign(static_cast<std::size_t>(request.options.width) * request.options.height, 1.0f);
     f->pixels.resize(f->image.values.size());
     return f;
   }
@@ -95,8 +95,8 @@ TEST(AppGpuHeatmapJob, SteppedOncePerUpdateAndShownOnlyWhenComplete) {
   app.open_scene("builtin:teapot?size=200");
   gpu_job_wait_built(app);  // the update that shows the structure starts the job and steps it once
   ASSERT_EQ(job.starts, 1);
-  EXPECT_EQ(job.request.width, kW);
-  EXPECT_EQ(job.request.height, kH);
+  EXPECT_EQ(job.request.options.width, kW);
+  EXPECT_EQ(job.request.options.height, kH);
   EXPECT_TRUE(job.request.shadow_lights.empty());
   for (int band = 1; band < 6; ++band) {
     ASSERT_TRUE(app.gpu_heatmap_progress());
@@ -146,7 +146,7 @@ TEST(AppGpuHeatmapJob, ANewViewMidTraceRestartsTheJob) {
   ASSERT_EQ(app.set_option("metric", "prims"), "");
   app.update(kW, kH);
   EXPECT_EQ(job.starts, 3);
-  EXPECT_EQ(job.request.metric, HeatMetric::prims);
+  EXPECT_EQ(job.request.options.metric, HeatMetric::prims);
   // Trace on the CPU again: the job is dropped, the worker traces.
   ASSERT_EQ(app.set_option("heatmap-gpu", "off"), "");
   app.update(kW, kH);
@@ -176,6 +176,20 @@ TEST(AppGpuHeatmapJob, AFailureMidTraceFallsBackToTheCpu) {
   EXPECT_EQ(app.stats_json()["view"]["device"], "cpu");
   EXPECT_EQ(job.starts, 1);
   app.set_gpu_heatmap_tracer(nullptr);
+}
+
+TEST(AppGpuHeatmapJob, BudgetIsTheSettingOrTheRestOfTheLastFrameCapped) {
+  // No previous frame, or a setting of 0 ("one band a frame"): the setting.
+  EXPECT_EQ(gpu_heatmap_budget_ms(5.0, 0.0, 0.0), 5.0);
+  EXPECT_EQ(gpu_heatmap_budget_ms(0.0, 40.0, 2.0), 0.0);
+  // A fast frame: the setting stays the larger.
+  EXPECT_EQ(gpu_heatmap_budget_ms(5.0, 6.0, 3.0), 5.0);
+  // A slow frame (llvmpipe): the rest of it, without its GPU step.
+  EXPECT_EQ(gpu_heatmap_budget_ms(5.0, 40.0, 10.0), 30.0);
+  // ...capped at 100 ms.
+  EXPECT_EQ(gpu_heatmap_budget_ms(5.0, 400.0, 10.0), 100.0);
+  // A frame that was all GPU step leaves the setting.
+  EXPECT_EQ(gpu_heatmap_budget_ms(5.0, 10.0, 12.0), 5.0);
 }
 
 }  // namespace unity_test_app_gpu_heatmap_job

@@ -36,10 +36,10 @@ HeatmapRequest request_for(const std::shared_ptr<const BuiltStructure>& b, int w
   HeatmapRequest r;
   r.structure = b;
   r.camera = camera_from_spec("", b->scene->scene, static_cast<float>(w) / h);
-  r.width = w;
-  r.height = h;
-  r.metric = m;
-  r.threads = 2;
+  r.options.width = w;
+  r.options.height = h;
+  r.options.metric = m;
+  r.options.threads = 2;
   return r;
 }
 
@@ -82,13 +82,8 @@ TEST(AppHeatmap, LevelsRefineToExactlyWhatRenderComputes) {
         }
 
     // The last level is core's heatmap, bit for bit.
-    HeatmapOptions ho;
-    ho.metric = m;
-    ho.width = w;
-    ho.height = h;
-    ho.threads = 2;
     HeatmapFigures fig;
-    const MetricImage expected = render_metric(*built->accel, r.camera, ho, &fig);
+    const MetricImage expected = render_metric(*built->accel, r.camera, r.options, &fig);
     for (std::size_t i = 0; i < expected.values.size(); ++i)
       ASSERT_TRUE(same_value(frames[3]->image.values[i], expected.values[i])) << "pixel " << i;
     EXPECT_EQ(frames[3]->summary.hits, fig.hits);

@@ -36,11 +36,11 @@ TEST(AppInstancesMetric, WorkerPixelsAndSummaryCountInstances) {
     const auto built = forest_built(structure);
     HeatmapRequest r;
     r.structure = built;
-    r.width = 40;
-    r.height = 30;
+    r.options.width = 40;
+    r.options.height = 30;
     r.camera = camera_from_spec("", built->scene->scene, 40.0f / 30.0f);
-    r.metric = c.view.metric;
-    r.threads = 2;
+    r.options.metric = c.view.metric;
+    r.options.threads = 2;
     std::shared_ptr<const HeatmapFrame> last;
     ASSERT_TRUE(trace_progressive(
         r, 1, [] { return true; }, [&](auto f) { last = f; }));
@@ -49,13 +49,14 @@ TEST(AppInstancesMetric, WorkerPixelsAndSummaryCountInstances) {
     ASSERT_EQ(tlas != nullptr, structure == "tlas");
     double sum = 0.0;
     std::uint32_t max = 0;
-    for (int y = 0; y < r.height; ++y)
-      for (int x = 0; x < r.width; ++x) {
+    for (int y = 0; y < r.options.height; ++y)
+      for (int x = 0; x < r.options.width; ++x) {
         const PixelFigures& p = last->at(x, y);
         EXPECT_EQ(p.value, static_cast<float>(p.instances));
         if (tlas) {
           TwoLevelRayStats ts;
-          tlas->closest_hit_two_level(primary_ray(r.camera, x, y, r.width, r.height), r.query, &ts);
+          tlas->closest_hit_two_level(primary_ray(r.camera, x, y, r.options.width, r.options.height), r.options.query,
+                                      &ts);
           ASSERT_EQ(p.instances, ts.instances_visited) << structure << " pixel " << x << "," << y;
         } else {
           ASSERT_EQ(p.instances, 0u);
@@ -63,7 +64,7 @@ TEST(AppInstancesMetric, WorkerPixelsAndSummaryCountInstances) {
         sum += p.instances;
         max = std::max(max, p.instances);
       }
-    EXPECT_NEAR(last->summary.mean_instances, sum / (r.width * r.height), 1e-9);
+    EXPECT_NEAR(last->summary.mean_instances, sum / (r.options.width * r.options.height), 1e-9);
     EXPECT_EQ(last->summary.max_instances, max);
     if (tlas) {
       EXPECT_GT(last->summary.mean_instances, 0.5);

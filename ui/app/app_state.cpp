@@ -1,11 +1,11 @@
 #include "ui/app/app_state.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "core/accel/tlas/tlas.h"
 #include "core/query/camera.h"
 #include "core/scene/effects.h"
-
-#include <algorithm>
-#include <cmath>
 
 namespace accelviz {
 namespace {
@@ -83,16 +83,7 @@ AppState::HeatmapKey AppState::heatmap_key(int w, int h) const {
   k.forward = cam.forward;
   k.up = cam.up;
   k.yfov = cam.yfov;
-  const HeatmapOptions o = view_heatmap_options(config(), w, h);
-  k.width = o.width;
-  k.height = o.height;
-  k.metric = o.metric;
-  k.test = o.query.triangle_test;
-  k.ordered = o.query.ordered;
-  k.back_to_front = o.query.back_to_front;
-  k.xray = o.query.xray;
-  k.c_trav = o.c_trav;
-  k.c_isect = o.c_isect;
+  k.options = view_heatmap_options(config(), w, h);
   k.shadows = current_ && shadow_rays_wanted(current_->scene->scene, config().effects);
   k.gpu = config().view.heatmap_gpu;
   return k;
@@ -100,10 +91,10 @@ AppState::HeatmapKey AppState::heatmap_key(int w, int h) const {
 
 AppState::FrameUpdate AppState::update(int view_width, int view_height) {
   FrameUpdate u;
-  // The previous frame's time outside the GPU heatmap's step (sizes its budget).
+  // The previous frame's time (with its GPU heatmap step's) sizes this frame's GPU budget.
   const auto now = std::chrono::steady_clock::now();
-  const double frame_other_ms =
-      last_update_ ? std::chrono::duration<double, std::milli>(now - *last_update_).count() - last_gpu_step_ms_ : 0.0;
+  const double last_frame_ms =
+      last_update_ ? std::chrono::duration<double, std::milli>(now - *last_update_).count() : 0.0;
   last_update_ = now;
   double step_ms = 0.0;
   view_w_ = view_width;
@@ -170,7 +161,7 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
   if (current_ && view_w_ > 0 && view_h_ > 0) {
     const HeatmapKey key = heatmap_key(view_w_, view_h_);
     if (!heatmap_requested_ || !(*heatmap_requested_ == key)) {
-      HeatmapRequest r = heatmap_request(view_heatmap_options(config(), view_w_, view_h_), current_, camera());
+      HeatmapRequest r{current_, camera(), key.options};
       r.shadow_lights = shadow_lights(current_->scene->scene, key.shadows);
       heatmap_on_gpu_ = false;
       gpu_frame_shown_ = false;
@@ -203,13 +194,8 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
     // the old heatmap stays up until the new one is complete).
     if (heatmap_on_gpu_ && gpu_job_ && gpu_job_->busy()) {
       try {
-        // heatmap-gpu-ms, or as long as the rest of the last frame took
-        // (capped at 100 ms) when that is longer: on a slow GL (llvmpipe
-        // draws a frame in tens of ms) the trace then gets about half the
-        // time instead of a sliver, and the window still draws at about half
-        // its rate. 0 stays "one band a frame".
-        double budget = static_cast<double>(config().view.heatmap_gpu_ms);
-        if (budget > 0.0 && frame_other_ms > 0.0) budget = std::max(budget, std::min(frame_other_ms, 100.0));
+        const double budget =
+            gpu_heatmap_budget_ms(static_cast<double>(config().view.heatmap_gpu_ms), last_frame_ms, last_gpu_step_ms_);
         const auto t_step = std::chrono::steady_clock::now();
         auto f = gpu_job_->step(budget);
         step_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_step).count();
@@ -228,9 +214,7 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
     }
     // Query options changed: the inspected ray is re-cast with them.
     const QueryOptions& q = config().structure.query;
-    if (inspection_ && (q.triangle_test != inspected_query_.triangle_test || q.ordered != inspected_query_.ordered ||
-                        q.back_to_front != inspected_query_.back_to_front || q.xray != inspected_query_.xray))
-      recast();
+    if (inspection_ && q != inspected_query_) recast();
   }
   if (auto latest = heatmaps_.latest(); !heatmap_on_gpu_ && latest && latest != heatmap_) {
     heatmap_ = std::move(latest);

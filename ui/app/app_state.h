@@ -4,6 +4,13 @@
 // inspected ray and the status line. The GUI main loop calls update() once
 // per frame, turns user input into calls here, and draws what it finds;
 // scripts drive the same calls, so a scripted run exercises the product.
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
 #include "ui/app/app_config.h"
 #include "ui/app/build_worker.h"
 #include "ui/app/gpu_heatmap_job.h"
@@ -12,14 +19,6 @@
 #include "ui/app/ray_inspection.h"
 #include "ui/app/screenshot_files.h"
 #include "ui/app/settings.h"
-
-#include <nlohmann/json.hpp>
-
-#include <chrono>
-#include <functional>
-#include <memory>
-#include <optional>
-#include <string>
 
 namespace accelviz {
 
@@ -145,19 +144,19 @@ class AppState {
   ScreenshotInfo screenshot_info(float scale_min, float scale_max) const;
 
  private:
+  // What the view's heatmap shows; a change restarts it.
   struct HeatmapKey {
     const BuiltStructure* structure = nullptr;
     glm::vec3 position{0.0f}, forward{0.0f}, up{0.0f};
     float yfov = 0.0f;
-    int width = 0, height = 0;
-    HeatMetric metric = HeatMetric::nodes;
-    TriangleTest test = TriangleTest::watertight;
-    bool ordered = true;
-    bool back_to_front = false, xray = false;
-    float c_trav = 1.0f, c_isect = 1.0f;
+    /// Compared by same_heatmap_image: its threads (and progress) restart nothing.
+    HeatmapOptions options;
     bool shadows = false;  ///< shadow rays traced (scene lights or forced on)
     bool gpu = false;      ///< heatmap-gpu
-    bool operator==(const HeatmapKey&) const = default;
+    bool operator==(const HeatmapKey& o) const {
+      return structure == o.structure && position == o.position && forward == o.forward && up == o.up &&
+             yfov == o.yfov && same_heatmap_image(options, o.options) && shadows == o.shadows && gpu == o.gpu;
+    }
   };
   HeatmapKey heatmap_key(int w, int h) const;
   void recast();
@@ -170,9 +169,9 @@ class AppState {
   bool reload_ = false;
   bool scene_loading_ = false;
   std::shared_ptr<const LoadedScene> preloaded_;  ///< open_loaded_scene's scene, until requested
-  std::uint64_t scene_request_id_ = 0;        ///< the build request that loads the wanted scene
-  std::string requested_scene_;               ///< of the last build request
-  std::optional<StructureChoice> requested_;  ///< of the last build request
+  std::uint64_t scene_request_id_ = 0;            ///< the build request that loads the wanted scene
+  std::string requested_scene_;                   ///< of the last build request
+  std::optional<StructureChoice> requested_;      ///< of the last build request
   std::uint64_t request_id_ = 0;
 
   std::shared_ptr<const BuiltStructure> current_;

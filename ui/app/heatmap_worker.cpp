@@ -92,7 +92,8 @@ HeatmapSummary summarise_pixels(std::span<const PixelFigures> pixels, double ren
 
 bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::function<bool()>& keep_going,
                        const std::function<void(std::shared_ptr<const HeatmapFrame>)>& publish) {
-  const int w = r.width, h = r.height;
+  const HeatmapOptions& o = r.options;
+  const int w = o.width, h = o.height;
   if (w <= 0 || h <= 0 || !r.structure || !r.structure->accel) return true;
   const Accelerator& accel = *r.structure->accel;
   const std::size_t n = static_cast<std::size_t>(w) * h;
@@ -100,10 +101,10 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
   MetricImage image;
   image.width = w;
   image.height = h;
-  image.metric = r.metric;
+  image.metric = o.metric;
   image.values.assign(n, std::numeric_limits<float>::quiet_NaN());
   std::vector<PixelFigures> pixels(n);
-  const unsigned threads = resolve_threads(r.threads);
+  const unsigned threads = resolve_threads(o.threads);
 
   int coarsest = 1;
   while (coarsest * 2 <= std::max(1, r.coarsest)) coarsest *= 2;
@@ -129,9 +130,9 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
         for (int x = done_before ? s : 0; x < w; x += done_before ? 2 * s : s) {
           const Ray ray = primary_ray(r.camera, x, y, w, h);
           RayStats stats;
-          const Hit hit = accel.closest_hit(ray, r.query, &stats);
+          const Hit hit = accel.closest_hit(ray, o.query, &stats);
           PixelFigures& p = pixels[static_cast<std::size_t>(y) * w + x];
-          p.value = metric_value(r.metric, ray, hit, stats, r.c_trav, r.c_isect);
+          p.value = metric_value(o.metric, ray, hit, stats, o.c_trav, o.c_isect);
           p.nodes = stats.nodes_visited;
           p.prims = stats.prim_tests;
           p.instances = stats.instances_visited;
@@ -141,7 +142,7 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
           if (hit.valid())
             for (const Light& l : r.shadow_lights) {
               RayStats ss;
-              p.shadowed += accel.any_hit(shadow_ray(ray, hit, l), r.query, &ss) ? 1u : 0u;
+              p.shadowed += accel.any_hit(shadow_ray(ray, hit, l), o.query, &ss) ? 1u : 0u;
               ++p.shadow_rays;
               p.shadow_nodes += ss.nodes_visited;
               p.shadow_prims += ss.prim_tests;

@@ -25,51 +25,16 @@ namespace accelviz {
 struct HeatmapRequest {
   std::shared_ptr<const BuiltStructure> structure;
   Camera camera;
-  int width = 0;
-  int height = 0;
-  HeatMetric metric = HeatMetric::nodes;
-  QueryOptions query;
-  float c_trav = 1.0f;  ///< cost metric weights
-  float c_isect = 1.0f;
-  unsigned threads = 0;  ///< 0: all hardware threads
-  int coarsest = 8;      ///< first lattice spacing (a power of two >= 1)
+  /// Metric, size, threads (0: all hardware threads), query options, cost
+  /// weights: what the CPU worker and the GPU heatmap trace with. Its
+  /// `progress` is not called: the worker cancels through its own keep_going.
+  HeatmapOptions options;
+  int coarsest = 8;  ///< first lattice spacing (a power of two >= 1)
   /// Shadow rays (effects by scene): from each primary hit, one any-hit ray
   /// per light here (core/scene/effects.h shadow_lights(); empty: none).
   /// Their work is counted apart from the primary ray's (PixelFigures::shadow_*).
   std::vector<Light> shadow_lights;
 };
-
-/// Core's options for tracing `r` (metric, size, threads, query options,
-/// cost weights; no progress callback): the GPU heatmap's, and what a
-/// request's frame was traced with.
-inline HeatmapOptions heatmap_options(const HeatmapRequest& r) {
-  HeatmapOptions o;
-  o.metric = r.metric;
-  o.width = r.width;
-  o.height = r.height;
-  o.threads = r.threads;
-  o.query = r.query;
-  o.c_trav = r.c_trav;
-  o.c_isect = r.c_isect;
-  return o;
-}
-
-/// A request tracing `structure` from `camera` with options `o` (the
-/// inverse of heatmap_options; no shadow lights, default coarsest level).
-inline HeatmapRequest heatmap_request(const HeatmapOptions& o, std::shared_ptr<const BuiltStructure> structure,
-                                      const Camera& camera) {
-  HeatmapRequest r;
-  r.structure = std::move(structure);
-  r.camera = camera;
-  r.width = o.width;
-  r.height = o.height;
-  r.metric = o.metric;
-  r.query = o.query;
-  r.c_trav = o.c_trav;
-  r.c_isect = o.c_isect;
-  r.threads = o.threads;
-  return r;
-}
 
 /// What one pixel's ray found (the hover tooltip shows these).
 struct PixelFigures {
