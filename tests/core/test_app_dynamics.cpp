@@ -194,15 +194,26 @@ Aabb root_box(const BuiltStructure& b) {
   return box ? *box : Aabb{};
 }
 
-}  // namespace app_dynamics_frames
-
-TEST(AppDynamicsFrames, TheShownStructureIsTheFrameAndReturnsToRestAtZero) {
-  using namespace app_dynamics_frames;
+AppSettings tlas_settings() {
   AppSettings settings;
   settings.config.structure.name = "tlas";
-  AppState app(settings);
-  app.open_scene("builtin:dynamic?size=1200");
-  ASSERT_TRUE(pump_app(app, [&] { return app.settled() && app.current(); }));
+  return settings;
+}
+
+}  // namespace app_dynamics_frames
+
+// An AppState showing builtin:dynamic?size=1200 built as tlas, settled.
+class AppDynamicsOnTlas : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    app.open_scene("builtin:dynamic?size=1200");
+    ASSERT_TRUE(app_dynamics_frames::pump_app(app, [&] { return app.settled() && app.current(); }));
+  }
+  AppState app{app_dynamics_frames::tlas_settings()};
+};
+
+TEST_F(AppDynamicsOnTlas, TheShownStructureIsTheFrameAndReturnsToRestAtZero) {
+  using namespace app_dynamics_frames;
   const std::shared_ptr<const BuiltStructure> rest = app.rest();
   ASSERT_EQ(app.current(), rest);
   const Aabb rest_box = root_box(*rest);
@@ -627,13 +638,7 @@ TEST(AppDynamicsViews, TlasAndBlasBoxSetsDifferWithTheExpectedCounts) {
   EXPECT_EQ(blas_max_depth(t), t.blas(0).build_stats().max_depth);
 }
 
-TEST(AppDynamicsViews, FramingAtTheBlasLevelFramesTheChosenInstanceOrSubtree) {
-  using namespace app_dynamics_frames;
-  AppSettings settings;
-  settings.config.structure.name = "tlas";
-  AppState app(settings);
-  app.open_scene("builtin:dynamic?size=1200");
-  ASSERT_TRUE(pump_app(app, [&] { return app.settled() && app.current(); }));
+TEST_F(AppDynamicsOnTlas, FramingAtTheBlasLevelFramesTheChosenInstanceOrSubtree) {
   const auto* tlas = dynamic_cast<const Tlas*>(app.current()->accel.get());
   ASSERT_NE(tlas, nullptr);
   ViewSettings& v = app.config().view;
