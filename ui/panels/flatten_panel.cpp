@@ -126,9 +126,7 @@ FlattenAction flatten_panel(FlattenPanelState& state, const Scene* scene, const 
   ImGui::EndDisabled();
   if (busy) {
     ImGui::SameLine();
-    if (ImGui::Button("Cancel")) action.cancel = true;
-    ImGui::SameLine();
-    ImGui::ProgressBar(static_cast<float>(fraction), ImVec2(-1.0f, 0.0f));
+    if (progress_cancel_row(fraction, nullptr, -1.0f, CancelAt::before)) action.cancel = true;
   }
 
   // The prediction, if it is of this scene and this selection.

@@ -257,12 +257,9 @@ bool structure_panel(StructureChoice& choice, const BuildProgress& progress, boo
 
   ImGui::Separator();
   ImGui::TextWrapped("Shown: %s", progress.shown.empty() ? "(none yet)" : progress.shown.c_str());
-  if (progress.busy) {
-    ImGui::ProgressBar(static_cast<float>(progress.fraction), ImVec2(-80.0f * layout.scale, 0.0f),
-                       progress.stage.c_str());
-    ImGui::SameLine();
-    if (ImGui::Button("Cancel")) cancel = true;
-  }
+  if (progress.busy &&
+      progress_cancel_row(progress.fraction, progress.stage.c_str(), -80.0f * layout.scale, CancelAt::after))
+    cancel = true;
   ImGui::End();
   return changed;
 }
@@ -635,6 +632,20 @@ void help_panel(bool& open, const PanelLayout& layout) {
         "and keyboard while they are hovered or focused. Documentation: docs/gui.md.");
   }
   ImGui::End();
+}
+
+bool progress_cancel_row(double fraction, const char* overlay, float bar_width, CancelAt cancel_at) {
+  bool cancel = false;
+  if (cancel_at == CancelAt::before) {
+    cancel = ImGui::Button("Cancel");
+    ImGui::SameLine();
+  }
+  ImGui::ProgressBar(static_cast<float>(fraction), ImVec2(bar_width, 0.0f), overlay);
+  if (cancel_at == CancelAt::after) {
+    ImGui::SameLine();
+    cancel = ImGui::Button("Cancel");
+  }
+  return cancel;
 }
 
 void status_bar(const std::string& message, const std::string& error, const BuildProgress& progress,

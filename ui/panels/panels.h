@@ -99,6 +99,12 @@ void status_bar(const std::string& message, const std::string& error, const Buil
                 const std::string& heatmap_status, const PanelLayout& layout);
 /// The figures of one heatmap pixel, as a tooltip at the mouse.
 void pixel_tooltip(int x, int y, const PixelFigures& p, HeatMetric metric, bool exact);
+/// A running job's row, from the cursor on: a progress bar `bar_width` wide
+/// (an ImGui item width: -1 fills the row, -w leaves w at its right) showing
+/// `fraction` and `overlay` (null: the percentage), with a Cancel button on
+/// the same line before or after it. Returns true when Cancel was clicked.
+enum class CancelAt { before, after };
+bool progress_cancel_row(double fraction, const char* overlay, float bar_width, CancelAt cancel_at);
 
 // ---- Cost of accuracy (accuracy_panel.cpp) -----------------------------------------------
 struct AccuracyPanelState {
