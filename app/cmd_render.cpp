@@ -59,6 +59,11 @@ std::pair<int, int> parse_pixel(const std::string& text) {
   }
 }
 
+/// The structure and query options of the command line (render's one side, --compare's A).
+CompareSide compare_side(const RenderOptions& o) {
+  return CompareSide{o.structure, o.structure_opts, o.triangle_test, o.order, o.xray};
+}
+
 /// The overlay view through the GL renderer (OSMesa), written to o.out.
 int run_render_raster(const RenderOptions& o, const GlobalOptions& global) {
   const ImageSize size = parse_size(o.size);
@@ -114,17 +119,7 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
   const double build_wall_ms = ms_since(t0);
   progress.end(std::to_string(static_cast<long long>(accel->build_stats().build_ms)) + " ms");
 
-  HeatmapOptions ho;
-  ho.metric = metric;
-  ho.width = size.width;
-  ho.height = size.height;
-  ho.threads = o.threads;
-  ho.query.triangle_test = parse_triangle_test(o.triangle_test);
-  ho.query.ordered = o.order != "unordered";
-  ho.query.back_to_front = o.order == "back-to-front";
-  ho.query.xray = o.xray;
-  ho.c_trav = o.structure_opts.ctrav;
-  ho.c_isect = o.structure_opts.cisect;
+  HeatmapOptions ho = heatmap_options_of(compare_side(o), metric, size, o.threads);
   HeatmapFigures fig;
   MetricImage img;
   nlohmann::json gpu_figures;
@@ -194,7 +189,7 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
   if (o.compare) {
     if (o.view != "heatmap") throw UsageError("--compare needs --view heatmap");
     CompareJob job{o.scene, o.camera, o.size, o.metric, o.colormap, o.legend, o.max, o.threads, o.out, o.force, {}, {}};
-    job.a = CompareSide{o.structure, o.structure_opts, o.triangle_test, o.order, o.xray};
+    job.a = compare_side(o);
     job.b = parse_compare_spec(*o.compare, job.a);
     return run_render_compare(job, global);
   }

@@ -113,6 +113,18 @@ QueryOptions query_of(const CompareSide& side) {
   return q;
 }
 
+HeatmapOptions heatmap_options_of(const CompareSide& side, HeatMetric metric, const ImageSize& size, unsigned threads) {
+  HeatmapOptions ho;
+  ho.metric = metric;
+  ho.width = size.width;
+  ho.height = size.height;
+  ho.threads = threads;
+  ho.query = query_of(side);
+  ho.c_trav = side.structure_opts.ctrav;
+  ho.c_isect = side.structure_opts.cisect;
+  return ho;
+}
+
 int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
   const ComparePaths paths = compare_paths(job.out);
   for (const std::string* p : {&paths.a, &paths.b, &paths.diff}) check_output_path(*p, job.force);
@@ -136,14 +148,7 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
     const StructureOptions so = c.structure_opts.to_options(job.threads, /*compute_epo=*/false);
     const std::unique_ptr<Accelerator> accel = build_accelerator(c.structure, scene.triangles, so, progress.callback());
     progress.end(std::to_string(static_cast<long long>(accel->build_stats().build_ms)) + " ms");
-    HeatmapOptions ho;
-    ho.metric = metric;
-    ho.width = size.width;
-    ho.height = size.height;
-    ho.threads = job.threads;
-    ho.query = query_of(c);
-    ho.c_trav = c.structure_opts.ctrav;
-    ho.c_isect = c.structure_opts.cisect;
+    HeatmapOptions ho = heatmap_options_of(c, metric, size, job.threads);
     progress.begin(std::string("rendering ") + tag);
     ho.progress = progress.callback();
     HeatmapFigures fig;

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "app/cli_common.h"
+#include "core/analysis/heatmap.h"
 
 namespace accelviz::cli {
 
@@ -32,6 +33,11 @@ ComparePaths compare_paths(const std::string& out);
 
 /// QueryOptions of a side (order, x-ray, triangle test).
 QueryOptions query_of(const CompareSide& side);
+
+/// The heatmap options of a side: `metric` on a `size` image traced on
+/// `threads`, with the side's query options and cost weights (--ctrav,
+/// --cisect). What `render` traces its one side with, and each side of --compare.
+HeatmapOptions heatmap_options_of(const CompareSide& side, HeatMetric metric, const ImageSize& size, unsigned threads);
 
 struct CompareJob {
   std::string scene;
