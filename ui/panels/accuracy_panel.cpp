@@ -268,13 +268,7 @@ AccuracyAction accuracy_panel(AccuracyPanelState& st, const SweepSnapshot* snap,
                               const std::string& structure, const PanelLayout& layout) {
   AccuracyAction act;
   const float s = layout.scale;
-  ImGui::SetNextWindowPos(ImVec2(356 * s, 60 * s), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(560 * s, 640 * s), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowCollapsed(st.collapsed_at_start, ImGuiCond_FirstUseEver);
-  if (!ImGui::Begin("Cost of accuracy")) {
-    ImGui::End();
-    return act;
-  }
+  if (!begin_panel("Cost of accuracy", layout, 356, 60, 560, 640, st.collapsed_at_start)) return act;
   if (st.params_for != structure) {
     st.params = default_sweep_params_text(structure);
     st.params_for = structure;

@@ -40,16 +40,9 @@ FlattenAction flatten_panel(FlattenPanelState& state, const Scene* scene, const 
                             double fraction, std::optional<std::uint32_t> clicked_instance, const PanelLayout& layout) {
   FlattenAction action;
   const float s = layout.scale;
-  ImGui::SetNextWindowPos(ImVec2(layout.width - 460 * s, 420 * s), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(440 * s, 420 * s), ImGuiCond_FirstUseEver);
-  if (state.collapsed_at_start) {
-    ImGui::SetNextWindowCollapsed(true, ImGuiCond_FirstUseEver);
-    state.collapsed_at_start = false;
-  }
-  if (!ImGui::Begin("Flatten what-if")) {
-    ImGui::End();
-    return action;
-  }
+  const bool collapsed = state.collapsed_at_start;
+  state.collapsed_at_start = false;
+  if (!begin_panel("Flatten what-if", layout, -460, 420, 440, 420, collapsed)) return action;
   if (!scene) {
     ImGui::TextDisabled("no scene");
     ImGui::End();

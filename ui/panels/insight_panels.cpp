@@ -16,13 +16,6 @@
 namespace accelviz::panels {
 namespace {
 
-void place_at(const PanelLayout& l, float x, float y, float w, float h) {
-  const float s = l.scale;
-  ImGui::SetNextWindowPos(ImVec2(x >= 0.0f ? x * s : l.width + x * s, y * s), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(w * s, h * s), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowCollapsed(true, ImGuiCond_FirstUseEver);
-}
-
 ImU32 to_u32(const glm::u8vec3& c) {
   return IM_COL32(c.x, c.y, c.z, 255);
 }
@@ -59,11 +52,7 @@ const char* kMetricNames[] = {"nodes", "prims", "cost"};
 ABAction ab_panel(ABPanelState& st, const ABResult* r, bool busy, const std::string& error,
                   const StructureChoice& current, const PanelLayout& layout) {
   ABAction act;
-  place_at(layout, 330.0f, 60.0f, 560.0f, 430.0f);
-  if (!ImGui::Begin("A/B compare")) {
-    ImGui::End();
-    return act;
-  }
+  if (!begin_panel("A/B compare", layout, 330.0f, 60.0f, 560.0f, 430.0f, true)) return act;
   if (ImGui::Button("Pin current as A")) act.pin = true;
   ImGui::SameLine();
   ImGui::BeginDisabled(!st.pinned || busy);
@@ -125,11 +114,7 @@ ABAction ab_panel(ABPanelState& st, const ABResult* r, bool busy, const std::str
 InsightAction insight_panel(InsightPanelState& st, const ViewInsight* v, const RegionTouch* region, bool busy,
                             const std::string& error, std::uint32_t selected, const PanelLayout& layout) {
   InsightAction act;
-  place_at(layout, 330.0f, 100.0f, 470.0f, 480.0f);
-  if (!ImGui::Begin("Predicted vs measured")) {
-    ImGui::End();
-    return act;
-  }
+  if (!begin_panel("Predicted vs measured", layout, 330.0f, 100.0f, 470.0f, 480.0f, true)) return act;
   if (ImGui::Button(busy ? "Measuring ..." : "Measure this view")) act.refresh = true;
   if (!error.empty()) ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.4f, 1.0f), "%s", error.c_str());
   if (!v) {
@@ -275,12 +260,8 @@ InsightAction insight_panel(InsightPanelState& st, const ViewInsight* v, const R
 
 bool explainer_panel(ExplainerState& st, const SplitExplanation* e, std::uint32_t node, const std::string& note,
                      const PanelLayout& layout) {
-  place_at(layout, 330.0f, 140.0f, 520.0f, 460.0f);
   bool changed = false;
-  if (!ImGui::Begin("SAH explainer")) {
-    ImGui::End();
-    return false;
-  }
+  if (!begin_panel("SAH explainer", layout, 330.0f, 140.0f, 520.0f, 460.0f, true)) return false;
   changed = ImGui::SliderInt("buckets B", &st.buckets, 2, 64, "%d", ImGuiSliderFlags_AlwaysClamp);
   ImGui::Combo("axis", &st.axis, "x\0y\0z\0");
   ImGui::SameLine();
@@ -450,11 +431,7 @@ std::optional<std::uint32_t> tree_panel(const StructureNodes* nodes, const std::
                                         std::uint32_t selected, bool& scroll_to_selected, const PanelLayout& layout,
                                         ColorMap map) {
   std::optional<std::uint32_t> clicked;
-  place_at(layout, 330.0f, 180.0f, 420.0f, 420.0f);
-  if (!ImGui::Begin("Tree")) {
-    ImGui::End();
-    return clicked;
-  }
+  if (!begin_panel("Tree", layout, 330.0f, 180.0f, 420.0f, 420.0f, true)) return clicked;
   if (!nodes || nodes->empty() || nodes->kind() == "grid") {
     ImGui::TextDisabled("The structure shown has no tree.");
   } else {

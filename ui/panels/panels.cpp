@@ -99,11 +99,7 @@ bool slider_int(const char* label, int& v, int lo, int hi, const char* help = nu
 SceneAction scene_panel(std::string& path_field, const std::vector<std::string>& recent, const Scene* scene,
                         const std::string& shown_spec, int active_camera, const PanelLayout& layout) {
   SceneAction a;
-  place(layout, 8, 8, 340, 260);
-  if (!ImGui::Begin("Scene")) {
-    ImGui::End();
-    return a;
-  }
+  if (!begin_panel("Scene", layout, 8, 8, 340, 260)) return a;
   ImGui::TextWrapped("%s", shown_spec.empty() ? "(loading...)" : shown_spec.c_str());
   ImGui::SetNextItemWidth(-70.0f * layout.scale);
   const bool enter = ImGui::InputTextWithHint("##path", ".gltf/.glb/.obj or builtin:NAME?size=N", &path_field,
@@ -158,11 +154,7 @@ SceneAction scene_panel(std::string& path_field, const std::vector<std::string>&
 bool structure_panel(StructureChoice& choice, const BuildProgress& progress, bool& cancel, const PanelLayout& layout) {
   cancel = false;
   bool changed = false;
-  place(layout, 8, 276, 340, 400);
-  if (!ImGui::Begin("Structure")) {
-    ImGui::End();
-    return false;
-  }
+  if (!begin_panel("Structure", layout, 8, 276, 340, 400)) return false;
   const std::vector<std::string>& names = structure_names();
   if (ImGui::BeginCombo("Type", choice.name.c_str())) {
     for (const std::string& n : names)
@@ -267,11 +259,7 @@ bool structure_panel(StructureChoice& choice, const BuildProgress& progress, boo
 // ---- Stats ---------------------------------------------------------------------------------
 
 void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const PanelLayout& layout) {
-  place(layout, -438, 8, 320, 340);
-  if (!ImGui::Begin("Stats")) {
-    ImGui::End();
-    return;
-  }
+  if (!begin_panel("Stats", layout, -438, 8, 320, 340)) return;
   if (!built) {
     ImGui::TextDisabled("no structure yet");
     ImGui::End();
@@ -325,11 +313,7 @@ void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const Pa
 
 bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout, QueryOptions* query) {
   bool changed = false;
-  place(layout, -438, 356, 320, 404);
-  if (!ImGui::Begin("View")) {
-    ImGui::End();
-    return false;
-  }
+  if (!begin_panel("View", layout, -438, 356, 320, 404)) return false;
   changed |= checkbox("Mesh", v.show_mesh);
   ImGui::SameLine();
   changed |= checkbox("Wireframe", v.show_wireframe);
@@ -632,6 +616,14 @@ void help_panel(bool& open, const PanelLayout& layout) {
         "and keyboard while they are hovered or focused. Documentation: docs/gui.md.");
   }
   ImGui::End();
+}
+
+bool begin_panel(const char* title, const PanelLayout& layout, float x, float y, float w, float h, bool collapsed) {
+  place(layout, x, y, w, h);
+  if (collapsed) ImGui::SetNextWindowCollapsed(true, ImGuiCond_FirstUseEver);
+  if (ImGui::Begin(title)) return true;
+  ImGui::End();
+  return false;
 }
 
 bool progress_cancel_row(double fraction, const char* overlay, float bar_width, CancelAt cancel_at) {

@@ -99,6 +99,12 @@ void status_bar(const std::string& message, const std::string& error, const Buil
                 const std::string& heatmap_status, const PanelLayout& layout);
 /// The figures of one heatmap pixel, as a tooltip at the mouse.
 void pixel_tooltip(int x, int y, const PixelFigures& p, HeatMetric metric, bool exact);
+/// Opens a panel's window: on first use placed at (x, y) (x < 0: from the
+/// right edge) and sized w × h, in units the layout scales, and collapsed when
+/// `collapsed`; then ImGui::Begin(title). False when the window is collapsed
+/// or clipped: it is already ended and the panel returns.
+bool begin_panel(const char* title, const PanelLayout& layout, float x, float y, float w, float h,
+                 bool collapsed = false);
 /// A running job's row, from the cursor on: a progress bar `bar_width` wide
 /// (an ImGui item width: -1 fills the row, -w leaves w at its right) showing
 /// `fraction` and `overlay` (null: the percentage), with a Cancel button on

@@ -40,13 +40,7 @@ RobustnessAction robustness_panel(RobustnessPanelState& st, const RobustnessSnap
                                   const std::string& structure, const PanelLayout& layout) {
   RobustnessAction act;
   const float s = layout.scale;
-  ImGui::SetNextWindowPos(ImVec2(380 * s, 90 * s), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(620 * s, 560 * s), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowCollapsed(st.collapsed_at_start, ImGuiCond_FirstUseEver);
-  if (!ImGui::Begin("Robustness")) {
-    ImGui::End();
-    return act;
-  }
+  if (!begin_panel("Robustness", layout, 380, 90, 620, 560, st.collapsed_at_start)) return act;
   ImGui::TextWrapped(
       "Adversarial rays (through vertices, shared edges, axis-aligned with +0/-0, grazing) traced with "
       "Moller-Trumbore vs watertight triangle tests and plain vs padded slab tests, against the "

@@ -17,13 +17,7 @@ ScenarioAction scenarios_panel(ScenarioPanelState& st, const ScenarioFigures* fi
                                const PanelLayout& layout) {
   ScenarioAction act;
   const float s = layout.scale;
-  ImGui::SetNextWindowPos(ImVec2(330.0f * s, 20.0f * s), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(560.0f * s, 420.0f * s), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowCollapsed(true, ImGuiCond_FirstUseEver);
-  if (!ImGui::Begin("Scenarios")) {
-    ImGui::End();
-    return act;
-  }
+  if (!begin_panel("Scenarios", layout, 330.0f, 20.0f, 560.0f, 420.0f, true)) return act;
   const auto& all = scenarios();
   for (int i = 0; i < static_cast<int>(all.size()); ++i) {
     if (i > 0) ImGui::SameLine();
