@@ -4,6 +4,7 @@
 #include <stb_image_write.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -12,11 +13,14 @@
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 
+#include "core/accel/bvh/bvh.h"
 #include "core/query/batch.h"
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
+#include "core/util/parallel.h"
 
 namespace accelviz {
 
@@ -93,6 +97,44 @@ float metric_value(HeatMetric m, const Ray& ray, const Hit& hit, const RayStats&
   return kNoValue;
 }
 
+namespace {
+
+/// trace_closest with statistics for a BVH: each chunk of rays goes to
+/// Bvh::closest_hits_counted (the same hits and counters as closest_hit per
+/// ray, several rays walked in turns). Progress and cancellation as
+/// trace_closest: after each chunk, one report at a time, a cancel stops
+/// every worker at its next chunk.
+bool trace_bvh_counted(const Bvh& bvh, std::span<const Ray> rays, std::span<Hit> hits, std::span<RayStats> stats,
+                       const QueryOptions& query, const BatchOptions& batch) {
+  const std::size_t n = rays.size();
+  std::atomic<std::size_t> done{0};
+  std::atomic<bool> cancelled{false};
+  std::mutex progress_mutex;
+  const auto range = [&](std::size_t begin, std::size_t end, unsigned /*thread*/) {
+    if (cancelled.load(std::memory_order_relaxed)) return;
+    const std::size_t count = end - begin;
+    for (std::size_t i = begin; i < end; ++i) stats[i] = RayStats{};
+    bvh.closest_hits_counted(rays.subspan(begin, count), hits.subspan(begin, count), stats.subspan(begin, count),
+                             query);
+    const std::size_t so_far = done.fetch_add(count, std::memory_order_relaxed) + count;
+    if (batch.progress) {
+      std::unique_lock lock(progress_mutex, std::try_to_lock);
+      if (lock.owns_lock() && !batch.progress(static_cast<double>(so_far) / static_cast<double>(n)))
+        cancelled.store(true, std::memory_order_relaxed);
+    }
+  };
+  const std::size_t chunk = std::max<std::size_t>(batch.chunk, 1);
+  if (resolve_threads(batch.threads) == 1) {
+    for (std::size_t b = 0; b < n && !cancelled.load(std::memory_order_relaxed); b += chunk)
+      range(b, std::min(n, b + chunk), 0u);
+  } else {
+    parallel_for(n, batch.threads, chunk, range);
+  }
+  return !cancelled.load();
+}
+
+}  // namespace
+
 MetricImage render_metric(const Accelerator& accel, const Camera& camera, const HeatmapOptions& opts,
                           HeatmapFigures* figures) {
   if (opts.width <= 0 || opts.height <= 0) throw std::invalid_argument("heatmap: image size must be positive");
@@ -107,7 +149,9 @@ MetricImage render_metric(const Accelerator& accel, const Camera& camera, const 
   batch.chunk = 64;
 
   const auto t0 = std::chrono::steady_clock::now();
-  const bool done = trace_closest(accel, rays, hits, opts.query, batch, stats);
+  const auto* bvh = dynamic_cast<const Bvh*>(&accel);
+  const bool done = bvh && !stats.empty() ? trace_bvh_counted(*bvh, rays, hits, stats, opts.query, batch)
+                                          : trace_closest(accel, rays, hits, opts.query, batch, stats);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   if (!done) throw BuildCancelled();
 

@@ -457,6 +457,78 @@ TEST(BvhQuery, StatisticsAgreeWithTheVisitTrace) {
   EXPECT_GT(culled_total, 0u);
 }
 
+// The heatmap's counted walk (closest hit with statistics and no trace, one
+// ray or several in turns) against the instrumented walk a trace takes: the
+// same hit to the bit and the same counters, ray by ray, on tree shapes with
+// one and several triangle blocks per leaf, both triangle tests, ordered and
+// not, and rays that miss, start inside, run along axes or end early.
+TEST(BvhQuery, CountedWalkMatchesTheTracedWalkPerRay) {
+  const auto tris = soup(1500, 11);
+  std::vector<Ray> rays = rays_through_unit_cube(600, 12);
+  std::mt19937 rng(13);
+  for (int i = 0; i < 150; ++i) {
+    const glm::vec3 inside(uniform(rng), uniform(rng), uniform(rng));
+    rays.emplace_back(inside, random_direction(rng));                                       // starts inside
+    rays.emplace_back(glm::vec3(inside.x, inside.y, -1.0f), glm::vec3(0.0f, 0.0f, 1.0f));  // along +z: ±0 components
+    rays.emplace_back(glm::vec3(-1.0f, inside.y, inside.z), glm::vec3(1.0f, 0.0f, 0.0f), 0.5f, 1.0f + inside.x);
+    rays.emplace_back(glm::vec3(3.0f, 3.0f, 3.0f) + inside, random_direction(rng));  // mostly misses
+  }
+  auto same_bits = [](float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+  std::size_t hits = 0, culled = 0;
+  for (int shape = 0; shape < 3; ++shape) {
+    BvhOptions o = quiet();
+    if (shape == 1) o.max_leaf_size = 1;
+    if (shape == 2) {
+      o.max_leaf_size = 11;  // leaves of up to three blocks, the last one partly padding
+      o.leaf_size_cap = 11;
+      o.splitter = BvhSplitter::median;
+    }
+    const Bvh bvh(tris, o);
+    for (const TriangleTest test : {TriangleTest::watertight, TriangleTest::moller_trumbore})
+      for (const bool ordered : {true, false}) {
+        QueryOptions q;
+        q.triangle_test = test;
+        q.ordered = ordered;
+        std::vector<Hit> batch_hits(rays.size());
+        std::vector<RayStats> batch_stats(rays.size());
+        for (RayStats& st : batch_stats) st.nodes_visited = 7;  // the counters are added, as closest_hit does
+        bvh.closest_hits_counted(rays, batch_hits, batch_stats, q);
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+          RayStats ref, one;
+          VisitTrace trace;
+          const Hit h_ref = bvh.closest_hit(rays[i], q, &ref, &trace);
+          const Hit h_one = bvh.closest_hit(rays[i], q, &one);
+          RayStats batch = batch_stats[i];
+          batch.nodes_visited -= 7;
+          for (const auto& [got, h] : {std::pair{one, h_one}, std::pair{batch, batch_hits[i]}}) {
+            ASSERT_EQ(got.nodes_visited, ref.nodes_visited) << "shape " << shape << " ray " << i;
+            EXPECT_EQ(got.box_tests, ref.box_tests);
+            EXPECT_EQ(got.prim_tests, ref.prim_tests);
+            EXPECT_EQ(got.nodes_culled, ref.nodes_culled);
+            EXPECT_EQ(got.nodes_missed, ref.nodes_missed);
+            EXPECT_EQ(got.leaves_skipped, 0u);
+            EXPECT_EQ(h.prim, h_ref.prim);
+            EXPECT_TRUE(same_bits(h.t, h_ref.t) && same_bits(h.u, h_ref.u) && same_bits(h.v, h_ref.v));
+            EXPECT_TRUE(same_bits(h.ng.x, h_ref.ng.x) && same_bits(h.ng.y, h_ref.ng.y) &&
+                        same_bits(h.ng.z, h_ref.ng.z));
+          }
+          hits += h_ref.valid();
+          culled += ref.nodes_culled;
+        }
+      }
+  }
+  EXPECT_GT(hits, 1000u);  // the comparison covers hits, misses and culling
+  EXPECT_GT(culled, 1000u);
+  const Bvh empty(std::vector<Triangle>{}, quiet());
+  std::vector<Hit> h(1);
+  std::vector<RayStats> st(1);
+  empty.closest_hits_counted(std::span(rays).first(1), h, st, {});
+  EXPECT_FALSE(h[0].valid());
+  EXPECT_EQ(st[0].box_tests, 0u);
+  std::vector<Hit> two(2);
+  EXPECT_THROW(empty.closest_hits_counted(std::span(rays).first(1), two, st, {}), std::invalid_argument);
+}
+
 TEST(BvhQuery, OrderedTraversalVisitsFewerNodes) {
   const auto tris = soup(5000, 7, 0.03f);
   const Bvh bvh(tris, quiet());

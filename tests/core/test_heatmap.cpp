@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "core/accel/brute_force.h"
+#include "core/accel/bvh/bvh.h"
 #include "core/analysis/heatmap.h"
 #include "core/query/batch.h"
 #include "core/query/camera.h"
@@ -247,6 +248,48 @@ TEST(Batch, StatsAreResetPerRay) {
   trace_closest(accel, rays, hits, {}, 2u, stats);
   trace_closest(accel, rays, hits, {}, 2u, stats);  // a second pass must not accumulate
   for (const RayStats& s : stats) EXPECT_EQ(s.prim_tests, tris.size());
+}
+
+// A BVH's counted heatmaps take Bvh::closest_hits_counted (several rays in
+// turns per chunk): each pixel still shows what the instrumented walk of a
+// trace counts for its ray, on one thread and on two, and a cancel still
+// throws.
+TEST(Heatmap, BvhCountedPixelsEqualTheTracedWalk) {
+  std::vector<Triangle> tris = tiny_scene();
+  for (int i = 0; i < 40; ++i) {  // enough triangles for a tree of a few levels
+    const float x = -3.0f + 0.15f * static_cast<float>(i), z = 0.05f * static_cast<float>(i % 7);
+    tris.push_back({{x, -2.5f, z}, {x + 0.4f, -2.5f, z}, {x + 0.2f, 2.5f, z + 0.3f}});
+  }
+  BvhOptions bo;
+  bo.compute_epo = false;
+  const Bvh bvh(tris, bo);
+  const Camera cam = tiny_camera();
+  for (HeatMetric metric : {HeatMetric::nodes, HeatMetric::prims})
+    for (unsigned threads : {1u, 2u}) {
+      HeatmapOptions opts;
+      opts.metric = metric;
+      opts.width = 41;
+      opts.height = 29;
+      opts.threads = threads;
+      HeatmapFigures fig;
+      const MetricImage img = render_metric(bvh, cam, opts, &fig);
+      std::uint64_t hits = 0;
+      for (int y = 0; y < opts.height; ++y)
+        for (int x = 0; x < opts.width; ++x) {
+          RayStats st;
+          VisitTrace trace;
+          hits += bvh.closest_hit(primary_ray(cam, x, y, opts.width, opts.height), opts.query, &st, &trace).valid();
+          EXPECT_EQ(img.at(x, y), static_cast<float>(metric == HeatMetric::nodes ? st.nodes_visited : st.prim_tests));
+        }
+      EXPECT_EQ(fig.hits, hits);
+      EXPECT_GT(hits, 0u);
+      EXPECT_LT(hits, fig.rays);
+    }
+  HeatmapOptions ho;
+  ho.width = 32;
+  ho.height = 32;
+  ho.progress = [](double) { return false; };
+  EXPECT_THROW(render_metric(bvh, cam, ho), BuildCancelled);
 }
 
 TEST(Batch, ProgressCanCancel) {

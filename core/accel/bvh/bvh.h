@@ -107,6 +107,12 @@ class Bvh final : public Accelerator {
                   VisitTrace* trace = nullptr) const override;
   bool any_hit(const Ray& ray, const QueryOptions& opts, RayStats* stats = nullptr) const override;
   const BuildStats& build_stats() const override { return stats_; }
+  /// closest_hit(rays[i], qo, &stats[i]) for every i (same hits, same
+  /// counters, added to stats[i]), several rays walked in turns so that one
+  /// ray's memory waits overlap another's work: the heatmap's counted path.
+  /// Throws std::invalid_argument when the span sizes differ.
+  void closest_hits_counted(std::span<const Ray> rays, std::span<Hit> hits, std::span<RayStats> stats,
+                            const QueryOptions& qo) const;
 
   std::span<const BvhNode> nodes() const { return nodes_; }
   /// Leaf ranges index this array; its values are primitive ids in scene order.

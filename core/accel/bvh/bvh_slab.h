@@ -51,18 +51,29 @@ struct SlabRay {
   __m128 inv_dir;   ///< (1/dx, 1/dy, 1/dz, NaN): lane 3 always yields NaN, which the max/min ignore
   __m128 neg_mask;  ///< all ones on axes where inv_dir < 0 (hi is the near plane), as in intersect_slab
 
+  SlabRay() = default;
   explicit SlabRay(const Ray& r)
       : origin(_mm_setr_ps(r.origin.x, r.origin.y, r.origin.z, 0.0f)),
         inv_dir(_mm_setr_ps(r.inv_dir.x, r.inv_dir.y, r.inv_dir.z, std::numeric_limits<float>::quiet_NaN())),
         neg_mask(_mm_cmplt_ps(inv_dir, _mm_setzero_ps())) {}
 };
 
+/// hi.xyz of a node with lane 3 (the node's index, read by the 16-byte load)
+/// cleared to +0. Read as a float, an index below 2^23 is a denormal, and a
+/// denormal operand of the subtraction below costs a microcode assist on
+/// every box test: clearing it took a third off the counted heatmap walk on
+/// the AMD EPYC of docs/performance.md. Lane 3 is discarded anyway (its
+/// inv_dir lane is NaN, so it stays NaN, as before).
+[[gnu::always_inline]] inline __m128 load_hi_xyz(const BvhNode& node) {
+  return _mm_and_ps(_mm_loadu_ps(&node.bounds.hi.x), _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)));
+}
+
 /// Takes a node, not a bare Aabb: the two 16-byte loads read lo.xyz+hi.x and
 /// hi.xyz+index, which stay inside the 32-byte node.
 [[gnu::always_inline]] inline bool slab_test(const BvhNode& node, const SlabRay& r, float tmin, float tmax,
                                              float& t_entry, float& t_exit) {
   const __m128 lo = _mm_loadu_ps(&node.bounds.lo.x);
-  const __m128 hi = _mm_loadu_ps(&node.bounds.hi.x);
+  const __m128 hi = load_hi_xyz(node);
   // Swap lo and hi on the negative axes: near/far without comparisons.
   const __m128 swap = _mm_and_ps(_mm_xor_ps(lo, hi), r.neg_mask);
   const __m128 near_plane = _mm_xor_ps(lo, swap);
@@ -85,16 +96,16 @@ struct SlabRay {
 
 /// Both children of an inner node at once (they are adjacent): the same
 /// per-box arithmetic as slab_test, with the two horizontal reductions
-/// interleaved so they share shuffles. Bit 0 of the result: first child hit,
-/// bit 1: second child hit. Entry/exit distances in t_entry[2], t_exit[2].
-[[gnu::always_inline]] inline int slab_test_pair(const BvhNode* children, const SlabRay& r, float tmin, float tmax,
-                                                 float* t_entry, float* t_exit) {
+/// interleaved so they share shuffles. Lane 0 of entry/exit: first child,
+/// lane 1: second child.
+[[gnu::always_inline]] inline void slab_pair_lanes(const BvhNode* children, const SlabRay& r, float tmin, float tmax,
+                                                   __m128& entry, __m128& exit) {
   const __m128 scale = _mm_set1_ps(kSlabExitScale);
   const __m128 vmin = _mm_set1_ps(tmin), vmax = _mm_set1_ps(tmax);
   __m128 t0[2], t1[2];
   for (int c = 0; c < 2; ++c) {
     const __m128 lo = _mm_loadu_ps(&children[c].bounds.lo.x);
-    const __m128 hi = _mm_loadu_ps(&children[c].bounds.hi.x);
+    const __m128 hi = load_hi_xyz(children[c]);
     const __m128 swap = _mm_and_ps(_mm_xor_ps(lo, hi), r.neg_mask);
     const __m128 tn = _mm_mul_ps(_mm_sub_ps(_mm_xor_ps(lo, swap), r.origin), r.inv_dir);
     const __m128 tf = _mm_mul_ps(_mm_mul_ps(_mm_sub_ps(_mm_xor_ps(hi, swap), r.origin), r.inv_dir), scale);
@@ -104,11 +115,34 @@ struct SlabRay {
   // (x0 x1 y0 y1) and (z0 z1 w0 w1) -> lane 0: child 0, lane 1: child 1.
   __m128 e = _mm_max_ps(_mm_unpacklo_ps(t0[0], t0[1]), _mm_unpackhi_ps(t0[0], t0[1]));
   __m128 x = _mm_min_ps(_mm_unpacklo_ps(t1[0], t1[1]), _mm_unpackhi_ps(t1[0], t1[1]));
-  e = _mm_max_ps(e, _mm_movehl_ps(e, e));
-  x = _mm_min_ps(x, _mm_movehl_ps(x, x));
+  entry = _mm_max_ps(e, _mm_movehl_ps(e, e));
+  exit = _mm_min_ps(x, _mm_movehl_ps(x, x));
+}
+
+/// slab_pair_lanes as a hit mask. Bit 0 of the result: first child hit,
+/// bit 1: second child hit. Entry/exit distances in t_entry[2], t_exit[2].
+[[gnu::always_inline]] inline int slab_test_pair(const BvhNode* children, const SlabRay& r, float tmin, float tmax,
+                                                 float* t_entry, float* t_exit) {
+  __m128 e, x;
+  slab_pair_lanes(children, r, tmin, tmax, e, x);
   _mm_storel_pi(reinterpret_cast<__m64*>(t_entry), e);
   _mm_storel_pi(reinterpret_cast<__m64*>(t_exit), x);
   return _mm_movemask_ps(_mm_cmple_ps(e, x)) & 3;
+}
+
+/// slab_test_pair plus the culling of the counted walk, without a branch:
+/// bits 0-1 of the result are slab_test_pair's (children whose box the ray
+/// crosses in [tmin, tmax]), bits 2-3 those of them whose entry is not
+/// beyond `cull_t` (!(t_entry > cull_t), the instrumented walk's test).
+/// Entry distances in t_entry[2].
+[[gnu::always_inline]] inline int slab_test_pair_cull(const BvhNode* children, const SlabRay& r, float tmin, float tmax,
+                                                      float cull_t, float* t_entry) {
+  __m128 e, x;
+  slab_pair_lanes(children, r, tmin, tmax, e, x);
+  _mm_storel_pi(reinterpret_cast<__m64*>(t_entry), e);
+  const __m128 hit = _mm_cmple_ps(e, x);
+  const __m128 kept = _mm_andnot_ps(_mm_cmpgt_ps(e, _mm_set1_ps(cull_t)), hit);
+  return (_mm_movemask_ps(hit) & 3) | ((_mm_movemask_ps(kept) & 3) << 2);
 }
 
 /// Per-ray constants of the four-box test: origin and inverse direction
@@ -196,7 +230,8 @@ struct WideSlabRay8 {
 #else
 
 struct SlabRay {
-  const Ray* ray;
+  const Ray* ray = nullptr;
+  SlabRay() = default;
   explicit SlabRay(const Ray& r) : ray(&r) {}
 };
 
@@ -209,6 +244,16 @@ inline int slab_test_pair(const BvhNode* children, const SlabRay& r, float tmin,
   const bool h0 = slab_test_scalar(children[0], *r.ray, tmin, tmax, t_entry[0], t_exit[0]);
   const bool h1 = slab_test_scalar(children[1], *r.ray, tmin, tmax, t_entry[1], t_exit[1]);
   return (h0 ? 1 : 0) | (h1 ? 2 : 0);
+}
+
+inline int slab_test_pair_cull(const BvhNode* children, const SlabRay& r, float tmin, float tmax, float cull_t,
+                               float* t_entry) {
+  float t_exit[2];
+  const int hit = slab_test_pair(children, r, tmin, tmax, t_entry, t_exit);
+  int kept = hit;
+  for (int c = 0; c < 2; ++c)
+    if (t_entry[c] > cull_t) kept &= ~(1 << c);
+  return hit | (kept << 2);
 }
 
 struct WideSlabRay {
