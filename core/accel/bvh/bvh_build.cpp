@@ -1,7 +1,9 @@
 // Top-down BVH construction driver, shared by all splitters.
 //
 // Steps:
-//  1. Validate the options and copy bounds/centroids into BuildPrim records.
+//  1. Validate the options and copy bounds/centroids into BuildPrim records
+//     (build_bvh; class Bvh fills the records straight from its triangles
+//     and calls build_bvh_records).
 //  2. Recurse from the root: a node becomes a leaf when it is small enough
 //     (max_leaf_size) or when the splitter's SAH says so; otherwise the
 //     splitter partitions its range in place and both children recurse.
@@ -16,9 +18,6 @@
 //  4. Statistics over the finished array (counts, depths, SAH cost).
 #include "core/accel/bvh/bvh_build.h"
 
-#include "core/analysis/sah.h"
-#include "core/util/parallel.h"
-
 #include <algorithm>
 #include <atomic>
 #include <bit>
@@ -29,14 +28,21 @@
 #include <string>
 #include <thread>
 
+#include "core/analysis/sah.h"
+#include "core/util/parallel.h"
+
 namespace accelviz {
 
 const char* to_string(BvhSplitter s) {
   switch (s) {
-    case BvhSplitter::binned_sah: return "binned";
-    case BvhSplitter::exact_sah: return "exact";
-    case BvhSplitter::median: return "median";
-    case BvhSplitter::lbvh: return "lbvh";
+    case BvhSplitter::binned_sah:
+      return "binned";
+    case BvhSplitter::exact_sah:
+      return "exact";
+    case BvhSplitter::median:
+      return "median";
+    case BvhSplitter::lbvh:
+      return "lbvh";
   }
   return "?";
 }
@@ -212,8 +218,7 @@ class Builder {
     std::unique_lock lock(progress_mutex_, std::try_to_lock);
     if (!lock.owns_lock() || cancelled_.load()) return;
     try {
-      if (!progress_(static_cast<double>(before + n) / static_cast<double>(prims_.size())))
-        cancelled_.store(true);
+      if (!progress_(static_cast<double>(before + n) / static_cast<double>(prims_.size()))) cancelled_.store(true);
     } catch (...) {
       callback_error_ = std::current_exception();
       cancelled_.store(true);
@@ -253,23 +258,40 @@ BvhTopology build_bvh(std::span<const Aabb> bounds, std::span<const glm::vec3> c
   if (bounds.size() != centroids.size())
     throw std::invalid_argument("build_bvh: " + std::to_string(bounds.size()) + " bounds but " +
                                 std::to_string(centroids.size()) + " centroids");
-  if (bounds.size() >= std::numeric_limits<std::uint32_t>::max())
+  check_prim_count(bounds.size());
+  // 1. Build records (in id order) and root bounds.
+  const std::size_t n = bounds.size();
+  std::vector<BuildPrim> prims;
+  prims.reserve(n);
+  Aabb root_bounds, root_centroids;
+  for (std::size_t i = 0; i < n; ++i) {
+    prims.push_back(BuildPrim{centroids[i], static_cast<std::uint32_t>(i), bounds[i]});
+    root_bounds.extend(bounds[i]);
+    root_centroids.extend(centroids[i]);
+  }
+  BvhTopology topo = build_bvh_records(prims, root_bounds, root_centroids, opts, progress);
+  topo.stats.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return topo;
+}
+
+namespace bvh_detail {
+
+void check_prim_count(std::size_t n) {
+  if (n >= std::numeric_limits<std::uint32_t>::max())
     throw std::invalid_argument("build_bvh: too many primitives for 32-bit indices");
+}
+
+BvhTopology build_bvh_records(std::span<BuildPrim> prims, const Aabb& root_bounds, const Aabb& root_centroids,
+                              const BvhOptions& opts, const ProgressCallback& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  validate(opts);
+  check_prim_count(prims.size());
 
   BvhTopology topo;
-  const std::size_t n = bounds.size();
+  const std::size_t n = prims.size();
   if (n > 0) {
-    // 1. Build records and root bounds.
-    std::vector<BuildPrim> prims(n);
-    Aabb root_bounds, root_centroids;
-    for (std::size_t i = 0; i < n; ++i) {
-      prims[i] = BuildPrim{centroids[i], static_cast<std::uint32_t>(i), bounds[i]};
-      root_bounds.extend(bounds[i]);
-      root_centroids.extend(centroids[i]);
-    }
     // 2.-3. Recursive build.
-    SplitParams params{opts.buckets, opts.max_leaf_size, opts.leaf_size_cap, opts.cost_traversal,
-                       opts.cost_intersect};
+    SplitParams params{opts.buckets, opts.max_leaf_size, opts.leaf_size_cap, opts.cost_traversal, opts.cost_intersect};
     if (opts.splitter == BvhSplitter::lbvh) {
       params.morton = morton_frame(root_centroids);
       lbvh_sort(prims, params.morton, resolve_threads(opts.threads));
@@ -284,8 +306,7 @@ BvhTopology build_bvh(std::span<const Aabb> bounds, std::span<const glm::vec3> c
     topo.nodes.reserve(2 * n);
     topo.nodes.resize(1);
     SplitScratch scratch;
-    builder.build(NodeWork{0, static_cast<std::uint32_t>(n), root_bounds, root_centroids, 0}, topo.nodes, 0,
-                  scratch);
+    builder.build(NodeWork{0, static_cast<std::uint32_t>(n), root_bounds, root_centroids, 0}, topo.nodes, 0, scratch);
     builder.finish();
     topo.nodes.shrink_to_fit();
     topo.prim_indices.resize(n);
@@ -306,5 +327,7 @@ BvhTopology build_bvh(std::span<const Aabb> bounds, std::span<const glm::vec3> c
   st.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return topo;
 }
+
+}  // namespace bvh_detail
 
 }  // namespace accelviz

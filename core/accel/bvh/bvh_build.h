@@ -2,17 +2,16 @@
 // Internals shared by the top-down BVH build driver (bvh_build.cpp) and the
 // splitters (one per file: bvh_build_binned.cpp, bvh_build_exact.cpp,
 // bvh_build_median.cpp). Not part of the public API: include bvh.h instead.
-#include "core/accel/bvh/bvh.h"
-#include "core/math/aabb.h"
-
-#include <glm/glm.hpp>
-
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <limits>
 #include <span>
 #include <vector>
+
+#include "core/accel/bvh/bvh.h"
+#include "core/math/aabb.h"
 
 namespace accelviz::bvh_detail {
 
@@ -51,9 +50,9 @@ enum class SplitOutcome {
 };
 
 struct SplitResult {
-  std::size_t mid = 0;           ///< primitives in the left child
-  Aabb bounds[2];                ///< children's geometric bounds
-  Aabb centroid_bounds[2];       ///< children's centroid bounds
+  std::size_t mid = 0;      ///< primitives in the left child
+  Aabb bounds[2];           ///< children's geometric bounds
+  Aabb centroid_bounds[2];  ///< children's centroid bounds
 };
 
 /// Per-thread buffers reused from node to node, so that the recursion does not allocate.
@@ -102,6 +101,14 @@ inline int bucket_of(float c, float lo, float k, int buckets) {
   return x < top ? static_cast<int>(x) : buckets - 1;
 }
 
+/// bucket_of(c, lo, k, buckets) <= plane for a plane 0 <= plane <= buckets - 2
+/// (the partition's test), in one compare: truncation and the clamp to
+/// [0, B-1] never move (c - lo)·k across the integer plane + 1, and NaN or
+/// negative values fail the compare and go left, as bucket 0 does.
+inline bool left_of_plane(float c, float lo, float k, int plane) {
+  return !((c - lo) * k >= static_cast<float>(plane + 1));
+}
+
 /// Resets the first `buckets` buckets of every axis to empty.
 void clear_bins(Bins& bins, int buckets);
 /// Adds every primitive to its bucket on all three axes (Wald 2007):
@@ -119,12 +126,12 @@ Aabb bucket_box(const Bins& bins, int axis, int b);
 /// Outcome of the binned SAH search over one node (split_binned_sah's steps
 /// 1-3; the explainer in core/analysis/insight runs the same code).
 struct BinnedSahSearch {
-  float k[3] = {0.0f, 0.0f, 0.0f};  ///< buckets per unit of centroid extent, per axis (0: axis unusable)
+  float k[3] = {0.0f, 0.0f, 0.0f};         ///< buckets per unit of centroid extent, per axis (0: axis unusable)
   bool usable[3] = {false, false, false};  ///< the axis's centroids spread (non-zero, finite extent)
-  float best_cost = kInfinity;      ///< A_L·N_L + A_R·N_R (half areas) of the best candidate
-  std::size_t best_left = 0;        ///< primitives left of the best plane
-  int best_axis = -1;               ///< -1: no plane separates anything
-  int best_bucket = -1;             ///< the best plane lies between buckets best_bucket and best_bucket + 1
+  float best_cost = kInfinity;             ///< A_L·N_L + A_R·N_R (half areas) of the best candidate
+  std::size_t best_left = 0;               ///< primitives left of the best plane
+  int best_axis = -1;                      ///< -1: no plane separates anything
+  int best_bucket = -1;                    ///< the best plane lies between buckets best_bucket and best_bucket + 1
 };
 /// Cost A_L·N_L + A_R·N_R of every candidate plane b (between buckets b and
 /// b+1) per axis; NaN where one side is empty or the axis is unusable.
@@ -144,12 +151,23 @@ bool binned_sah_search(int buckets, std::span<const BuildPrim> prims, const Aabb
 /// depth budget runs short. Fills the children's bounds.
 void split_object_median(std::span<BuildPrim> prims, const Aabb& centroid_bounds, SplitResult& out);
 
+/// build_bvh's steps 2-4 on records the caller has filled: prims[i].id == i
+/// (id order, as lbvh_sort requires), `root_bounds`/`root_centroids` their
+/// Aabb::extend unions in id order. Reorders `prims`. class Bvh calls this
+/// with records made straight from its triangles (no bounds/centroid arrays).
+BvhTopology build_bvh_records(std::span<BuildPrim> prims, const Aabb& root_bounds, const Aabb& root_centroids,
+                              const BvhOptions& opts, const ProgressCallback& progress = {});
+/// Throws std::invalid_argument when n primitives do not fit 32-bit indices.
+void check_prim_count(std::size_t n);
+
 /// Geometric and centroid bounds of a range.
 void range_bounds(std::span<const BuildPrim> prims, Aabb& bounds, Aabb& centroid_bounds);
 
 /// Sort key of a centroid coordinate: NaN maps to +inf so that comparisons stay
 /// a strict weak order even on garbage input (std::sort requires one).
-inline float sort_key(float c) { return c == c ? c : std::numeric_limits<float>::infinity(); }
+inline float sort_key(float c) {
+  return c == c ? c : std::numeric_limits<float>::infinity();
+}
 
 /// Strict "a before b" on `axis`, ties broken by id: every primitive has a unique position.
 inline bool centroid_less(const BuildPrim& a, const BuildPrim& b, int axis) {
