@@ -20,6 +20,15 @@
 namespace accelviz::bvh_detail {
 
 void clear_bins(Bins& bins, int buckets) {
+#if defined(__SSE2__) && !defined(ACCELVIZ_NO_SIMD)
+  const __m128 lo = _mm_set1_ps(kInfinity), hi = _mm_set1_ps(-kInfinity);
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < buckets; ++b) {
+      _mm_store_ps(bins.lo[a][b], lo);
+      _mm_store_ps(bins.hi[a][b], hi);
+      bins.count[a][b] = 0;
+    }
+#else
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < buckets; ++b) {
       for (int l = 0; l < 4; ++l) {
@@ -28,6 +37,7 @@ void clear_bins(Bins& bins, int buckets) {
       }
       bins.count[a][b] = 0;
     }
+#endif
 }
 
 void bin_primitives_scalar(std::span<const BuildPrim> prims, const glm::vec3& origin, const float k[3], int buckets,
@@ -117,7 +127,14 @@ namespace {
   return _mm_andnot_ps(empty, area);
 }
 
-void sweep_costs(const Bins& bins, int nb, float (&cost_of)[3][kMaxBuckets]) {
+/// Every candidate plane of the three axes, one lane per axis: cost[b] =
+/// A_L·N_L + A_R·N_R of the plane between buckets b and b+1, left[b] = N_L.
+struct SweepOut {
+  alignas(16) float cost[kMaxBuckets][4];
+  alignas(16) std::int32_t left[kMaxBuckets][4];
+};
+
+void sweep_planes(const Bins& bins, int nb, SweepOut& out) {
   alignas(16) float right_area[kMaxBuckets][4];
   alignas(16) float right_count[kMaxBuckets][4];
   __m128 lo[3], hi[3];
@@ -141,7 +158,6 @@ void sweep_costs(const Bins& bins, int nb, float (&cost_of)[3][kMaxBuckets]) {
     hi[a] = _mm_set1_ps(-kInfinity);
   }
   cnt = _mm_setzero_si128();
-  alignas(16) float cost[4];
   for (int b = 0; b < nb - 1; ++b) {
     for (int a = 0; a < 3; ++a) {
       lo[a] = _mm_min_ps(_mm_load_ps(bins.lo[a][b]), lo[a]);
@@ -149,10 +165,68 @@ void sweep_costs(const Bins& bins, int nb, float (&cost_of)[3][kMaxBuckets]) {
     }
     cnt = _mm_add_epi32(cnt, _mm_setr_epi32(static_cast<int>(bins.count[0][b]), static_cast<int>(bins.count[1][b]),
                                             static_cast<int>(bins.count[2][b]), 0));
-    _mm_store_ps(cost, _mm_add_ps(_mm_mul_ps(half_areas3(lo, hi), _mm_cvtepi32_ps(cnt)),
-                                  _mm_mul_ps(_mm_load_ps(right_area[b]), _mm_load_ps(right_count[b]))));
-    for (int a = 0; a < 3; ++a) cost_of[a][b] = cost[a];
+    _mm_store_ps(out.cost[b], _mm_add_ps(_mm_mul_ps(half_areas3(lo, hi), _mm_cvtepi32_ps(cnt)),
+                                         _mm_mul_ps(_mm_load_ps(right_area[b]), _mm_load_ps(right_count[b]))));
+    _mm_store_si128(reinterpret_cast<__m128i*>(out.left[b]), cnt);
   }
+}
+
+void sweep_costs(const Bins& bins, int nb, float (&cost_of)[3][kMaxBuckets]) {
+  SweepOut out;
+  sweep_planes(bins, nb, out);
+  for (int b = 0; b < nb - 1; ++b)
+    for (int a = 0; a < 3; ++a) cost_of[a][b] = out.cost[b][a];
+}
+
+/// The candidate loop of search_impl (better_split over axes, then planes,
+/// in order) without its branches: the winner is the cheapest candidate
+/// (NaN never wins), among equally cheap ones the most balanced, and among
+/// those the first in (axis, plane) order, which is what the sequential
+/// loop keeps. Needs n < 2^30 (imbalances in int32 lanes).
+void select_plane(const SweepOut& sw, int nb, std::size_t n, const bool usable[3], BinnedSahSearch& s) {
+  const __m128i zero = _mm_setzero_si128(), nv = _mm_set1_epi32(static_cast<int>(n));
+  const __m128i use = _mm_setr_epi32(usable[0] ? -1 : 0, usable[1] ? -1 : 0, usable[2] ? -1 : 0, 0);
+  const __m128 inf = _mm_set1_ps(kInfinity);
+  const auto valid_at = [&](int b) {  // usable axis, both sides non-empty
+    const __m128i l = _mm_load_si128(reinterpret_cast<const __m128i*>(sw.left[b]));
+    return _mm_andnot_si128(_mm_or_si128(_mm_cmpeq_epi32(l, zero), _mm_cmpeq_epi32(l, nv)), use);
+  };
+  // 1. The lowest cost of a candidate (min ignores NaN: _mm_min_ps returns its second operand then).
+  __m128 m = inf;
+  for (int b = 0; b < nb - 1; ++b) {
+    const __m128 valid = _mm_castsi128_ps(valid_at(b));
+    const __m128 c = _mm_or_ps(_mm_and_ps(valid, _mm_load_ps(sw.cost[b])), _mm_andnot_ps(valid, inf));
+    m = _mm_min_ps(c, m);
+  }
+  m = _mm_min_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(2, 3, 0, 1)));
+  m = _mm_min_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
+  // 2. Per axis, the first plane of that cost with the smallest imbalance |2·N_L - n|.
+  const __m128i big = _mm_set1_epi32(std::numeric_limits<std::int32_t>::max());
+  __m128i best_key = big, best_b = _mm_set1_epi32(-1);
+  for (int b = 0; b < nb - 1; ++b) {
+    const __m128i eq = _mm_and_si128(valid_at(b), _mm_castps_si128(_mm_cmpeq_ps(_mm_load_ps(sw.cost[b]), m)));
+    const __m128i l = _mm_load_si128(reinterpret_cast<const __m128i*>(sw.left[b]));
+    const __m128i d = _mm_sub_epi32(_mm_add_epi32(l, l), nv);
+    const __m128i sign = _mm_srai_epi32(d, 31);
+    const __m128i imb = _mm_sub_epi32(_mm_xor_si128(d, sign), sign);
+    const __m128i key = _mm_or_si128(_mm_and_si128(eq, imb), _mm_andnot_si128(eq, big));
+    const __m128i take = _mm_cmplt_epi32(key, best_key);
+    best_key = _mm_or_si128(_mm_and_si128(take, key), _mm_andnot_si128(take, best_key));
+    best_b = _mm_or_si128(_mm_and_si128(take, _mm_set1_epi32(b)), _mm_andnot_si128(take, best_b));
+  }
+  alignas(16) std::int32_t key[4], bb[4];
+  _mm_store_si128(reinterpret_cast<__m128i*>(key), best_key);
+  _mm_store_si128(reinterpret_cast<__m128i*>(bb), best_b);
+  // 3. Across axes: the smallest imbalance, the first axis on a tie.
+  std::int32_t best = std::numeric_limits<std::int32_t>::max();
+  for (int a = 0; a < 3; ++a)
+    if (key[a] < best) {
+      best = key[a];
+      s.best_axis = a;
+      s.best_bucket = bb[a];
+      s.best_left = static_cast<std::size_t>(sw.left[bb[a]][a]);
+      s.best_cost = sw.cost[bb[a]][a];
+    }
 }
 #else
 void sweep_costs(const Bins& bins, int nb, float (&cost_of)[3][kMaxBuckets]) {
@@ -226,6 +300,16 @@ bool search_impl(int nb, std::span<const BuildPrim> prims, const Aabb& centroid_
   // 2. Binning: one pass, all three axes. (Only the B buckets in use are cleared.)
   clear_bins(bins, nb);
   bin_primitives(prims, centroid_bounds.lo, s.k, nb, bins);
+#if defined(__SSE2__) && !defined(ACCELVIZ_NO_SIMD)
+  if constexpr (!Record) {
+    if (n < (std::size_t{1} << 30)) {
+      SweepOut sw;
+      sweep_planes(bins, nb, sw);
+      select_plane(sw, nb, n, s.usable, s);
+      return true;
+    }
+  }
+#endif
 
   // 3. SAH at every bucket boundary: a right-to-left sweep stores the right
   //    side's area and count, a left-to-right sweep completes the cost
@@ -279,13 +363,28 @@ SplitOutcome split_binned_sah(const SplitParams& params, std::span<BuildPrim> pr
 
   // 4. Children's bounds are the unions of their buckets' bounds.
   Aabb child_bounds[2];
+#if defined(__SSE2__) && !defined(ACCELVIZ_NO_SIMD)
+  for (int side = 0; side < 2; ++side) {
+    __m128 cl = _mm_set1_ps(kInfinity), ch = _mm_set1_ps(-kInfinity);
+    for (int b = side == 0 ? 0 : best_bucket + 1; b < (side == 0 ? best_bucket + 1 : nb); ++b) {
+      cl = _mm_min_ps(_mm_load_ps(bins.lo[best_axis][b]), cl);  // Aabb::extend: glm::min(acc, box)
+      ch = _mm_max_ps(_mm_load_ps(bins.hi[best_axis][b]), ch);
+    }
+    alignas(16) float l[4], h[4];
+    _mm_store_ps(l, cl);
+    _mm_store_ps(h, ch);
+    child_bounds[side] = Aabb{{l[0], l[1], l[2]}, {h[0], h[1], h[2]}};
+  }
+#else
   for (int b = 0; b < nb; ++b) child_bounds[b <= best_bucket ? 0 : 1].extend(bucket_box(bins, best_axis, b));
+#endif
 
   // 5. In-place two-ended partition (Hoare), gathering the children's
-  //    centroid bounds on the way; each primitive is classified once.
+  //    centroid bounds on the way; each primitive is classified once
+  //    (left_of_plane: bucket_of(c) <= best_bucket without its branches).
   const int a = best_axis;
   const float lo_a = lo[a], k_a = k[a];
-  const auto goes_left = [&](const BuildPrim& p) { return bucket_of(p.centroid[a], lo_a, k_a, nb) <= best_bucket; };
+  const auto goes_left = [&](const BuildPrim& p) { return left_of_plane(p.centroid[a], lo_a, k_a, best_bucket); };
   CentroidBounds cb_left, cb_right;
   std::size_t i = 0, j = n;
   for (;;) {
