@@ -392,6 +392,253 @@ Hit traverse(const BvhView& bvh, const Ray& ray, const Collector& c) {
   }
 }
 
+/// The heatmap's walk: closest hit with statistics and no trace over the
+/// binary tree (QueryOptions without back_to_front and xray). It takes the
+/// decisions of traverse<false, Ordered, true, Test> and gives the same hit
+/// and the same RayStats (tests/core/test_bvh_query.cpp compares the two per
+/// ray); it only does less to get them:
+///  - counters are locals, added once at the end, and two of them are
+///    derived: every inner node entered tests both children (box_tests =
+///    1 + 2 * inner nodes entered), and every box tested is entered, missed
+///    or culled, since a closest-hit walk pops every pending entry;
+///  - each child pair is tested once against [tmin, ray.tmax] (missed =
+///    not crossed) with the culling (entry beyond the closest hit) a second
+///    compare on the same lanes, then the fast path's branch-free push;
+///  - watertight leaves test four triangles at a time (bvh_tri4.h: lanes in
+///    the leaf's order, accepted against the closest hit in that order, as
+///    the scalar loop would), each triangle still counting as one test;
+///  - it is a state advanced one node per step(), so that several rays can
+///    be walked in turns (walk_counted_batch): deep in a dense mesh
+///    neighbouring rays share few nodes and a lone walk mostly waits on
+///    memory; each step asks for what the next steps will read (a kept
+///    child's child pair, a leaf's first block) before it is needed.
+/// Interleaved: a leaf takes two steps, the first only looks its blocks up.
+template <bool Ordered, TriangleTest Test, bool Interleaved>
+class CountedWalk {
+ public:
+  /// Starts the walk of `ray` (kept by reference). False: there is nothing
+  /// to walk (empty tree, or the ray misses the root box); finish() then
+  /// already gives the final result.
+  bool start(const BvhView& bvh, const Ray& ray) {
+    ray_ = &ray;
+    best_ = Hit{};
+    closest_ = ray.tmax;
+    sp_ = 0;
+    visited_ = inner_ = missed_ = prims_ = 0;
+    leaf_ready_ = false;
+    empty_ = bvh.node_count == 0;
+    if (empty_) return false;
+    sr_ = SlabRay(ray);
+    float r0, r1;
+    if (!slab_test(bvh.nodes[0], sr_, ray.tmin, closest_, r0, r1)) {
+      missed_ = 1;
+      return false;
+    }
+    visited_ = 1;
+    if constexpr (Test == TriangleTest::watertight) {
+      wr_ = InlineWatertightRay(ray);
+#ifdef ACCELVIZ_BVH_TRI4_SSE2
+      tr4_ = bvh_detail::Tri4Ray(wr_);
+#endif
+    }
+    node_ = 0;
+    return true;
+  }
+
+  /// Walks one node; false when the walk is over.
+  [[gnu::always_inline]] bool step(const BvhView& bvh) {
+    const Ray& ray = *ray_;
+    const float tmin = ray.tmin;
+    const BvhNode& n = bvh.nodes[node_];
+    if (n.count == 0) {
+      const std::uint32_t i0 = n.index;
+      float te[2];
+      const int bits = slab_test_pair_cull(bvh.nodes + i0, sr_, tmin, ray.tmax, closest_, te);
+      const int mask = bits >> 2;
+      ++inner_;
+      missed_ += 2u - static_cast<std::uint32_t>((bits & 1) + ((bits >> 1) & 1));  // (no popcnt in x86-64 v1)
+      // What each kept child leads to: its child pair, or a leaf's entry of
+      // leaf_block (a missed or culled child asks for itself, in cache).
+      for (std::uint32_t c = 0; c < 2; ++c) {
+        const BvhNode& ch = bvh.nodes[i0 + c];
+        const void* next = ch.count == 0 ? static_cast<const void*>(bvh.nodes + ch.index)
+                                         : static_cast<const void*>(bvh.leaf_block + i0 + c);
+        __builtin_prefetch((mask >> c) & 1 ? next : &ch);
+      }
+      if (mask != 0) {
+        const bool both = mask == 3;
+        const bool second_first = Ordered && te[1] < te[0];
+        stack_[sp_] = {i0 + 1u - (second_first ? 1u : 0u), second_first ? te[0] : te[1]};
+        sp_ += both ? 1u : 0u;
+        node_ = both ? i0 + (second_first ? 1u : 0u) : i0 + static_cast<std::uint32_t>(mask >> 1);
+        ++visited_;
+        return true;
+      }
+    } else {
+      if constexpr (Interleaved) {
+        if (!leaf_ready_) {
+          block_ = bvh.leaf_block[node_];
+          const char* b = reinterpret_cast<const char*>(bvh.blocks + block_);
+          __builtin_prefetch(b);
+          __builtin_prefetch(b + 64);
+          __builtin_prefetch(b + sizeof(bvh_detail::TriBlock4) - 1);
+          leaf_ready_ = true;
+          return true;
+        }
+        leaf_ready_ = false;
+      } else {
+        block_ = bvh.leaf_block[node_];
+      }
+      leaf(bvh, n);
+    }
+    // Pop the next node whose entry still lies before the closest hit.
+    while (sp_ > 0) {
+      const Entry e = stack_[--sp_];
+      if (e.t_entry > closest_) continue;
+      node_ = e.node;
+      ++visited_;
+      return true;
+    }
+    return false;
+  }
+
+  /// Adds the walk's counters to `stats`; returns the hit (prim = leaf-order position).
+  const Hit& finish(RayStats& stats) const {
+    if (!empty_) {
+      const std::uint32_t boxes = 1 + 2 * inner_;
+      stats.nodes_visited += visited_;
+      stats.box_tests += boxes;
+      stats.nodes_missed += missed_;
+      stats.nodes_culled += boxes - visited_ - missed_;
+      stats.prim_tests += prims_;
+    }
+    return best_;
+  }
+
+ private:
+  struct Entry {
+    std::uint32_t node;
+    float t_entry;
+  };
+
+  void take(std::uint32_t k, const Hit& h, const Triangle& tri) {
+    if (h.t < best_.t) {  // first found wins ties, as in traverse
+      best_ = h;
+      best_.prim = k;
+      best_.ng = triangle_normal(tri);
+      closest_ = h.t;
+    }
+  }
+
+  [[gnu::always_inline]] void leaf(const BvhView& bvh, const BvhNode& n) {
+    const Ray& ray = *ray_;
+    const float tmin = ray.tmin;
+    prims_ += n.count;
+    const bvh_detail::TriBlock4* blk = bvh.blocks + block_;
+#ifdef ACCELVIZ_BVH_TRI4_SSE2
+    if constexpr (Test == TriangleTest::watertight) {
+      for (std::uint32_t left = n.count; left > 0; ++blk) {
+        const int valid = left >= 4 ? 0xF : (1 << left) - 1;
+        left = left >= 4 ? left - 4 : 0;
+        bvh_detail::Tri4Result r;
+        bvh_detail::intersect_tri4(*blk, tr4_, tmin, r);
+        int lanes = (r.candidate | r.special) & valid;
+        while (lanes != 0) {
+          const int l = std::countr_zero(static_cast<unsigned>(lanes));
+          lanes &= lanes - 1;
+          const Triangle tri = bvh_detail::tri4_triangle(*blk, static_cast<std::uint32_t>(l));
+          Hit h;
+          bool hit;
+          if ((r.special >> l) & 1) {
+            hit = intersect_watertight(ray, wr_.wr, tri, tmin, closest_, h);
+          } else {
+            hit = bvh_detail::tri4_accept(r, l, closest_);
+            h.t = r.t[l];
+            h.u = r.u[l];
+            h.v = r.v[l];
+          }
+          if (hit) take(blk->pos[l], h, tri);
+        }
+      }
+      return;
+    }
+#endif
+    for (std::uint32_t j = 0; j < n.count; ++j) {
+      const Triangle tri = bvh_detail::tri4_triangle(blk[j >> 2], j & 3);
+      Hit h;
+      if (test_triangle<Test>(ray, wr_, tri, tmin, closest_, h)) take(n.index + j, h, tri);
+    }
+  }
+
+  SlabRay sr_;
+  InlineWatertightRay wr_;
+#ifdef ACCELVIZ_BVH_TRI4_SSE2
+  bvh_detail::Tri4Ray tr4_{InlineWatertightRay()};
+#endif
+  const Ray* ray_ = nullptr;
+  Hit best_;
+  float closest_ = 0.0f;
+  std::uint32_t node_ = 0, block_ = 0, sp_ = 0;
+  std::uint32_t visited_ = 0, inner_ = 0, missed_ = 0, prims_ = 0;
+  bool leaf_ready_ = false, empty_ = false;
+  Entry stack_[kBvhMaxDepth];
+};
+
+template <bool Ordered, TriangleTest Test>
+Hit traverse_counted(const BvhView& bvh, const Ray& ray, RayStats& stats) {
+  CountedWalk<Ordered, Test, false> w;
+  if (w.start(bvh, ray))
+    while (w.step(bvh)) {
+    }
+  return w.finish(stats);
+}
+
+/// CountedWalk over `rays`, kWalks of them in turns: each ray's result
+/// (prim mapped to scene ids) into hits[i], its counters added to stats[i].
+template <bool Ordered, TriangleTest Test>
+void walk_counted_batch(const BvhView& bvh, std::span<const Ray> rays, std::span<Hit> hits, std::span<RayStats> stats) {
+  constexpr int kWalks = 8;
+  CountedWalk<Ordered, Test, true> walk[kWalks];
+  std::size_t ray_of[kWalks];
+  int active[kWalks];  // the walks in progress: walk[active[0 .. live)]
+  std::size_t next = 0;
+  const auto finish = [&](int w, std::size_t i) {
+    Hit h = walk[w].finish(stats[i]);
+    if (h.valid()) h.prim = bvh.prim_ids[h.prim];
+    hits[i] = h;
+  };
+  // Starts rays on walk w until one needs walking; false when none are left.
+  const auto refill = [&](int w) {
+    while (next < rays.size()) {
+      const std::size_t i = next++;
+      if (walk[w].start(bvh, rays[i])) {
+        ray_of[w] = i;
+        return true;
+      }
+      finish(w, i);
+    }
+    return false;
+  };
+  int live = 0;
+  for (int w = 0; w < kWalks; ++w)
+    if (refill(w)) active[live++] = w;
+  while (live > 0) {
+    for (int a = 0; a < live;) {
+      const int w = active[a];
+      if (walk[w].step(bvh)) {
+        ++a;
+        continue;
+      }
+      finish(w, ray_of[w]);
+      if (refill(w)) {
+        ++a;
+      } else {
+        active[a] = active[--live];
+      }
+    }
+  }
+}
+
 #if defined(ACCELVIZ_BVH_WIDE8_AVX2)
 #define ACCELVIZ_BVH_WIDE8 1
 #endif
@@ -470,12 +717,38 @@ Hit Bvh::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, Vi
     h = wide8_  ? dispatch_wide8<false>(*wide8_, v, ray, qo)
         : wide_ ? dispatch_wide<false>(*wide_, v, ray, qo)
                 : dispatch<false, false>(v, ray, qo, Collector{nullptr, nullptr});
+  } else if (stats != nullptr && trace == nullptr && !qo.back_to_front && !qo.xray) {
+    const bool wt = qo.triangle_test == TriangleTest::watertight;
+    if (qo.ordered)
+      h = wt ? traverse_counted<true, TriangleTest::watertight>(v, ray, *stats)
+             : traverse_counted<true, TriangleTest::moller_trumbore>(v, ray, *stats);
+    else
+      h = wt ? traverse_counted<false, TriangleTest::watertight>(v, ray, *stats)
+             : traverse_counted<false, TriangleTest::moller_trumbore>(v, ray, *stats);
   } else {
     RayStats local;
     h = dispatch<false, true>(v, ray, qo, Collector{stats ? stats : &local, trace, qo.back_to_front, qo.xray});
   }
   if (h.valid()) h.prim = prim_indices_[h.prim];  // the traversals set ng
   return h;
+}
+
+void Bvh::closest_hits_counted(std::span<const Ray> rays, std::span<Hit> hits, std::span<RayStats> stats,
+                               const QueryOptions& qo) const {
+  if (hits.size() != rays.size() || stats.size() != rays.size())
+    throw std::invalid_argument("Bvh::closest_hits_counted: hits and stats must match the ray count");
+  if (qo.back_to_front || qo.xray) {
+    for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = closest_hit(rays[i], qo, &stats[i]);
+    return;
+  }
+  const BvhView v{nodes_.data(), blocks_.data(), leaf_block_.data(), prim_indices_.data(), nodes_.size()};
+  const bool wt = qo.triangle_test == TriangleTest::watertight;
+  if (qo.ordered)
+    wt ? walk_counted_batch<true, TriangleTest::watertight>(v, rays, hits, stats)
+       : walk_counted_batch<true, TriangleTest::moller_trumbore>(v, rays, hits, stats);
+  else
+    wt ? walk_counted_batch<false, TriangleTest::watertight>(v, rays, hits, stats)
+       : walk_counted_batch<false, TriangleTest::moller_trumbore>(v, rays, hits, stats);
 }
 
 bool Bvh::any_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats) const {
