@@ -4,6 +4,7 @@
 #include "core/accel/factory.h"
 #include "core/geometry/triangle.h"
 #include "core/scene/scene.h"
+#include "core/util/timing.h"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -126,9 +127,6 @@ class Progress {
 };
 
 using Clock = std::chrono::steady_clock;
-inline double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 /// "12.3 MiB", "512 B" for humans.
 std::string format_bytes(std::uint64_t bytes);

@@ -8,6 +8,7 @@
 #include "core/scene/load.h"
 #ifdef ACCELVIZ_HAVE_UI
 #include "app/gui/gui.h"
+#include "core/util/one_line.h"
 #endif
 
 #include <CLI/CLI.hpp>
@@ -21,12 +22,6 @@
 #include <vector>
 
 namespace {
-
-/// Error messages stay on one line whatever the thrower put in them.
-std::string one_line(std::string s) {
-  std::replace(s.begin(), s.end(), '\n', ' ');
-  return s;
-}
 
 /// Whether a lone argument names a scene rather than a mistyped subcommand:
 /// a built-in spec, a scene file extension, or a file that exists.
@@ -106,7 +101,7 @@ int main(int argc, char** argv) {
         return run_gui(g);
       } catch (const NoWindow& e) {
         if (want_window) throw std::runtime_error(std::string("cannot open a window: ") + e.what());
-        if (!global.quiet) std::fprintf(stderr, "accelviz: cannot open a window (%s)\n", one_line(e.what()).c_str());
+        if (!global.quiet) std::fprintf(stderr, "accelviz: cannot open a window (%s)\n", joined_line(e.what()).c_str());
       }
     } else if (want_window) {
       throw std::runtime_error(
@@ -118,7 +113,7 @@ int main(int argc, char** argv) {
 #endif
     return cli::run_demo(global);
   } catch (const cli::UsageError& e) {
-    std::fprintf(stderr, "accelviz: %s\n", one_line(e.what()).c_str());
+    std::fprintf(stderr, "accelviz: %s\n", joined_line(e.what()).c_str());
     return 2;
   } catch (const BuildCancelled&) {
     std::fprintf(stderr, "accelviz: cancelled\n");
@@ -127,7 +122,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "accelviz: out of memory\n");
     return 1;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "accelviz: %s\n", one_line(e.what()).c_str());
+    std::fprintf(stderr, "accelviz: %s\n", joined_line(e.what()).c_str());
     return 1;
   }
 }

@@ -22,6 +22,7 @@ std::optional<EmbreeQuality> parse_embree_quality(std::string_view name) {
 #ifdef ACCELVIZ_HAVE_EMBREE
 
 #include "core/analysis/sah.h"
+#include "core/util/timing.h"
 
 #include <embree3/rtcore.h>
 
@@ -39,10 +40,6 @@ namespace accelviz {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 /// A device with an error callback that keeps the first message, and a
 /// memory monitor that tracks what Embree holds. Released on destruction.

@@ -1,5 +1,6 @@
 // Animation sampling and the per-frame update of a two-level structure (see animation.h).
 #include "core/scene/animation.h"
+#include "core/util/timing.h"
 
 #include <algorithm>
 #include <chrono>
@@ -12,9 +13,6 @@ namespace accelviz {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 glm::quat to_quat(const glm::vec4& v) {
   return glm::quat(v.w, v.x, v.y, v.z);

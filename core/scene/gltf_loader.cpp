@@ -17,6 +17,7 @@
 //      cameras, lights, animations;
 //   5. Scene::flatten() builds world triangles, dropping non-finite ones.
 #include "core/scene/load.h"
+#include "core/util/one_line.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
@@ -47,31 +48,10 @@ constexpr std::uint64_t kMaxWorldTriangles = std::uint64_t{1} << 28;
 constexpr std::size_t kMaxJsonDepth = 256;
 /// tinygltf takes the file size as `unsigned int`; GLB lengths are 32-bit.
 constexpr std::uint64_t kMaxFileBytes = std::numeric_limits<std::uint32_t>::max();
-/// Long messages (tinygltf can quote a whole data URI) are cut to this.
-constexpr std::size_t kMaxMessageChars = 300;
 
 constexpr std::uint32_t kGlbMagic = 0x46546C67;      // "glTF"
 constexpr std::uint32_t kGlbChunkJson = 0x4E4F534A;  // "JSON"
 constexpr std::uint32_t kGlbChunkBin = 0x004E4942;   // "BIN\0"
-
-/// First non-empty line of a (possibly multi-line) message, trimmed and cut
-/// to a readable length, so that every SceneError stays one line.
-std::string one_line(const std::string& text) {
-  std::size_t start = 0;
-  while (start < text.size()) {
-    std::size_t end = text.find_first_of("\r\n", start);
-    if (end == std::string::npos) end = text.size();
-    std::string line = text.substr(start, end - start);
-    const auto first = line.find_first_not_of(" \t");
-    if (first != std::string::npos) {
-      line = line.substr(first, line.find_last_not_of(" \t") - first + 1);
-      if (line.size() > kMaxMessageChars) line = line.substr(0, kMaxMessageChars) + "...";
-      return line;
-    }
-    start = end + 1;
-  }
-  return "unknown error";
-}
 
 /// Every line of a message, each made one line (tinygltf warnings come joined).
 std::vector<std::string> lines_of(const std::string& text) {
@@ -81,7 +61,7 @@ std::vector<std::string> lines_of(const std::string& text) {
     std::size_t end = text.find_first_of("\r\n", start);
     if (end == std::string::npos) end = text.size();
     const std::string line = text.substr(start, end - start);
-    if (line.find_first_not_of(" \t") != std::string::npos) out.push_back(one_line(line));
+    if (line.find_first_not_of(" \t") != std::string::npos) out.push_back(first_line(line));
     start = end + 1;
   }
   return out;
@@ -352,8 +332,8 @@ class GltfConverter {
   }
 
  private:
-  [[noreturn]] void fail(const std::string& problem) const { throw SceneError(path_ + ": " + one_line(problem)); }
-  void warn(const std::string& message) { scene_.report.warnings.push_back(one_line(message)); }
+  [[noreturn]] void fail(const std::string& problem) const { throw SceneError(path_ + ": " + first_line(problem)); }
+  void warn(const std::string& message) { scene_.report.warnings.push_back(first_line(message)); }
 
   // --- accessors -----------------------------------------------------------
 
@@ -1059,7 +1039,7 @@ class GltfConverter {
 // --- Step 1: reading the file ----------------------------------------------
 
 [[noreturn]] void fail_file(const std::string& path, const std::string& problem) {
-  throw SceneError(path + ": " + one_line(problem));
+  throw SceneError(path + ": " + first_line(problem));
 }
 
 std::vector<unsigned char> read_file(const std::string& path) {
@@ -1148,7 +1128,7 @@ bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, in
 /// tinygltf's messages, made one line and, for the common missing external
 /// buffer, rephrased to name the file plainly.
 std::string tinygltf_problem(const std::string& err) {
-  const std::string line = one_line(err);
+  const std::string line = first_line(err);
   const std::string not_found = "File not found : ";
   if (line.rfind(not_found, 0) == 0) return "external buffer file '" + line.substr(not_found.size()) + "' not found";
   // Its message would quote the whole data URI.

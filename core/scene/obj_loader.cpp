@@ -18,6 +18,7 @@
 //   4. coordinates our scan read as NaN/inf are restored, so flatten() drops
 //      those triangles and counts them instead of placing them at the origin.
 #include "core/scene/load.h"
+#include "core/util/one_line.h"
 
 #include <tiny_obj_loader.h>
 
@@ -40,27 +41,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr std::size_t kMaxMessageChars = 300;
-
-std::string one_line(const std::string& text) {
-  std::string line;
-  for (const char c : text) {
-    if (c == '\n' || c == '\r') {
-      if (line.find_first_not_of(" \t") != std::string::npos) break;
-      line.clear();
-      continue;
-    }
-    line += c;
-  }
-  const auto first = line.find_first_not_of(" \t");
-  if (first == std::string::npos) return "unknown error";
-  line = line.substr(first, line.find_last_not_of(" \t") - first + 1);
-  if (line.size() > kMaxMessageChars) line = line.substr(0, kMaxMessageChars) + "...";
-  return line;
-}
-
 [[noreturn]] void fail(const std::string& path, const std::string& problem) {
-  throw SceneError(path + ": " + one_line(problem));
+  throw SceneError(path + ": " + first_line(problem));
 }
 
 /// A token as it appears in a message: cut short, control bytes shown as '?'.
@@ -247,7 +229,7 @@ std::vector<std::string> warning_lines(const std::string& text) {
   std::istringstream in(text);
   std::string line;
   while (std::getline(in, line))
-    if (line.find_first_not_of(" \t\r.") != std::string::npos) out.push_back(one_line(line));
+    if (line.find_first_not_of(" \t\r.") != std::string::npos) out.push_back(first_line(line));
   return out;
 }
 

@@ -334,7 +334,7 @@ TEST(Voxels, DegenerateInputsTerminate) {
   EXPECT_GE(vp.occupied_count(), 1u);
   EXPECT_TRUE(vp.occupied_at({1, 2, 3}));
   Scene dup(100, Triangle{{0, 0, 0}, {1, 0, 0}, {0, 1, 1}});
-  const Voxels vd(dup, VoxelOptions{6});
+  const Voxels vd(dup, VoxelOptions{5});
   EXPECT_EQ(vd.to_dense().bits, voxelize_dense(dup, vd.domain()).bits);
   Scene seg{{{0, 0, 0}, {1, 1, 1}, {1, 1, 1}}};
   const Voxels vs(seg, VoxelOptions{4});

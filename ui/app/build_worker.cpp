@@ -6,18 +6,11 @@
 
 #include "core/accel/factory.h"
 #include "core/scene/load.h"
+#include "core/util/one_line.h"
+#include "core/util/timing.h"
 
 namespace accelviz {
 namespace {
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-std::string one_line(std::string s) {
-  std::replace(s.begin(), s.end(), '\n', ' ');
-  return s;
-}
 
 BuildWorker::LoadFn default_load(BuildWorker::LoadFn load) {
   if (load) return load;
@@ -115,7 +108,7 @@ BuildOutcome BuildWorker::execute(std::uint64_t id, const BuildRequest& r) {
         throw;
       } catch (const std::exception& e) {
         out.result = BuildOutcome::Result::failed;
-        out.error = one_line(e.what());
+        out.error = joined_line(e.what());
         out.scene_error = true;
         return out;
       }
@@ -152,7 +145,7 @@ BuildOutcome BuildWorker::execute(std::uint64_t id, const BuildRequest& r) {
     out.error = "out of memory while building " + r.structure.name;
   } catch (const std::exception& e) {
     out.result = BuildOutcome::Result::failed;
-    out.error = r.structure.name + ": " + one_line(e.what());
+    out.error = r.structure.name + ": " + joined_line(e.what());
   }
   return out;
 }

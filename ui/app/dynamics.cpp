@@ -7,6 +7,7 @@
 
 #include "core/accel/factory.h"
 #include "core/accel/tlas/tlas.h"
+#include "core/util/timing.h"
 
 namespace accelviz {
 
@@ -47,9 +48,6 @@ struct DynamicsWorker::State {
 
 namespace {
 using Published = std::shared_ptr<const DynamicsSnapshot>;
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 /// The view shows the two-level structure: the animator's own tree is the frame.
 bool shows_tlas(const DynamicsRequest& r) {
   return r.structure && r.structure->name == "tlas";

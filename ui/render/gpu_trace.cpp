@@ -8,6 +8,7 @@
 
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
+#include "core/util/timing.h"
 
 namespace accelviz {
 namespace {
@@ -27,10 +28,6 @@ static_assert(sizeof(GpuPixel) == 32);
 static_assert(sizeof(Triangle) == 36, "the shader reads triangles as 9 packed floats");
 
 constexpr int kGroup = 8;  // local_size_x/y of trace_bvh.comp
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 /// A storage buffer with `bytes` of `data` (at least 4 bytes: GL rejects empty stores).
 GlObject make_storage(const void* data, std::size_t bytes, const char* what) {

@@ -9,10 +9,6 @@
 
 namespace accelviz {
 
-namespace {
-struct NoTestedSet {};
-}  // namespace
-
 template <bool kCollect, bool kAnyHit>
 Hit Grid::traverse(const Ray& ray, const QueryOptions& qo, RayStats* stats, VisitTrace* trace) const {
   Hit best;
@@ -52,7 +48,7 @@ Hit Grid::traverse(const Ray& ray, const QueryOptions& qo, RayStats* stats, Visi
   const WatertightRay wr(ray.direction);
   float tmax = ray.tmax;
   spatial::Mailbox mailbox;
-  [[maybe_unused]] std::conditional_t<kCollect, spatial::TestedSet, NoTestedSet> tested;
+  [[maybe_unused]] spatial::TestedSetFor<kCollect> tested;
   [[maybe_unused]] float t_cell = iv.t_entry;
 
   for (;;) {

@@ -52,10 +52,10 @@ struct Split {
   double cost = std::numeric_limits<double>::infinity();
 };
 
-class Builder {
+class KdBuilder {
  public:
-  Builder(std::span<const Triangle> tris, const KdTreeOptions& opts, int max_depth, const ProgressCallback& progress,
-          std::vector<KdNode>& nodes, std::vector<std::uint32_t>& refs)
+  KdBuilder(std::span<const Triangle> tris, const KdTreeOptions& opts, int max_depth, const ProgressCallback& progress,
+            std::vector<KdNode>& nodes, std::vector<std::uint32_t>& refs)
       : tris_(tris), opts_(opts), max_depth_(max_depth), progress_(progress), nodes_(nodes), refs_(refs) {}
 
   // Builds the subtree for `prims` (with their bounds clipped to `box`) at
@@ -244,7 +244,7 @@ KdTree::KdTree(std::span<const Triangle> triangles, const KdTreeOptions& opts, c
           : std::min(kKdMaxDepth,
                      static_cast<int>(std::lround(8.0 + 1.3 * std::log2(static_cast<double>(std::max<std::size_t>(n, 1))))));
 
-  Builder builder(tris_, opts_, max_depth, progress, nodes_, prim_refs_);
+  KdBuilder builder(tris_, opts_, max_depth, progress, nodes_, prim_refs_);
   if (n > 0) builder.build(prims, cb, bounds_, 0, 1.0);
   nodes_.shrink_to_fit();
   prim_refs_.shrink_to_fit();

@@ -7,10 +7,6 @@
 
 namespace accelviz {
 
-namespace {
-struct NoTestedSet {};
-}  // namespace
-
 template <bool kCollect, bool kAnyHit>
 Hit KdTree::traverse(const Ray& ray, const QueryOptions& qo, RayStats* stats, VisitTrace* trace) const {
   Hit best;
@@ -38,7 +34,7 @@ Hit KdTree::traverse(const Ray& ray, const QueryOptions& qo, RayStats* stats, Vi
   const WatertightRay wr(ray.direction);
   float tmax = ray.tmax;  // shrinks to the closest candidate
   spatial::Mailbox mailbox;
-  [[maybe_unused]] std::conditional_t<kCollect, spatial::TestedSet, NoTestedSet> tested;
+  [[maybe_unused]] spatial::TestedSetFor<kCollect> tested;
 
   std::uint32_t node = 0;
   float t0 = iv.t_entry, t1 = iv.t_exit;

@@ -21,6 +21,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 #include <unordered_set>
 
 namespace accelviz::spatial {
@@ -139,5 +140,13 @@ class TestedSet {
  private:
   std::unordered_set<std::uint32_t> ids_;
 };
+
+/// What the fast path keeps instead of a TestedSet: nothing.
+struct NoTestedSet {};
+
+/// The tested-primitive set of a traversal: a TestedSet on the statistics
+/// path (kCollect), an empty struct that compiles away otherwise.
+template <bool kCollect>
+using TestedSetFor = std::conditional_t<kCollect, TestedSet, NoTestedSet>;
 
 }  // namespace accelviz::spatial

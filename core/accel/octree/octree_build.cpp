@@ -27,10 +27,10 @@ bool boxes_overlap(const Aabb& a, const Aabb& b) {
          b.lo.z <= a.hi.z;
 }
 
-class Builder {
+class OctreeBuilder {
  public:
-  Builder(std::span<const Triangle> tris, const OctreeOptions& opts, float pad, const ProgressCallback& progress,
-          std::vector<OctreeNode>& nodes, std::vector<std::uint32_t>& refs)
+  OctreeBuilder(std::span<const Triangle> tris, const OctreeOptions& opts, float pad, const ProgressCallback& progress,
+                std::vector<OctreeNode>& nodes, std::vector<std::uint32_t>& refs)
       : tris_(tris), opts_(opts), pad_(pad), progress_(progress), nodes_(nodes), refs_(refs) {}
 
   // Fills nodes_[node] (already allocated) for the cell `box` holding `prims`.
@@ -160,7 +160,7 @@ Octree::Octree(std::span<const Triangle> triangles, const OctreeOptions& opts, c
     }
     pad = spatial::cell_padding(root_.lo, root_.hi);
   }
-  Builder builder(tris_, opts_, pad, progress, nodes_, prim_refs_);
+  OctreeBuilder builder(tris_, opts_, pad, progress, nodes_, prim_refs_);
   if (n > 0) {
     nodes_.emplace_back();
     builder.build(0, prims, root_, 0, 1.0);

@@ -12,8 +12,6 @@ namespace accelviz {
 
 namespace {
 
-struct NoTestedSet {};
-
 struct OctantPiece {
   int octant;
   float t0, t1;
@@ -73,7 +71,7 @@ Hit Octree::traverse(const Ray& ray, const QueryOptions& qo, RayStats* stats, Vi
   const WatertightRay wr(ray.direction);
   float tmax = ray.tmax;
   spatial::Mailbox mailbox;
-  [[maybe_unused]] std::conditional_t<kCollect, spatial::TestedSet, NoTestedSet> tested;
+  [[maybe_unused]] spatial::TestedSetFor<kCollect> tested;
 
   while (sp > 0) {
     const Entry e = stack[--sp];

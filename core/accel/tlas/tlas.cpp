@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/accel/tlas/tlas_overlap.h"
+#include "core/util/timing.h"
 
 namespace accelviz {
 
@@ -25,9 +26,6 @@ Aabb corners_box(const Aabb& box, const glm::mat4& m) {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 bool finite3(const glm::vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);

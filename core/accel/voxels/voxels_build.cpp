@@ -25,10 +25,10 @@ struct Octant {
   VoxelNode node;  // interior only
 };
 
-class Builder {
+class VoxelBuilder {
  public:
-  Builder(std::span<const Triangle> tris, const VoxelDomain& d, const ProgressCallback& progress,
-          std::vector<VoxelNode>& nodes)
+  VoxelBuilder(std::span<const Triangle> tris, const VoxelDomain& d, const ProgressCallback& progress,
+               std::vector<VoxelNode>& nodes)
       : tris_(tris), d_(d), progress_(progress), nodes_(nodes) {}
 
   // The size³ block at (x, y, z) holding `prims` (which overlap the block).
@@ -115,7 +115,7 @@ Voxels::Voxels(std::span<const Triangle> triangles, const VoxelOptions& opts, co
     if (is_finite_triangle(triangles[i]) && voxel_overlap(triangles[i], domain_.box(), root_pad))
       prims.push_back(static_cast<std::uint32_t>(i));
 
-  Builder builder(triangles, domain_, progress, nodes_);
+  VoxelBuilder builder(triangles, domain_, progress, nodes_);
   const Octant root = builder.build(0, 0, 0, domain_.resolution, prims);
   if (root.kind == Octant::interior) {
     nodes_.push_back(root.node);

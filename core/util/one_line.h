@@ -1,0 +1,41 @@
+#pragma once
+// Error and warning messages that stay on one line, whatever the thrower put
+// in them: the loaders keep a message's first non-blank line (tinygltf and
+// tinyobjloader can quote a whole data URI or several warnings joined), the
+// app joins a multi-line exception text into one line.
+#include <algorithm>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace accelviz {
+
+/// Long messages are cut to this many characters (plus "...").
+inline constexpr std::size_t kMaxMessageChars = 300;
+
+/// First non-blank line of `text`, trimmed of spaces and tabs and cut to
+/// kMaxMessageChars; "unknown error" when there is none.
+inline std::string first_line(const std::string& text) {
+  std::size_t start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find_first_of("\r\n", start);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(start, end - start);
+    const auto first = line.find_first_not_of(" \t");
+    if (first != std::string::npos) {
+      line = line.substr(first, line.find_last_not_of(" \t") - first + 1);
+      if (line.size() > kMaxMessageChars) line = line.substr(0, kMaxMessageChars) + "...";
+      return line;
+    }
+    start = end + 1;
+  }
+  return "unknown error";
+}
+
+/// `text` with every newline made a space (nothing is dropped).
+inline std::string joined_line(std::string text) {
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  return text;
+}
+
+}  // namespace accelviz
