@@ -77,6 +77,10 @@ void StructureCli::add_to(CLI::App* app) {
       ->check(CLI::IsMember({"low", "medium", "high"}))
       ->capture_default_str()
       ->group("Structure");
+  app->add_flag("--embree-robust", embree_robust,
+                "Embree robust mode (RTC_SCENE_FLAG_ROBUST: no optimisations that lose watertightness), the "
+                "counterpart of our watertight triangle test")
+      ->group("Structure");
 }
 
 StructureOptions StructureCli::to_options(unsigned threads, bool compute_epo) const {
@@ -95,6 +99,7 @@ StructureOptions StructureCli::to_options(unsigned threads, bool compute_epo) co
   o.bvh.compute_epo = compute_epo;
   o.bvh.wide_width = wide;
   o.embree.quality = parse_embree_quality(embree_quality).value_or(EmbreeQuality::medium);
+  o.embree.robust = embree_robust;
   return o;
 }
 

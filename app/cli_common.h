@@ -76,6 +76,7 @@ struct StructureCli {
   float ctrav = BvhOptions{}.cost_traversal;
   float cisect = BvhOptions{}.cost_intersect;
   std::string embree_quality = "medium";
+  bool embree_robust = false;
 
   void add_to(CLI::App* app);
   /// Options for the factory; `threads` is the build thread count.

@@ -256,6 +256,7 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   j["repeat"] = o.repeat;
   j["size"] = {size.width, size.height};
   j["triangle_test"] = o.triangle_test;
+  if (kHaveEmbree) j["embree_robust"] = so.embree.robust;
   j["ray_sets"] = nlohmann::json::object();
   for (const RaySet& set : sets) {
     j["ray_sets"][set.name] = {{"rays", set.rays.size()}};
@@ -316,8 +317,9 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   }
 
   // ---- text ----
-  std::printf("scene %s: %zu triangles; %u threads; medians of %d runs; %s triangle test\n", o.scene.c_str(),
-              scene.triangles.size(), all, o.repeat, o.triangle_test.c_str());
+  std::printf("scene %s: %zu triangles; %u threads; medians of %d runs; %s triangle test%s\n", o.scene.c_str(),
+              scene.triangles.size(), all, o.repeat, o.triangle_test.c_str(),
+              kHaveEmbree ? (so.embree.robust ? "; Embree robust" : "; Embree default (not robust)") : "");
   for (const RaySet& set : sets)
     std::printf("  %-8s %zu rays%s\n", set.name.c_str(), set.rays.size(),
                 set.name == "shadow" && synthetic_light ? " (to a synthetic light: the scene has none)" : "");

@@ -46,5 +46,16 @@ assert "build_ms" in r and "closest_mrays_1t" in r["primary"]
 e = j["structures"][0]["embree_binary_bvh"]
 assert e["sah_cost"] > 0 and e["sah_ratio_ours_over_embree"] > 0
 assert j["structures"][1]["per_ray_counters"] is False
+assert j["embree_robust"] is False
 print("embree ratios ok")'
+  # --embree-robust: Embree's watertight counterpart, said so in the JSON and the text.
+  "$accelviz" -q bench 'builtin:soup?size=2000' --structure bvh,embree --embree-robust --rays shadow --size 16x16 \
+    --repeat 1 --json | python3 -c '
+import json, sys
+j = json.load(sys.stdin)
+assert j["embree_robust"] is True, j.get("embree_robust")
+assert j["ratios_vs_embree"]["bvh"]["shadow"]["any_mrays_1t"] > 0
+print("embree robust ok")'
+  "$accelviz" -q bench 'builtin:soup?size=2000' --structure embree --embree-robust --rays primary --size 8x8 \
+    --repeat 1 | grep -q "Embree robust" || { echo "FAIL: text output does not say Embree robust"; exit 1; }
 fi
