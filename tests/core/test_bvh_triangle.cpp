@@ -3,13 +3,15 @@
 // bit for bit the same t, u, v, on random input and on the cases that take
 // the special paths (rays through shared edges and vertices, axis-aligned
 // rays, huge and tiny coordinates, degenerate triangles, t at the interval
-// ends).
+// ends). The wide path's four-lane Moller-Trumbore test is checked against
+// the scalar one on the same inputs.
 #include <gtest/gtest.h>
 
 #include <cstring>
 #include <random>
 #include <vector>
 
+#include "core/accel/bvh/bvh_tri4.h"
 #include "core/accel/bvh/bvh_triangle.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
@@ -52,6 +54,22 @@ void expect_same(const Ray& ray, const Triangle& tri, float tmin, float tmax, Co
   if (hm) {
     ASSERT_TRUE(same_bits(m.t, n.t) && same_bits(m.u, n.u) && same_bits(m.v, n.v));
   }
+#ifdef ACCELVIZ_BVH_TRI4_SSE2
+  // The wide path's four-lane Moller-Trumbore (bvh_tri4.h), the triangle in
+  // every lane (a block of one: padding lanes repeat it): each lane must be
+  // the scalar test bit for bit.
+  std::vector<bvh_detail::TriBlock4> blocks;
+  bvh_detail::append_tri4_blocks([&](std::uint32_t) -> const Triangle& { return tri; }, 0, 1, blocks);
+  bvh_detail::Tri4MtResult r4;
+  bvh_detail::intersect_tri4_mt(blocks[0], bvh_detail::Tri4MtRay(ray), tmin, r4);
+  for (int l = 0; l < 4; ++l) {
+    const bool h4 = ((r4.candidate >> l) & 1) && r4.t[l] <= tmax;
+    ASSERT_EQ(h4, hm) << "lane " << l;
+    if (hm) {
+      ASSERT_TRUE(same_bits(m.t, r4.t[l]) && same_bits(m.u, r4.u[l]) && same_bits(m.v, r4.v[l])) << "lane " << l;
+    }
+  }
+#endif
 }
 
 glm::vec3 rand_vec(std::mt19937& rng, float scale) {

@@ -161,6 +161,66 @@ struct Tri4Result {
   out.candidate = _mm_movemask_ps(ok) & ~sp;
 }
 
+/// Per-ray constants of the four-lane Moller-Trumbore test.
+struct Tri4MtRay {
+  __m128 ox, oy, oz, dx, dy, dz;
+  explicit Tri4MtRay(const Ray& r)
+      : ox(_mm_set1_ps(r.origin.x)),
+        oy(_mm_set1_ps(r.origin.y)),
+        oz(_mm_set1_ps(r.origin.z)),
+        dx(_mm_set1_ps(r.direction.x)),
+        dy(_mm_set1_ps(r.direction.y)),
+        dz(_mm_set1_ps(r.direction.z)) {}
+};
+
+/// The tmax-independent part of the Moller-Trumbore test on four lanes.
+struct Tri4MtResult {
+  alignas(16) float t[4], u[4], v[4];
+  int candidate = 0;  ///< lanes with det != 0, u, v inside and t >= tmin (tmax not yet applied)
+};
+
+/// intersect_moller_trumbore_inline (core/geometry/triangle_inline.h) on the
+/// four lanes of a block: the same operations in the same order (glm::cross,
+/// glm::dot as (x + y) + z, one IEEE division), so each lane's t, u, v and
+/// outcome are bit for bit the scalar test's (the core library never
+/// contracts to FMA). A lane is a hit when it is a candidate and t <= tmax,
+/// the scalar test's last check. NaN compares false in both, so a NaN u or v
+/// passes and a NaN t fails in both.
+[[gnu::always_inline]] inline void intersect_tri4_mt(const TriBlock4& b, const Tri4MtRay& r, float tmin,
+                                                     Tri4MtResult& out) {
+  const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+  const __m128 v0x = _mm_load_ps(b.v[0]), v0y = _mm_load_ps(b.v[1]), v0z = _mm_load_ps(b.v[2]);
+  const __m128 e1x = _mm_sub_ps(_mm_load_ps(b.v[3]), v0x), e1y = _mm_sub_ps(_mm_load_ps(b.v[4]), v0y),
+               e1z = _mm_sub_ps(_mm_load_ps(b.v[5]), v0z);
+  const __m128 e2x = _mm_sub_ps(_mm_load_ps(b.v[6]), v0x), e2y = _mm_sub_ps(_mm_load_ps(b.v[7]), v0y),
+               e2z = _mm_sub_ps(_mm_load_ps(b.v[8]), v0z);
+  // p = cross(d, e2)
+  const __m128 px = _mm_sub_ps(_mm_mul_ps(r.dy, e2z), _mm_mul_ps(e2y, r.dz));
+  const __m128 py = _mm_sub_ps(_mm_mul_ps(r.dz, e2x), _mm_mul_ps(e2z, r.dx));
+  const __m128 pz = _mm_sub_ps(_mm_mul_ps(r.dx, e2y), _mm_mul_ps(e2x, r.dy));
+  const __m128 det = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e1x, px), _mm_mul_ps(e1y, py)), _mm_mul_ps(e1z, pz));
+  const __m128 inv = _mm_div_ps(one, det);
+  const __m128 sx = _mm_sub_ps(r.ox, v0x), sy = _mm_sub_ps(r.oy, v0y), sz = _mm_sub_ps(r.oz, v0z);
+  const __m128 u =
+      _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(sx, px), _mm_mul_ps(sy, py)), _mm_mul_ps(sz, pz)), inv);
+  // q = cross(s, e1)
+  const __m128 qx = _mm_sub_ps(_mm_mul_ps(sy, e1z), _mm_mul_ps(e1y, sz));
+  const __m128 qy = _mm_sub_ps(_mm_mul_ps(sz, e1x), _mm_mul_ps(e1z, sx));
+  const __m128 qz = _mm_sub_ps(_mm_mul_ps(sx, e1y), _mm_mul_ps(e1x, sy));
+  const __m128 v =
+      _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(r.dx, qx), _mm_mul_ps(r.dy, qy)), _mm_mul_ps(r.dz, qz)), inv);
+  const __m128 t =
+      _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(e2x, qx), _mm_mul_ps(e2y, qy)), _mm_mul_ps(e2z, qz)), inv);
+  const __m128 reject =
+      _mm_or_ps(_mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(det, zero), _mm_cmplt_ps(u, zero)), _mm_cmpgt_ps(u, one)),
+                _mm_or_ps(_mm_cmplt_ps(v, zero), _mm_cmpgt_ps(_mm_add_ps(u, v), one)));
+  const __m128 ok = _mm_andnot_ps(reject, _mm_cmpge_ps(t, _mm_set1_ps(tmin)));
+  _mm_store_ps(out.t, t);
+  _mm_store_ps(out.u, u);
+  _mm_store_ps(out.v, v);
+  out.candidate = _mm_movemask_ps(ok);
+}
+
 /// The scalar test's tmax-dependent acceptance of candidate lane l.
 [[gnu::always_inline]] inline bool tri4_accept(const Tri4Result& r, int l, float tmax) {
   const float det = r.det[l], T = r.T[l];

@@ -27,6 +27,9 @@ Hit traverse_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& b
   // Watertight leaves: four triangles per test (bvh_tri4.h).
   constexpr bool kTri4 = Test == TriangleTest::watertight;
   bvh_detail::Tri4Ray tr4(wr);
+  // Moller-Trumbore leaves: the same, four triangles per test.
+  constexpr bool kTri4Mt = Test == TriangleTest::moller_trumbore;
+  const bvh_detail::Tri4MtRay tm4(ray);
 #endif
 
   struct Entry {
@@ -126,6 +129,28 @@ Hit traverse_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& b
               h.v = r.v[l];
             }
             if (take(hit, h, k, tri)) return best;
+          }
+        }
+      } else if constexpr (kTri4Mt) {
+        // Lanes in order, each accepted against the closest hit so far, as
+        // the scalar loop below would (t <= tmax is the scalar test's last check).
+        const bvh_detail::TriBlock4* blk = bvh.blocks + child;
+        for (std::uint32_t left = meta; left > 0; ++blk) {
+          const int valid = left >= 4 ? 0xF : (1 << left) - 1;
+          left = left >= 4 ? left - 4 : 0;
+          bvh_detail::Tri4MtResult r;
+          bvh_detail::intersect_tri4_mt(*blk, tm4, tmin, r);
+          int lanes = r.candidate & valid;
+          while (lanes != 0) {
+            const int l = std::countr_zero(static_cast<unsigned>(lanes));
+            lanes &= lanes - 1;
+            if (!(r.t[l] <= closest)) continue;
+            Hit h;
+            h.t = r.t[l];
+            h.u = r.u[l];
+            h.v = r.v[l];
+            if (take(true, h, blk->pos[l], bvh_detail::tri4_triangle(*blk, static_cast<std::uint32_t>(l))))
+              return best;
           }
         }
       } else
