@@ -38,6 +38,15 @@ run_one() {
     >"$build/$t.log" 2>&1
 }
 
+# The targets write each input into a private directory under TMPDIR
+# (fuzz_common.h); libFuzzer ends without running destructors, so point
+# TMPDIR into the build directory and remove it afterwards: nothing is left in /tmp.
+fuzz_tmp="$(realpath "$build")/tmp"
+rm -rf "$fuzz_tmp"
+mkdir -p "$fuzz_tmp"
+export TMPDIR="$fuzz_tmp"
+trap 'rm -rf "$fuzz_tmp"' EXIT
+
 declare -A pids
 for t in $targets; do
   echo "== $t: ${seconds}s from tests/fuzz/corpus/${t#fuzz_}"
