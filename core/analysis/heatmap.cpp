@@ -101,36 +101,16 @@ namespace {
 
 /// trace_closest with statistics for a BVH: each chunk of rays goes to
 /// Bvh::closest_hits_counted (the same hits and counters as closest_hit per
-/// ray, several rays walked in turns). Progress and cancellation as
-/// trace_closest: after each chunk, one report at a time, a cancel stops
-/// every worker at its next chunk.
+/// ray, several rays walked in turns), with trace_closest's progress and
+/// cancellation (for_each_chunk).
 bool trace_bvh_counted(const Bvh& bvh, std::span<const Ray> rays, std::span<Hit> hits, std::span<RayStats> stats,
                        const QueryOptions& query, const BatchOptions& batch) {
-  const std::size_t n = rays.size();
-  std::atomic<std::size_t> done{0};
-  std::atomic<bool> cancelled{false};
-  std::mutex progress_mutex;
-  const auto range = [&](std::size_t begin, std::size_t end, unsigned /*thread*/) {
-    if (cancelled.load(std::memory_order_relaxed)) return;
+  return for_each_chunk(rays.size(), batch, [&](std::size_t begin, std::size_t end) {
     const std::size_t count = end - begin;
     for (std::size_t i = begin; i < end; ++i) stats[i] = RayStats{};
     bvh.closest_hits_counted(rays.subspan(begin, count), hits.subspan(begin, count), stats.subspan(begin, count),
                              query);
-    const std::size_t so_far = done.fetch_add(count, std::memory_order_relaxed) + count;
-    if (batch.progress) {
-      std::unique_lock lock(progress_mutex, std::try_to_lock);
-      if (lock.owns_lock() && !batch.progress(static_cast<double>(so_far) / static_cast<double>(n)))
-        cancelled.store(true, std::memory_order_relaxed);
-    }
-  };
-  const std::size_t chunk = std::max<std::size_t>(batch.chunk, 1);
-  if (resolve_threads(batch.threads) == 1) {
-    for (std::size_t b = 0; b < n && !cancelled.load(std::memory_order_relaxed); b += chunk)
-      range(b, std::min(n, b + chunk), 0u);
-  } else {
-    parallel_for(n, batch.threads, chunk, range);
-  }
-  return !cancelled.load();
+  });
 }
 
 }  // namespace

@@ -11,19 +11,12 @@ namespace accelviz {
 
 namespace {
 
-/// Runs per_ray(i, stats_or_null) over all rays on the worker threads.
-/// Progress is reported after each chunk by whichever worker finished it (the
-/// calling thread may get no chunk at all when the others are quicker), one
-/// call at a time: a worker that finds the callback busy skips its report
-/// rather than wait. A cancel stops every worker at its next chunk.
+/// Runs per_ray(i, stats_or_null) over all rays on the worker threads
+/// (for_each_chunk), each ray's stats reset first when there are any.
 template <typename PerRay>
 bool run_batch(std::size_t n, std::span<RayStats> stats, const BatchOptions& batch, PerRay&& per_ray) {
-  std::atomic<std::size_t> done{0};
-  std::atomic<bool> cancelled{false};
-  std::mutex progress_mutex;
   const bool with_stats = !stats.empty();
-  auto range = [&](std::size_t begin, std::size_t end, unsigned /*thread*/) {
-    if (cancelled.load(std::memory_order_relaxed)) return;
+  return for_each_chunk(n, batch, [&](std::size_t begin, std::size_t end) {
     if (with_stats) {
       for (std::size_t i = begin; i < end; ++i) {
         stats[i] = RayStats{};
@@ -32,6 +25,25 @@ bool run_batch(std::size_t n, std::span<RayStats> stats, const BatchOptions& bat
     } else {
       for (std::size_t i = begin; i < end; ++i) per_ray(i, nullptr);
     }
+  });
+}
+
+void check_sizes(std::size_t rays, std::size_t out, std::size_t stats, const char* fn) {
+  if (out != rays) throw std::invalid_argument(std::string(fn) + ": output span size differs from the ray count");
+  if (stats != 0 && stats != rays)
+    throw std::invalid_argument(std::string(fn) + ": stats span must be empty or match the ray count");
+}
+
+}  // namespace
+
+bool for_each_chunk(std::size_t n, const BatchOptions& batch,
+                    const std::function<void(std::size_t begin, std::size_t end)>& per_chunk) {
+  std::atomic<std::size_t> done{0};
+  std::atomic<bool> cancelled{false};
+  std::mutex progress_mutex;
+  auto range = [&](std::size_t begin, std::size_t end, unsigned /*thread*/) {
+    if (cancelled.load(std::memory_order_relaxed)) return;
+    per_chunk(begin, end);
     const std::size_t so_far = done.fetch_add(end - begin, std::memory_order_relaxed) + (end - begin);
     if (batch.progress) {
       std::unique_lock lock(progress_mutex, std::try_to_lock);
@@ -50,14 +62,6 @@ bool run_batch(std::size_t n, std::span<RayStats> stats, const BatchOptions& bat
   }
   return !cancelled.load();
 }
-
-void check_sizes(std::size_t rays, std::size_t out, std::size_t stats, const char* fn) {
-  if (out != rays) throw std::invalid_argument(std::string(fn) + ": output span size differs from the ray count");
-  if (stats != 0 && stats != rays)
-    throw std::invalid_argument(std::string(fn) + ": stats span must be empty or match the ray count");
-}
-
-}  // namespace
 
 bool trace_closest(const Accelerator& accel, std::span<const Ray> rays, std::span<Hit> hits,
                    const QueryOptions& query, const BatchOptions& batch, std::span<RayStats> stats) {

@@ -5,6 +5,7 @@
 #include "core/accel/accel.h"
 
 #include <cstdint>
+#include <functional>
 #include <span>
 
 namespace accelviz {
@@ -14,6 +15,16 @@ struct BatchOptions {
   std::size_t chunk = 256;      ///< rays handed to a worker at a time (dynamic balancing)
   ProgressCallback progress;    ///< optional; called from worker threads, one call at a time; false cancels
 };
+
+/// Runs per_chunk(begin, end) over [0, n) in chunks of batch.chunk on
+/// batch.threads workers (dynamic balancing), what trace_closest and
+/// trace_any run on. Progress is reported after each chunk by whichever worker
+/// finished it (the calling thread may get no chunk at all when the others
+/// are quicker), one call at a time: a worker that finds the callback busy
+/// skips its report rather than wait. A cancel stops every worker at its next
+/// chunk; returns false then.
+bool for_each_chunk(std::size_t n, const BatchOptions& batch,
+                    const std::function<void(std::size_t begin, std::size_t end)>& per_chunk);
 
 /// Closest hit of every ray into `hits` (same size as `rays`). When `stats` is
 /// non-empty it must have the same size and receives each ray's counters
