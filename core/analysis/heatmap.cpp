@@ -4,7 +4,6 @@
 #include <stb_image_write.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -13,14 +12,12 @@
 #include <filesystem>
 #include <limits>
 #include <memory>
-#include <mutex>
 #include <stdexcept>
 
 #include "core/accel/bvh/bvh.h"
 #include "core/query/batch.h"
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
-#include "core/util/parallel.h"
 
 namespace accelviz {
 

@@ -49,23 +49,11 @@ std::size_t make_wide(std::span<const BvhNode> nodes, const std::function<void(s
 Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const ProgressCallback& progress) : opts_(opts) {
   const auto t0 = std::chrono::steady_clock::now();
   validate(opts_);
-  bvh_detail::check_prim_count(triangles.size());
   // The builder's records straight from the triangles (no bounds/centroid
-  // arrays to fill and copy), with the root's bounds as build_bvh makes them.
-  BvhTopology topo;
-  {
-    std::vector<bvh_detail::BuildPrim> prims;
-    prims.reserve(triangles.size());
-    Aabb root_bounds, root_centroids;
-    for (std::size_t i = 0; i < triangles.size(); ++i) {
-      const Aabb b = triangles[i].bounds();
-      const glm::vec3 c = triangles[i].centroid();
-      prims.push_back(bvh_detail::BuildPrim{c, static_cast<std::uint32_t>(i), b});
-      root_bounds.extend(b);
-      root_centroids.extend(c);
-    }
-    topo = bvh_detail::build_bvh_records(prims, root_bounds, root_centroids, opts_, progress);
-  }
+  // arrays to fill and copy).
+  BvhTopology topo = bvh_detail::build_bvh_from(
+      triangles.size(), [&](std::size_t i) { return triangles[i].bounds(); },
+      [&](std::size_t i) { return triangles[i].centroid(); }, opts_, progress);
   nodes_ = std::move(topo.nodes);
   prim_indices_ = std::move(topo.prim_indices);
   stats_ = std::move(topo.stats);

@@ -258,18 +258,10 @@ BvhTopology build_bvh(std::span<const Aabb> bounds, std::span<const glm::vec3> c
   if (bounds.size() != centroids.size())
     throw std::invalid_argument("build_bvh: " + std::to_string(bounds.size()) + " bounds but " +
                                 std::to_string(centroids.size()) + " centroids");
-  check_prim_count(bounds.size());
-  // 1. Build records (in id order) and root bounds.
-  const std::size_t n = bounds.size();
-  std::vector<BuildPrim> prims;
-  prims.reserve(n);
-  Aabb root_bounds, root_centroids;
-  for (std::size_t i = 0; i < n; ++i) {
-    prims.push_back(BuildPrim{centroids[i], static_cast<std::uint32_t>(i), bounds[i]});
-    root_bounds.extend(bounds[i]);
-    root_centroids.extend(centroids[i]);
-  }
-  BvhTopology topo = build_bvh_records(prims, root_bounds, root_centroids, opts, progress);
+  // 1. Build records (in id order) and root bounds, then the tree.
+  BvhTopology topo = build_bvh_from(
+      bounds.size(), [&](std::size_t i) { return bounds[i]; }, [&](std::size_t i) { return centroids[i]; }, opts,
+      progress);
   topo.stats.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return topo;
 }

@@ -160,6 +160,26 @@ BvhTopology build_bvh_records(std::span<BuildPrim> prims, const Aabb& root_bound
 /// Throws std::invalid_argument when n primitives do not fit 32-bit indices.
 void check_prim_count(std::size_t n);
 
+/// build_bvh_records over n primitives whose records (in id order) and root
+/// bounds come from `bounds_at(i)` and `centroid_at(i)`: what build_bvh does
+/// from its arrays and class Bvh straight from its triangles.
+template <class BoundsAt, class CentroidAt>
+BvhTopology build_bvh_from(std::size_t n, const BoundsAt& bounds_at, const CentroidAt& centroid_at,
+                           const BvhOptions& opts, const ProgressCallback& progress) {
+  check_prim_count(n);
+  std::vector<BuildPrim> prims;
+  prims.reserve(n);
+  Aabb root_bounds, root_centroids;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Aabb b = bounds_at(i);
+    const glm::vec3 c = centroid_at(i);
+    prims.push_back(BuildPrim{c, static_cast<std::uint32_t>(i), b});
+    root_bounds.extend(b);
+    root_centroids.extend(c);
+  }
+  return build_bvh_records(prims, root_bounds, root_centroids, opts, progress);
+}
+
 /// Geometric and centroid bounds of a range.
 void range_bounds(std::span<const BuildPrim> prims, Aabb& bounds, Aabb& centroid_bounds);
 
