@@ -4,10 +4,6 @@
 // (or per batch), never per node: inside, each structure runs a traversal
 // templated on whether it collects statistics, so the fast path has no
 // counters at all.
-#include "core/geometry/hit.h"
-#include "core/geometry/triangle.h"
-#include "core/math/ray.h"
-
 #include <cstdint>
 #include <exception>
 #include <functional>
@@ -17,20 +13,24 @@
 #include <string>
 #include <vector>
 
+#include "core/geometry/hit.h"
+#include "core/geometry/triangle.h"
+#include "core/math/ray.h"
+
 namespace accelviz {
 
 /// Per-ray traversal figures, under names common to all structures so that
 /// heatmaps compare across them. A structure leaves what it has no notion of at 0.
 struct RayStats {
-  std::uint32_t nodes_visited = 0;   ///< nodes (or cells) entered
-  std::uint32_t box_tests = 0;       ///< ray-box tests performed
-  std::uint32_t prim_tests = 0;      ///< ray-primitive tests performed
-  std::uint32_t nodes_culled = 0;    ///< children skipped: entry t beyond the closest hit so far
-  std::uint32_t nodes_missed = 0;    ///< children whose box the ray missed
+  std::uint32_t nodes_visited = 0;        ///< nodes (or cells) entered
+  std::uint32_t box_tests = 0;            ///< ray-box tests performed
+  std::uint32_t prim_tests = 0;           ///< ray-primitive tests performed
+  std::uint32_t nodes_culled = 0;         ///< children skipped: entry t beyond the closest hit so far
+  std::uint32_t nodes_missed = 0;         ///< children whose box the ray missed
   std::uint32_t repeated_prim_tests = 0;  ///< tests of a primitive already tested by this ray
-  std::uint32_t empty_cells = 0;     ///< empty cells/voxels stepped (grids)
-  std::uint32_t leaves_skipped = 0;  ///< any-hit (BVH): leaves the ray crosses that the early exit never reached
-  std::uint32_t instances_visited = 0;  ///< two-level: instances whose BLAS the ray entered (0 for single-level)
+  std::uint32_t empty_cells = 0;          ///< empty cells/voxels stepped (grids)
+  std::uint32_t leaves_skipped = 0;       ///< any-hit (BVH): leaves the ray crosses that the early exit never reached
+  std::uint32_t instances_visited = 0;    ///< two-level: instances whose BLAS the ray entered (0 for single-level)
 
   RayStats& operator+=(const RayStats& o) {
     nodes_visited += o.nodes_visited;
@@ -118,7 +118,22 @@ class Accelerator {
   /// True when anything lies in [ray.tmin, ray.tmax]; stops at the first hit found.
   virtual bool any_hit(const Ray& ray, const QueryOptions& opts, RayStats* stats = nullptr) const = 0;
 
+  /// Closest hits of a span of rays: hits[i] = closest_hit(rays[i], opts,
+  /// stats.empty() ? nullptr : &stats[i]), the same hits and counters (added
+  /// to stats[i] as closest_hit adds them; callers reset them). One virtual
+  /// call per span, so a structure whose walk gains from several rays at once
+  /// overrides closest_hits_span (Bvh walks counted rays in turns). What
+  /// trace_closest, heatmaps and the GUI's heatmap worker call. Throws
+  /// std::invalid_argument when hits, or a non-empty stats, differ in size from rays.
+  void closest_hits(std::span<const Ray> rays, std::span<Hit> hits, const QueryOptions& opts,
+                    std::span<RayStats> stats = {}) const;
+
   virtual const BuildStats& build_stats() const = 0;
+
+ protected:
+  /// closest_hits after its size checks; the default calls closest_hit per ray.
+  virtual void closest_hits_span(std::span<const Ray> rays, std::span<Hit> hits, const QueryOptions& opts,
+                                 std::span<RayStats> stats) const;
 };
 
 }  // namespace accelviz

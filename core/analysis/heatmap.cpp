@@ -14,7 +14,6 @@
 #include <memory>
 #include <stdexcept>
 
-#include "core/accel/bvh/bvh.h"
 #include "core/query/batch.h"
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
@@ -94,24 +93,6 @@ float metric_value(HeatMetric m, const Ray& ray, const Hit& hit, const RayStats&
   return kNoValue;
 }
 
-namespace {
-
-/// trace_closest with statistics for a BVH: each chunk of rays goes to
-/// Bvh::closest_hits_counted (the same hits and counters as closest_hit per
-/// ray, several rays walked in turns), with trace_closest's progress and
-/// cancellation (for_each_chunk).
-bool trace_bvh_counted(const Bvh& bvh, std::span<const Ray> rays, std::span<Hit> hits, std::span<RayStats> stats,
-                       const QueryOptions& query, const BatchOptions& batch) {
-  return for_each_chunk(rays.size(), batch, [&](std::size_t begin, std::size_t end) {
-    const std::size_t count = end - begin;
-    for (std::size_t i = begin; i < end; ++i) stats[i] = RayStats{};
-    bvh.closest_hits_counted(rays.subspan(begin, count), hits.subspan(begin, count), stats.subspan(begin, count),
-                             query);
-  });
-}
-
-}  // namespace
-
 MetricImage render_metric(const Accelerator& accel, const Camera& camera, const HeatmapOptions& opts,
                           HeatmapFigures* figures) {
   if (opts.width <= 0 || opts.height <= 0) throw std::invalid_argument("heatmap: image size must be positive");
@@ -126,9 +107,7 @@ MetricImage render_metric(const Accelerator& accel, const Camera& camera, const 
   batch.chunk = 64;
 
   const auto t0 = std::chrono::steady_clock::now();
-  const auto* bvh = dynamic_cast<const Bvh*>(&accel);
-  const bool done = bvh && !stats.empty() ? trace_bvh_counted(*bvh, rays, hits, stats, opts.query, batch)
-                                          : trace_closest(accel, rays, hits, opts.query, batch, stats);
+  const bool done = trace_closest(accel, rays, hits, opts.query, batch, stats);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   if (!done) throw BuildCancelled();
 

@@ -1,11 +1,11 @@
 #include "core/query/batch.h"
 
-#include "core/util/parallel.h"
-
 #include <algorithm>
 #include <atomic>
 #include <mutex>
 #include <stdexcept>
+
+#include "core/util/parallel.h"
 
 namespace accelviz {
 
@@ -63,20 +63,24 @@ bool for_each_chunk(std::size_t n, const BatchOptions& batch,
   return !cancelled.load();
 }
 
-bool trace_closest(const Accelerator& accel, std::span<const Ray> rays, std::span<Hit> hits,
-                   const QueryOptions& query, const BatchOptions& batch, std::span<RayStats> stats) {
+bool trace_closest(const Accelerator& accel, std::span<const Ray> rays, std::span<Hit> hits, const QueryOptions& query,
+                   const BatchOptions& batch, std::span<RayStats> stats) {
   check_sizes(rays.size(), hits.size(), stats.size(), "trace_closest");
-  return run_batch(rays.size(), stats, batch, [&](std::size_t i, RayStats* s) {
-    hits[i] = accel.closest_hit(rays[i], query, s, nullptr);
+  // One closest_hits call per chunk: a structure that walks several rays at
+  // once (Bvh's counted walk) gets the whole chunk.
+  return for_each_chunk(rays.size(), batch, [&](std::size_t begin, std::size_t end) {
+    const std::size_t count = end - begin;
+    std::span<RayStats> chunk_stats = stats.empty() ? stats : stats.subspan(begin, count);
+    for (RayStats& s : chunk_stats) s = RayStats{};
+    accel.closest_hits(rays.subspan(begin, count), hits.subspan(begin, count), query, chunk_stats);
   });
 }
 
 bool trace_any(const Accelerator& accel, std::span<const Ray> rays, std::span<std::uint8_t> occluded,
                const QueryOptions& query, const BatchOptions& batch, std::span<RayStats> stats) {
   check_sizes(rays.size(), occluded.size(), stats.size(), "trace_any");
-  return run_batch(rays.size(), stats, batch, [&](std::size_t i, RayStats* s) {
-    occluded[i] = accel.any_hit(rays[i], query, s) ? 1 : 0;
-  });
+  return run_batch(rays.size(), stats, batch,
+                   [&](std::size_t i, RayStats* s) { occluded[i] = accel.any_hit(rays[i], query, s) ? 1 : 0; });
 }
 
 }  // namespace accelviz

@@ -492,7 +492,7 @@ TEST(BvhQuery, CountedWalkMatchesTheTracedWalkPerRay) {
         std::vector<Hit> batch_hits(rays.size());
         std::vector<RayStats> batch_stats(rays.size());
         for (RayStats& st : batch_stats) st.nodes_visited = 7;  // the counters are added, as closest_hit does
-        bvh.closest_hits_counted(rays, batch_hits, batch_stats, q);
+        bvh.closest_hits(rays, batch_hits, q, batch_stats);
         for (std::size_t i = 0; i < rays.size(); ++i) {
           RayStats ref, one;
           VisitTrace trace;
@@ -522,11 +522,11 @@ TEST(BvhQuery, CountedWalkMatchesTheTracedWalkPerRay) {
   const Bvh empty(std::vector<Triangle>{}, quiet());
   std::vector<Hit> h(1);
   std::vector<RayStats> st(1);
-  empty.closest_hits_counted(std::span(rays).first(1), h, st, {});
+  empty.closest_hits(std::span(rays).first(1), h, {}, st);
   EXPECT_FALSE(h[0].valid());
   EXPECT_EQ(st[0].box_tests, 0u);
   std::vector<Hit> two(2);
-  EXPECT_THROW(empty.closest_hits_counted(std::span(rays).first(1), two, st, {}), std::invalid_argument);
+  EXPECT_THROW(empty.closest_hits(std::span(rays).first(1), two, {}, st), std::invalid_argument);
 }
 
 TEST(BvhQuery, OrderedTraversalVisitsFewerNodes) {

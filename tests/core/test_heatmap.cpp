@@ -5,6 +5,7 @@
 
 #include "core/accel/brute_force.h"
 #include "core/accel/bvh/bvh.h"
+#include "core/accel/factory.h"
 #include "core/analysis/heatmap.h"
 #include "core/query/batch.h"
 #include "core/query/camera.h"
@@ -250,7 +251,7 @@ TEST(Batch, StatsAreResetPerRay) {
   for (const RayStats& s : stats) EXPECT_EQ(s.prim_tests, tris.size());
 }
 
-// A BVH's counted heatmaps take Bvh::closest_hits_counted (several rays in
+// A BVH's counted heatmaps take Bvh's closest_hits (several rays in
 // turns per chunk): each pixel still shows what the instrumented walk of a
 // trace counts for its ray, on one thread and on two, and a cancel still
 // throws.
@@ -331,5 +332,44 @@ TEST(Batch, SizeMismatchThrows) {
   hits.resize(10);
   std::vector<RayStats> stats(3);
   EXPECT_THROW(trace_closest(accel, rays, hits, {}, 1u, stats), std::invalid_argument);
+}
+
+// closest_hits (one call per span; what trace_closest hands each chunk) gives
+// every structure's closest_hit per ray: the same hits and, with statistics,
+// the same counters, added to what the span held; sizes are checked.
+TEST(Batch, ClosestHitsOfASpanEqualClosestHitPerRay) {
+  std::vector<Triangle> tris = tiny_scene();
+  for (int i = 0; i < 40; ++i) {
+    const float x = -3.0f + 0.15f * static_cast<float>(i), z = 0.05f * static_cast<float>(i % 7);
+    tris.push_back({{x, -2.5f, z}, {x + 0.4f, -2.5f, z}, {x + 0.2f, 2.5f, z + 0.3f}});
+  }
+  const std::vector<Ray> rays = primary_rays(tiny_camera(), 23, 17);
+  for (const std::string& name : structure_names()) {
+    SCOPED_TRACE(name);
+    const auto accel = build_accelerator(name, tris, StructureOptions{});
+    std::vector<Hit> fast(rays.size()), counted(rays.size());
+    std::vector<RayStats> stats(rays.size());
+    for (RayStats& st : stats) st.prim_tests = 5;
+    accel->closest_hits(rays, fast, {});
+    accel->closest_hits(rays, counted, {}, stats);
+    std::size_t hits = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      RayStats one;
+      const Hit h = accel->closest_hit(rays[i], {}, &one);
+      EXPECT_EQ(fast[i].prim, h.prim);
+      EXPECT_EQ(fast[i].t, h.t);
+      EXPECT_EQ(counted[i].prim, h.prim);
+      EXPECT_EQ(counted[i].t, h.t);
+      EXPECT_EQ(stats[i].prim_tests, one.prim_tests + 5);
+      EXPECT_EQ(stats[i].nodes_visited, one.nodes_visited);
+      hits += h.valid();
+    }
+    EXPECT_GT(hits, 0u);
+    EXPECT_LT(hits, rays.size());
+    std::vector<Hit> short_hits(rays.size() - 1);
+    std::vector<RayStats> short_stats(2);
+    EXPECT_THROW(accel->closest_hits(rays, short_hits, {}), std::invalid_argument);
+    EXPECT_THROW(accel->closest_hits(rays, fast, {}, short_stats), std::invalid_argument);
+  }
 }
 }  // namespace unity_test_heatmap

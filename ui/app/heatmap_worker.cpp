@@ -120,6 +120,9 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
     std::atomic<bool> stopped{false};
     const auto t0 = std::chrono::steady_clock::now();
     parallel_for(rows.size(), threads, 1, [&](std::size_t b, std::size_t e, unsigned ti) {
+      std::vector<Ray> row_rays;
+      std::vector<Hit> row_hits;
+      std::vector<RayStats> row_stats;
       for (std::size_t i = b; i < e; ++i) {
         if (stopped.load(std::memory_order_relaxed) || !keep_going()) {
           stopped = true;
@@ -127,10 +130,19 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
         }
         const int y = rows[i];
         const bool done_before = s < coarsest && y % (2 * s) == 0;
-        for (int x = done_before ? s : 0; x < w; x += done_before ? 2 * s : s) {
-          const Ray ray = primary_ray(r.camera, x, y, w, h);
-          RayStats stats;
-          const Hit hit = accel.closest_hit(ray, o.query, &stats);
+        // The row's pixels in one closest_hits call: a BVH walks them
+        // several rays in turns (the counted walk render_metric runs).
+        const int x0 = done_before ? s : 0, dx = done_before ? 2 * s : s;
+        row_rays.clear();
+        for (int x = x0; x < w; x += dx) row_rays.push_back(primary_ray(r.camera, x, y, w, h));
+        row_hits.resize(row_rays.size());
+        row_stats.assign(row_rays.size(), RayStats{});
+        accel.closest_hits(row_rays, row_hits, o.query, row_stats);
+        for (std::size_t k = 0; k < row_rays.size(); ++k) {
+          const int x = x0 + static_cast<int>(k) * dx;
+          const Ray& ray = row_rays[k];
+          const Hit& hit = row_hits[k];
+          const RayStats& stats = row_stats[k];
           PixelFigures& p = pixels[static_cast<std::size_t>(y) * w + x];
           p.value = metric_value(o.metric, ray, hit, stats, o.c_trav, o.c_isect);
           p.nodes = stats.nodes_visited;

@@ -51,9 +51,8 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
   validate(opts_);
   // The builder's records straight from the triangles (no bounds/centroid
   // arrays to fill and copy).
-  BvhTopology topo = bvh_detail::build_bvh_from(
-      triangles.size(), [&](std::size_t i) { return triangles[i].bounds(); },
-      [&](std::size_t i) { return triangles[i].centroid(); }, opts_, progress);
+  BvhTopology topo = bvh_detail::build_bvh_from_boxes(
+      triangles.size(), [&](std::size_t i) { return triangles[i].bounds(); }, opts_, progress);
   nodes_ = std::move(topo.nodes);
   prim_indices_ = std::move(topo.prim_indices);
   stats_ = std::move(topo.stats);
@@ -721,12 +720,10 @@ Hit Bvh::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, Vi
   return h;
 }
 
-void Bvh::closest_hits_counted(std::span<const Ray> rays, std::span<Hit> hits, std::span<RayStats> stats,
-                               const QueryOptions& qo) const {
-  if (hits.size() != rays.size() || stats.size() != rays.size())
-    throw std::invalid_argument("Bvh::closest_hits_counted: hits and stats must match the ray count");
-  if (qo.back_to_front || qo.xray) {
-    for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = closest_hit(rays[i], qo, &stats[i]);
+void Bvh::closest_hits_span(std::span<const Ray> rays, std::span<Hit> hits, const QueryOptions& qo,
+                            std::span<RayStats> stats) const {
+  if (stats.empty() || qo.back_to_front || qo.xray) {
+    Accelerator::closest_hits_span(rays, hits, qo, stats);
     return;
   }
   const BvhView v{nodes_.data(), blocks_.data(), leaf_block_.data(), prim_indices_.data(), nodes_.size()};

@@ -10,6 +10,7 @@
 // for triangles and adds the queries and refitting.
 #include "core/accel/accel.h"
 #include "core/math/aabb.h"
+#include "core/util/huge_page_allocator.h"
 
 #include <memory>
 
@@ -41,7 +42,7 @@ const char* to_string(BvhSplitter s);
 
 struct BvhOptions {
   BvhSplitter splitter = BvhSplitter::binned_sah;  ///< split strategy
-  int buckets = 16;              ///< binned SAH bucket count B, 2..256
+  int buckets = 32;              ///< binned SAH bucket count B, 2..256 (min(B, 4 + n/20) on a node of n primitives)
   int max_leaf_size = 4;         ///< a node with <= this many primitives always becomes a leaf (1..255)
   int leaf_size_cap = 16;        ///< SAH splitters may keep up to this many primitives in a leaf when that is cheaper than splitting; above it a node is always split (max_leaf_size..255)
   float cost_traversal = 1.0f;   ///< C_trav: cost of visiting an inner node (> 0, finite)
@@ -107,12 +108,6 @@ class Bvh final : public Accelerator {
                   VisitTrace* trace = nullptr) const override;
   bool any_hit(const Ray& ray, const QueryOptions& opts, RayStats* stats = nullptr) const override;
   const BuildStats& build_stats() const override { return stats_; }
-  /// closest_hit(rays[i], qo, &stats[i]) for every i (same hits, same
-  /// counters, added to stats[i]), several rays walked in turns so that one
-  /// ray's memory waits overlap another's work: the heatmap's counted path.
-  /// Throws std::invalid_argument when the span sizes differ.
-  void closest_hits_counted(std::span<const Ray> rays, std::span<Hit> hits, std::span<RayStats> stats,
-                            const QueryOptions& qo) const;
 
   std::span<const BvhNode> nodes() const { return nodes_; }
   /// Leaf ranges index this array; its values are primitive ids in scene order.
@@ -131,13 +126,21 @@ class Bvh final : public Accelerator {
   /// count mismatch.
   void refit(std::span<const Triangle> moved_triangles);
 
+ protected:
+  /// With stats: several rays walked in turns (the same hits and counters as
+  /// closest_hit per ray) so that one ray's memory waits overlap another's
+  /// work: what counted heatmaps and counting passes run. Without: the fast
+  /// path per ray.
+  void closest_hits_span(std::span<const Ray> rays, std::span<Hit> hits, const QueryOptions& qo,
+                         std::span<RayStats> stats) const override;
+
  private:
   /// sah_cost, and epo when enabled, over `triangles` in scene order.
   void update_quality_stats(std::span<const Triangle> triangles);
 
   std::vector<BvhNode> nodes_;
   std::vector<std::uint32_t> prim_indices_;
-  std::vector<bvh_detail::TriBlock4> blocks_;  ///< the triangles, four per block, each leaf from a new block
+  HugePageVector<bvh_detail::TriBlock4> blocks_;  ///< the triangles, four per block, each leaf from a new block
   std::vector<std::uint32_t> leaf_block_;      ///< per binary node: a leaf's first block (unused for inner nodes)
   std::unique_ptr<bvh_detail::WideBvh> wide_;    ///< 4-wide copy for the fast path (null when not used)
   std::unique_ptr<bvh_detail::WideBvh8> wide8_;  ///< 8-wide copy for the fast path (null when not used)

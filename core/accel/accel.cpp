@@ -1,0 +1,25 @@
+#include "core/accel/accel.h"
+
+#include <stdexcept>
+
+namespace accelviz {
+
+void Accelerator::closest_hits(std::span<const Ray> rays, std::span<Hit> hits, const QueryOptions& opts,
+                               std::span<RayStats> stats) const {
+  if (hits.size() != rays.size())
+    throw std::invalid_argument("closest_hits: " + name() + ": the hit span differs in size from the ray span");
+  if (!stats.empty() && stats.size() != rays.size())
+    throw std::invalid_argument("closest_hits: " + name() + ": the stats span must be empty or match the ray span");
+  closest_hits_span(rays, hits, opts, stats);
+}
+
+void Accelerator::closest_hits_span(std::span<const Ray> rays, std::span<Hit> hits, const QueryOptions& opts,
+                                    std::span<RayStats> stats) const {
+  if (stats.empty()) {
+    for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = closest_hit(rays[i], opts);
+  } else {
+    for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = closest_hit(rays[i], opts, &stats[i]);
+  }
+}
+
+}  // namespace accelviz
