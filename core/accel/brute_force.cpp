@@ -1,4 +1,5 @@
 #include "core/accel/brute_force.h"
+#include "core/util/timing.h"
 
 #include <chrono>
 
@@ -11,7 +12,7 @@ BruteForce::BruteForce(std::span<const Triangle> triangles, const BruteForceOpti
     boxes_.reserve(tris_.size());
     for (const Triangle& t : tris_) boxes_.push_back(t.bounds());
   }
-  stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  stats_.build_ms = ms_since(t0);
   stats_.node_count = 0;
   stats_.leaf_count = 1;
   stats_.memory_bytes = boxes_.size() * sizeof(Aabb);

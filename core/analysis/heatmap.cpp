@@ -17,6 +17,7 @@
 #include "core/query/batch.h"
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
+#include "core/util/timing.h"
 
 namespace accelviz {
 
@@ -108,7 +109,7 @@ MetricImage render_metric(const Accelerator& accel, const Camera& camera, const 
 
   const auto t0 = std::chrono::steady_clock::now();
   const bool done = trace_closest(accel, rays, hits, opts.query, batch, stats);
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  const double ms = ms_since(t0);
   if (!done) throw BuildCancelled();
 
   return metric_image_from_hits(rays, hits, stats, opts, ms, figures);

@@ -4,6 +4,7 @@
 #include "core/query/batch.h"
 #include "core/util/parallel.h"
 #include "core/util/random.h"
+#include "core/util/timing.h"
 
 #include <chrono>
 #include <cmath>
@@ -83,7 +84,7 @@ RefitDecayResult run_refit_decay(std::span<const Triangle> rest, std::span<const
     f.frame = k;
     const auto t0 = std::chrono::steady_clock::now();
     tree->refit(current);
-    f.refit_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    f.refit_ms = ms_since(t0);
     f.refits_since_build = ++refits;
     f.sah_refit = tree->build_stats().sah_cost;
     auto fresh = std::make_unique<Bvh>(current, bo);

@@ -10,6 +10,7 @@
 #include "core/accel/reference.h"
 #include "core/util/parallel.h"
 #include "core/util/random.h"
+#include "core/util/timing.h"
 
 namespace accelviz {
 
@@ -253,7 +254,7 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
             reference_count(bvh, triangles, ray, ref[i].t - ref[i].t_tolerance, ref[i].t + ref[i].t_tolerance, pad);
     }
   });
-  res.reference_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_ref).count();
+  res.reference_ms = ms_since(t_ref);
   for (const ReferenceHit& h : ref) res.reference_hits += h.valid();
   check();
 
@@ -297,7 +298,7 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
       }
       if ((i & 4095) == 4095) check();
     }
-    v.ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    v.ms = ms_since(t0);
     v.mrays_per_s = v.ms > 0.0 ? static_cast<double>(res.rays) / (v.ms * 1e3) : 0.0;
     // Classification (not timed).
     for (std::size_t i = 0; i < res.rays; ++i) {

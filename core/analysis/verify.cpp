@@ -3,6 +3,7 @@
 #include "core/query/camera.h"
 #include "core/util/parallel.h"
 #include "core/util/random.h"
+#include "core/util/timing.h"
 
 #include <algorithm>
 #include <chrono>
@@ -186,7 +187,7 @@ VerifyResult verify_structures(std::span<const Triangle> triangles, std::span<co
   parallel_for(rays.size(), threads, 64, [&](std::size_t b, std::size_t e, unsigned) {
     for (std::size_t i = b; i < e; ++i) ref[i] = ref_tracer.closest_hit(rays[i]);
   });
-  res.reference_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_ref).count();
+  res.reference_ms = ms_since(t_ref);
   for (const ReferenceHit& h : ref) res.reference_hits += h.valid();
 
   const QueryOptions q;  // watertight, ordered: the product's defaults
@@ -230,7 +231,7 @@ VerifyResult verify_structures(std::span<const Triangle> triangles, std::span<co
     res.per_structure.emplace_back(s.label, sum);
     res.total += sum;
   }
-  res.total_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_start).count();
+  res.total_ms = ms_since(t_start);
   return res;
 }
 

@@ -6,6 +6,7 @@
 #include "core/accel/tlas/tlas.h"
 #include "core/query/camera.h"
 #include "core/scene/effects.h"
+#include "core/util/timing.h"
 
 namespace accelviz {
 namespace {
@@ -198,7 +199,7 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
             gpu_heatmap_budget_ms(static_cast<double>(config().view.heatmap_gpu_ms), last_frame_ms, last_gpu_step_ms_);
         const auto t_step = std::chrono::steady_clock::now();
         auto f = gpu_job_->step(budget);
-        step_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_step).count();
+        step_ms = ms_since(t_step);
         if (f) {
           heatmap_ = std::move(f);
           gpu_frame_shown_ = true;

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "core/accel/tlas/flatten_json.h"
+#include "core/util/timing.h"
 
 namespace accelviz {
 
@@ -143,7 +144,7 @@ FlattenResult run_flatten_request(const FlattenRequest& r, const std::function<b
     if (fraction) fraction(1.0);
     out.committed = std::move(loaded);
   }
-  out.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  out.ms = ms_since(t0);
   return out;
 }
 

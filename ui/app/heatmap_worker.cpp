@@ -8,6 +8,7 @@
 #include "core/query/camera.h"
 #include "core/scene/effects.h"
 #include "core/util/parallel.h"
+#include "core/util/timing.h"
 
 namespace accelviz {
 namespace {
@@ -164,7 +165,7 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
         }
       }
     });
-    render_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    render_ms += ms_since(t0);
     if (stopped) return false;
     for (const Accumulator& a : acc) total.merge(a);
 

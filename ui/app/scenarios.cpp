@@ -10,6 +10,7 @@
 #include "core/analysis/heatmap.h"
 #include "core/query/camera.h"
 #include "core/scene/load.h"
+#include "core/util/timing.h"
 
 namespace accelviz {
 
@@ -132,7 +133,7 @@ ScenarioRow measure(const std::string& structure, const Scene& scene, const Scen
   ScenarioRow r;
   r.structure = structure;
   r.triangles = scene.triangles.size();
-  r.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  r.build_ms = ms_since(t0);
   r.sah = accel->build_stats().sah_cost;
   r.max_depth = accel->build_stats().max_depth;
   r.leaf_volume_ratio = leaf_volume_ratio(*accel);

@@ -3,6 +3,7 @@
 #include "core/accel/grid/grid.h"
 #include "core/accel/kdtree/spatial_traversal.h"
 #include "core/geometry/tri_box_overlap.h"
+#include "core/util/timing.h"
 
 #include <algorithm>
 #include <chrono>
@@ -158,7 +159,7 @@ Grid::Grid(std::span<const Triangle> triangles, const GridOptions& opts, const P
   std::uint64_t empty = 0;
   const std::size_t ncells = cell_start_.empty() ? 0 : cell_start_.size() - 1;
   for (std::size_t c = 0; c < ncells; ++c) empty += cell_start_[c] == cell_start_[c + 1];
-  stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count();
+  stats_.build_ms = ms_since(t_start);
   stats_.node_count = ncells;
   stats_.leaf_count = ncells;
   stats_.max_depth = 0;

@@ -2,6 +2,7 @@
 // with perfect splits (triangles clipped to the node box, Havran 2000).
 #include "core/accel/kdtree/kdtree.h"
 #include "core/geometry/tri_box_overlap.h"
+#include "core/util/timing.h"
 
 #include <algorithm>
 #include <chrono>
@@ -249,7 +250,7 @@ KdTree::KdTree(std::span<const Triangle> triangles, const KdTreeOptions& opts, c
   nodes_.shrink_to_fit();
   prim_refs_.shrink_to_fit();
 
-  stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count();
+  stats_.build_ms = ms_since(t_start);
   stats_.node_count = nodes_.size();
   stats_.leaf_count = builder.leaves_;
   stats_.max_depth = builder.deepest_;

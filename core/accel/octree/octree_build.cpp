@@ -3,6 +3,7 @@
 #include "core/accel/kdtree/spatial_traversal.h"
 #include "core/accel/octree/octree.h"
 #include "core/geometry/tri_box_overlap.h"
+#include "core/util/timing.h"
 
 #include <algorithm>
 #include <chrono>
@@ -168,7 +169,7 @@ Octree::Octree(std::span<const Triangle> triangles, const OctreeOptions& opts, c
   nodes_.shrink_to_fit();
   prim_refs_.shrink_to_fit();
 
-  stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count();
+  stats_.build_ms = ms_since(t_start);
   stats_.node_count = nodes_.size();
   stats_.leaf_count = builder.leaves_;
   stats_.max_depth = builder.deepest_;

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/query/camera.h"
+#include "core/util/timing.h"
 
 namespace accelviz {
 
@@ -106,7 +107,7 @@ TwoLevelFigures measure(const Scene& scene, const Camera& camera, int width, int
       inst += s.instances_visited;
     }
   }
-  f.trace_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  f.trace_ms = ms_since(t0);
   if (f.rays > 0) {
     f.mean_nodes = nodes / static_cast<double>(f.rays);
     f.mean_prims = prims / static_cast<double>(f.rays);

@@ -3,6 +3,7 @@
 // on the way back, octants that came back all full collapse into their
 // parent, and only octants that are neither empty nor full get a node.
 #include "core/accel/voxels/voxels.h"
+#include "core/util/timing.h"
 
 #include <array>
 #include <chrono>
@@ -129,7 +130,7 @@ Voxels::Voxels(std::span<const Triangle> triangles, const VoxelOptions& opts, co
   // The dense grid at this resolution: one bit per voxel, in 64-bit words.
   const std::uint64_t voxels = static_cast<std::uint64_t>(domain_.resolution) * domain_.resolution * domain_.resolution;
   const double dense_bytes = static_cast<double>((voxels + 63) / 64 * 8);
-  stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count();
+  stats_.build_ms = ms_since(t_start);
   stats_.node_count = nodes_.size();
   stats_.leaf_count = builder.full_octants_ + (root_ == Root::full ? 1 : 0);
   stats_.max_depth = static_cast<std::uint32_t>(domain_.level);
