@@ -125,6 +125,22 @@ Scene load_scene_noting_warnings(const std::string& spec, bool quiet) {
   return scene;
 }
 
+Scene load_scene_with_progress(const std::string& spec, bool quiet, Progress& progress) {
+  progress.begin("loading " + spec);
+  Scene scene = load_scene_noting_warnings(spec, quiet);
+  progress.end(std::to_string(scene.triangles.size()) + " triangles");
+  return scene;
+}
+
+std::unique_ptr<Accelerator> build_with_progress(const std::string& structure, const Scene& scene, StructureOptions so,
+                                                 Progress& progress, const std::string& label) {
+  progress.begin("building " + (label.empty() ? structure : label));
+  so.scene = &scene;
+  std::unique_ptr<Accelerator> accel = build_accelerator(structure, scene.triangles, so, progress.callback());
+  progress.end(std::to_string(static_cast<long long>(accel->build_stats().build_ms)) + " ms");
+  return accel;
+}
+
 void check_output_path(const std::string& path, bool force) {
   std::error_code ec;
   const fs::path p(path);

@@ -1,19 +1,18 @@
 #pragma once
 // What the subcommands share: option groups, parsing of small values, output
 // file rules, progress on stderr, timing. Thin: the work happens in core/.
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <functional>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
 #include "core/accel/factory.h"
 #include "core/geometry/triangle.h"
 #include "core/scene/scene.h"
 #include "core/util/timing.h"
-
-#include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
-
-#include <chrono>
-#include <functional>
-#include <mutex>
-#include <string>
-#include <vector>
 
 namespace accelviz::cli {
 
@@ -126,6 +125,17 @@ class Progress {
   std::chrono::steady_clock::time_point last_;
   std::mutex mutex_;  ///< builders may report from several threads
 };
+
+/// load_scene_noting_warnings between progress lines ("loading SPEC", then
+/// its triangle count).
+Scene load_scene_with_progress(const std::string& spec, bool quiet, Progress& progress);
+
+/// Builds `structure` over the scene's triangles between progress lines
+/// ("building LABEL", LABEL the structure's name when empty; then its build
+/// ms). "tlas" takes its two levels from the scene's meshes and instances
+/// (so.scene is set to `scene`, which must outlive the structure).
+std::unique_ptr<Accelerator> build_with_progress(const std::string& structure, const Scene& scene, StructureOptions so,
+                                                 Progress& progress, const std::string& label = {});
 
 using Clock = std::chrono::steady_clock;
 

@@ -68,15 +68,10 @@ CompareSide compare_side(const RenderOptions& o) {
 int run_render_raster(const RenderOptions& o, const GlobalOptions& global) {
   const ImageSize size = parse_size(o.size);
   Progress progress(global.quiet);
-  progress.begin("loading " + o.scene);
-  const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
-  progress.end(std::to_string(scene.triangles.size()) + " triangles");
+  const Scene scene = load_scene_with_progress(o.scene, global.quiet, progress);
   const Camera camera = camera_for(o.camera, scene, size);
-  progress.begin("building " + o.structure);
-  StructureOptions so = o.structure_opts.to_options(o.threads, /*compute_epo=*/false);
-  so.scene = &scene;  // "tlas" builds its two levels from the scene's meshes and instances
-  const std::unique_ptr<Accelerator> accel = build_accelerator(o.structure, scene.triangles, so, progress.callback());
-  progress.end(std::to_string(static_cast<long long>(accel->build_stats().build_ms)) + " ms");
+  const std::unique_ptr<Accelerator> accel =
+      build_with_progress(o.structure, scene, o.structure_opts.to_options(o.threads, /*compute_epo=*/false), progress);
 
   RasterOptions ro = o.raster;
   if (!o.ray_pixel.empty()) ro.ray_pixel = parse_pixel(o.ray_pixel);
@@ -105,19 +100,12 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
   const HeatMetric metric = parse_metric(o.metric).value();
   Progress progress(global.quiet);
 
-  progress.begin("loading " + o.scene);
-  const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
-  progress.end(std::to_string(scene.triangles.size()) + " triangles");
-
+  const Scene scene = load_scene_with_progress(o.scene, global.quiet, progress);
   const Camera camera = camera_for(o.camera, scene, size);
-
-  progress.begin("building " + o.structure);
-  StructureOptions so = o.structure_opts.to_options(o.threads, /*compute_epo=*/false);
-  so.scene = &scene;  // "tlas" builds its two levels from the scene's meshes and instances
   const auto t0 = Clock::now();
-  const std::unique_ptr<Accelerator> accel = build_accelerator(o.structure, scene.triangles, so, progress.callback());
+  const std::unique_ptr<Accelerator> accel =
+      build_with_progress(o.structure, scene, o.structure_opts.to_options(o.threads, /*compute_epo=*/false), progress);
   const double build_wall_ms = ms_since(t0);
-  progress.end(std::to_string(static_cast<long long>(accel->build_stats().build_ms)) + " ms");
 
   HeatmapOptions ho = heatmap_options_of(compare_side(o), metric, size, o.threads);
   HeatmapFigures fig;

@@ -1,13 +1,12 @@
 // accelviz trace SCENE --rays IN.rays --out OUT [--any]: traces a ray file
 // through one structure and writes the closest hits (HITS) or the occlusion
 // bits (OCCL); prints the build and trace figures as one JSON line.
-#include "app/cli_common.h"
+#include <memory>
 
+#include "app/cli_common.h"
 #include "core/query/batch.h"
 #include "core/query/ray_file.h"
 #include "core/util/parallel.h"
-
-#include <memory>
 
 namespace accelviz::cli {
 
@@ -33,16 +32,10 @@ int run_trace(const TraceOptions& o, const GlobalOptions& global) {
   const std::vector<Ray> rays = read_rays(o.rays);
   progress.end(std::to_string(rays.size()) + " rays");
 
-  progress.begin("loading " + o.scene);
-  const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
-  progress.end(std::to_string(scene.triangles.size()) + " triangles");
-
-  progress.begin("building " + o.structure);
-  StructureOptions so = o.structure_opts.to_options(o.threads, /*compute_epo=*/false);
-  so.scene = &scene;  // "tlas" builds its two levels from the scene's meshes and instances
-  const std::unique_ptr<Accelerator> accel = build_accelerator(o.structure, scene.triangles, so, progress.callback());
+  const Scene scene = load_scene_with_progress(o.scene, global.quiet, progress);
+  const std::unique_ptr<Accelerator> accel =
+      build_with_progress(o.structure, scene, o.structure_opts.to_options(o.threads, /*compute_epo=*/false), progress);
   const double build_ms = accel->build_stats().build_ms;
-  progress.end(std::to_string(static_cast<long long>(build_ms)) + " ms");
 
   QueryOptions q;
   q.triangle_test = parse_triangle_test(o.triangle_test);
@@ -88,8 +81,9 @@ int run_trace(const TraceOptions& o, const GlobalOptions& global) {
 Command add_trace_command(CLI::App& parent, const GlobalOptions& global) {
   auto o = std::make_shared<TraceOptions>();
   CLI::App* sub = parent.add_subcommand(
-      "trace", "Trace a ray file (RAYS) through a structure; write closest hits (HITS) or, with --any, occlusion "
-               "bits (OCCL). Formats: docs/file-formats-rays.md");
+      "trace",
+      "Trace a ray file (RAYS) through a structure; write closest hits (HITS) or, with --any, occlusion "
+      "bits (OCCL). Formats: docs/file-formats-rays.md");
   sub->add_option("SCENE", o->scene, "Scene file (.gltf, .glb, .obj) or builtin:NAME[?key=value&...]")->required();
   sub->add_option("--rays,-r", o->rays, "Input ray file (RAYS)")->required();
   sub->add_option("--out,-o", o->out, "Output file: HITS, or OCCL with --any (never overwritten without --force)")

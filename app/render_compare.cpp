@@ -133,9 +133,7 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
   if (!metric_needs_stats(metric))
     throw UsageError("--compare: needs a cost metric (nodes, prims, cost or instances), not --metric " + job.metric);
   Progress progress(global.quiet);
-  progress.begin("loading " + job.scene);
-  const Scene scene = load_scene_noting_warnings(job.scene, global.quiet);
-  progress.end(std::to_string(scene.triangles.size()) + " triangles");
+  const Scene scene = load_scene_with_progress(job.scene, global.quiet, progress);
   const Camera camera = camera_for(job.camera, scene, size);
 
   nlohmann::json sides = nlohmann::json::object();
@@ -144,10 +142,9 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
   for (int s = 0; s < 2; ++s) {
     const CompareSide& c = *side[s];
     const char* tag = s == 0 ? "A" : "B";
-    progress.begin(std::string("building ") + tag + ": " + c.structure);
-    const StructureOptions so = c.structure_opts.to_options(job.threads, /*compute_epo=*/false);
-    const std::unique_ptr<Accelerator> accel = build_accelerator(c.structure, scene.triangles, so, progress.callback());
-    progress.end(std::to_string(static_cast<long long>(accel->build_stats().build_ms)) + " ms");
+    const std::unique_ptr<Accelerator> accel =
+        build_with_progress(c.structure, scene, c.structure_opts.to_options(job.threads, /*compute_epo=*/false),
+                            progress, std::string(tag) + ": " + c.structure);
     HeatmapOptions ho = heatmap_options_of(c, metric, size, job.threads);
     progress.begin(std::string("rendering ") + tag);
     ho.progress = progress.callback();

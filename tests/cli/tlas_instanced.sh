@@ -19,6 +19,11 @@ n=$(python3 -c "import sys; print(max(500, int(3000 * float(sys.argv[1]))))" "$s
 "$accelviz" -q trace "$scene" --rays "$tmp/p.rays" --out "$tmp/tlas.hits" -s tlas -j 2 >"$tmp/tlas.json"
 "$accelviz" -q trace "$scene" --rays "$tmp/p.rays" --out "$tmp/bvh.hits" -s bvh -j 2 >/dev/null
 "$accelviz" -q verify "$scene" -s tlas --rays "$n" --seed 5 -j 2 --json >"$tmp/verify.json"
+# render and render --compare: the same two-level structure (the scene's
+# instances) on both, so A's figures equal the plain render's.
+"$accelviz" -q render "$scene" -s tlas --metric instances --size 40x30 --out "$tmp/r.png" -j 2 | tail -1 >"$tmp/render.json"
+"$accelviz" -q render "$scene" -s tlas --metric instances --size 40x30 --out "$tmp/c.png" -j 2 \
+  --compare 'structure=bvh' | tail -1 >"$tmp/compare.json"
 # A scene without shared meshes: one instance, one BLAS.
 "$accelviz" -q bench 'builtin:teapot?size=500' -s tlas --size 16x12 --repeat 1 -j 2 --json >"$tmp/plain.json"
 
@@ -54,5 +59,9 @@ v = json.load(open(f"{tmp}/verify.json"))
 assert v["ok"] and v["rays"] == n and v["reference_hits"] > n // 4, v
 assert set(v["structures"]) == {"tlas"}, v["structures"].keys()
 assert v["structures"]["tlas"]["ok"] and v["structures"]["tlas"]["mismatched_prim"] == 0, v["structures"]["tlas"]
+r, c = json.load(open(f"{tmp}/render.json")), json.load(open(f"{tmp}/compare.json"))
+assert c["a"]["structure"] == "tlas" and c["a"]["mean"] == r["mean"] and c["a"]["max"] == r["max"], (c["a"], r)
+# A ray that misses the ground's box enters no instance; one that hits a tree crosses the ground's too.
+assert r["max"] >= 2, r
 print("tlas over the forest's instances: 11 instances, 2 BLAS; trace and verify agree with the flattened hits")
 PY
