@@ -37,11 +37,10 @@ static_assert(sizeof(TriBlock4) == 160);
 inline constexpr std::uint32_t kTri4Empty = 0xFFFFFFFFu;
 
 /// Blocks for leaf positions [first, first + count): `tri(k)` is the
-/// triangle at leaf position k. Appended to `out`; returns the index of the
-/// first block.
-template <class TriAt>
-std::uint32_t append_tri4_blocks(const TriAt& tri, std::uint32_t first, std::uint32_t count,
-                                 std::vector<TriBlock4>& out) {
+/// triangle at leaf position k. Appended to `out` (a vector of TriBlock4,
+/// class Bvh's on huge pages); returns the index of the first block.
+template <class TriAt, class Blocks>
+std::uint32_t append_tri4_blocks(const TriAt& tri, std::uint32_t first, std::uint32_t count, Blocks& out) {
   const auto start = static_cast<std::uint32_t>(out.size());
   for (std::uint32_t b = 0; b < count; b += 4) {
     TriBlock4 blk{};
@@ -67,8 +66,8 @@ std::uint32_t append_tri4_blocks(const TriAt& tri, std::uint32_t first, std::uin
 
 /// Copies the triangles at the blocks' positions again (after a refit):
 /// `tri(k)` is the triangle now at leaf position k.
-template <class TriAt>
-void refit_tri4_blocks(const TriAt& tri, std::vector<TriBlock4>& blocks) {
+template <class TriAt, class Blocks>
+void refit_tri4_blocks(const TriAt& tri, Blocks& blocks) {
   for (TriBlock4& blk : blocks)
     for (std::uint32_t l = 0; l < 4; ++l) {
       const std::uint32_t p = blk.pos[l] != kTri4Empty ? blk.pos[l] : blk.pos[0];

@@ -21,6 +21,7 @@
 
 #include "core/accel/bvh/bvh.h"
 #include "core/accel/bvh/bvh_tri4.h"
+#include "core/util/huge_page_allocator.h"
 
 namespace accelviz::bvh_detail {
 
@@ -44,7 +45,9 @@ inline constexpr std::uint32_t kWideEmpty = 0xFFFFFFFFu;
 
 template <int W>
 struct WideBvhT {
-  std::vector<WideNodeT<W>> nodes;    ///< root at 0; empty when the binary tree is
+  /// Root at 0; empty when the binary tree is. On huge pages where the
+  /// system allows (huge_page_allocator.h): the walk reads it at random.
+  HugePageVector<WideNodeT<W>> nodes;
   std::vector<std::uint32_t> source;  ///< W per wide node: the binary node each slot copies (kWideEmpty if unused)
 };
 struct WideBvh : WideBvhT<4> {};
