@@ -3,12 +3,14 @@
 // quoted against Embree when it is among the structures.
 //
 // Protocol (docs/cli.md): the ray sets are generated once, from the first
-// structure's primary hits. Per structure: `repeat` builds (median build
-// time; the other build figures are deterministic and come from the last
-// build); per ray set, closest-hit and any-hit throughput on one thread and
-// on all threads, each the median of `repeat` timed passes without counters;
-// then one instrumented pass for the mean node visits and primitive tests
-// per ray, kept out of the timings.
+// structure's primary hits. `repeat` rounds that build every structure once,
+// in turn (median build time; the other build figures are deterministic and
+// come from the last build); per ray set, closest-hit and any-hit throughput
+// on one thread and on all threads, each the median of `repeat` timed passes
+// without counters, the structures again taking turns within each round so
+// that a change of machine load falls on all of them alike; then one
+// instrumented pass for the mean node visits and primitive tests per ray,
+// kept out of the timings.
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -63,38 +65,59 @@ double mrays(std::size_t n, double ms) {
   return ms > 0.0 ? static_cast<double>(n) / (ms * 1e3) : 0.0;
 }
 
-template <typename Trace>
-double timed_median(int repeat, std::size_t n, Trace&& trace) {
-  std::vector<double> v;
-  for (int r = 0; r < repeat; ++r) {
-    const auto t0 = Clock::now();
-    trace();
-    v.push_back(mrays(n, ms_since(t0)));
-  }
-  return median(v);
+/// One timed pass of every structure in turn, `repeat` rounds; returns each
+/// structure's median Mrays/s. Rounds alternate the structures so that a
+/// change of machine load during the run falls on all of them alike.
+template <typename Pass>
+std::vector<double> timed_medians_in_turns(std::size_t structures, int repeat, std::size_t n, Pass&& pass) {
+  std::vector<std::vector<double>> v(structures);
+  for (int r = 0; r < repeat; ++r)
+    for (std::size_t i = 0; i < structures; ++i) {
+      const auto t0 = Clock::now();
+      pass(i);
+      v[i].push_back(mrays(n, ms_since(t0)));
+    }
+  std::vector<double> out;
+  for (std::vector<double>& runs : v) out.push_back(median(std::move(runs)));
+  return out;
 }
 
-QueryFigures measure(const Accelerator& accel, const std::vector<Ray>& rays, const QueryOptions& q, unsigned all,
-                     int repeat, Progress& progress, const std::string& label) {
-  QueryFigures f;
+/// Throughput of every structure on one ray set, the structures in turns
+/// (timed_medians_in_turns) for each of the four figures.
+std::vector<QueryFigures> measure_in_turns(const std::vector<std::unique_ptr<Accelerator>>& accels,
+                                           const std::vector<Ray>& rays, const QueryOptions& q, unsigned all,
+                                           int repeat, Progress& progress, const std::string& label) {
+  std::vector<QueryFigures> f(accels.size());
   const std::size_t n = rays.size();
   if (n == 0) return f;
   std::vector<Hit> hits(n);
   std::vector<std::uint8_t> occluded(n);
-  progress.begin(label + ": closest hit, 1 thread");
-  f.closest_1t = timed_median(repeat, n, [&] { trace_closest(accel, rays, hits, q, 1u); });
-  progress.end();
-  progress.begin(label + ": closest hit, " + std::to_string(all) + " threads");
-  f.closest_nt = timed_median(repeat, n, [&] { trace_closest(accel, rays, hits, q, all); });
-  progress.end();
-  progress.begin(label + ": any hit, 1 thread");
-  f.any_1t = timed_median(repeat, n, [&] { trace_any(accel, rays, occluded, q, 1u); });
-  progress.end();
-  progress.begin(label + ": any hit, " + std::to_string(all) + " threads");
-  f.any_nt = timed_median(repeat, n, [&] { trace_any(accel, rays, occluded, q, all); });
-  progress.end();
+  const auto figure = [&](const std::string& what, double QueryFigures::*field, auto&& pass) {
+    progress.begin(label + ": " + what);
+    const std::vector<double> m = timed_medians_in_turns(accels.size(), repeat, n, pass);
+    for (std::size_t i = 0; i < f.size(); ++i) f[i].*field = m[i];
+    progress.end();
+  };
+  const std::string threads = std::to_string(all) + " threads";
+  figure("closest hit, 1 thread", &QueryFigures::closest_1t,
+         [&](std::size_t i) { trace_closest(*accels[i], rays, hits, q, 1u); });
+  figure("closest hit, " + threads, &QueryFigures::closest_nt,
+         [&](std::size_t i) { trace_closest(*accels[i], rays, hits, q, all); });
+  figure("any hit, 1 thread", &QueryFigures::any_1t,
+         [&](std::size_t i) { trace_any(*accels[i], rays, occluded, q, 1u); });
+  figure("any hit, " + threads, &QueryFigures::any_nt,
+         [&](std::size_t i) { trace_any(*accels[i], rays, occluded, q, all); });
+  return f;
+}
 
-  progress.begin(label + ": counting pass");
+/// One instrumented pass per query kind for the mean counters per ray, kept
+/// out of the timings.
+void count_per_ray(const Accelerator& accel, const std::vector<Ray>& rays, const QueryOptions& q, unsigned all,
+                   QueryFigures& f) {
+  const std::size_t n = rays.size();
+  if (n == 0) return;
+  std::vector<Hit> hits(n);
+  std::vector<std::uint8_t> occluded(n);
   std::vector<RayStats> stats(n);
   trace_closest(accel, rays, hits, q, all, stats);
   double nodes = 0, prims = 0, boxes = 0, hit_count = 0;
@@ -120,8 +143,6 @@ QueryFigures measure(const Accelerator& accel, const std::vector<Ray>& rays, con
   f.any_prims = prims / n;
   f.any_boxes = boxes / n;
   f.occluded_fraction = hit_count / n;
-  progress.end();
-  return f;
 }
 
 nlohmann::json query_json(const QueryFigures& f) {
@@ -217,31 +238,42 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
                  "(benchmark only)\n",
                  o.scene.c_str(), synthetic_position->x, synthetic_position->y, synthetic_position->z);
 
-  // ---- per structure ----
-  std::vector<StructureResult> results;
-  for (const std::string& name : o.structures) {
-    StructureResult r;
-    r.name = name;
-    std::unique_ptr<Accelerator> accel;
-    for (int k = 0; k < o.repeat; ++k) {
+  // ---- builds: each round builds every structure once, in turn ----
+  const std::size_t count = o.structures.size();
+  std::vector<StructureResult> results(count);
+  std::vector<std::unique_ptr<Accelerator>> accels(count);
+  for (int k = 0; k < o.repeat; ++k)
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::string& name = o.structures[i];
+      results[i].name = name;
       progress.begin("building " + name + " (" + std::to_string(k + 1) + "/" + std::to_string(o.repeat) + ")");
-      accel.reset();  // never two copies in memory
-      accel = build_bench_structure(name, scene.triangles, so, progress.callback());
-      r.build_ms.push_back(accel->build_stats().build_ms);
-      progress.end(std::to_string(static_cast<long long>(r.build_ms.back())) + " ms");
+      accels[i].reset();  // never two copies of one structure in memory
+      accels[i] = build_bench_structure(name, scene.triangles, so, progress.callback());
+      results[i].build_ms.push_back(accels[i]->build_stats().build_ms);
+      progress.end(std::to_string(static_cast<long long>(results[i].build_ms.back())) + " ms");
     }
-    r.stats = accel->build_stats();
+  for (std::size_t i = 0; i < count; ++i) {
+    StructureResult& r = results[i];
+    r.stats = accels[i]->build_stats();
 #ifdef ACCELVIZ_HAVE_EMBREE
-    if (name == "bvh" && !scene.triangles.empty()) {
+    if (r.name == "bvh" && !scene.triangles.empty()) {
       progress.begin("Embree rtcBuildBVH binary tree for the SAH comparison");
       r.embree_bvh = embree_binary_bvh_sah(scene.triangles, so.bvh.cost_traversal, so.bvh.cost_intersect, o.threads,
                                            so.bvh.max_leaf_size, std::min(so.bvh.leaf_size_cap, 32));
       progress.end();
     }
 #endif
-    for (const RaySet& set : sets)
-      r.queries.push_back({set.name, measure(*accel, set.rays, q, all, o.repeat, progress, name + " " + set.name)});
-    results.push_back(std::move(r));
+  }
+
+  // ---- queries: per ray set and figure, the structures in turns ----
+  for (const RaySet& set : sets) {
+    std::vector<QueryFigures> f = measure_in_turns(accels, set.rays, q, all, o.repeat, progress, set.name);
+    for (std::size_t i = 0; i < count; ++i) {
+      progress.begin(o.structures[i] + " " + set.name + ": counting pass");
+      count_per_ray(*accels[i], set.rays, q, all, f[i]);
+      progress.end();
+      results[i].queries.push_back({set.name, f[i]});
+    }
   }
 
   const StructureResult* embree = nullptr;

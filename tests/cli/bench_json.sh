@@ -9,6 +9,10 @@ trap 'rm -rf "$tmp"' EXIT
   >"$tmp/bench.json" 2>"$tmp/progress.txt"
 python3 -m json.tool "$tmp/bench.json" >/dev/null
 [ -s "$tmp/progress.txt" ] || { echo "FAIL: no progress on stderr"; exit 1; }
+# The rounds build the structures in turn (A, B, A, B), not A's repeats then B's.
+builds=$(grep -o '^building [a-z-]* ([0-9]/2)' "$tmp/progress.txt" | tr '\n' ';')
+[ "$builds" = "building bvh (1/2);building brute-bbox (1/2);building bvh (2/2);building brute-bbox (2/2);" ] ||
+  { echo "FAIL: builds not in turns: $builds"; exit 1; }
 python3 - "$tmp/bench.json" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))
