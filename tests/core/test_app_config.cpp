@@ -177,7 +177,7 @@ TEST(AppConfig, SameBuildIgnoresQueryAndOtherTypesOptions) {
 TEST(AppConfig, DescriptionsAndCaption) {
   AppConfig c;
   EXPECT_EQ(describe_structure(c.structure),
-            "bvh (splitter=binned, buckets=16, leaf=4, leaf-cap=16, ctrav=1, cisect=1)");
+            "bvh (splitter=binned, buckets=32, leaf=4, leaf-cap=16, ctrav=1, cisect=1)");
   c.structure.name = "brute";
   EXPECT_EQ(describe_structure(c.structure), "brute");
   c.structure.name = "grid";

@@ -35,6 +35,7 @@ Cubes cubes(std::initializer_list<float> xs) {
 BvhOptions opts(int buckets, int max_leaf = 1, float c_trav = 1.0f) {
   BvhOptions o;
   o.buckets = buckets;
+  o.small_node_buckets = false;  // the hand-computed cases bin their few primitives into B buckets
   o.max_leaf_size = max_leaf;
   o.leaf_size_cap = 16;
   o.cost_traversal = c_trav;
@@ -151,8 +152,11 @@ TEST(InsightExplainer, MatchesWhatTheBuilderDid) {
   }
   BvhOptions o;
   o.compute_epo = false;
-  for (const int buckets : {4, 16, 64}) {
-    o.buckets = buckets;
+  // With small_node_buckets the root (300 primitives) bins into min(B, 19)
+  // buckets, its children into fewer: the explainer must use the same counts.
+  for (const int buckets : {4, 16, 64, -16, -64}) {
+    o.buckets = std::abs(buckets);
+    o.small_node_buckets = buckets > 0;
     const Bvh bvh(tris, o);
     const auto nodes = bvh.nodes();
     const auto prims_below = [&](std::uint32_t n) {

@@ -56,8 +56,6 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
   nodes_ = std::move(topo.nodes);
   prim_indices_ = std::move(topo.prim_indices);
   stats_ = std::move(topo.stats);
-  nodes_.shrink_to_fit();
-  prim_indices_.shrink_to_fit();
   // The triangles as blocks of four, each leaf from a new block (its
   // triangles contiguous, in leaf order), the blocks in the order the wide
   // tree's leaf slots are laid out (else in node order).

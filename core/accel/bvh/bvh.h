@@ -42,7 +42,8 @@ const char* to_string(BvhSplitter s);
 
 struct BvhOptions {
   BvhSplitter splitter = BvhSplitter::binned_sah;  ///< split strategy
-  int buckets = 32;              ///< binned SAH bucket count B, 2..256 (min(B, 4 + n/20) on a node of n primitives)
+  int buckets = 32;              ///< binned SAH bucket count B, 2..256
+  bool small_node_buckets = true;  ///< binned SAH: min(B, 4 + n/20) buckets on a node of n primitives (Embree's rule: cheaper small nodes); false: B everywhere
   int max_leaf_size = 4;         ///< a node with <= this many primitives always becomes a leaf (1..255)
   int leaf_size_cap = 16;        ///< SAH splitters may keep up to this many primitives in a leaf when that is cheaper than splitting; above it a node is always split (max_leaf_size..255)
   float cost_traversal = 1.0f;   ///< C_trav: cost of visiting an inner node (> 0, finite)

@@ -284,6 +284,7 @@ BvhTopology build_bvh_records(std::span<BuildPrim> prims, const Aabb& root_bound
   if (n > 0) {
     // 2.-3. Recursive build.
     SplitParams params{opts.buckets, opts.max_leaf_size, opts.leaf_size_cap, opts.cost_traversal, opts.cost_intersect};
+    params.small_node_buckets = opts.small_node_buckets;
     if (opts.splitter == BvhSplitter::lbvh) {
       params.morton = morton_frame(root_centroids);
       lbvh_sort(prims, params.morton, resolve_threads(opts.threads));
@@ -293,14 +294,15 @@ BvhTopology build_bvh_records(std::span<BuildPrim> prims, const Aabb& root_bound
                           : opts.splitter == BvhSplitter::lbvh      ? split_lbvh
                                                                     : split_median;
     Builder builder(params, split, prims, resolve_threads(opts.threads), progress);
-    // At most 2n - 1 nodes: reserving them all spares the regrowth copies
-    // (pages never written are never touched); shrink_to_fit trims after.
+    // At most 2n - 1 nodes: reserving them all spares the regrowth copies.
+    // No shrink_to_fit after: pages never written are never touched (not
+    // resident), and trimming would copy the whole array (18.5 MB and 4.5k
+    // page faults on the dragon) for address space alone.
     topo.nodes.reserve(2 * n);
     topo.nodes.resize(1);
     SplitScratch scratch;
     builder.build(NodeWork{0, static_cast<std::uint32_t>(n), root_bounds, root_centroids, 0}, topo.nodes, 0, scratch);
     builder.finish();
-    topo.nodes.shrink_to_fit();
     topo.prim_indices.resize(n);
     for (std::size_t i = 0; i < n; ++i) topo.prim_indices[i] = prims[i].id;
   } else if (progress && !progress(1.0)) {

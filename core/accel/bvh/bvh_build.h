@@ -35,12 +35,13 @@ struct MortonFrame {
 
 /// The options a splitter needs, already validated.
 struct SplitParams {
-  int buckets = 16;
+  int buckets = 32;
   int max_leaf_size = 4;
   int leaf_size_cap = 16;
   float cost_traversal = 1.0f;
   float cost_intersect = 1.0f;
-  MortonFrame morton;  ///< lbvh only
+  MortonFrame morton;              ///< lbvh only
+  bool small_node_buckets = true;  ///< binned only: binned_bucket_count's rule
 };
 
 enum class SplitOutcome {
@@ -109,6 +110,17 @@ inline bool left_of_plane(float c, float lo, float k, int plane) {
   return !((c - lo) * k >= static_cast<float>(plane + 1));
 }
 
+/// Buckets the binned SAH uses on a node of n primitives: with
+/// `small_node_buckets` (BvhOptions, default), B on large nodes and
+/// min(B, 4 + n/20) on smaller ones (Embree's rule in its binned builders): a
+/// small node's split is found among fewer planes, which saves most of the
+/// per-node cost of clearing and sweeping B buckets at a small SAH price;
+/// without, B everywhere. split_binned_sah and the explainer both use it.
+inline int binned_bucket_count(int buckets, bool small_node_buckets, std::size_t n) {
+  const std::size_t small = 4 + n / 20;
+  return small_node_buckets && small < static_cast<std::size_t>(buckets) ? static_cast<int>(small) : buckets;
+}
+
 /// Resets the first `buckets` buckets of every axis to empty.
 void clear_bins(Bins& bins, int buckets);
 /// Adds every primitive to its bucket on all three axes (Wald 2007):
@@ -173,6 +185,27 @@ BvhTopology build_bvh_from(std::size_t n, const BoundsAt& bounds_at, const Centr
   for (std::size_t i = 0; i < n; ++i) {
     const Aabb b = bounds_at(i);
     const glm::vec3 c = centroid_at(i);
+    prims.push_back(BuildPrim{c, static_cast<std::uint32_t>(i), b});
+    root_bounds.extend(b);
+    root_centroids.extend(c);
+  }
+  return build_bvh_records(prims, root_bounds, root_centroids, opts, progress);
+}
+
+/// build_bvh_from with each primitive's centroid taken as the centre of its
+/// box (what Embree's builders bin on): class Bvh builds from these. For a
+/// triangle the box centre bins better than the vertex average: dragon SAH
+/// 50.11 against 51.70 at the default buckets (docs/bvh.md).
+template <class BoundsAt>
+BvhTopology build_bvh_from_boxes(std::size_t n, const BoundsAt& bounds_at, const BvhOptions& opts,
+                                 const ProgressCallback& progress) {
+  check_prim_count(n);
+  std::vector<BuildPrim> prims;
+  prims.reserve(n);
+  Aabb root_bounds, root_centroids;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Aabb b = bounds_at(i);
+    const glm::vec3 c = b.center();
     prims.push_back(BuildPrim{c, static_cast<std::uint32_t>(i), b});
     root_bounds.extend(b);
     root_centroids.extend(c);

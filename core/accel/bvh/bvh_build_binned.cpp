@@ -346,8 +346,8 @@ bool binned_sah_search(int buckets, std::span<const BuildPrim> prims, const Aabb
 
 SplitOutcome split_binned_sah(const SplitParams& params, std::span<BuildPrim> prims, const Aabb& bounds,
                               const Aabb& centroid_bounds, SplitScratch& /*scratch*/, SplitResult& out) {
-  const int nb = params.buckets;
   const std::size_t n = prims.size();
+  const int nb = binned_bucket_count(params.buckets, params.small_node_buckets, n);
 
   // 1-3. Scale, binning and the SAH at every bucket boundary (shared with the
   //      explainer in core/analysis/insight). Bins is left uninitialised.

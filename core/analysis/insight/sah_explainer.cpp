@@ -37,7 +37,7 @@ SplitExplanation explain_binned_split(std::span<const Aabb> bounds, std::span<co
   SplitExplanation e;
   const std::size_t n = prims.size();
   e.prims = n;
-  e.buckets = opts.buckets;
+  e.buckets = binned_bucket_count(opts.buckets, opts.small_node_buckets, n);
   range_bounds(prims, e.bounds, e.centroid_bounds);
   const SplitParams params{opts.buckets, opts.max_leaf_size, opts.leaf_size_cap, opts.cost_traversal,
                            opts.cost_intersect};
@@ -56,14 +56,14 @@ SplitExplanation explain_binned_split(std::span<const Aabb> bounds, std::span<co
   const auto table = std::make_unique<CostTable>();
   CandidateCosts* costs = &table->c;
   BinnedSahSearch s;
-  const bool binned = binned_sah_search(opts.buckets, prims, e.centroid_bounds, *bins, s, costs);
+  const bool binned = binned_sah_search(e.buckets, prims, e.centroid_bounds, *bins, s, costs);
   const double node_area = e.bounds.half_area();
   // Normalised by the node's area; a node without area gives every child ratio 1.
   const auto full_cost = [&](double area_count, std::size_t nl, std::size_t nr) {
     const double weighted = node_area > 0.0 ? area_count / node_area : static_cast<double>(nl + nr);
     return static_cast<double>(opts.cost_traversal) + static_cast<double>(opts.cost_intersect) * weighted;
   };
-  const int nb = opts.buckets;
+  const int nb = e.buckets;
   if (binned) {
     for (int a = 0; a < 3; ++a) {
       AxisExplanation& ax = e.axes[a];
@@ -130,7 +130,7 @@ SplitExplanation explain_bvh_node(const Bvh& bvh, std::uint32_t node, const BvhO
   std::vector<glm::vec3> centroids(tris.size());
   for (std::size_t i = 0; i < tris.size(); ++i) {
     bounds[i] = tris[i].bounds();
-    centroids[i] = tris[i].centroid();
+    centroids[i] = bounds[i].center();  // what class Bvh bins on
   }
   return explain_binned_split(bounds, centroids, opts);
 }

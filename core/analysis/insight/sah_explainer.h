@@ -44,7 +44,7 @@ const char* to_string(SplitDecision d);
 
 struct SplitExplanation {
   std::size_t prims = 0;
-  int buckets = 0;
+  int buckets = 0;       ///< buckets used, as the build does (binned_bucket_count)
   Aabb bounds;           ///< node box
   Aabb centroid_bounds;  ///< box of the centroids (what is binned)
   AxisExplanation axes[3];
@@ -63,7 +63,8 @@ struct SplitExplanation {
 SplitExplanation explain_binned_split(std::span<const Aabb> bounds, std::span<const glm::vec3> centroids,
                                       const BvhOptions& opts);
 
-/// Explains the split of the primitives below `node` of a built tree, with
+/// Explains the split of the primitives below `node` of a built tree (their
+/// centroids taken as their boxes' centres, as class Bvh builds), with
 /// `opts` (e.g. another bucket count than the tree was built with).
 /// Throws std::out_of_range for a bad node.
 SplitExplanation explain_bvh_node(const Bvh& bvh, std::uint32_t node, const BvhOptions& opts);
