@@ -25,17 +25,23 @@
 namespace accelviz {
 namespace {
 
+/// The fast path's leaf slots take binary subtrees whose leaves fill at most
+/// this many triangle blocks (collapse_to_wide's merge_blocks): fewer wide
+/// nodes per ray, the binary tree unchanged (docs/bvh.md, docs/performance.md).
+constexpr int kWideMergeBlocks = 2;
+
 /// Collapses `nodes` into `wide`, leaf slots pointing at the triangle blocks; returns its bytes.
 template <int W>
 std::size_t make_wide(std::span<const BvhNode> nodes, const std::function<void(std::uint32_t)>& add_leaf,
                       std::span<const std::uint32_t> leaf_block, bvh_detail::WideBvhT<W>& wide, BuildStats& stats) {
-  bvh_detail::collapse_to_wide(nodes, wide);
-  // The triangle blocks in the order the fast path's leaf slots are laid out.
+  bvh_detail::collapse_to_wide(nodes, wide, kWideMergeBlocks);
+  // The triangle blocks in the order the fast path's leaf slots are laid out
+  // (a slot's binary leaves one after the other).
   for (std::size_t w = 0; w < wide.nodes.size(); ++w)
     for (int s = 0; s < W; ++s)
       if (wide.nodes[w].meta[s] != 0 && wide.nodes[w].meta[s] != bvh_detail::kWideEmpty)
-        add_leaf(wide.source[W * w + s]);
-  bvh_detail::point_leaf_slots_at_blocks(wide, leaf_block);
+        bvh_detail::for_each_leaf_under(nodes, wide.source[W * w + s], add_leaf);
+  bvh_detail::point_leaf_slots_at_blocks(wide, nodes, leaf_block);
   const std::size_t node_bytes = wide.nodes.size() * sizeof(bvh_detail::WideNodeT<W>);
   const std::size_t source_bytes = wide.source.size() * sizeof(std::uint32_t);
   stats.extra["wide_nodes"] = static_cast<double>(wide.nodes.size());

@@ -64,6 +64,18 @@ std::uint32_t append_tri4_blocks(const TriAt& tri, std::uint32_t first, std::uin
       {b.v[0][l], b.v[1][l], b.v[2][l]}, {b.v[3][l], b.v[4][l], b.v[5][l]}, {b.v[6][l], b.v[7][l], b.v[8][l]}};
 }
 
+/// Bit l set: lane l holds a triangle (not padding).
+[[gnu::always_inline]] inline int tri4_used_lanes(const TriBlock4& b) {
+#ifdef ACCELVIZ_BVH_TRI4_SSE2
+  const __m128i pos = _mm_load_si128(reinterpret_cast<const __m128i*>(b.pos));
+  return 0xF & ~_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(pos, _mm_set1_epi32(-1))));
+#else
+  int used = 0;
+  for (int l = 0; l < 4; ++l) used |= (b.pos[l] != kTri4Empty ? 1 : 0) << l;
+  return used;
+#endif
+}
+
 /// Copies the triangles at the blocks' positions again (after a refit):
 /// `tri(k)` is the triangle now at leaf position k.
 template <class TriAt, class Blocks>
@@ -200,8 +212,7 @@ struct Tri4MtResult {
   const __m128 det = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e1x, px), _mm_mul_ps(e1y, py)), _mm_mul_ps(e1z, pz));
   const __m128 inv = _mm_div_ps(one, det);
   const __m128 sx = _mm_sub_ps(r.ox, v0x), sy = _mm_sub_ps(r.oy, v0y), sz = _mm_sub_ps(r.oz, v0z);
-  const __m128 u =
-      _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(sx, px), _mm_mul_ps(sy, py)), _mm_mul_ps(sz, pz)), inv);
+  const __m128 u = _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(sx, px), _mm_mul_ps(sy, py)), _mm_mul_ps(sz, pz)), inv);
   // q = cross(s, e1)
   const __m128 qx = _mm_sub_ps(_mm_mul_ps(sy, e1z), _mm_mul_ps(e1y, sz));
   const __m128 qy = _mm_sub_ps(_mm_mul_ps(sz, e1x), _mm_mul_ps(e1z, sx));

@@ -28,13 +28,43 @@ WideNodeT<W> empty_node() {
   return w;
 }
 
+/// Per binary node: the triangle blocks its leaves fill (each leaf from a
+/// new block), its primitive count and its first leaf position. Children are
+/// stored after their parents, so one reverse sweep fills them.
+struct SubtreeBlocks {
+  std::vector<std::uint32_t> blocks, count, first;
+  explicit SubtreeBlocks(std::span<const BvhNode> binary)
+      : blocks(binary.size()), count(binary.size()), first(binary.size()) {
+    for (std::size_t i = binary.size(); i-- > 0;) {
+      const BvhNode& n = binary[i];
+      if (n.count > 0) {
+        blocks[i] = (n.count + 3) / 4;
+        count[i] = n.count;
+        first[i] = n.index;
+      } else {
+        blocks[i] = blocks[n.index] + blocks[n.index + 1];
+        count[i] = count[n.index] + count[n.index + 1];
+        first[i] = first[n.index];
+      }
+    }
+  }
+};
+
 }  // namespace
 
 template <int W>
-void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide) {
+void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide, int merge_blocks) {
   wide.nodes.clear();
   wide.source.clear();
   if (binary.empty()) return;
+  const SubtreeBlocks sub(binary);
+  // Binary nodes that become one leaf slot: the leaves, and with merging the
+  // inner nodes over few enough blocks (a slot counts at most 255 primitives).
+  std::vector<std::uint8_t> leaf_like(binary.size(), 0);
+  for (std::size_t i = 0; i < binary.size(); ++i)
+    leaf_like[i] =
+        binary[i].count > 0 ||
+        (merge_blocks > 0 && sub.blocks[i] <= static_cast<std::uint32_t>(merge_blocks) && sub.count[i] <= 255u);
   wide.nodes.reserve(binary.size() / 2 + 1);
   wide.source.reserve(2 * binary.size() + 4);
 
@@ -42,11 +72,11 @@ void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide) {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> work;
   wide.nodes.push_back(empty_node<W>());
   wide.source.insert(wide.source.end(), W, kWideEmpty);
-  if (binary[0].count > 0) {
+  if (leaf_like[0]) {
     // A single leaf: one slot.
     set_slot(wide.nodes[0], 0, binary[0].bounds);
-    wide.nodes[0].child[0] = binary[0].index;
-    wide.nodes[0].meta[0] = binary[0].count;
+    wide.nodes[0].child[0] = sub.first[0];
+    wide.nodes[0].meta[0] = sub.count[0];
     wide.source[0] = 0;
     return;
   }
@@ -62,7 +92,7 @@ void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide) {
       float best = -1.0f;
       for (int s = 0; s < n; ++s) {
         const BvhNode& c = binary[slots[s]];
-        if (c.count == 0 && c.bounds.surface_area() > best) {
+        if (!leaf_like[slots[s]] && c.bounds.surface_area() > best) {
           best = c.bounds.surface_area();
           open = s;
         }
@@ -80,9 +110,9 @@ void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide) {
       const BvhNode& c = binary[slots[s]];
       wide.source[W * w + s] = slots[s];
       set_slot(wide.nodes[w], s, c.bounds);
-      if (c.count > 0) {
-        wide.nodes[w].child[s] = c.index;
-        wide.nodes[w].meta[s] = c.count;
+      if (leaf_like[slots[s]]) {
+        wide.nodes[w].child[s] = sub.first[slots[s]];
+        wide.nodes[w].meta[s] = sub.count[slots[s]];
       } else {
         const auto child = static_cast<std::uint32_t>(wide.nodes.size());
         wide.nodes.push_back(empty_node<W>());
@@ -101,11 +131,19 @@ void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide) {
 }
 
 template <int W>
-void point_leaf_slots_at_blocks(WideBvhT<W>& wide, std::span<const std::uint32_t> leaf_block) {
+void point_leaf_slots_at_blocks(WideBvhT<W>& wide, std::span<const BvhNode> binary,
+                                std::span<const std::uint32_t> leaf_block) {
   for (std::size_t w = 0; w < wide.nodes.size(); ++w)
     for (int s = 0; s < W; ++s)
-      if (wide.nodes[w].meta[s] != 0 && wide.nodes[w].meta[s] != kWideEmpty)
-        wide.nodes[w].child[s] = leaf_block[wide.source[W * w + s]];
+      if (wide.nodes[w].meta[s] != 0 && wide.nodes[w].meta[s] != kWideEmpty) {
+        std::uint32_t first = kWideEmpty, blocks = 0;
+        for_each_leaf_under(binary, wide.source[W * w + s], [&](std::uint32_t leaf) {
+          if (first == kWideEmpty) first = leaf_block[leaf];
+          blocks += (binary[leaf].count + 3) / 4;
+        });
+        wide.nodes[w].child[s] = first;
+        wide.nodes[w].meta[s] = blocks;
+      }
 }
 
 template <int W>
@@ -138,10 +176,10 @@ bool cpu_has_wide8() {
 #endif
 }
 
-template void collapse_to_wide<4>(std::span<const BvhNode>, WideBvhT<4>&);
-template void collapse_to_wide<8>(std::span<const BvhNode>, WideBvhT<8>&);
-template void point_leaf_slots_at_blocks<4>(WideBvhT<4>&, std::span<const std::uint32_t>);
-template void point_leaf_slots_at_blocks<8>(WideBvhT<8>&, std::span<const std::uint32_t>);
+template void collapse_to_wide<4>(std::span<const BvhNode>, WideBvhT<4>&, int);
+template void collapse_to_wide<8>(std::span<const BvhNode>, WideBvhT<8>&, int);
+template void point_leaf_slots_at_blocks<4>(WideBvhT<4>&, std::span<const BvhNode>, std::span<const std::uint32_t>);
+template void point_leaf_slots_at_blocks<8>(WideBvhT<8>&, std::span<const BvhNode>, std::span<const std::uint32_t>);
 template void refit_wide<4>(WideBvhT<4>&, std::span<const BvhNode>);
 template void refit_wide<8>(WideBvhT<8>&, std::span<const BvhNode>);
 template int wide_slab_test_scalar<4>(const WideNodeT<4>&, const Ray&, float, float, float*, float*);

@@ -28,8 +28,8 @@ namespace accelviz::bvh_detail {
 /// W child boxes in structure-of-arrays order, then the children (W = 4:
 /// 128 bytes, SSE; W = 8: 256 bytes, AVX2). meta = 0: inner wide node
 /// `child`; 1..255: leaf of `meta` primitives starting at leaf position
-/// `child` (after point_leaf_slots_at_blocks: at triangle block `child`);
-/// kWideEmpty: unused slot.
+/// `child` (after point_leaf_slots_at_blocks: `meta` triangle blocks starting
+/// at block `child`); kWideEmpty: unused slot.
 template <int W>
 struct alignas(64) WideNodeT {
   float bounds[6][W];  ///< [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z][slot]
@@ -53,18 +53,41 @@ struct WideBvhT {
 struct WideBvh : WideBvhT<4> {};
 struct WideBvh8 : WideBvhT<8> {};
 
-/// Points every leaf slot at the first triangle block of the binary leaf it
-/// copies (`leaf_block[binary node]`, class Bvh's leaf-order blocks of
-/// bvh_tri4.h); before, collapse_to_wide's leaf slots name leaf positions.
+/// Calls f(leaf) for every binary leaf under `node` (itself if a leaf), left
+/// child first: the order of their primitive ranges.
+template <class F>
+void for_each_leaf_under(std::span<const BvhNode> binary, std::uint32_t node, const F& f) {
+  if (binary[node].count > 0) {
+    f(node);
+    return;
+  }
+  for_each_leaf_under(binary, binary[node].index, f);
+  for_each_leaf_under(binary, binary[node].index + 1, f);
+}
+
+/// Points every leaf slot at its triangle blocks (class Bvh's blocks of
+/// bvh_tri4.h, each binary leaf from a new block, `leaf_block[binary leaf]`
+/// its first): child = the first block of the slot's first binary leaf,
+/// meta = the blocks of all its binary leaves, which the caller laid out one
+/// after the other (for_each_leaf_under's order). Before, collapse_to_wide's
+/// leaf slots name leaf positions and primitive counts.
 template <int W>
-void point_leaf_slots_at_blocks(WideBvhT<W>& wide, std::span<const std::uint32_t> leaf_block);
+void point_leaf_slots_at_blocks(WideBvhT<W>& wide, std::span<const BvhNode> binary,
+                                std::span<const std::uint32_t> leaf_block);
 
 /// Collapses a binary node array: each wide node takes a binary inner node's
 /// children and keeps opening the child with the largest surface area until
 /// it has W (or only leaves are left). Deterministic; wide children are
 /// stored after their parent.
+///
+/// merge_blocks > 0: a binary inner node whose leaves fill at most that many
+/// triangle blocks of four (each leaf from a new block) becomes one leaf slot
+/// (its box, all its primitives, which are contiguous), as if the builder had
+/// kept it as a leaf. The binary tree, which is built, shown and counted, is
+/// unchanged; only the fast path's copy has fewer, larger leaves (see
+/// docs/bvh.md: fewer wide nodes to fetch per ray).
 template <int W>
-void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide);
+void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide, int merge_blocks = 0);
 inline WideBvh collapse_to_wide(std::span<const BvhNode> binary) {
   WideBvh w;
   collapse_to_wide<4>(binary, w);

@@ -106,10 +106,9 @@ Hit traverse_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& b
       if constexpr (kTri4) {
         // Lanes in slot order are the leaf's triangles in order: the same
         // sequence of tests and acceptances as the scalar loop below.
-        const bvh_detail::TriBlock4* blk = bvh.blocks + child;
-        for (std::uint32_t left = meta; left > 0; ++blk) {
-          const int valid = left >= 4 ? 0xF : (1 << left) - 1;
-          left = left >= 4 ? left - 4 : 0;
+        const bvh_detail::TriBlock4* const end = bvh.blocks + child + meta;
+        for (const bvh_detail::TriBlock4* blk = bvh.blocks + child; blk != end; ++blk) {
+          const int valid = bvh_detail::tri4_used_lanes(*blk);
           bvh_detail::Tri4Result r;
           bvh_detail::intersect_tri4(*blk, tr4, tmin, r);
           int lanes = (r.candidate | r.special) & valid;
@@ -134,10 +133,9 @@ Hit traverse_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& b
       } else if constexpr (kTri4Mt) {
         // Lanes in order, each accepted against the closest hit so far, as
         // the scalar loop below would (t <= tmax is the scalar test's last check).
-        const bvh_detail::TriBlock4* blk = bvh.blocks + child;
-        for (std::uint32_t left = meta; left > 0; ++blk) {
-          const int valid = left >= 4 ? 0xF : (1 << left) - 1;
-          left = left >= 4 ? left - 4 : 0;
+        const bvh_detail::TriBlock4* const end = bvh.blocks + child + meta;
+        for (const bvh_detail::TriBlock4* blk = bvh.blocks + child; blk != end; ++blk) {
+          const int valid = bvh_detail::tri4_used_lanes(*blk);
           bvh_detail::Tri4MtResult r;
           bvh_detail::intersect_tri4_mt(*blk, tm4, tmin, r);
           int lanes = r.candidate & valid;
@@ -149,16 +147,16 @@ Hit traverse_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& b
             h.t = r.t[l];
             h.u = r.u[l];
             h.v = r.v[l];
-            if (take(true, h, blk->pos[l], bvh_detail::tri4_triangle(*blk, static_cast<std::uint32_t>(l))))
-              return best;
+            if (take(true, h, blk->pos[l], bvh_detail::tri4_triangle(*blk, static_cast<std::uint32_t>(l)))) return best;
           }
         }
       } else
 #endif
-        // A wide leaf slot names its first block; the leaf's triangles are
-        // its blocks' lanes in order.
-        for (std::uint32_t j = 0; j < meta; ++j) {
+        // A wide leaf slot names its first block and its block count; the
+        // leaf's triangles are its blocks' used lanes in order.
+        for (std::uint32_t j = 0; j < 4 * meta; ++j) {
           const bvh_detail::TriBlock4& blk = bvh.blocks[child + (j >> 2)];
+          if (blk.pos[j & 3] == bvh_detail::kTri4Empty) continue;
           const Triangle tri = bvh_detail::tri4_triangle(blk, j & 3);
           Hit h;
           const bool hit = test_triangle<Test>(ray, wr, tri, tmin, closest, h);

@@ -1,0 +1,121 @@
+// The wide fast path's merged leaf slots (collapse_to_wide's merge_blocks) and
+// the huge-page allocator of its arrays.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "core/accel/brute_force.h"
+#include "core/accel/bvh/bvh.h"
+#include "core/accel/bvh/bvh_wide.h"
+#include "core/util/huge_page_allocator.h"
+
+// Own namespace: this file is compiled together with others (unity build).
+namespace unity_test_bvh_wide_merge {
+
+using namespace accelviz;
+
+float merge_uniform(std::mt19937& rng) {
+  return static_cast<float>(rng() >> 8) * (1.0f / 16777216.0f);
+}
+
+std::vector<Triangle> merge_soup(std::size_t n, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::vector<Triangle> tris(n);
+  for (Triangle& t : tris) {
+    const glm::vec3 c(merge_uniform(rng), merge_uniform(rng), merge_uniform(rng));
+    const auto jitter = [&] {
+      return glm::vec3(merge_uniform(rng), merge_uniform(rng), merge_uniform(rng)) * 0.06f - 0.03f;
+    };
+    t = {c + jitter(), c + jitter(), c + jitter()};
+  }
+  return tris;
+}
+
+TEST(BvhWideMerge, MergedSlotsCoverEveryLeafOnceWithTheirSubtreeBox) {
+  const auto tris = merge_soup(3000, 41);
+  BvhOptions o;
+  o.compute_epo = false;
+  const Bvh bvh(tris, o);
+  const auto nodes = bvh.nodes();
+  bvh_detail::WideBvh8 plain, merged;
+  bvh_detail::collapse_to_wide(nodes, plain);
+  bvh_detail::collapse_to_wide(nodes, merged, 2);
+  std::vector<int> leaf_seen(nodes.size(), 0);
+  int merged_slots = 0;
+  for (std::size_t w = 0; w < merged.nodes.size(); ++w)
+    for (int s = 0; s < 8; ++s) {
+      const bvh_detail::WideNode8& n = merged.nodes[w];
+      if (n.meta[s] == bvh_detail::kWideEmpty || n.meta[s] == 0) continue;
+      const std::uint32_t src = merged.source[8 * w + s];
+      ASSERT_LT(src, nodes.size());
+      EXPECT_EQ(n.bounds[0][s], nodes[src].bounds.lo.x);
+      EXPECT_EQ(n.bounds[5][s], nodes[src].bounds.hi.z);
+      // The slot's primitives: its binary leaves' ranges, one after the other.
+      std::uint32_t count = 0, blocks = 0, next = n.child[s];
+      bvh_detail::for_each_leaf_under(nodes, src, [&](std::uint32_t leaf) {
+        ++leaf_seen[leaf];
+        EXPECT_EQ(nodes[leaf].index, next);
+        next = nodes[leaf].index + nodes[leaf].count;
+        count += nodes[leaf].count;
+        blocks += (nodes[leaf].count + 3) / 4;
+      });
+      EXPECT_EQ(n.meta[s], count);
+      EXPECT_LE(count, 255u);
+      if (nodes[src].count == 0) {
+        ++merged_slots;
+        EXPECT_LE(blocks, 2u);
+      }
+    }
+  for (std::size_t i = 0; i < nodes.size(); ++i) EXPECT_EQ(leaf_seen[i], nodes[i].count > 0 ? 1 : 0) << i;
+  EXPECT_GT(merged_slots, 0);
+  EXPECT_LT(merged.nodes.size(), plain.nodes.size());
+}
+
+TEST(BvhWideMerge, MergingTreeAnswersLikeBruteForce) {
+  // Class Bvh walks merged slots (blocks of several binary leaves, padding
+  // lanes between them): the same hits as brute force, every width and test.
+  const auto tris = merge_soup(1500, 42);
+  const BruteForce bf(tris);
+  std::mt19937 rng(43);
+  for (int width : {4, 8}) {
+    BvhOptions o;
+    o.compute_epo = false;
+    o.wide_width = width;
+    const Bvh bvh(tris, o);
+    for (int i = 0; i < 3000; ++i) {
+      const glm::vec3 a(merge_uniform(rng), merge_uniform(rng), merge_uniform(rng));
+      const glm::vec3 b(merge_uniform(rng), merge_uniform(rng), merge_uniform(rng));
+      if (glm::length(b - a) < 1e-3f) continue;
+      const Ray ray(a * 1.4f - 0.2f, glm::normalize(b - a));
+      for (TriangleTest test : {TriangleTest::watertight, TriangleTest::moller_trumbore}) {
+        QueryOptions q;
+        q.triangle_test = test;
+        const Hit h = bvh.closest_hit(ray, q), r = bf.closest_hit(ray, q);
+        ASSERT_EQ(h.valid(), r.valid()) << width << " ray " << i;
+        if (r.valid()) {
+          EXPECT_EQ(h.t, r.t) << width << " ray " << i;
+        }
+        ASSERT_EQ(bvh.any_hit(ray, q), r.valid()) << width << " ray " << i;
+      }
+    }
+  }
+}
+
+TEST(HugePageAllocator, LargeArraysSitOnHugePageBoundariesSmallOnesAreOrdinary) {
+  HugePageVector<std::uint32_t> big(kHugePageBytes / sizeof(std::uint32_t) + 7);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(big.data()) % kHugePageBytes, 0u);
+  for (std::size_t i = 0; i < big.size(); ++i) big[i] = static_cast<std::uint32_t>(i);
+  HugePageVector<std::uint32_t> copy = big;  // copies through the allocator too
+  EXPECT_EQ(copy.back(), static_cast<std::uint32_t>(big.size() - 1));
+  HugePageVector<std::uint32_t> small(10, 3u);
+  small.push_back(4u);
+  EXPECT_EQ(small.size(), 11u);
+  EXPECT_EQ(small.back(), 4u);
+  big.clear();
+  big.shrink_to_fit();
+  EXPECT_TRUE(big.empty());
+}
+
+}  // namespace unity_test_bvh_wide_merge
