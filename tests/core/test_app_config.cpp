@@ -18,7 +18,7 @@ namespace {
 const std::map<std::string, std::string> kOtherValues = {
     {"structure", "kdtree"},
     {"splitter", "exact"},
-    {"buckets", "32"},
+    {"buckets", "12"},
     {"leaf", "2"},
     {"leaf-cap", "8"},
     {"ctrav", "1.5"},
