@@ -196,6 +196,9 @@ std::vector<BvhOptions> option_sets() {
     // Leaf 4: the 4-wide SSE fast path; otherwise the default (8-wide AVX2
     // where this CPU has AVX2, else 4-wide).
     o.wide_width = leaf == 4 ? 4 : 0;
+    // Leaves 1 and 4: merged wide leaf slots (BvhOptions::wide_merge_blocks;
+    // these small scenes would not merge by default); 16: the default.
+    o.wide_merge_blocks = leaf == 16 ? -1 : 2;
     for (int b : {2, 16, 256}) {
       o.splitter = BvhSplitter::binned_sah;
       o.buckets = b;

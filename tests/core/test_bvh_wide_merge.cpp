@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include "core/accel/brute_force.h"
@@ -83,7 +84,9 @@ TEST(BvhWideMerge, MergingTreeAnswersLikeBruteForce) {
     BvhOptions o;
     o.compute_epo = false;
     o.wide_width = width;
+    o.wide_merge_blocks = 2;  // this small tree would not merge by default (auto: 16 MiB of blocks)
     const Bvh bvh(tris, o);
+    EXPECT_EQ(bvh.build_stats().extra.at("wide_merge_blocks"), 2.0);
     for (int i = 0; i < 3000; ++i) {
       const glm::vec3 a(merge_uniform(rng), merge_uniform(rng), merge_uniform(rng));
       const glm::vec3 b(merge_uniform(rng), merge_uniform(rng), merge_uniform(rng));
@@ -100,6 +103,23 @@ TEST(BvhWideMerge, MergingTreeAnswersLikeBruteForce) {
         ASSERT_EQ(bvh.any_hit(ray, q), r.valid()) << width << " ray " << i;
       }
     }
+  }
+}
+
+TEST(BvhWideMerge, AutoMergesOnlyLargeTreesAndTheOptionIsChecked) {
+  const auto tris = merge_soup(2000, 44);
+  BvhOptions o;
+  o.compute_epo = false;
+  o.wide_width = 8;
+  const Bvh automatic(tris, o);  // 2000 triangles: far below 16 MiB of blocks
+  EXPECT_EQ(automatic.build_stats().extra.at("wide_merge_blocks"), 0.0);
+  o.wide_merge_blocks = 2;
+  const Bvh merged(tris, o);
+  EXPECT_LT(merged.build_stats().extra.at("wide_nodes"), automatic.build_stats().extra.at("wide_nodes"));
+  EXPECT_EQ(merged.build_stats().extra.at("memory_tri_blocks"), automatic.build_stats().extra.at("memory_tri_blocks"));
+  for (int bad : {-2, 64}) {
+    o.wide_merge_blocks = bad;
+    EXPECT_THROW(Bvh(tris, o), std::invalid_argument) << bad;
   }
 }
 

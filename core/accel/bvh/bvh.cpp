@@ -25,16 +25,22 @@
 namespace accelviz {
 namespace {
 
-/// The fast path's leaf slots take binary subtrees whose leaves fill at most
-/// this many triangle blocks (collapse_to_wide's merge_blocks): fewer wide
-/// nodes per ray, the binary tree unchanged (docs/bvh.md, docs/performance.md).
+/// BvhOptions::wide_merge_blocks = -1: the fast path's leaf slots take binary
+/// subtrees whose leaves fill at most kWideMergeBlocks triangle blocks when
+/// the blocks take kWideMergeMinBytes or more. Fewer wide nodes to fetch per
+/// ray pays where the walk waits on memory (dragon: 46 MB of blocks); on a
+/// mesh whose tree stays in cache (bunny: 3.7 MB) the extra triangle tests
+/// made shadow rays slower (docs/performance.md, 2026-12-02).
 constexpr int kWideMergeBlocks = 2;
+constexpr std::size_t kWideMergeMinBytes = std::size_t{16} << 20;
 
 /// Collapses `nodes` into `wide`, leaf slots pointing at the triangle blocks; returns its bytes.
 template <int W>
 std::size_t make_wide(std::span<const BvhNode> nodes, const std::function<void(std::uint32_t)>& add_leaf,
-                      std::span<const std::uint32_t> leaf_block, bvh_detail::WideBvhT<W>& wide, BuildStats& stats) {
-  bvh_detail::collapse_to_wide(nodes, wide, kWideMergeBlocks);
+                      std::span<const std::uint32_t> leaf_block, int merge_blocks, bvh_detail::WideBvhT<W>& wide,
+                      BuildStats& stats) {
+  bvh_detail::collapse_to_wide(nodes, wide, merge_blocks);
+  stats.extra["wide_merge_blocks"] = merge_blocks;
   // The triangle blocks in the order the fast path's leaf slots are laid out
   // (a slot's binary leaves one after the other).
   for (std::size_t w = 0; w < wide.nodes.size(); ++w)
@@ -75,15 +81,18 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
   };
   std::size_t wide_bytes = 0;
   if (opts_.wide_traversal && !nodes_.empty()) {
+    const int merge = opts_.wide_merge_blocks >= 0                                        ? opts_.wide_merge_blocks
+                      : block_count * sizeof(bvh_detail::TriBlock4) >= kWideMergeMinBytes ? kWideMergeBlocks
+                                                                                          : 0;
     const int width = opts_.wide_width == 0                                   ? (bvh_detail::cpu_has_wide8() ? 8 : 4)
                       : opts_.wide_width == 8 && !bvh_detail::cpu_has_wide8() ? 4
                                                                               : opts_.wide_width;
     if (width == 8) {
       wide8_ = std::make_unique<bvh_detail::WideBvh8>();
-      wide_bytes = make_wide(nodes_, add_leaf, leaf_block_, *wide8_, stats_);
+      wide_bytes = make_wide(nodes_, add_leaf, leaf_block_, merge, *wide8_, stats_);
     } else {
       wide_ = std::make_unique<bvh_detail::WideBvh>();
-      wide_bytes = make_wide(nodes_, add_leaf, leaf_block_, *wide_, stats_);
+      wide_bytes = make_wide(nodes_, add_leaf, leaf_block_, merge, *wide_, stats_);
     }
     stats_.extra["wide_width"] = width;
   } else {

@@ -52,6 +52,7 @@ struct BvhOptions {
   bool compute_epo = true;       ///< Bvh only: compute the EPO metric into build_stats().extra["epo"] (costs a pass over the tree per triangle)
   bool wide_traversal = true;    ///< Bvh only: uninstrumented queries walk a wide collapse of the tree (faster); statistics and traces always walk the binary tree
   int wide_width = 0;            ///< Bvh only: width of that collapse: 0 = 8 (AVX2) where the CPU has AVX2, else 4 (SSE); 4; or 8 (falls back to 4 without AVX2)
+  int wide_merge_blocks = -1;    ///< Bvh only: the collapse makes one leaf slot of a binary subtree whose leaves fill at most this many triangle blocks (0: never; -1: 2 when the triangle blocks take 16 MiB or more, else 0); -1..63
 };
 
 /// Throws std::invalid_argument naming the offending option when `opts` is out of range.

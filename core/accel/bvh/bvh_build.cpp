@@ -64,6 +64,8 @@ void validate(const BvhOptions& o) {
     fail("cost_intersect must be finite and > 0, got " + std::to_string(o.cost_intersect));
   if (o.wide_width != 0 && o.wide_width != 4 && o.wide_width != 8)
     fail("wide_width must be 0 (auto), 4 or 8, got " + std::to_string(o.wide_width));
+  if (o.wide_merge_blocks < -1 || o.wide_merge_blocks > 63)
+    fail("wide_merge_blocks must be in -1..63 (-1: auto), got " + std::to_string(o.wide_merge_blocks));
 }
 
 namespace bvh_detail {
