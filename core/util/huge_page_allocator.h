@@ -14,6 +14,8 @@
 #include <cstddef>
 #include <cstdlib>
 #include <new>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #if defined(__linux__)
@@ -44,6 +46,18 @@ struct HugePageAllocator {
     madvise(p, bytes, MADV_HUGEPAGE);  // a hint: failure leaves ordinary pages
 #endif
     return static_cast<T*>(p);
+  }
+
+  /// resize() default-initialises (a trivial element is left unwritten, not
+  /// zeroed), so the pages are first touched, and faulted in, by whoever fills
+  /// them: class Bvh fills its triangle blocks on all build threads.
+  template <class U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
   }
 
   void deallocate(T* p, std::size_t n) noexcept {

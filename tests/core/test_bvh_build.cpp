@@ -431,6 +431,10 @@ TEST(BvhBuild, ThreadCountDoesNotChangeTheNodeArray) {
       EXPECT_EQ(std::memcmp(b.nodes().data(), ref.nodes().data(), ref.nodes().size_bytes()), 0);
       EXPECT_EQ(std::memcmp(b.prim_indices().data(), ref.prim_indices().data(), ref.prim_indices().size_bytes()), 0);
       EXPECT_EQ(b.build_stats().sah_cost, ref.build_stats().sah_cost);
+      // The triangle blocks, filled on all build threads, hold the same triangles.
+      const std::vector<Triangle> got = b.copy_leaf_triangles(), want = ref.copy_leaf_triangles();
+      ASSERT_EQ(got.size(), want.size());
+      EXPECT_EQ(std::memcmp(got.data(), want.data(), want.size() * sizeof(Triangle)), 0);
     }
   }
 }

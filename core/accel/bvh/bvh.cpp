@@ -21,6 +21,7 @@
 #include "core/accel/bvh/bvh_wide.h"
 #include "core/analysis/epo.h"
 #include "core/analysis/sah.h"
+#include "core/util/parallel.h"
 
 namespace accelviz {
 namespace {
@@ -70,14 +71,19 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
   stats_ = std::move(topo.stats);
   // The triangles as blocks of four, each leaf from a new block (its
   // triangles contiguous, in leaf order), the blocks in the order the wide
-  // tree's leaf slots are laid out (else in node order).
+  // tree's leaf slots are laid out (else in node order): first the leaves in
+  // that order and their first blocks, then the blocks filled on all build
+  // threads (each leaf its own range; the pages are first touched there).
   std::size_t block_count = 0;
-  for (const BvhNode& n : nodes_) block_count += (n.count + 3) / 4;
-  blocks_.reserve(block_count);
+  for (const BvhNode& n : nodes_) block_count += bvh_detail::tri4_block_count(n.count);
   leaf_block_.assign(nodes_.size(), 0);
+  std::vector<std::uint32_t> leaf_order;
+  leaf_order.reserve(nodes_.size() / 2 + 1);
+  std::uint32_t next_block = 0;
   const std::function<void(std::uint32_t)> add_leaf = [&](std::uint32_t i) {
-    const auto tri_at = [&](std::uint32_t k) -> const Triangle& { return triangles[prim_indices_[k]]; };
-    leaf_block_[i] = bvh_detail::append_tri4_blocks(tri_at, nodes_[i].index, nodes_[i].count, blocks_);
+    leaf_order.push_back(i);
+    leaf_block_[i] = next_block;
+    next_block += bvh_detail::tri4_block_count(nodes_[i].count);
   };
   std::size_t wide_bytes = 0;
   if (opts_.wide_traversal && !nodes_.empty()) {
@@ -99,6 +105,14 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
     for (std::uint32_t i = 0; i < nodes_.size(); ++i)
       if (nodes_[i].count > 0) add_leaf(i);
   }
+  blocks_.resize(block_count);  // default-initialised: not written here (HugePageAllocator)
+  parallel_for(leaf_order.size(), opts_.threads, 4096, [&](std::size_t begin, std::size_t end, unsigned) {
+    const auto tri_at = [&](std::uint32_t k) -> const Triangle& { return triangles[prim_indices_[k]]; };
+    for (std::size_t j = begin; j < end; ++j) {
+      const BvhNode& leaf = nodes_[leaf_order[j]];
+      bvh_detail::fill_tri4_blocks(tri_at, leaf.index, leaf.count, blocks_.data() + leaf_block_[leaf_order[j]]);
+    }
+  });
   const std::size_t node_bytes = nodes_.size() * sizeof(BvhNode);
   const std::size_t index_bytes = prim_indices_.size() * sizeof(std::uint32_t);
   const std::size_t block_bytes = blocks_.size() * sizeof(bvh_detail::TriBlock4);

@@ -36,12 +36,17 @@ static_assert(sizeof(TriBlock4) == 160);
 
 inline constexpr std::uint32_t kTri4Empty = 0xFFFFFFFFu;
 
-/// Blocks for leaf positions [first, first + count): `tri(k)` is the
-/// triangle at leaf position k. Appended to `out` (a vector of TriBlock4,
-/// class Bvh's on huge pages); returns the index of the first block.
-template <class TriAt, class Blocks>
-std::uint32_t append_tri4_blocks(const TriAt& tri, std::uint32_t first, std::uint32_t count, Blocks& out) {
-  const auto start = static_cast<std::uint32_t>(out.size());
+/// Number of blocks that hold `count` triangles.
+constexpr std::uint32_t tri4_block_count(std::uint32_t count) {
+  return (count + 3) / 4;
+}
+
+/// Writes the tri4_block_count(count) blocks for leaf positions
+/// [first, first + count) to out[0..]: `tri(k)` is the triangle at leaf
+/// position k. Leaves write disjoint block ranges, so class Bvh fills them on
+/// all build threads.
+template <class TriAt>
+void fill_tri4_blocks(const TriAt& tri, std::uint32_t first, std::uint32_t count, TriBlock4* out) {
   for (std::uint32_t b = 0; b < count; b += 4) {
     TriBlock4 blk{};
     for (std::uint32_t l = 0; l < 4; ++l) {
@@ -53,8 +58,17 @@ std::uint32_t append_tri4_blocks(const TriAt& tri, std::uint32_t first, std::uin
         for (int a = 0; a < 3; ++a) blk.v[3 * k + a][l] = (&vs[k]->x)[a];
       blk.pos[l] = used ? first + b + l : kTri4Empty;
     }
-    out.push_back(blk);
+    out[b / 4] = blk;
   }
+}
+
+/// fill_tri4_blocks appended to `out` (a vector of TriBlock4); returns the
+/// index of the first block.
+template <class TriAt, class Blocks>
+std::uint32_t append_tri4_blocks(const TriAt& tri, std::uint32_t first, std::uint32_t count, Blocks& out) {
+  const auto start = static_cast<std::uint32_t>(out.size());
+  out.resize(start + tri4_block_count(count));
+  fill_tri4_blocks(tri, first, count, out.data() + start);
   return start;
 }
 
