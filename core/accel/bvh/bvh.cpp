@@ -22,6 +22,7 @@
 #include "core/analysis/epo.h"
 #include "core/analysis/sah.h"
 #include "core/util/parallel.h"
+#include "core/util/timing.h"
 
 namespace accelviz {
 namespace {
@@ -122,7 +123,7 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
   stats_.extra["memory_tri_blocks"] = static_cast<double>(block_bytes);
   stats_.extra["memory_leaf_block_index"] = static_cast<double>(leaf_block_bytes);
   stats_.memory_bytes = node_bytes + index_bytes + block_bytes + leaf_block_bytes + wide_bytes;
-  stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  stats_.build_ms = ms_since(t0);
   update_quality_stats(triangles);
 }
 
@@ -148,7 +149,7 @@ void Bvh::update_quality_stats(std::span<const Triangle> triangles) {
     const auto t0 = std::chrono::steady_clock::now();
     stats_.extra["epo"] =
         bvh_epo(nodes_, prim_indices_, triangles, opts_.cost_traversal, opts_.cost_intersect, opts_.threads);
-    stats_.extra["epo_ms"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    stats_.extra["epo_ms"] = ms_since(t0);
   }
 }
 
@@ -171,7 +172,7 @@ void Bvh::refit(std::span<const Triangle> moved) {
   bvh_detail::refit_tri4_blocks([&](std::uint32_t k) -> const Triangle& { return moved[prim_indices_[k]]; }, blocks_);
   if (wide_) bvh_detail::refit_wide(*wide_, nodes_);
   if (wide8_) bvh_detail::refit_wide(*wide8_, nodes_);
-  stats_.extra["refit_ms"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  stats_.extra["refit_ms"] = ms_since(t0);
   update_quality_stats(moved);
 }
 

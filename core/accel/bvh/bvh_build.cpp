@@ -30,6 +30,7 @@
 
 #include "core/analysis/sah.h"
 #include "core/util/parallel.h"
+#include "core/util/timing.h"
 
 namespace accelviz {
 
@@ -262,9 +263,9 @@ BvhTopology build_bvh(std::span<const Aabb> bounds, std::span<const glm::vec3> c
                                 std::to_string(centroids.size()) + " centroids");
   // 1. Build records (in id order) and root bounds, then the tree.
   BvhTopology topo = build_bvh_from(
-      bounds.size(), [&](std::size_t i) { return bounds[i]; }, [&](std::size_t i) { return centroids[i]; }, opts,
-      progress);
-  topo.stats.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      bounds.size(), [&](std::size_t i) { return bounds[i]; }, [&](std::size_t i, const Aabb&) { return centroids[i]; },
+      opts, progress);
+  topo.stats.build_ms = ms_since(t0);
   return topo;
 }
 
@@ -320,7 +321,7 @@ BvhTopology build_bvh_records(std::span<BuildPrim> prims, const Aabb& root_bound
   st.avg_leaf_depth = shape.avg_leaf_depth;
   st.memory_bytes = topo.nodes.size() * sizeof(BvhNode) + topo.prim_indices.size() * sizeof(std::uint32_t);
   st.sah_cost = bvh_sah_cost(topo.nodes, opts.cost_traversal, opts.cost_intersect);
-  st.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  st.build_ms = ms_since(t0);
   return topo;
 }
 

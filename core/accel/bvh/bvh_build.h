@@ -173,8 +173,9 @@ BvhTopology build_bvh_records(std::span<BuildPrim> prims, const Aabb& root_bound
 void check_prim_count(std::size_t n);
 
 /// build_bvh_records over n primitives whose records (in id order) and root
-/// bounds come from `bounds_at(i)` and `centroid_at(i)`: what build_bvh does
-/// from its arrays and class Bvh straight from its triangles.
+/// bounds come from `bounds_at(i)` and `centroid_at(i, box)` (box =
+/// bounds_at(i)): what build_bvh does from its arrays and class Bvh straight
+/// from its triangles (build_bvh_from_boxes).
 template <class BoundsAt, class CentroidAt>
 BvhTopology build_bvh_from(std::size_t n, const BoundsAt& bounds_at, const CentroidAt& centroid_at,
                            const BvhOptions& opts, const ProgressCallback& progress) {
@@ -184,7 +185,7 @@ BvhTopology build_bvh_from(std::size_t n, const BoundsAt& bounds_at, const Centr
   Aabb root_bounds, root_centroids;
   for (std::size_t i = 0; i < n; ++i) {
     const Aabb b = bounds_at(i);
-    const glm::vec3 c = centroid_at(i);
+    const glm::vec3 c = centroid_at(i, b);
     prims.push_back(BuildPrim{c, static_cast<std::uint32_t>(i), b});
     root_bounds.extend(b);
     root_centroids.extend(c);
@@ -199,18 +200,8 @@ BvhTopology build_bvh_from(std::size_t n, const BoundsAt& bounds_at, const Centr
 template <class BoundsAt>
 BvhTopology build_bvh_from_boxes(std::size_t n, const BoundsAt& bounds_at, const BvhOptions& opts,
                                  const ProgressCallback& progress) {
-  check_prim_count(n);
-  std::vector<BuildPrim> prims;
-  prims.reserve(n);
-  Aabb root_bounds, root_centroids;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Aabb b = bounds_at(i);
-    const glm::vec3 c = b.center();
-    prims.push_back(BuildPrim{c, static_cast<std::uint32_t>(i), b});
-    root_bounds.extend(b);
-    root_centroids.extend(c);
-  }
-  return build_bvh_records(prims, root_bounds, root_centroids, opts, progress);
+  return build_bvh_from(
+      n, bounds_at, [](std::size_t, const Aabb& box) { return box.center(); }, opts, progress);
 }
 
 /// Geometric and centroid bounds of a range.
