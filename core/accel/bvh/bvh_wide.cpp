@@ -38,7 +38,7 @@ struct SubtreeBlocks {
     for (std::size_t i = binary.size(); i-- > 0;) {
       const BvhNode& n = binary[i];
       if (n.count > 0) {
-        blocks[i] = (n.count + 3) / 4;
+        blocks[i] = tri4_block_count(n.count);
         count[i] = n.count;
         first[i] = n.index;
       } else {
@@ -140,7 +140,7 @@ void point_leaf_slots_at_blocks(WideBvhT<W>& wide, std::span<const BvhNode> bina
         std::uint32_t first = kWideEmpty, blocks = 0;
         for_each_leaf_under(binary, wide.source[W * w + s], [&](std::uint32_t leaf) {
           if (first == kWideEmpty) first = leaf_block[leaf];
-          blocks += (binary[leaf].count + 3) / 4;
+          blocks += tri4_block_count(binary[leaf].count);
         });
         wide.nodes[w].child[s] = first;
         wide.nodes[w].meta[s] = blocks;
