@@ -78,7 +78,7 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
   std::size_t block_count = 0;
   for (const BvhNode& n : nodes_) block_count += bvh_detail::tri4_block_count(n.count);
   leaf_block_.assign(nodes_.size(), 0);
-  std::vector<std::uint32_t> leaf_order;
+  HugePageVector<std::uint32_t> leaf_order;
   leaf_order.reserve(nodes_.size() / 2 + 1);
   std::uint32_t next_block = 0;
   const std::function<void(std::uint32_t)> add_leaf = [&](std::uint32_t i) {

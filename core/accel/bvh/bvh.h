@@ -79,8 +79,8 @@ inline constexpr std::uint32_t kBvhMaxDepth = 64;
 /// that do not need the primitives themselves (sah_cost, depths, counts,
 /// memory of nodes + indices, build time).
 struct BvhTopology {
-  std::vector<BvhNode> nodes;
-  std::vector<std::uint32_t> prim_indices;
+  HugePageVector<BvhNode> nodes;
+  HugePageVector<std::uint32_t> prim_indices;
   BuildStats stats;
 };
 
@@ -140,10 +140,10 @@ class Bvh final : public Accelerator {
   /// sah_cost, and epo when enabled, over `triangles` in scene order.
   void update_quality_stats(std::span<const Triangle> triangles);
 
-  std::vector<BvhNode> nodes_;
-  std::vector<std::uint32_t> prim_indices_;
+  HugePageVector<BvhNode> nodes_;
+  HugePageVector<std::uint32_t> prim_indices_;
   HugePageVector<bvh_detail::TriBlock4> blocks_;  ///< the triangles, four per block, each leaf from a new block
-  std::vector<std::uint32_t> leaf_block_;      ///< per binary node: a leaf's first block (unused for inner nodes)
+  HugePageVector<std::uint32_t> leaf_block_;    ///< per binary node: a leaf's first block (unused for inner nodes)
   std::unique_ptr<bvh_detail::WideBvh> wide_;    ///< 4-wide copy for the fast path (null when not used)
   std::unique_ptr<bvh_detail::WideBvh8> wide8_;  ///< 8-wide copy for the fast path (null when not used)
   BvhOptions opts_;

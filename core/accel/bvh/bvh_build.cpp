@@ -116,7 +116,7 @@ class Builder {
   }
 
   /// Builds the subtree of `w` into `out`, whose element `slot` is the subtree root.
-  void build(const NodeWork& w, std::vector<BvhNode>& out, std::uint32_t slot, SplitScratch& scratch) {
+  void build(const NodeWork& w, HugePageVector<BvhNode>& out, std::uint32_t slot, SplitScratch& scratch) {
     if (cancelled_.load(std::memory_order_relaxed)) return;
     const std::size_t n = w.end - w.begin;
     if (n <= static_cast<std::size_t>(params_.max_leaf_size)) {
@@ -158,7 +158,7 @@ class Builder {
     if (right.end - right.begin >= kParallelMinPrims && try_acquire_thread()) {
       // The right subtree goes into its own vector (its root at 0) on another
       // thread; the left one is built here, straight into `out`.
-      std::vector<BvhNode> right_nodes;
+      HugePageVector<BvhNode> right_nodes;
       std::exception_ptr right_error;
       std::thread worker([&] {
         try {
@@ -210,7 +210,7 @@ class Builder {
   }
 
  private:
-  void make_leaf(const NodeWork& w, std::vector<BvhNode>& out, std::uint32_t slot) {
+  void make_leaf(const NodeWork& w, HugePageVector<BvhNode>& out, std::uint32_t slot) {
     out[slot] = BvhNode{w.bounds, w.begin, w.end - w.begin};
     if (!progress_) return;
     const std::uint64_t n = w.end - w.begin;

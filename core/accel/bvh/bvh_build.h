@@ -180,7 +180,7 @@ template <class BoundsAt, class CentroidAt>
 BvhTopology build_bvh_from(std::size_t n, const BoundsAt& bounds_at, const CentroidAt& centroid_at,
                            const BvhOptions& opts, const ProgressCallback& progress) {
   check_prim_count(n);
-  std::vector<BuildPrim> prims;
+  HugePageVector<BuildPrim> prims;
   prims.reserve(n);
   Aabb root_bounds, root_centroids;
   for (std::size_t i = 0; i < n; ++i) {

@@ -32,7 +32,7 @@ WideNodeT<W> empty_node() {
 /// new block), its primitive count and its first leaf position. Children are
 /// stored after their parents, so one reverse sweep fills them.
 struct SubtreeBlocks {
-  std::vector<std::uint32_t> blocks, count, first;
+  HugePageVector<std::uint32_t> blocks, count, first;
   explicit SubtreeBlocks(std::span<const BvhNode> binary)
       : blocks(binary.size()), count(binary.size()), first(binary.size()) {
     for (std::size_t i = binary.size(); i-- > 0;) {
@@ -60,7 +60,7 @@ void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide, int me
   const SubtreeBlocks sub(binary);
   // Binary nodes that become one leaf slot: the leaves, and with merging the
   // inner nodes over few enough blocks (a slot counts at most 255 primitives).
-  std::vector<std::uint8_t> leaf_like(binary.size(), 0);
+  HugePageVector<std::uint8_t> leaf_like(binary.size(), 0);
   for (std::size_t i = 0; i < binary.size(); ++i)
     leaf_like[i] =
         binary[i].count > 0 ||

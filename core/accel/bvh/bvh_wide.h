@@ -48,7 +48,7 @@ struct WideBvhT {
   /// Root at 0; empty when the binary tree is. On huge pages where the
   /// system allows (huge_page_allocator.h): the walk reads it at random.
   HugePageVector<WideNodeT<W>> nodes;
-  std::vector<std::uint32_t> source;  ///< W per wide node: the binary node each slot copies (kWideEmpty if unused)
+  HugePageVector<std::uint32_t> source;  ///< W per wide node: the binary node each slot copies (kWideEmpty if unused)
 };
 struct WideBvh : WideBvhT<4> {};
 struct WideBvh8 : WideBvhT<8> {};

@@ -69,7 +69,7 @@ void lbvh_sort(std::span<BuildPrim> prims, const MortonFrame& frame, unsigned th
   const std::size_t n = prims.size();
   if (n < 2) return;
   threads = std::max(1u, std::min<unsigned>(threads, static_cast<unsigned>((n + 65535) / 65536)));
-  std::vector<std::uint32_t> keys(n), keys_tmp(n), order(n), order_tmp(n);
+  HugePageVector<std::uint32_t> keys(n), keys_tmp(n), order(n), order_tmp(n);
   const auto chunk = [&](unsigned t) {
     return std::pair<std::size_t, std::size_t>{n * t / threads, n * (t + 1) / threads};
   };
@@ -121,7 +121,7 @@ void lbvh_sort(std::span<BuildPrim> prims, const MortonFrame& frame, unsigned th
     keys.swap(keys_tmp);
     order.swap(order_tmp);
   }
-  std::vector<BuildPrim> sorted(n);
+  HugePageVector<BuildPrim> sorted(n);
   for_chunks([&](unsigned t) {
     const auto [b, e] = chunk(t);
     for (std::size_t i = b; i < e; ++i) sorted[i] = prims[order[i]];

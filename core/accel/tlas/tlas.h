@@ -141,7 +141,7 @@ class Tlas final : public Accelerator {
   std::vector<std::shared_ptr<Bvh>> blas_;
   std::vector<std::uint32_t> blas_mesh_;  ///< scene mesh of each BLAS
   std::vector<TlasInstance> instances_;
-  std::vector<BvhNode> tlas_nodes_;
+  HugePageVector<BvhNode> tlas_nodes_;
   std::vector<std::uint32_t> tlas_prims_;  ///< instance ids in TLAS leaf order
   std::uint64_t instanced_triangles_ = 0;
   BuildStats stats_;
