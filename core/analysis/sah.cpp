@@ -2,6 +2,8 @@
 
 #include <vector>
 
+#include "core/util/huge_page_allocator.h"
+
 namespace accelviz {
 
 double bvh_sah_cost(std::span<const BvhNode> nodes, double cost_traversal, double cost_intersect) {
@@ -26,7 +28,7 @@ TreeShape bvh_tree_shape(std::span<const BvhNode> nodes) {
   if (nodes.empty()) return s;
   // Children always follow their parent in the array, so one forward sweep
   // propagates depths.
-  std::vector<std::uint32_t> depth(nodes.size(), 0);
+  HugePageVector<std::uint32_t> depth(nodes.size(), 0);  // fresh pages: cheaper as huge ones (huge_page_allocator.h)
   double depth_sum = 0.0;
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     const BvhNode& n = nodes[i];

@@ -11,7 +11,6 @@
 
 #include <bit>
 #include <chrono>
-#include <functional>
 #include <stdexcept>
 #include <string>
 
@@ -38,18 +37,14 @@ constexpr std::size_t kWideMergeMinBytes = std::size_t{16} << 20;
 
 /// Collapses `nodes` into `wide`, leaf slots pointing at the triangle blocks; returns its bytes.
 template <int W>
-std::size_t make_wide(std::span<const BvhNode> nodes, const std::function<void(std::uint32_t)>& add_leaf,
-                      std::span<const std::uint32_t> leaf_block, int merge_blocks, bvh_detail::WideBvhT<W>& wide,
+std::size_t make_wide(std::span<const BvhNode> nodes, HugePageVector<std::uint32_t>& leaf_order,
+                      std::span<std::uint32_t> leaf_block, int merge_blocks, bvh_detail::WideBvhT<W>& wide,
                       BuildStats& stats) {
   bvh_detail::collapse_to_wide(nodes, wide, merge_blocks);
   stats.extra["wide_merge_blocks"] = merge_blocks;
   // The triangle blocks in the order the fast path's leaf slots are laid out
   // (a slot's binary leaves one after the other).
-  for (std::size_t w = 0; w < wide.nodes.size(); ++w)
-    for (int s = 0; s < W; ++s)
-      if (wide.nodes[w].meta[s] != 0 && wide.nodes[w].meta[s] != bvh_detail::kWideEmpty)
-        bvh_detail::for_each_leaf_under(nodes, wide.source[W * w + s], add_leaf);
-  bvh_detail::point_leaf_slots_at_blocks(wide, nodes, leaf_block);
+  bvh_detail::lay_out_leaf_blocks(wide, nodes, leaf_order, leaf_block);
   const std::size_t node_bytes = wide.nodes.size() * sizeof(bvh_detail::WideNodeT<W>);
   const std::size_t source_bytes = wide.source.size() * sizeof(std::uint32_t);
   stats.extra["wide_nodes"] = static_cast<double>(wide.nodes.size());
@@ -80,12 +75,6 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
   leaf_block_.assign(nodes_.size(), 0);
   HugePageVector<std::uint32_t> leaf_order;
   leaf_order.reserve(nodes_.size() / 2 + 1);
-  std::uint32_t next_block = 0;
-  const std::function<void(std::uint32_t)> add_leaf = [&](std::uint32_t i) {
-    leaf_order.push_back(i);
-    leaf_block_[i] = next_block;
-    next_block += bvh_detail::tri4_block_count(nodes_[i].count);
-  };
   std::size_t wide_bytes = 0;
   if (opts_.wide_traversal && !nodes_.empty()) {
     const int merge = opts_.wide_merge_blocks >= 0                                        ? opts_.wide_merge_blocks
@@ -96,15 +85,20 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
                                                                               : opts_.wide_width;
     if (width == 8) {
       wide8_ = std::make_unique<bvh_detail::WideBvh8>();
-      wide_bytes = make_wide(nodes_, add_leaf, leaf_block_, merge, *wide8_, stats_);
+      wide_bytes = make_wide(nodes_, leaf_order, leaf_block_, merge, *wide8_, stats_);
     } else {
       wide_ = std::make_unique<bvh_detail::WideBvh>();
-      wide_bytes = make_wide(nodes_, add_leaf, leaf_block_, merge, *wide_, stats_);
+      wide_bytes = make_wide(nodes_, leaf_order, leaf_block_, merge, *wide_, stats_);
     }
     stats_.extra["wide_width"] = width;
   } else {
+    std::uint32_t next_block = 0;
     for (std::uint32_t i = 0; i < nodes_.size(); ++i)
-      if (nodes_[i].count > 0) add_leaf(i);
+      if (nodes_[i].count > 0) {
+        leaf_order.push_back(i);
+        leaf_block_[i] = next_block;
+        next_block += bvh_detail::tri4_block_count(nodes_[i].count);
+      }
   }
   blocks_.resize(block_count);  // default-initialised: not written here (HugePageAllocator)
   parallel_for(leaf_order.size(), opts_.threads, 4096, [&](std::size_t begin, std::size_t end, unsigned) {

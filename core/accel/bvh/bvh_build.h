@@ -12,6 +12,7 @@
 
 #include "core/accel/bvh/bvh.h"
 #include "core/math/aabb.h"
+#include "core/util/parallel.h"
 
 namespace accelviz::bvh_detail {
 
@@ -172,23 +173,40 @@ BvhTopology build_bvh_records(std::span<BuildPrim> prims, const Aabb& root_bound
 /// Throws std::invalid_argument when n primitives do not fit 32-bit indices.
 void check_prim_count(std::size_t n);
 
+/// Records per chunk of build_bvh_from's parallel fill.
+inline constexpr std::size_t kRecordChunk = 16384;
+
 /// build_bvh_records over n primitives whose records (in id order) and root
 /// bounds come from `bounds_at(i)` and `centroid_at(i, box)` (box =
 /// bounds_at(i)): what build_bvh does from its arrays and class Bvh straight
-/// from its triangles (build_bvh_from_boxes).
+/// from its triangles (build_bvh_from_boxes). bounds_at and centroid_at are
+/// called from all build threads.
+
 template <class BoundsAt, class CentroidAt>
 BvhTopology build_bvh_from(std::size_t n, const BoundsAt& bounds_at, const CentroidAt& centroid_at,
                            const BvhOptions& opts, const ProgressCallback& progress) {
   check_prim_count(n);
-  HugePageVector<BuildPrim> prims;
-  prims.reserve(n);
+  // The records on all build threads, in fixed chunks whose bounds merge in
+  // chunk order: the root boxes do not depend on the thread count.
+  HugePageVector<BuildPrim> prims(n);
+  const std::size_t chunks = (n + kRecordChunk - 1) / kRecordChunk;
+  std::vector<Aabb> chunk_bounds(chunks), chunk_centroids(chunks);
+  parallel_for(n, opts.threads, kRecordChunk, [&](std::size_t begin, std::size_t end, unsigned) {
+    Aabb rb, rc;
+    for (std::size_t i = begin; i < end; ++i) {
+      const Aabb b = bounds_at(i);
+      const glm::vec3 c = centroid_at(i, b);
+      prims[i] = BuildPrim{c, static_cast<std::uint32_t>(i), b};
+      rb.extend(b);
+      rc.extend(c);
+    }
+    chunk_bounds[begin / kRecordChunk] = rb;
+    chunk_centroids[begin / kRecordChunk] = rc;
+  });
   Aabb root_bounds, root_centroids;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Aabb b = bounds_at(i);
-    const glm::vec3 c = centroid_at(i, b);
-    prims.push_back(BuildPrim{c, static_cast<std::uint32_t>(i), b});
-    root_bounds.extend(b);
-    root_centroids.extend(c);
+  for (std::size_t k = 0; k < chunks; ++k) {
+    root_bounds.extend(chunk_bounds[k]);
+    root_centroids.extend(chunk_centroids[k]);
   }
   return build_bvh_records(prims, root_bounds, root_centroids, opts, progress);
 }

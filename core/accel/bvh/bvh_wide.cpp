@@ -132,19 +132,22 @@ void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide, int me
 }
 
 template <int W>
-void point_leaf_slots_at_blocks(WideBvhT<W>& wide, std::span<const BvhNode> binary,
-                                std::span<const std::uint32_t> leaf_block) {
+std::uint32_t lay_out_leaf_blocks(WideBvhT<W>& wide, std::span<const BvhNode> binary,
+                                  HugePageVector<std::uint32_t>& leaf_order, std::span<std::uint32_t> leaf_block) {
+  std::uint32_t next = 0;
   for (std::size_t w = 0; w < wide.nodes.size(); ++w)
     for (int s = 0; s < W; ++s)
       if (wide.nodes[w].meta[s] != 0 && wide.nodes[w].meta[s] != kWideEmpty) {
-        std::uint32_t first = kWideEmpty, blocks = 0;
+        const std::uint32_t first = next;
         for_each_leaf_under(binary, wide.source[W * w + s], [&](std::uint32_t leaf) {
-          if (first == kWideEmpty) first = leaf_block[leaf];
-          blocks += tri4_block_count(binary[leaf].count);
+          leaf_order.push_back(leaf);
+          leaf_block[leaf] = next;
+          next += tri4_block_count(binary[leaf].count);
         });
         wide.nodes[w].child[s] = first;
-        wide.nodes[w].meta[s] = blocks;
+        wide.nodes[w].meta[s] = next - first;
       }
+  return next;
 }
 
 template <int W>
@@ -179,8 +182,10 @@ bool cpu_has_wide8() {
 
 template void collapse_to_wide<4>(std::span<const BvhNode>, WideBvhT<4>&, int);
 template void collapse_to_wide<8>(std::span<const BvhNode>, WideBvhT<8>&, int);
-template void point_leaf_slots_at_blocks<4>(WideBvhT<4>&, std::span<const BvhNode>, std::span<const std::uint32_t>);
-template void point_leaf_slots_at_blocks<8>(WideBvhT<8>&, std::span<const BvhNode>, std::span<const std::uint32_t>);
+template std::uint32_t lay_out_leaf_blocks<4>(WideBvhT<4>&, std::span<const BvhNode>, HugePageVector<std::uint32_t>&,
+                                              std::span<std::uint32_t>);
+template std::uint32_t lay_out_leaf_blocks<8>(WideBvhT<8>&, std::span<const BvhNode>, HugePageVector<std::uint32_t>&,
+                                              std::span<std::uint32_t>);
 template void refit_wide<4>(WideBvhT<4>&, std::span<const BvhNode>);
 template void refit_wide<8>(WideBvhT<8>&, std::span<const BvhNode>);
 template int wide_slab_test_scalar<4>(const WideNodeT<4>&, const Ray&, float, float, float*, float*);

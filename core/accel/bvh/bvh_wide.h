@@ -28,7 +28,7 @@ namespace accelviz::bvh_detail {
 /// W child boxes in structure-of-arrays order, then the children (W = 4:
 /// 128 bytes, SSE; W = 8: 256 bytes, AVX2). meta = 0: inner wide node
 /// `child`; 1..255: leaf of `meta` primitives starting at leaf position
-/// `child` (after point_leaf_slots_at_blocks: `meta` triangle blocks starting
+/// `child` (after lay_out_leaf_blocks: `meta` triangle blocks starting
 /// at block `child`); kWideEmpty: unused slot.
 template <int W>
 struct alignas(64) WideNodeT {
@@ -65,15 +65,17 @@ void for_each_leaf_under(std::span<const BvhNode> binary, std::uint32_t node, co
   for_each_leaf_under(binary, binary[node].index + 1, f);
 }
 
-/// Points every leaf slot at its triangle blocks (class Bvh's blocks of
-/// bvh_tri4.h, each binary leaf from a new block, `leaf_block[binary leaf]`
-/// its first): child = the first block of the slot's first binary leaf,
-/// meta = the blocks of all its binary leaves, which the caller laid out one
-/// after the other (for_each_leaf_under's order). Before, collapse_to_wide's
-/// leaf slots name leaf positions and primitive counts.
+/// Lays class Bvh's triangle blocks (bvh_tri4.h) out in the order of the
+/// leaf slots and points every leaf slot at its blocks, in one walk: each
+/// slot's binary leaves one after the other (for_each_leaf_under's order),
+/// each binary leaf from a new block. Appends every binary leaf to
+/// `leaf_order`, sets `leaf_block[binary leaf]` to its first block, and sets
+/// the slot's child = its first block, meta = its block count (before, a
+/// leaf slot names a leaf position and a primitive count, as collapse_to_wide
+/// leaves it). Returns the number of blocks laid out.
 template <int W>
-void point_leaf_slots_at_blocks(WideBvhT<W>& wide, std::span<const BvhNode> binary,
-                                std::span<const std::uint32_t> leaf_block);
+std::uint32_t lay_out_leaf_blocks(WideBvhT<W>& wide, std::span<const BvhNode> binary,
+                                  HugePageVector<std::uint32_t>& leaf_order, std::span<std::uint32_t> leaf_block);
 
 /// Collapses a binary node array: each wide node takes a binary inner node's
 /// children and keeps opening the child with the largest surface area until
