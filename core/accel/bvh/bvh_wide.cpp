@@ -55,9 +55,6 @@ struct SubtreeBlocks {
 };
 
 
-/// Binary trees smaller than this collapse on one thread.
-constexpr std::size_t kWideCollapseParallelMinNodes = std::size_t{1} << 17;
-
 /// One step of the collapse: fills wide node `w` of `nodes`/`source` with the
 /// slots gathered under binary inner node `b` and appends an empty wide node
 /// for each inner slot; returns the (wide node, binary node) pairs still to
@@ -149,9 +146,6 @@ void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide, int me
   }
   const std::span<const Item> parts(queue.data() + head, queue.size() - head);
   if (parts.empty()) return;
-  // A small tree collapses faster than threads start (bunny, 85k binary
-  // nodes: 1.8 ms on one thread, 2.1 ms on two).
-  if (binary.size() < kWideCollapseParallelMinNodes) threads = 1;
 
   // 2. Each pending subtree depth first into its own arrays, whose node 0
   //    stands for the subtree's (already allocated) root.
