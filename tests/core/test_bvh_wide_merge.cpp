@@ -3,10 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
-#include <cstring>
 #include <random>
 #include <stdexcept>
-#include <string>
 #include <vector>
 
 #include "core/accel/brute_force.h"
@@ -122,39 +120,6 @@ TEST(BvhWideMerge, AutoMergesOnlyLargeTreesAndTheOptionIsChecked) {
   for (int bad : {-2, 64}) {
     o.wide_merge_blocks = bad;
     EXPECT_THROW(Bvh(tris, o), std::invalid_argument) << bad;
-  }
-}
-
-TEST(BvhWideMerge, CollapseLayoutDoesNotDependOnTheThreadCount) {
-  // Enough wide nodes that the breadth-first top stops at kWideCollapseParts
-  // pending subtrees and the parts are collapsed on several threads.
-  const auto tris = merge_soup(20000, 43);
-  BvhOptions o;
-  o.compute_epo = false;
-  o.threads = 1;
-  const Bvh bvh(tris, o);
-  for (int merge : {0, 2}) {
-    bvh_detail::WideBvhT<8> ref;
-    bvh_detail::collapse_to_wide(bvh.nodes(), ref, merge, 1);
-    ASSERT_GT(ref.nodes.size(), 4 * bvh_detail::kWideCollapseParts);
-    for (unsigned threads : {2u, 3u, 0u}) {
-      SCOPED_TRACE("merge " + std::to_string(merge) + ", threads " + std::to_string(threads));
-      bvh_detail::WideBvhT<8> got;
-      bvh_detail::collapse_to_wide(bvh.nodes(), got, merge, threads);
-      ASSERT_EQ(got.nodes.size(), ref.nodes.size());
-      EXPECT_EQ(std::memcmp(got.nodes.data(), ref.nodes.data(), ref.nodes.size() * sizeof(ref.nodes[0])), 0);
-      ASSERT_EQ(got.source, ref.source);
-    }
-    // Every wide node but the root has exactly one parent, stored before it.
-    std::vector<int> parents(ref.nodes.size(), 0);
-    for (std::size_t w = 0; w < ref.nodes.size(); ++w)
-      for (int s = 0; s < 8; ++s)
-        if (ref.nodes[w].meta[s] == 0) {
-          ASSERT_GT(ref.nodes[w].child[s], w);
-          ASSERT_LT(ref.nodes[w].child[s], ref.nodes.size());
-          ++parents[ref.nodes[w].child[s]];
-        }
-    for (std::size_t w = 1; w < ref.nodes.size(); ++w) EXPECT_EQ(parents[w], 1) << w;
   }
 }
 

@@ -38,9 +38,9 @@ constexpr std::size_t kWideMergeMinBytes = std::size_t{16} << 20;
 /// Collapses `nodes` into `wide`, leaf slots pointing at the triangle blocks; returns its bytes.
 template <int W>
 std::size_t make_wide(std::span<const BvhNode> nodes, HugePageVector<std::uint32_t>& leaf_order,
-                      std::span<std::uint32_t> leaf_block, int merge_blocks, unsigned threads,
-                      bvh_detail::WideBvhT<W>& wide, BuildStats& stats) {
-  bvh_detail::collapse_to_wide(nodes, wide, merge_blocks, threads);
+                      std::span<std::uint32_t> leaf_block, int merge_blocks, bvh_detail::WideBvhT<W>& wide,
+                      BuildStats& stats) {
+  bvh_detail::collapse_to_wide(nodes, wide, merge_blocks);
   stats.extra["wide_merge_blocks"] = merge_blocks;
   // The triangle blocks in the order the fast path's leaf slots are laid out
   // (a slot's binary leaves one after the other).
@@ -85,10 +85,10 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
                                                                               : opts_.wide_width;
     if (width == 8) {
       wide8_ = std::make_unique<bvh_detail::WideBvh8>();
-      wide_bytes = make_wide(nodes_, leaf_order, leaf_block_, merge, opts_.threads, *wide8_, stats_);
+      wide_bytes = make_wide(nodes_, leaf_order, leaf_block_, merge, *wide8_, stats_);
     } else {
       wide_ = std::make_unique<bvh_detail::WideBvh>();
-      wide_bytes = make_wide(nodes_, leaf_order, leaf_block_, merge, opts_.threads, *wide_, stats_);
+      wide_bytes = make_wide(nodes_, leaf_order, leaf_block_, merge, *wide_, stats_);
     }
     stats_.extra["wide_width"] = width;
   } else {

@@ -2,11 +2,7 @@
 #include "core/accel/bvh/bvh_wide.h"
 
 #include "core/accel/bvh/bvh_slab.h"
-#include <algorithm>
-#include <vector>
-
 #include "core/math/aabb.h"
-#include "core/util/parallel.h"
 
 namespace accelviz::bvh_detail {
 namespace {
@@ -54,62 +50,10 @@ struct SubtreeBlocks {
   }
 };
 
-
-/// One step of the collapse: fills wide node `w` of `nodes`/`source` with the
-/// slots gathered under binary inner node `b` and appends an empty wide node
-/// for each inner slot; returns the (wide node, binary node) pairs still to
-/// fill, in slot order.
-template <int W>
-int fill_wide_node(std::span<const BvhNode> binary, const SubtreeBlocks& sub,
-                   std::span<const std::uint8_t> leaf_like, HugePageVector<WideNodeT<W>>& nodes,
-                   HugePageVector<std::uint32_t>& source, std::uint32_t w, std::uint32_t b,
-                   std::pair<std::uint32_t, std::uint32_t> (&pending)[W]) {
-  // 1. Gather up to W binary nodes under b: open the largest inner one.
-  std::uint32_t slots[W] = {binary[b].index, binary[b].index + 1};
-  int n = 2;
-  while (n < W) {
-    int open = -1;
-    float best = -1.0f;
-    for (int s = 0; s < n; ++s) {
-      const BvhNode& c = binary[slots[s]];
-      if (!leaf_like[slots[s]] && c.bounds.surface_area() > best) {
-        best = c.bounds.surface_area();
-        open = s;
-      }
-    }
-    if (open < 0) break;  // only leaves left
-    const std::uint32_t opened = slots[open];
-    // Keep the children in place of their parent: spatial order survives.
-    for (int s = n; s > open + 1; --s) slots[s] = slots[s - 1];
-    slots[open] = binary[opened].index;
-    slots[open + 1] = binary[opened].index + 1;
-    ++n;
-  }
-  // 2. Fill the slots; inner slots get new wide nodes, allocated together.
-  int count = 0;
-  for (int s = 0; s < n; ++s) {
-    const BvhNode& c = binary[slots[s]];
-    source[W * w + s] = slots[s];
-    set_slot(nodes[w], s, c.bounds);
-    if (leaf_like[slots[s]]) {
-      nodes[w].child[s] = sub.first[slots[s]];
-      nodes[w].meta[s] = sub.count[slots[s]];
-    } else {
-      const auto child = static_cast<std::uint32_t>(nodes.size());
-      nodes.push_back(empty_node<W>());
-      source.insert(source.end(), W, kWideEmpty);
-      nodes[w].child[s] = child;
-      nodes[w].meta[s] = 0;
-      pending[count++] = {child, slots[s]};
-    }
-  }
-  return count;
-}
-
 }  // namespace
 
 template <int W>
-void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide, int merge_blocks, unsigned threads) {
+void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide, int merge_blocks) {
   wide.nodes.clear();
   wide.source.clear();
   if (binary.empty()) return;
@@ -124,6 +68,8 @@ void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide, int me
   wide.nodes.reserve(binary.size() / 2 + 1);
   wide.source.reserve(2 * binary.size() + 4);
 
+  // Work list of (wide node to fill, binary node whose children it takes).
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> work;
   wide.nodes.push_back(empty_node<W>());
   wide.source.insert(wide.source.end(), W, kWideEmpty);
   if (leaf_like[0]) {
@@ -134,71 +80,55 @@ void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide, int me
     wide.source[0] = 0;
     return;
   }
-  using Item = std::pair<std::uint32_t, std::uint32_t>;  // (wide node to fill, binary node whose children it takes)
-  // 1. The top, breadth first, until enough subtrees are pending.
-  std::vector<Item> queue{{0, 0}};
-  std::size_t head = 0;
-  while (head < queue.size() && queue.size() - head < kWideCollapseParts) {
-    const Item it = queue[head++];
-    Item pending[W];
-    const int k = fill_wide_node<W>(binary, sub, leaf_like, wide.nodes, wide.source, it.first, it.second, pending);
-    queue.insert(queue.end(), pending, pending + k);
-  }
-  const std::span<const Item> parts(queue.data() + head, queue.size() - head);
-  if (parts.empty()) return;
-
-  // 2. Each pending subtree depth first into its own arrays, whose node 0
-  //    stands for the subtree's (already allocated) root.
-  struct Part {
-    HugePageVector<WideNodeT<W>> nodes;
-    HugePageVector<std::uint32_t> source;
-  };
-  std::vector<Part> out(parts.size());
-  parallel_for(parts.size(), threads, 1, [&](std::size_t begin, std::size_t end, unsigned) {
-    std::vector<Item> work;
-    Item pending_here[W];
-    for (std::size_t p = begin; p < end; ++p) {
-      Part& part = out[p];
-      part.nodes.reserve(sub.count[parts[p].second] / 4 + 1);
-      part.source.reserve(W * (sub.count[parts[p].second] / 4 + 1));
-      part.nodes.push_back(empty_node<W>());
-      part.source.insert(part.source.end(), W, kWideEmpty);
-      work.assign(1, Item{0, parts[p].second});
-      while (!work.empty()) {
-        const Item it = work.back();
-        work.pop_back();
-        const int k =
-            fill_wide_node<W>(binary, sub, leaf_like, part.nodes, part.source, it.first, it.second, pending_here);
-        for (int i = k - 1; i >= 0; --i) work.push_back(pending_here[i]);  // first slot first (pushed last)
+  work.push_back({0, 0});
+  while (!work.empty()) {
+    const auto [w, b] = work.back();
+    work.pop_back();
+    // 1. Gather up to W binary nodes under b: open the largest inner one.
+    std::uint32_t slots[W] = {binary[b].index, binary[b].index + 1};
+    int n = 2;
+    while (n < W) {
+      int open = -1;
+      float best = -1.0f;
+      for (int s = 0; s < n; ++s) {
+        const BvhNode& c = binary[slots[s]];
+        if (!leaf_like[slots[s]] && c.bounds.surface_area() > best) {
+          best = c.bounds.surface_area();
+          open = s;
+        }
+      }
+      if (open < 0) break;  // only leaves left
+      const std::uint32_t opened = slots[open];
+      // Keep the children in place of their parent: spatial order survives.
+      for (int s = n; s > open + 1; --s) slots[s] = slots[s - 1];
+      slots[open] = binary[opened].index;
+      slots[open + 1] = binary[opened].index + 1;
+      ++n;
+    }
+    // 2. Fill the slots; inner slots get new wide nodes, allocated together.
+    for (int s = 0; s < n; ++s) {
+      const BvhNode& c = binary[slots[s]];
+      wide.source[W * w + s] = slots[s];
+      set_slot(wide.nodes[w], s, c.bounds);
+      if (leaf_like[slots[s]]) {
+        wide.nodes[w].child[s] = sub.first[slots[s]];
+        wide.nodes[w].meta[s] = sub.count[slots[s]];
+      } else {
+        const auto child = static_cast<std::uint32_t>(wide.nodes.size());
+        wide.nodes.push_back(empty_node<W>());
+        wide.source.insert(wide.source.end(), W, kWideEmpty);
+        wide.nodes[w].child[s] = child;
+        wide.nodes[w].meta[s] = 0;
       }
     }
-  });
-
-  // 3. Splice the parts after the top, in order: a part's node 0 replaces its
-  //    root's placeholder, local node i >= 1 goes to base + i - 1.
-  std::vector<std::size_t> base(parts.size());
-  std::size_t total = wide.nodes.size();
-  for (std::size_t p = 0; p < parts.size(); ++p) {
-    base[p] = total;
-    total += out[p].nodes.size() - 1;
+    // Depth first, first slot first (pushed last).
+    for (int s = n - 1; s >= 0; --s)
+      if (wide.nodes[w].meta[s] == 0) work.push_back({wide.nodes[w].child[s], slots[s]});
   }
-  wide.nodes.resize(total);
-  wide.source.resize(W * total);
-  parallel_for(parts.size(), threads, 1, [&](std::size_t begin, std::size_t end, unsigned) {
-    for (std::size_t p = begin; p < end; ++p) {
-      const Part& part = out[p];
-      const auto rebase = [&](WideNodeT<W> node) {
-        for (int s = 0; s < W; ++s)
-          if (node.meta[s] == 0) node.child[s] = static_cast<std::uint32_t>(base[p] + node.child[s] - 1);
-        return node;
-      };
-      const std::uint32_t root = parts[p].first;
-      wide.nodes[root] = rebase(part.nodes[0]);
-      std::copy_n(part.source.begin(), W, wide.source.begin() + W * root);
-      for (std::size_t i = 1; i < part.nodes.size(); ++i) wide.nodes[base[p] + i - 1] = rebase(part.nodes[i]);
-      std::copy(part.source.begin() + W, part.source.end(), wide.source.begin() + W * base[p]);
-    }
-  });
+  // The reserve above is sized for 2-wide and wider trees use a fraction of
+  // it, but it is not trimmed: its untouched pages are never resident, and a
+  // trimming copy (shrink_to_fit) cost a fresh page fault per page of the
+  // nodes, about 4 % of a dragon build.
 }
 
 template <int W>
@@ -250,8 +180,8 @@ bool cpu_has_wide8() {
 #endif
 }
 
-template void collapse_to_wide<4>(std::span<const BvhNode>, WideBvhT<4>&, int, unsigned);
-template void collapse_to_wide<8>(std::span<const BvhNode>, WideBvhT<8>&, int, unsigned);
+template void collapse_to_wide<4>(std::span<const BvhNode>, WideBvhT<4>&, int);
+template void collapse_to_wide<8>(std::span<const BvhNode>, WideBvhT<8>&, int);
 template std::uint32_t lay_out_leaf_blocks<4>(WideBvhT<4>&, std::span<const BvhNode>, HugePageVector<std::uint32_t>&,
                                               std::span<std::uint32_t>);
 template std::uint32_t lay_out_leaf_blocks<8>(WideBvhT<8>&, std::span<const BvhNode>, HugePageVector<std::uint32_t>&,

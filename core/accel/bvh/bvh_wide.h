@@ -79,11 +79,8 @@ std::uint32_t lay_out_leaf_blocks(WideBvhT<W>& wide, std::span<const BvhNode> bi
 
 /// Collapses a binary node array: each wide node takes a binary inner node's
 /// children and keeps opening the child with the largest surface area until
-/// it has W (or only leaves are left). Wide children are stored after their
-/// parent: the top of the tree breadth first until kWideCollapseParts subtrees
-/// are pending, then each of those subtrees depth first (first slot first),
-/// one after the other. The subtrees are collapsed on up to `threads` threads
-/// (0: all) and the layout does not depend on the thread count.
+/// it has W (or only leaves are left). Deterministic; wide children are
+/// stored after their parent.
 ///
 /// merge_blocks > 0: a binary inner node whose leaves fill at most that many
 /// triangle blocks of four (each leaf from a new block) becomes one leaf slot
@@ -92,9 +89,7 @@ std::uint32_t lay_out_leaf_blocks(WideBvhT<W>& wide, std::span<const BvhNode> bi
 /// unchanged; only the fast path's copy has fewer, larger leaves (see
 /// docs/bvh.md: fewer wide nodes to fetch per ray).
 template <int W>
-void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide, int merge_blocks = 0, unsigned threads = 1);
-/// Pending subtrees at which collapse_to_wide's breadth-first top stops.
-inline constexpr std::size_t kWideCollapseParts = 64;
+void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide, int merge_blocks = 0);
 inline WideBvh collapse_to_wide(std::span<const BvhNode> binary) {
   WideBvh w;
   collapse_to_wide<4>(binary, w);
