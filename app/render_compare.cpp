@@ -114,15 +114,8 @@ QueryOptions query_of(const CompareSide& side) {
 }
 
 HeatmapOptions heatmap_options_of(const CompareSide& side, HeatMetric metric, const ImageSize& size, unsigned threads) {
-  HeatmapOptions ho;
-  ho.metric = metric;
-  ho.width = size.width;
-  ho.height = size.height;
-  ho.threads = threads;
-  ho.query = query_of(side);
-  ho.c_trav = side.structure_opts.ctrav;
-  ho.c_isect = side.structure_opts.cisect;
-  return ho;
+  return heatmap_options(metric, size.width, size.height, threads, query_of(side), side.structure_opts.ctrav,
+                         side.structure_opts.cisect);
 }
 
 int run_render_compare(const CompareJob& job, const GlobalOptions& global) {

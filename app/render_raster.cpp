@@ -80,14 +80,8 @@ void render_raster(const Scene& scene, const Accelerator& accel, const Camera& c
 
   // The heatmap blended over the mesh.
   if (ro.blend > 0.0f) {
-    HeatmapOptions ho;
-    ho.metric = parse_metric(metric_name).value();
-    ho.width = size.width;
-    ho.height = size.height;
-    ho.threads = threads;
-    ho.query = query;
-    ho.c_trav = c_trav;
-    ho.c_isect = c_isect;
+    const HeatmapOptions ho =
+        heatmap_options(parse_metric(metric_name).value(), size.width, size.height, threads, query, c_trav, c_isect);
     HeatmapFigures fig;
     const MetricImage img = render_metric(accel, camera, ho, &fig);
     renderer.set_heatmap(img);

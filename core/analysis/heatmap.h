@@ -43,6 +43,14 @@ struct HeatmapOptions {
   ProgressCallback progress;  ///< optional; false cancels (render_metric then throws BuildCancelled)
 };
 
+/// The options of a `metric` heatmap of width x height pixels traced on
+/// `threads` threads (0: all) with `query`, the cost metric weighted by
+/// c_trav and c_isect (the structure's SAH costs where it has them). The one
+/// place that fills them for the CLI (render, render --compare, the raster
+/// blend) and the GUI (the view, the compare and scenario jobs).
+HeatmapOptions heatmap_options(HeatMetric metric, int width, int height, unsigned threads,
+                               const QueryOptions& query = {}, float c_trav = 1.0f, float c_isect = 1.0f);
+
 /// Whether `a` and `b` trace the same image: metric, size, query options and
 /// cost weights all equal. `threads` and `progress` are left out on purpose:
 /// they change neither the rays nor the values (and a std::function has no

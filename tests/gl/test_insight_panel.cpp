@@ -11,6 +11,7 @@
 #include "core/accel/factory.h"
 #include "core/scene/load.h"
 #include "tests/gl/imgui_headless.h"
+#include "ui/app/insight_jobs.h"
 #include "ui/panels/insight_panels.h"
 
 namespace accelviz {
@@ -28,6 +29,35 @@ struct InsightPanelHarness : test::HeadlessImGuiContext {
     ImGui::Render();
   }
 };
+
+TEST(InsightJobs, ABCostMetricWeighsEachSideWithItsOwnSahCosts) {
+  // The A/B compare's cost image is c_trav * nodes + c_isect * prims with
+  // the side's own costs (as the view and render --compare), not 1 and 1.
+  auto loaded = std::make_shared<LoadedScene>();
+  loaded->scene = load_scene("builtin:teapot?size=800");
+  ABRequest r;
+  r.scene = loaded;
+  r.a.options.bvh.cost_traversal = 2.0f;
+  r.a.options.bvh.cost_intersect = 3.0f;
+  r.b = r.a;
+  r.camera = look_at({6.0f, 4.0f, 8.0f}, {0.0f, 1.2f, 0.0f}, 0.7f);
+  r.width = 32;
+  r.height = 24;
+  r.threads = 1;
+  const std::atomic<bool> cancel{false};
+  const auto image = [&](HeatMetric m) {
+    r.metric = m;
+    return run_ab(r, cancel).image_a;
+  };
+  const MetricImage cost = image(HeatMetric::cost), nodes = image(HeatMetric::nodes), prims = image(HeatMetric::prims);
+  ASSERT_EQ(cost.values.size(), nodes.values.size());
+  double total = 0.0;
+  for (std::size_t i = 0; i < cost.values.size(); ++i) {
+    EXPECT_FLOAT_EQ(cost.values[i], 2.0f * nodes.values[i] + 3.0f * prims.values[i]) << i;
+    total += prims.values[i];
+  }
+  EXPECT_GT(total, 0.0);  // some rays test triangles: the weights matter
+}
 
 ViewInsight teapot_insight() {
   auto loaded = std::make_shared<LoadedScene>();

@@ -429,15 +429,9 @@ std::string describe_structure(const StructureChoice& choice) {
 }
 
 HeatmapOptions view_heatmap_options(const AppConfig& config, int width, int height) {
-  HeatmapOptions o;
-  o.metric = config.view.metric;
-  o.width = width;
-  o.height = height;
-  o.threads = config.structure.options.threads;
-  o.query = config.structure.query;
-  o.c_trav = config.structure.options.bvh.cost_traversal;
-  o.c_isect = config.structure.options.bvh.cost_intersect;
-  return o;
+  const StructureOptions& so = config.structure.options;
+  return heatmap_options(config.view.metric, width, height, so.threads, config.structure.query, so.bvh.cost_traversal,
+                         so.bvh.cost_intersect);
 }
 
 std::string screenshot_caption(const AppConfig& config) {

@@ -138,13 +138,9 @@ ScenarioRow measure(const std::string& structure, const Scene& scene, const Scen
   r.max_depth = accel->build_stats().max_depth;
   r.leaf_volume_ratio = leaf_volume_ratio(*accel);
   const Camera cam = camera_from_spec("", scene, static_cast<float>(o.width) / static_cast<float>(o.height));
-  HeatmapOptions ho;
-  ho.width = o.width;
-  ho.height = o.height;
-  ho.threads = o.threads;
+  HeatmapOptions ho = heatmap_options(HeatMetric::nodes, o.width, o.height, o.threads);
   ho.progress = keep_going;
   HeatmapFigures f;
-  ho.metric = HeatMetric::nodes;
   render_metric(*accel, cam, ho, &f);
   r.nodes_per_ray = f.mean;
   ho.metric = HeatMetric::prims;
