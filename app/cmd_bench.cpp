@@ -10,7 +10,8 @@
 // without counters, the structures again taking turns within each round so
 // that a change of machine load falls on all of them alike; then one
 // instrumented pass for the mean node visits and primitive tests per ray,
-// kept out of the timings.
+// kept out of the timings. `warmup` untimed rounds (builds, passes) may come
+// before the timed ones.
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -32,6 +33,7 @@ struct BenchOptions {
   std::string rays = "all";
   std::string size = "800x600";
   int repeat = 5;
+  int warmup = 0;  ///< untimed rounds before the timed ones (builds and every figure)
   unsigned threads = 0;
   bool json = false;
   std::string camera;
@@ -69,7 +71,10 @@ double mrays(std::size_t n, double ms) {
 /// structure's median Mrays/s. Rounds alternate the structures so that a
 /// change of machine load during the run falls on all of them alike.
 template <typename Pass>
-std::vector<double> timed_medians_in_turns(std::size_t structures, int repeat, std::size_t n, Pass&& pass) {
+std::vector<double> timed_medians_in_turns(std::size_t structures, int warmup, int repeat, std::size_t n,
+                                           Pass&& pass) {
+  for (int r = 0; r < warmup; ++r)
+    for (std::size_t i = 0; i < structures; ++i) pass(i);
   std::vector<std::vector<double>> v(structures);
   for (int r = 0; r < repeat; ++r)
     for (std::size_t i = 0; i < structures; ++i) {
@@ -86,7 +91,7 @@ std::vector<double> timed_medians_in_turns(std::size_t structures, int repeat, s
 /// (timed_medians_in_turns) for each of the four figures.
 std::vector<QueryFigures> measure_in_turns(const std::vector<std::unique_ptr<Accelerator>>& accels,
                                            const std::vector<Ray>& rays, const QueryOptions& q, unsigned all,
-                                           int repeat, Progress& progress, const std::string& label) {
+                                           int warmup, int repeat, Progress& progress, const std::string& label) {
   std::vector<QueryFigures> f(accels.size());
   const std::size_t n = rays.size();
   if (n == 0) return f;
@@ -94,7 +99,7 @@ std::vector<QueryFigures> measure_in_turns(const std::vector<std::unique_ptr<Acc
   std::vector<std::uint8_t> occluded(n);
   const auto figure = [&](const std::string& what, double QueryFigures::*field, auto&& pass) {
     progress.begin(label + ": " + what);
-    const std::vector<double> m = timed_medians_in_turns(accels.size(), repeat, n, pass);
+    const std::vector<double> m = timed_medians_in_turns(accels.size(), warmup, repeat, n, pass);
     for (std::size_t i = 0; i < f.size(); ++i) f[i].*field = m[i];
     progress.end();
   };
@@ -242,15 +247,17 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   const std::size_t count = o.structures.size();
   std::vector<StructureResult> results(count);
   std::vector<std::unique_ptr<Accelerator>> accels(count);
-  for (int k = 0; k < o.repeat; ++k)
+  for (int k = -o.warmup; k < o.repeat; ++k)
     for (std::size_t i = 0; i < count; ++i) {
       const std::string& name = o.structures[i];
       results[i].name = name;
-      progress.begin("building " + name + " (" + std::to_string(k + 1) + "/" + std::to_string(o.repeat) + ")");
+      progress.begin(k < 0 ? "building " + name + " (warm-up " + std::to_string(k + o.warmup + 1) + "/" +
+                                 std::to_string(o.warmup) + ")"
+                           : "building " + name + " (" + std::to_string(k + 1) + "/" + std::to_string(o.repeat) + ")");
       accels[i].reset();  // never two copies of one structure in memory
       accels[i] = build_bench_structure(name, scene.triangles, so, progress.callback());
-      results[i].build_ms.push_back(accels[i]->build_stats().build_ms);
-      progress.end(std::to_string(static_cast<long long>(results[i].build_ms.back())) + " ms");
+      if (k >= 0) results[i].build_ms.push_back(accels[i]->build_stats().build_ms);
+      progress.end(std::to_string(static_cast<long long>(accels[i]->build_stats().build_ms)) + " ms");
     }
   for (std::size_t i = 0; i < count; ++i) {
     StructureResult& r = results[i];
@@ -267,7 +274,8 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
 
   // ---- queries: per ray set and figure, the structures in turns ----
   for (const RaySet& set : sets) {
-    std::vector<QueryFigures> f = measure_in_turns(accels, set.rays, q, all, o.repeat, progress, set.name);
+    std::vector<QueryFigures> f =
+        measure_in_turns(accels, set.rays, q, all, o.warmup, o.repeat, progress, set.name);
     for (std::size_t i = 0; i < count; ++i) {
       progress.begin(o.structures[i] + " " + set.name + ": counting pass");
       count_per_ray(*accels[i], set.rays, q, all, f[i]);
@@ -286,6 +294,7 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   j["triangles"] = scene.triangles.size();
   j["threads"] = all;
   j["repeat"] = o.repeat;
+  j["warmup"] = o.warmup;
   j["size"] = {size.width, size.height};
   j["triangle_test"] = o.triangle_test;
   if (kHaveEmbree) j["embree_robust"] = so.embree.robust;
@@ -349,8 +358,9 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   }
 
   // ---- text ----
-  std::printf("scene %s: %zu triangles; %u threads; medians of %d runs; %s triangle test%s\n", o.scene.c_str(),
-              scene.triangles.size(), all, o.repeat, o.triangle_test.c_str(),
+  const std::string warm = o.warmup > 0 ? " after " + std::to_string(o.warmup) + " untimed" : "";
+  std::printf("scene %s: %zu triangles; %u threads; medians of %d runs%s; %s triangle test%s\n", o.scene.c_str(),
+              scene.triangles.size(), all, o.repeat, warm.c_str(), o.triangle_test.c_str(),
               kHaveEmbree ? (so.embree.robust ? "; Embree robust" : "; Embree default (not robust)") : "");
   for (const RaySet& set : sets)
     std::printf("  %-8s %zu rays%s\n", set.name.c_str(), set.rays.size(),
@@ -425,6 +435,11 @@ Command add_bench_command(CLI::App& parent, const GlobalOptions& global) {
       ->capture_default_str();
   sub->add_option("--repeat,-n", o->repeat, "Runs per figure; the median is reported")
       ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  sub->add_option("--warmup", o->warmup,
+                  "Untimed rounds before the timed ones: builds of every structure and passes of every figure "
+                  "(first runs in a process can be slower: cold caches, fresh memory)")
+      ->check(CLI::Range(0, 100))
       ->capture_default_str();
   sub->add_option("--threads,-j", o->threads,
                   "Threads of the all-threads figures and of builds (0: all hardware threads)")

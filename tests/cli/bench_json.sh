@@ -13,11 +13,27 @@ python3 -m json.tool "$tmp/bench.json" >/dev/null
 builds=$(grep -o '^building [a-z-]* ([0-9]/2)' "$tmp/progress.txt" | tr '\n' ';')
 [ "$builds" = "building bvh (1/2);building brute-bbox (1/2);building bvh (2/2);building brute-bbox (2/2);" ] ||
   { echo "FAIL: builds not in turns: $builds"; exit 1; }
+# --warmup N: N untimed build rounds first (in turns too), then the timed ones; only those are reported.
+"$accelviz" bench 'builtin:soup?size=2000' --structure bvh,brute-bbox --rays primary --size 8x8 --repeat 2 \
+  --warmup 1 --json >"$tmp/warm.json" 2>"$tmp/warm.txt"
+builds=$(grep -o '^building [a-z-]* ([a-z -]*[0-9]/[0-9])' "$tmp/warm.txt" | tr '\n' ';')
+[ "$builds" = "building bvh (warm-up 1/1);building brute-bbox (warm-up 1/1);building bvh (1/2);building brute-bbox (1/2);building bvh (2/2);building brute-bbox (2/2);" ] ||
+  { echo "FAIL: warm-up builds: $builds"; exit 1; }
+python3 -c '
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["warmup"] == 1 and j["repeat"] == 2, (j["warmup"], j["repeat"])
+for s in j["structures"]:
+    assert len(s["build"]["build_ms_runs"]) == 2, s["build"]["build_ms_runs"]
+print("bench warmup ok")' "$tmp/warm.json"
+"$accelviz" bench 'builtin:soup?size=2000' --structure bvh --rays primary --size 8x8 --warmup -1 2>/dev/null &&
+  { echo "FAIL: --warmup -1 accepted"; exit 1; }
 python3 - "$tmp/bench.json" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))
-for k in ["scene", "triangles", "threads", "repeat", "ray_sets", "structures"]:
+for k in ["scene", "triangles", "threads", "repeat", "warmup", "ray_sets", "structures"]:
     assert k in j, k
+assert j["warmup"] == 0
 assert set(j["ray_sets"]) == {"primary", "diffuse", "shadow"}, j["ray_sets"]
 assert j["ray_sets"]["primary"]["rays"] == 24 * 16
 names = [s["name"] for s in j["structures"]]
@@ -39,7 +55,10 @@ print("bench json ok")
 PY
 
 # With Embree: ratios and Embree's binary-BVH SAH beside ours.
-if "$accelviz" render --help | grep -q embree; then
+# (The help goes to a file first: with pipefail, `grep -q` closing the pipe
+# early could fail the pipeline and skip this part silently.)
+"$accelviz" render --help >"$tmp/help.txt"
+if grep -q embree "$tmp/help.txt"; then
   "$accelviz" -q bench 'builtin:soup?size=2000' --structure bvh,embree --rays primary --size 16x16 --repeat 1 --json \
     | python3 -c '
 import json, sys
@@ -61,5 +80,6 @@ assert j["embree_robust"] is True, j.get("embree_robust")
 assert j["ratios_vs_embree"]["bvh"]["shadow"]["any_mrays_1t"] > 0
 print("embree robust ok")'
   "$accelviz" -q bench 'builtin:soup?size=2000' --structure embree --embree-robust --rays primary --size 8x8 \
-    --repeat 1 | grep -q "Embree robust" || { echo "FAIL: text output does not say Embree robust"; exit 1; }
+    --repeat 1 >"$tmp/robust.txt"
+  grep -q "Embree robust" "$tmp/robust.txt" || { echo "FAIL: text output does not say Embree robust"; exit 1; }
 fi

@@ -16,7 +16,10 @@ if "$accelviz" -q rays "$scene" --out "$tmp/primary.rays" 2>/dev/null; then echo
 
 structures="brute bvh kdtree grid octree"
 "$accelviz" info 'builtin:soup?size=10' >/dev/null
-if "$accelviz" --help | grep -q embree || "$accelviz" render --help | grep -q embree; then structures="$structures embree"; fi
+# The help goes to a variable first: with pipefail, `grep -q` closing the
+# pipe early could fail the pipeline and leave Embree out silently.
+help="$("$accelviz" --help)$("$accelviz" render --help)"
+if grep -q embree <<<"$help"; then structures="$structures embree"; fi
 
 for kind in primary diffuse shadow; do
   for s in $structures; do
