@@ -71,8 +71,7 @@ double mrays(std::size_t n, double ms) {
 /// structure's median Mrays/s. Rounds alternate the structures so that a
 /// change of machine load during the run falls on all of them alike.
 template <typename Pass>
-std::vector<double> timed_medians_in_turns(std::size_t structures, int warmup, int repeat, std::size_t n,
-                                           Pass&& pass) {
+std::vector<double> timed_medians_in_turns(std::size_t structures, int warmup, int repeat, std::size_t n, Pass&& pass) {
   for (int r = 0; r < warmup; ++r)
     for (std::size_t i = 0; i < structures; ++i) pass(i);
   std::vector<std::vector<double>> v(structures);
@@ -274,8 +273,7 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
 
   // ---- queries: per ray set and figure, the structures in turns ----
   for (const RaySet& set : sets) {
-    std::vector<QueryFigures> f =
-        measure_in_turns(accels, set.rays, q, all, o.warmup, o.repeat, progress, set.name);
+    std::vector<QueryFigures> f = measure_in_turns(accels, set.rays, q, all, o.warmup, o.repeat, progress, set.name);
     for (std::size_t i = 0; i < count; ++i) {
       progress.begin(o.structures[i] + " " + set.name + ": counting pass");
       count_per_ray(*accels[i], set.rays, q, all, f[i]);

@@ -45,8 +45,8 @@ ABResult run_ab(const ABRequest& r, const std::atomic<bool>& cancel) {
     (s == 0 ? out.build_ms_a : out.build_ms_b) = accel->build_stats().build_ms;
     (s == 0 ? out.sah_a : out.sah_b) = accel->build_stats().sah_cost;
     // The cost metric with each side's own SAH costs, as render --compare.
-    HeatmapOptions ho = heatmap_options(r.metric, r.width, r.height, r.threads, side[s]->query,
-                                        so.bvh.cost_traversal, so.bvh.cost_intersect);
+    HeatmapOptions ho = heatmap_options(r.metric, r.width, r.height, r.threads, side[s]->query, so.bvh.cost_traversal,
+                                        so.bvh.cost_intersect);
     ho.progress = stopper(cancel);
     *img[s] = render_metric(*accel, r.camera, ho);
   }

@@ -143,7 +143,7 @@ class Bvh final : public Accelerator {
   HugePageVector<BvhNode> nodes_;
   HugePageVector<std::uint32_t> prim_indices_;
   HugePageVector<bvh_detail::TriBlock4> blocks_;  ///< the triangles, four per block, each leaf from a new block
-  HugePageVector<std::uint32_t> leaf_block_;    ///< per binary node: a leaf's first block (unused for inner nodes)
+  HugePageVector<std::uint32_t> leaf_block_;      ///< per binary node: a leaf's first block (unused for inner nodes)
   std::unique_ptr<bvh_detail::WideBvh> wide_;    ///< 4-wide copy for the fast path (null when not used)
   std::unique_ptr<bvh_detail::WideBvh8> wide8_;  ///< 8-wide copy for the fast path (null when not used)
   BvhOptions opts_;
