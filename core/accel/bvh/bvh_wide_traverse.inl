@@ -94,7 +94,8 @@ Hit traverse_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& b
         // walks through large trees overlap the memory latency (as Embree).
         for (int j = k - 1; j >= 1; --j) {
           const std::uint32_t c = n.child[slot[j]], m = n.meta[slot[j]];
-          const char* p = m == 0 ? reinterpret_cast<const char*>(wide + c) : reinterpret_cast<const char*>(bvh.blocks + c);
+          const char* p =
+              m == 0 ? reinterpret_cast<const char*>(wide + c) : reinterpret_cast<const char*>(bvh.blocks + c);
           __builtin_prefetch(p);
           __builtin_prefetch(p + 64);
           __builtin_prefetch(p + 128);
