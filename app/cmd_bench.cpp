@@ -250,9 +250,9 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
     for (std::size_t i = 0; i < count; ++i) {
       const std::string& name = o.structures[i];
       results[i].name = name;
-      progress.begin(k < 0 ? "building " + name + " (warm-up " + std::to_string(k + o.warmup + 1) + "/" +
-                                 std::to_string(o.warmup) + ")"
-                           : "building " + name + " (" + std::to_string(k + 1) + "/" + std::to_string(o.repeat) + ")");
+      const std::string round = k < 0 ? "warm-up " + std::to_string(k + o.warmup + 1) + "/" + std::to_string(o.warmup)
+                                      : std::to_string(k + 1) + "/" + std::to_string(o.repeat);
+      progress.begin("building " + name + " (" + round + ")");
       accels[i].reset();  // never two copies of one structure in memory
       accels[i] = build_bench_structure(name, scene.triangles, so, progress.callback());
       if (k >= 0) results[i].build_ms.push_back(accels[i]->build_stats().build_ms);

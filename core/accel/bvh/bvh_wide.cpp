@@ -132,8 +132,8 @@ void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide, int me
 }
 
 template <int W>
-std::uint32_t lay_out_leaf_blocks(WideBvhT<W>& wide, std::span<const BvhNode> binary,
-                                  HugePageVector<std::uint32_t>& leaf_order, std::span<std::uint32_t> leaf_block) {
+void lay_out_leaf_blocks(WideBvhT<W>& wide, std::span<const BvhNode> binary, HugePageVector<std::uint32_t>& leaf_order,
+                         std::span<std::uint32_t> leaf_block) {
   std::uint32_t next = 0;
   for (std::size_t w = 0; w < wide.nodes.size(); ++w)
     for (int s = 0; s < W; ++s)
@@ -147,7 +147,6 @@ std::uint32_t lay_out_leaf_blocks(WideBvhT<W>& wide, std::span<const BvhNode> bi
         wide.nodes[w].child[s] = first;
         wide.nodes[w].meta[s] = next - first;
       }
-  return next;
 }
 
 template <int W>
@@ -182,10 +181,10 @@ bool cpu_has_wide8() {
 
 template void collapse_to_wide<4>(std::span<const BvhNode>, WideBvhT<4>&, int);
 template void collapse_to_wide<8>(std::span<const BvhNode>, WideBvhT<8>&, int);
-template std::uint32_t lay_out_leaf_blocks<4>(WideBvhT<4>&, std::span<const BvhNode>, HugePageVector<std::uint32_t>&,
-                                              std::span<std::uint32_t>);
-template std::uint32_t lay_out_leaf_blocks<8>(WideBvhT<8>&, std::span<const BvhNode>, HugePageVector<std::uint32_t>&,
-                                              std::span<std::uint32_t>);
+template void lay_out_leaf_blocks<4>(WideBvhT<4>&, std::span<const BvhNode>, HugePageVector<std::uint32_t>&,
+                                     std::span<std::uint32_t>);
+template void lay_out_leaf_blocks<8>(WideBvhT<8>&, std::span<const BvhNode>, HugePageVector<std::uint32_t>&,
+                                     std::span<std::uint32_t>);
 template void refit_wide<4>(WideBvhT<4>&, std::span<const BvhNode>);
 template void refit_wide<8>(WideBvhT<8>&, std::span<const BvhNode>);
 template int wide_slab_test_scalar<4>(const WideNodeT<4>&, const Ray&, float, float, float*, float*);

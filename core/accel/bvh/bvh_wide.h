@@ -72,10 +72,10 @@ void for_each_leaf_under(std::span<const BvhNode> binary, std::uint32_t node, co
 /// `leaf_order`, sets `leaf_block[binary leaf]` to its first block, and sets
 /// the slot's child = its first block, meta = its block count (before, a
 /// leaf slot names a leaf position and a primitive count, as collapse_to_wide
-/// leaves it). Returns the number of blocks laid out.
+/// leaves it).
 template <int W>
-std::uint32_t lay_out_leaf_blocks(WideBvhT<W>& wide, std::span<const BvhNode> binary,
-                                  HugePageVector<std::uint32_t>& leaf_order, std::span<std::uint32_t> leaf_block);
+void lay_out_leaf_blocks(WideBvhT<W>& wide, std::span<const BvhNode> binary, HugePageVector<std::uint32_t>& leaf_order,
+                         std::span<std::uint32_t> leaf_block);
 
 /// Collapses a binary node array: each wide node takes a binary inner node's
 /// children and keeps opening the child with the largest surface area until
