@@ -534,6 +534,76 @@ TEST(BvhBuild, SimdBinningAgreesWithScalarTwin) {
   }
 }
 
+TEST(BvhBuild, ParallelSplitEqualsTheSerialSplitElementForElement) {
+  // split_binned_sah on a large node with lent threads (binning on several
+  // threads) must leave the records, the cut and the children's boxes exactly
+  // as the serial split does: the node array may not depend on the thread
+  // count. Scenes: random boxes; centroids on few values (many ties, -0 and
+  // +0 among them); a plane with nothing on the wrong side; nearly everything
+  // on one side.
+  std::mt19937 rng(41);
+  const std::size_t n = 3 * bvh_detail::kParallelSplitMinPrims + 123;
+  for (int scene = 0; scene < 4; ++scene) {
+    SCOPED_TRACE("scene " + std::to_string(scene));
+    std::vector<bvh_detail::BuildPrim> prims(n);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      glm::vec3 a(uniform(rng), uniform(rng), uniform(rng)), b = a + 0.01f * glm::vec3(uniform(rng), 1.0f, 0.5f);
+      if (scene == 1) {
+        const float v[4] = {-0.0f, 0.0f, 0.25f, 1.0f};
+        a = glm::vec3(v[rng() % 4], v[rng() % 4], v[rng() % 4]);
+        b = a;
+      } else if (scene == 2) {
+        a.x = i < n / 3 ? 0.1f * a.x : 0.5f + 0.5f * a.x;  // sorted into two clusters already
+        b.x = a.x;
+      } else if (scene == 3 && i % 1000 != 0) {
+        a.y = b.y = 0.5f;
+      }
+      const Aabb box{glm::min(a, b), glm::max(a, b)};
+      prims[i] = {box.center(), i, box};
+    }
+    Aabb bounds, centroids;
+    bvh_detail::range_bounds(prims, bounds, centroids);
+    const bvh_detail::SplitParams params;
+    bvh_detail::SplitScratch serial_scratch;
+    std::vector<bvh_detail::BuildPrim> want = prims;
+    bvh_detail::SplitResult want_r;
+    ASSERT_EQ(bvh_detail::split_binned_sah(params, want, bounds, centroids, serial_scratch, want_r),
+              bvh_detail::SplitOutcome::split);
+    if (scene == 2) {  // the clusters are in place: the partition swapped nothing
+      EXPECT_EQ(std::memcmp(want.data(), prims.data(), n * sizeof(prims[0])), 0);
+    }
+    for (unsigned helpers : {1u, 2u, 3u, 6u}) {
+      SCOPED_TRACE("helpers " + std::to_string(helpers));
+      std::vector<bvh_detail::BuildPrim> got = prims;
+      bvh_detail::SplitScratch scratch;
+      scratch.helpers = helpers;
+      bvh_detail::SplitResult r;
+      ASSERT_EQ(bvh_detail::split_binned_sah(params, got, bounds, centroids, scratch, r),
+                bvh_detail::SplitOutcome::split);
+      EXPECT_EQ(r.mid, want_r.mid);
+      EXPECT_EQ(std::memcmp(got.data(), want.data(), n * sizeof(got[0])), 0);
+      for (int side = 0; side < 2; ++side) {
+        EXPECT_EQ(std::memcmp(&r.bounds[side], &want_r.bounds[side], sizeof(Aabb)), 0);
+        // Centroid bounds: the same values (a zero's sign may differ; no later test can tell).
+        EXPECT_TRUE(r.centroid_bounds[side].lo == want_r.centroid_bounds[side].lo);
+        EXPECT_TRUE(r.centroid_bounds[side].hi == want_r.centroid_bounds[side].hi);
+      }
+      // The parallel binning alone: the serial pass's bins, bit for bit.
+      const float k[3] = {32.0f, 17.0f, 5.0f};
+      bvh_detail::Bins one, many;
+      bvh_detail::clear_bins(one, 32);
+      bvh_detail::clear_bins(many, 32);
+      bvh_detail::bin_primitives(prims, centroids.lo, k, 32, one);
+      bvh_detail::bin_primitives_parallel(prims, centroids.lo, k, 32, many, helpers + 1);
+      for (int a = 0; a < 3; ++a) {  // the 32 buckets in use
+        EXPECT_EQ(std::memcmp(one.lo[a], many.lo[a], 32 * sizeof(one.lo[a][0])), 0);
+        EXPECT_EQ(std::memcmp(one.hi[a], many.hi[a], 32 * sizeof(one.hi[a][0])), 0);
+        EXPECT_EQ(std::memcmp(one.count[a], many.count[a], 32 * sizeof(one.count[a][0])), 0);
+      }
+    }
+  }
+}
+
 // ---- Quality ordering between splitters ----
 
 TEST(BvhBuild, BinnedWith256BucketsBeatsMedian) {

@@ -132,6 +132,7 @@ class Builder {
     if (w.depth + ceil_log2(n) >= kBvhMaxDepth) {
       split_object_median(range, w.centroid_bounds, s);
     } else {
+      const ThreadLoan loan(*this, scratch, n);
       const SplitOutcome r = split_(params_, range, w.bounds, w.centroid_bounds, scratch, s);
       if (r == SplitOutcome::leaf) {
         make_leaf(w, out, slot);
@@ -227,6 +228,24 @@ class Builder {
       cancelled_.store(true);
     }
   }
+
+  /// Idle build threads lent to one large binned split for its duration
+  /// (SplitScratch::helpers): the top of the tree, where fewer subtrees than
+  /// threads are under way, splits on all of them instead of one.
+  struct ThreadLoan {
+    Builder& builder;
+    SplitScratch& scratch;
+    ThreadLoan(Builder& b, SplitScratch& s, std::size_t n) : builder(b), scratch(s) {
+      scratch.helpers = 0;
+      if (b.split_ != split_binned_sah || n < kParallelSplitMinPrims) return;
+      while (scratch.helpers + 1 < n / kParallelSplitGrain && b.try_acquire_thread()) ++scratch.helpers;
+    }
+    ~ThreadLoan() {
+      for (; scratch.helpers > 0; --scratch.helpers) builder.release_thread();
+    }
+    ThreadLoan(const ThreadLoan&) = delete;
+    ThreadLoan& operator=(const ThreadLoan&) = delete;
+  };
 
   bool try_acquire_thread() {
     unsigned active = active_threads_.load();

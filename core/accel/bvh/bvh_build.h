@@ -57,9 +57,19 @@ struct SplitResult {
   Aabb centroid_bounds[2];  ///< children's centroid bounds
 };
 
+/// Nodes of at least this many primitives may be split on several threads:
+/// the builder lends its idle threads to them (SplitScratch::helpers), one per
+/// kParallelSplitGrain primitives at most. Only the binned SAH uses them, to
+/// bin (bin_primitives_parallel); its partition stays serial.
+inline constexpr std::size_t kParallelSplitMinPrims = 32768;
+inline constexpr std::size_t kParallelSplitGrain = 16384;
+
 /// Per-thread buffers reused from node to node, so that the recursion does not allocate.
 struct SplitScratch {
   std::vector<float> suffix_area;  ///< exact sweep: half area of prims [i, n)
+  /// Threads this split may use besides the calling one (set by the builder
+  /// for the duration of one split; 0: split on the calling thread alone).
+  unsigned helpers = 0;
 };
 
 /// Signature shared by the splitters. `prims` is the node's range,
@@ -132,6 +142,12 @@ void bin_primitives(std::span<const BuildPrim> prims, const glm::vec3& origin, c
                     Bins& bins);
 void bin_primitives_scalar(std::span<const BuildPrim> prims, const glm::vec3& origin, const float k[3], int buckets,
                            Bins& bins);
+/// bin_primitives on `threads` threads: each bins a contiguous slice into its
+/// own Bins, and the slices merge in order with bin_primitives' min/max
+/// operand order, so `bins` comes out bit for bit as bin_primitives leaves it
+/// (for bounds without NaN). `bins` must be cleared for `buckets`.
+void bin_primitives_parallel(std::span<const BuildPrim> prims, const glm::vec3& origin, const float k[3], int buckets,
+                             Bins& bins, unsigned threads);
 
 /// Box of bucket b on `axis` (empty when the bucket is).
 Aabb bucket_box(const Bins& bins, int axis, int b);
@@ -153,9 +169,10 @@ using CandidateCosts = float[3][kMaxBuckets];
 /// Bins `prims` into `buckets` buckets over `centroid_bounds` on every
 /// usable axis and evaluates the SAH at the B-1 bucket boundaries. Returns
 /// false (bins untouched) when no axis is usable (all centroids on one
-/// point). With `costs`, also records every candidate's cost.
+/// point). With `costs`, also records every candidate's cost. With
+/// threads > 1 the binning runs on that many threads (the same bins).
 bool binned_sah_search(int buckets, std::span<const BuildPrim> prims, const Aabb& centroid_bounds, Bins& bins,
-                       BinnedSahSearch& out, CandidateCosts* costs = nullptr);
+                       BinnedSahSearch& out, CandidateCosts* costs = nullptr, unsigned threads = 1);
 
 /// Object median split: orders the range by centroid on the axis of largest
 /// centroid extent (ties by primitive id, so the result is unique) and cuts
