@@ -114,8 +114,13 @@ QueryOptions query_of(const CompareSide& side) {
 }
 
 HeatmapOptions heatmap_options_of(const CompareSide& side, HeatMetric metric, const ImageSize& size, unsigned threads) {
-  return heatmap_options(metric, size.width, size.height, threads, query_of(side), side.structure_opts.ctrav,
-                         side.structure_opts.cisect);
+  return {.metric = metric,
+          .width = size.width,
+          .height = size.height,
+          .threads = threads,
+          .query = query_of(side),
+          .c_trav = side.structure_opts.ctrav,
+          .c_isect = side.structure_opts.cisect};
 }
 
 int run_render_compare(const CompareJob& job, const GlobalOptions& global) {

@@ -80,8 +80,13 @@ void render_raster(const Scene& scene, const Accelerator& accel, const Camera& c
 
   // The heatmap blended over the mesh.
   if (ro.blend > 0.0f) {
-    const HeatmapOptions ho =
-        heatmap_options(parse_metric(metric_name).value(), size.width, size.height, threads, query, c_trav, c_isect);
+    const HeatmapOptions ho{.metric = parse_metric(metric_name).value(),
+                            .width = size.width,
+                            .height = size.height,
+                            .threads = threads,
+                            .query = query,
+                            .c_trav = c_trav,
+                            .c_isect = c_isect};
     HeatmapFigures fig;
     const MetricImage img = render_metric(accel, camera, ho, &fig);
     renderer.set_heatmap(img);

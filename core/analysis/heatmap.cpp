@@ -94,19 +94,6 @@ float metric_value(HeatMetric m, const Ray& ray, const Hit& hit, const RayStats&
   return kNoValue;
 }
 
-HeatmapOptions heatmap_options(HeatMetric metric, int width, int height, unsigned threads, const QueryOptions& query,
-                               float c_trav, float c_isect) {
-  HeatmapOptions o;
-  o.metric = metric;
-  o.width = width;
-  o.height = height;
-  o.threads = threads;
-  o.query = query;
-  o.c_trav = c_trav;
-  o.c_isect = c_isect;
-  return o;
-}
-
 MetricImage render_metric(const Accelerator& accel, const Camera& camera, const HeatmapOptions& opts,
                           HeatmapFigures* figures) {
   if (opts.width <= 0 || opts.height <= 0) throw std::invalid_argument("heatmap: image size must be positive");

@@ -32,6 +32,10 @@ std::optional<HeatMetric> parse_metric(std::string_view name);
 /// Whether the metric needs per-ray counters (a slower, instrumented pass).
 bool metric_needs_stats(HeatMetric m);
 
+/// Callers fill it with designated initializers, naming every field they set;
+/// c_trav and c_isect are the structure's SAH costs where it has them (the
+/// CLI's render, render --compare and raster blend, the GUI's view, compare
+/// and scenario jobs).
 struct HeatmapOptions {
   HeatMetric metric = HeatMetric::nodes;
   int width = 800;  ///< image size in pixels (the legend is added outside it)
@@ -42,14 +46,6 @@ struct HeatmapOptions {
   float c_isect = 1.0f;       ///< cost metric: cost of a primitive test
   ProgressCallback progress;  ///< optional; false cancels (render_metric then throws BuildCancelled)
 };
-
-/// The options of a `metric` heatmap of width x height pixels traced on
-/// `threads` threads (0: all) with `query`, the cost metric weighted by
-/// c_trav and c_isect (the structure's SAH costs where it has them). The one
-/// place that fills them for the CLI (render, render --compare, the raster
-/// blend) and the GUI (the view, the compare and scenario jobs).
-HeatmapOptions heatmap_options(HeatMetric metric, int width, int height, unsigned threads,
-                               const QueryOptions& query = {}, float c_trav = 1.0f, float c_isect = 1.0f);
 
 /// Whether `a` and `b` trace the same image: metric, size, query options and
 /// cost weights all equal. `threads` and `progress` are left out on purpose:

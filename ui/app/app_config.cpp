@@ -430,8 +430,13 @@ std::string describe_structure(const StructureChoice& choice) {
 
 HeatmapOptions view_heatmap_options(const AppConfig& config, int width, int height) {
   const StructureOptions& so = config.structure.options;
-  return heatmap_options(config.view.metric, width, height, so.threads, config.structure.query, so.bvh.cost_traversal,
-                         so.bvh.cost_intersect);
+  return {.metric = config.view.metric,
+          .width = width,
+          .height = height,
+          .threads = so.threads,
+          .query = config.structure.query,
+          .c_trav = so.bvh.cost_traversal,
+          .c_isect = so.bvh.cost_intersect};
 }
 
 std::string screenshot_caption(const AppConfig& config) {

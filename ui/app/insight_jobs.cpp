@@ -45,9 +45,14 @@ ABResult run_ab(const ABRequest& r, const std::atomic<bool>& cancel) {
     (s == 0 ? out.build_ms_a : out.build_ms_b) = accel->build_stats().build_ms;
     (s == 0 ? out.sah_a : out.sah_b) = accel->build_stats().sah_cost;
     // The cost metric with each side's own SAH costs, as render --compare.
-    HeatmapOptions ho = heatmap_options(r.metric, r.width, r.height, r.threads, side[s]->query, so.bvh.cost_traversal,
-                                        so.bvh.cost_intersect);
-    ho.progress = stopper(cancel);
+    const HeatmapOptions ho{.metric = r.metric,
+                            .width = r.width,
+                            .height = r.height,
+                            .threads = r.threads,
+                            .query = side[s]->query,
+                            .c_trav = so.bvh.cost_traversal,
+                            .c_isect = so.bvh.cost_intersect,
+                            .progress = stopper(cancel)};
     *img[s] = render_metric(*accel, r.camera, ho);
   }
   out.diff = difference_image(out.image_a, out.image_b, &out.figures);

@@ -138,8 +138,8 @@ ScenarioRow measure(const std::string& structure, const Scene& scene, const Scen
   r.max_depth = accel->build_stats().max_depth;
   r.leaf_volume_ratio = leaf_volume_ratio(*accel);
   const Camera cam = camera_from_spec("", scene, static_cast<float>(o.width) / static_cast<float>(o.height));
-  HeatmapOptions ho = heatmap_options(HeatMetric::nodes, o.width, o.height, o.threads);
-  ho.progress = keep_going;
+  HeatmapOptions ho{
+      .metric = HeatMetric::nodes, .width = o.width, .height = o.height, .threads = o.threads, .progress = keep_going};
   HeatmapFigures f;
   render_metric(*accel, cam, ho, &f);
   r.nodes_per_ray = f.mean;

@@ -94,11 +94,8 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
   } else {
     std::uint32_t next_block = 0;
     for (std::uint32_t i = 0; i < nodes_.size(); ++i)
-      if (nodes_[i].count > 0) {
-        leaf_order.push_back(i);
-        leaf_block_[i] = next_block;
-        next_block += bvh_detail::tri4_block_count(nodes_[i].count);
-      }
+      if (nodes_[i].count > 0)
+        next_block = bvh_detail::append_leaf_blocks(nodes_, i, next_block, leaf_order, leaf_block_);
   }
   blocks_.resize(block_count);  // default-initialised: not written here (HugePageAllocator)
   parallel_for(leaf_order.size(), opts_.threads, 4096, [&](std::size_t begin, std::size_t end, unsigned) {

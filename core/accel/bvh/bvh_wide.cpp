@@ -140,9 +140,7 @@ void lay_out_leaf_blocks(WideBvhT<W>& wide, std::span<const BvhNode> binary, Hug
       if (wide.nodes[w].meta[s] != 0 && wide.nodes[w].meta[s] != kWideEmpty) {
         const std::uint32_t first = next;
         for_each_leaf_under(binary, wide.source[W * w + s], [&](std::uint32_t leaf) {
-          leaf_order.push_back(leaf);
-          leaf_block[leaf] = next;
-          next += tri4_block_count(binary[leaf].count);
+          next = append_leaf_blocks(binary, leaf, next, leaf_order, leaf_block);
         });
         wide.nodes[w].child[s] = first;
         wide.nodes[w].meta[s] = next - first;

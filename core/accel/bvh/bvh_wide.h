@@ -65,6 +65,18 @@ void for_each_leaf_under(std::span<const BvhNode> binary, std::uint32_t node, co
   for_each_leaf_under(binary, binary[node].index + 1, f);
 }
 
+/// One step of laying the triangle blocks out: binary leaf `leaf` goes next
+/// in `leaf_order`, from block `next` on (leaf_block[leaf] = next). Returns
+/// the block after its last. lay_out_leaf_blocks and class Bvh without a
+/// wide copy (leaves in node order) both lay their leaves out with it.
+inline std::uint32_t append_leaf_blocks(std::span<const BvhNode> binary, std::uint32_t leaf, std::uint32_t next,
+                                        HugePageVector<std::uint32_t>& leaf_order,
+                                        std::span<std::uint32_t> leaf_block) {
+  leaf_order.push_back(leaf);
+  leaf_block[leaf] = next;
+  return next + tri4_block_count(binary[leaf].count);
+}
+
 /// Lays class Bvh's triangle blocks (bvh_tri4.h) out in the order of the
 /// leaf slots and points every leaf slot at its blocks, in one walk: each
 /// slot's binary leaves one after the other (for_each_leaf_under's order),
