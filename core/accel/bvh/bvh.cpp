@@ -115,7 +115,7 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
   stats_.extra["memory_leaf_block_index"] = static_cast<double>(leaf_block_bytes);
   stats_.memory_bytes = node_bytes + index_bytes + block_bytes + leaf_block_bytes + wide_bytes;
   stats_.build_ms = ms_since(t0);
-  update_quality_stats(triangles);
+  update_quality_stats(triangles, /*sah_known=*/true);
 }
 
 Bvh::~Bvh() = default;
@@ -132,8 +132,10 @@ Bvh::Bvh(const Bvh& o)
 Bvh::Bvh(Bvh&&) noexcept = default;
 Bvh& Bvh::operator=(Bvh&&) noexcept = default;
 
-void Bvh::update_quality_stats(std::span<const Triangle> triangles) {
-  stats_.sah_cost = bvh_sah_cost(nodes_, opts_.cost_traversal, opts_.cost_intersect);
+void Bvh::update_quality_stats(std::span<const Triangle> triangles, bool sah_known) {
+  // After a build the SAH cost is the builder's (the same sum over the same
+  // nodes); after a refit the boxes moved.
+  if (!sah_known) stats_.sah_cost = bvh_sah_cost(nodes_, opts_.cost_traversal, opts_.cost_intersect);
   if (opts_.compute_epo) {
     // Not part of build_ms: it is a measurement of the tree, not a step of
     // making it; its own time is reported beside it.

@@ -326,7 +326,9 @@ BvhTopology build_bvh_records(std::span<BuildPrim> prims, const Aabb& root_bound
     builder.build(NodeWork{0, static_cast<std::uint32_t>(n), root_bounds, root_centroids, 0}, topo.nodes, 0, scratch);
     builder.finish();
     topo.prim_indices.resize(n);
-    for (std::size_t i = 0; i < n; ++i) topo.prim_indices[i] = prims[i].id;
+    parallel_for(n, resolve_threads(opts.threads), kRecordChunk, [&](std::size_t begin, std::size_t end, unsigned) {
+      for (std::size_t i = begin; i < end; ++i) topo.prim_indices[i] = prims[i].id;
+    });
   } else if (progress && !progress(1.0)) {
     throw BuildCancelled();
   }
