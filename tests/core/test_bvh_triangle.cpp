@@ -3,8 +3,9 @@
 // bit for bit the same t, u, v, on random input and on the cases that take
 // the special paths (rays through shared edges and vertices, axis-aligned
 // rays, huge and tiny coordinates, degenerate triangles, t at the interval
-// ends). The wide path's four-lane Moller-Trumbore test is checked against
-// the scalar one on the same inputs.
+// ends). The wide path's four-lane tests (Moller-Trumbore, and watertight
+// with its special lanes sent to the scalar test) are checked against the
+// scalar ones on the same inputs.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -67,6 +68,26 @@ void expect_same(const Ray& ray, const Triangle& tri, float tmin, float tmax, Co
     ASSERT_EQ(h4, hm) << "lane " << l;
     if (hm) {
       ASSERT_TRUE(same_bits(m.t, r4.t[l]) && same_bits(m.u, r4.u[l]) && same_bits(m.v, r4.v[l])) << "lane " << l;
+    }
+  }
+  // The four-lane watertight test as the wide walk uses it: a special lane
+  // goes to the scalar test, a candidate lane is accepted against tmax.
+  bvh_detail::Tri4Result w4;
+  bvh_detail::intersect_tri4(blocks[0], bvh_detail::Tri4Ray(iwr), tmin, w4);
+  for (int l = 0; l < 4; ++l) {
+    Hit h;
+    bool h4 = false;
+    if ((w4.special >> l) & 1) {
+      h4 = bvh_detail::intersect_watertight_inline(ray, iwr, tri, tmin, tmax, h);
+    } else if ((w4.candidate >> l) & 1) {
+      h4 = bvh_detail::tri4_accept(w4, l, tmax);
+      h.t = w4.t[l];
+      h.u = w4.u[l];
+      h.v = w4.v[l];
+    }
+    ASSERT_EQ(h4, ha) << "watertight lane " << l;
+    if (ha) {
+      ASSERT_TRUE(same_bits(a.t, h.t) && same_bits(a.u, h.u) && same_bits(a.v, h.v)) << "watertight lane " << l;
     }
   }
 #endif
