@@ -438,8 +438,8 @@ SplitOutcome split_binned_sah(const SplitParams& params, std::span<BuildPrim> pr
   const auto goes_left = [&](const BuildPrim& p) { return left_of_plane(p.centroid[a], lo_a, k_a, best_bucket); };
   //    Serial even when threads are lent: a parallel version (each thread
   //    listing its slice's misplaced records, then swapping the k-th pairs)
-  //    measured 5-11 ms on the dragon's root against 3-4 ms for this loop
-  //    (2 vCPUs; the fresh index array's page faults and a second pass).
+  //    measured 5.6-11.1 ms on the dragon's root against 3.1-7.0 ms for this
+  //    loop (2 vCPUs; the fresh index array's page faults and a second pass).
   CentroidBounds cb_left, cb_right;
   std::size_t i = 0, j = n;
   for (;;) {
