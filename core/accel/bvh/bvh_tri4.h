@@ -155,8 +155,8 @@ struct Tri4Result {
   const __m128 any_neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(U, zero), _mm_cmplt_ps(V, zero)), _mm_cmplt_ps(W, zero));
   const __m128 any_pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(U, zero), _mm_cmpgt_ps(V, zero)), _mm_cmpgt_ps(W, zero));
   __m128 ok = _mm_andnot_ps(_mm_and_ps(any_neg, any_pos), _mm_cmpneq_ps(det, zero));
-  // Most blocks a ray reaches miss it on all four lanes: then nothing below
-  // can make a lane a candidate or special (both need `ok` or `special`).
+  // No lane inside and none special: nothing below can make a lane a
+  // candidate or special (both need `ok` or `special`), so stop here.
   if (_mm_movemask_ps(_mm_or_ps(ok, special)) == 0) {
     out.special = 0;
     out.candidate = 0;
