@@ -115,7 +115,7 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
   stats_.extra["memory_leaf_block_index"] = static_cast<double>(leaf_block_bytes);
   stats_.memory_bytes = node_bytes + index_bytes + block_bytes + leaf_block_bytes + wide_bytes;
   stats_.build_ms = ms_since(t0);
-  update_quality_stats(triangles, /*sah_known=*/true);
+  update_epo(triangles);  // sah_cost: the builder's, over these nodes
 }
 
 Bvh::~Bvh() = default;
@@ -132,10 +132,7 @@ Bvh::Bvh(const Bvh& o)
 Bvh::Bvh(Bvh&&) noexcept = default;
 Bvh& Bvh::operator=(Bvh&&) noexcept = default;
 
-void Bvh::update_quality_stats(std::span<const Triangle> triangles, bool sah_known) {
-  // After a build the SAH cost is the builder's (the same sum over the same
-  // nodes); after a refit the boxes moved.
-  if (!sah_known) stats_.sah_cost = bvh_sah_cost(nodes_, opts_.cost_traversal, opts_.cost_intersect);
+void Bvh::update_epo(std::span<const Triangle> triangles) {
   if (opts_.compute_epo) {
     // Not part of build_ms: it is a measurement of the tree, not a step of
     // making it; its own time is reported beside it.
@@ -166,7 +163,8 @@ void Bvh::refit(std::span<const Triangle> moved) {
   if (wide_) bvh_detail::refit_wide(*wide_, nodes_);
   if (wide8_) bvh_detail::refit_wide(*wide8_, nodes_);
   stats_.extra["refit_ms"] = ms_since(t0);
-  update_quality_stats(moved);
+  stats_.sah_cost = bvh_sah_cost(nodes_, opts_.cost_traversal, opts_.cost_intersect);  // the boxes moved
+  update_epo(moved);
 }
 
 std::vector<Triangle> Bvh::copy_leaf_triangles() const {

@@ -137,9 +137,8 @@ class Bvh final : public Accelerator {
                          std::span<RayStats> stats) const override;
 
  private:
-  /// sah_cost (unless `sah_known`: the builder's, over the same nodes) and,
-  /// with compute_epo, epo over `triangles` in scene order.
-  void update_quality_stats(std::span<const Triangle> triangles, bool sah_known = false);
+  /// With compute_epo: epo (and epo_ms) over `triangles` in scene order.
+  void update_epo(std::span<const Triangle> triangles);
 
   HugePageVector<BvhNode> nodes_;
   HugePageVector<std::uint32_t> prim_indices_;

@@ -9,8 +9,8 @@
 // O(n + B), no sorting.
 #include <array>
 #include <limits>
+#include <memory>
 #include <utility>
-#include <vector>
 
 #include "core/accel/bvh/bvh_build.h"
 
@@ -130,7 +130,7 @@ void bin_primitives_parallel(std::span<const BuildPrim> prims, const glm::vec3& 
     return;
   }
   const std::size_t n = prims.size();
-  std::vector<Bins> part(threads);
+  const std::unique_ptr<Bins[]> part(new Bins[threads]);  // left uninitialised: clear_bins sets what is used
   parallel_for(threads, threads, 1, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t t = begin; t < end; ++t) {
       clear_bins(part[t], buckets);
@@ -398,7 +398,7 @@ SplitOutcome split_binned_sah(const SplitParams& params, std::span<BuildPrim> pr
                               const Aabb& centroid_bounds, SplitScratch& scratch, SplitResult& out) {
   const std::size_t n = prims.size();
   const int nb = binned_bucket_count(params.buckets, params.small_node_buckets, n);
-  const unsigned threads = n >= kParallelSplitMinPrims ? scratch.helpers + 1 : 1;
+  const unsigned threads = scratch.helpers + 1;  // the builder lends threads to large nodes only
 
   // 1-3. Scale, binning and the SAH at every bucket boundary (shared with the
   //      explainer in core/analysis/insight). Bins is left uninitialised.
