@@ -6,18 +6,6 @@
 
 namespace accelviz {
 
-WatertightRay::WatertightRay(const glm::vec3& dir) {
-  // Dominant axis becomes z; keep the winding by swapping x/y when dir[kz] < 0.
-  const glm::vec3 a = glm::abs(dir);
-  kz = (a.x > a.y) ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
-  kx = (kz + 1) % 3;
-  ky = (kx + 1) % 3;
-  if (dir[kz] < 0.0f) std::swap(kx, ky);
-  sx = dir[kx] / dir[kz];
-  sy = dir[ky] / dir[kz];
-  sz = 1.0f / dir[kz];
-}
-
 namespace {
 
 // The whole watertight test in double precision, for triangles whose float

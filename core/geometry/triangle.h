@@ -1,9 +1,10 @@
 #pragma once
 // Ray-triangle intersection: watertight (default) and Moller-Trumbore (fast).
+#include <cmath>
+#include <glm/glm.hpp>
+
 #include "core/geometry/hit.h"
 #include "core/math/aabb.h"
-
-#include <glm/glm.hpp>
 
 namespace accelviz {
 
@@ -38,6 +39,32 @@ struct WatertightRay {
   WatertightRay() = default;
   explicit WatertightRay(const glm::vec3& dir);
 };
+
+// Inline and free of data-dependent branches: rays of a diffuse bounce pick
+// their dominant axis and its sign at random, and the branchy form (glm::abs
+// and nested selections) mispredicted several times per ray on every
+// traversal's set-up. The selections below compile to conditional moves; the
+// axes, signs and quotients are those of the nested form (std::fabs and
+// glm::abs order the same values; the divisions take the same operands).
+inline WatertightRay::WatertightRay(const glm::vec3& dir) {
+  const float* d = &dir.x;
+  const float ax = std::fabs(d[0]), ay = std::fabs(d[1]), az = std::fabs(d[2]);
+  // Dominant axis becomes z (first of equal maxima: x over y, and x/y over z only when strictly larger).
+  const float axy = ay < ax ? ax : ay;           // the larger of x and y (x only when strictly larger)
+  const int kxy = static_cast<int>(!(ax > ay));  // its axis
+  const int z = kxy + (2 - kxy) * static_cast<int>(!(axy > az));
+  // Keep the winding: swap x/y when dir[kz] < 0.
+  const int x = (0x09 >> (2 * z)) & 3;  // (z + 1) % 3 from a 2-bit table: 0->1, 1->2, 2->0
+  const int y = (0x12 >> (2 * z)) & 3;  // (z + 2) % 3: 0->2, 1->0, 2->1
+  const float dz = d[z];
+  const int swap = -static_cast<int>(dz < 0.0f);  // all ones or zero
+  kz = z;
+  kx = x ^ ((x ^ y) & swap);
+  ky = y ^ ((x ^ y) & swap);
+  sx = d[kx] / dz;
+  sy = d[ky] / dz;
+  sz = 1.0f / dz;
+}
 
 /// Watertight test. Accepts t in [tmin, tmax]; on a hit fills t, u, v of
 /// `hit` (not prim or ng) and returns true. Edge functions that round to

@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <utility>
 #include <vector>
 
 #include "core/geometry/triangle.h"
@@ -197,5 +199,48 @@ TEST(TriangleHardCases, SceneTranslatedBy1e7) {
     const glm::vec3 o = c + glm::vec3(std::floor(rng.range(-8, 8)), std::floor(rng.range(-8, 8)), 1.0f);
     ASSERT_GE(count_hits(tris, Ray(o, target - o), true), 1) << "i=" << i;
   }
+}
+// WatertightRay's constructor picks the axes without branches (triangle.h);
+// it must pick exactly what the paper's nested selection picks, including
+// on ties between components (the first axis of equal maxima wins x over y,
+// z otherwise), on signed zeros and on negative dominant components (x and y
+// swapped to keep the winding), and divide the same operands.
+TEST(TriangleHardCases, WatertightAxesMatchTheNestedSelectionOnTiesAndSignedZeros) {
+  const auto nested = [](const glm::vec3& dir) {
+    WatertightRay w;
+    const glm::vec3 a = glm::abs(dir);
+    w.kz = (a.x > a.y) ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
+    w.kx = (w.kz + 1) % 3;
+    w.ky = (w.kx + 1) % 3;
+    if (dir[w.kz] < 0.0f) std::swap(w.kx, w.ky);
+    w.sx = dir[w.kx] / dir[w.kz];
+    w.sy = dir[w.ky] / dir[w.kz];
+    w.sz = 1.0f / dir[w.kz];
+    return w;
+  };
+  const float values[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, -0.5f, 2.0f, -2.0f, 1e-30f, -1e30f};
+  int checked = 0, swapped = 0, ties = 0;
+  const auto check = [&](const glm::vec3& d) {
+    if (d.x == 0.0f && d.y == 0.0f && d.z == 0.0f) return;  // not a direction
+    const WatertightRay got(d), want = nested(d);
+    ASSERT_EQ(got.kx, want.kx) << d.x << " " << d.y << " " << d.z;
+    ASSERT_EQ(got.ky, want.ky) << d.x << " " << d.y << " " << d.z;
+    ASSERT_EQ(got.kz, want.kz) << d.x << " " << d.y << " " << d.z;
+    // Bit for bit (NaN-free here: the dominant component is never zero).
+    ASSERT_EQ(std::memcmp(&got.sx, &want.sx, sizeof(float)), 0) << d.x << " " << d.y << " " << d.z;
+    ASSERT_EQ(std::memcmp(&got.sy, &want.sy, sizeof(float)), 0) << d.x << " " << d.y << " " << d.z;
+    ASSERT_EQ(std::memcmp(&got.sz, &want.sz, sizeof(float)), 0) << d.x << " " << d.y << " " << d.z;
+    ++checked;
+    swapped += d[want.kz] < 0.0f;
+    ties += std::fabs(d.x) == std::fabs(d.y) || std::fabs(d.y) == std::fabs(d.z) || std::fabs(d.x) == std::fabs(d.z);
+  };
+  for (float x : values)
+    for (float y : values)
+      for (float z : values) check({x, y, z});
+  Lcg rng{7};
+  for (int i = 0; i < 100000; ++i) check({rng.range(-1, 1), rng.range(-1, 1), rng.range(-1, 1)});
+  EXPECT_GT(swapped, 1000);  // both signs of the dominant axis were exercised
+  EXPECT_GT(ties, 400);      // and ties between components (from the table)
+  EXPECT_GT(checked, 100900);
 }
 }  // namespace unity_test_triangle
