@@ -2,30 +2,23 @@
 // next boundary distances recomputed from the cell index at every step
 // (instead of accumulated by adding t_delta) so that rounding does not
 // drift along long rays.
+#include <type_traits>
+
 #include "core/accel/grid/grid.h"
 #include "core/accel/kdtree/spatial_traversal.h"
-
-#include <type_traits>
 
 namespace accelviz {
 
 template <bool kCollect, bool kAnyHit>
 Hit Grid::traverse(const Ray& ray, const QueryOptions& qo, RayStats* stats, VisitTrace* trace) const {
-  Hit best;
-  if (cell_start_.empty() || !spatial::is_traversable(ray)) return best;
+  if (cell_start_.empty() || !spatial::is_traversable(ray)) return Hit{};
 
   // 1. Clip the ray to the grid's box (robust slab test); the ray may start
   //    inside or outside.
   SlabInterval iv;
   const bool in_box = intersect_slab(bounds_, ray, iv);
-  if constexpr (kCollect) {
-    if (stats) ++stats->box_tests;
-    if (!in_box) {
-      if (stats) ++stats->nodes_missed;
-      if (trace) trace->steps.push_back({VisitStep::Kind::node_missed, 0, iv.t_entry, iv.t_exit});
-    }
-  }
-  if (!in_box) return best;
+  spatial::record_root_test<kCollect>(in_box, iv.t_entry, iv.t_exit, stats, trace);
+  if (!in_box) return Hit{};
   const float t_end = iv.t_exit;
 
   // 2. Starting cell, step direction and the distance to the next boundary
@@ -45,60 +38,35 @@ Hit Grid::traverse(const Ray& ray, const QueryOptions& qo, RayStats* stats, Visi
     }
   }
 
-  const WatertightRay wr(ray.direction);
-  float tmax = ray.tmax;
-  spatial::Mailbox mailbox;
-  [[maybe_unused]] spatial::TestedSetFor<kCollect> tested;
+  spatial::CellPrimTests<kCollect, kAnyHit> prims(ray, qo.triangle_test, opts_.mailboxing, tris_, stats, trace);
   [[maybe_unused]] float t_cell = iv.t_entry;
 
   for (;;) {
     // 3. The current cell covers [t_cell, t_exit] of the ray.
     const float t_exit = std::min(std::min(t_next[0], t_next[1]), std::min(t_next[2], t_end));
-    const std::size_t cell =
-        static_cast<std::size_t>(idx[0]) + static_cast<std::size_t>(res_[0]) * (idx[1] + static_cast<std::size_t>(res_[1]) * idx[2]);
+    const std::size_t cell = static_cast<std::size_t>(idx[0]) +
+                             static_cast<std::size_t>(res_[0]) * (idx[1] + static_cast<std::size_t>(res_[1]) * idx[2]);
     const std::uint32_t begin = cell_start_[cell], end = cell_start_[cell + 1];
     if constexpr (kCollect) {
       if (stats) {
         ++stats->nodes_visited;
         if (begin == end) ++stats->empty_cells;
       }
-      if (trace) trace->steps.push_back({VisitStep::Kind::node_entered, static_cast<std::uint32_t>(cell), t_cell, t_exit});
+      if (trace)
+        trace->steps.push_back({VisitStep::Kind::node_entered, static_cast<std::uint32_t>(cell), t_cell, t_exit});
     }
-    for (std::uint32_t k = begin; k < end; ++k) {
-      const std::uint32_t id = refs_[k];
-      if (opts_.mailboxing && mailbox.seen(id)) continue;
-      if constexpr (kCollect) {
-        if (stats) {
-          ++stats->prim_tests;
-          if (tested.repeat(id)) ++stats->repeated_prim_tests;
-        }
-      }
-      Hit h;
-      const bool hit = intersect_triangle(qo.triangle_test, ray, wr, tris_[id], ray.tmin, tmax, h);
-      if constexpr (kCollect) {
-        if (trace)
-          trace->steps.push_back(
-              {hit ? VisitStep::Kind::prim_hit : VisitStep::Kind::prim_miss, id, hit ? h.t : kInfinity, kInfinity});
-      }
-      if (hit) {
-        best = h;
-        best.prim = id;
-        if constexpr (kAnyHit) return best;
-        tmax = h.t;
-      }
-    }
+    if (prims.test(refs_.data() + begin, end - begin)) return prims.result();
     // 4. Done when the closest candidate lies within this cell's range (a
     //    candidate beyond it may still be beaten in a later cell), or when
     //    the ray leaves the grid or its segment.
-    if (tmax <= t_exit || t_exit >= t_end) break;
+    if (prims.tmax() <= t_exit || t_exit >= t_end) break;
     const int a = t_next[0] <= t_next[1] ? (t_next[0] <= t_next[2] ? 0 : 2) : (t_next[1] <= t_next[2] ? 1 : 2);
     idx[a] += step[a];
     if (step[a] == 0 || idx[a] < 0 || idx[a] >= res_[a]) break;
     if constexpr (kCollect) t_cell = t_next[a];
     t_next[a] = (plane(a, idx[a] + (step[a] > 0)) - ray.origin[a]) * ray.inv_dir[a];
   }
-  if (best.valid()) best.ng = triangle_normal(tris_[best.prim]);
-  return best;
+  return prims.result();
 }
 
 Hit Grid::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, VisitTrace* trace) const {

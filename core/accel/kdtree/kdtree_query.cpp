@@ -1,28 +1,21 @@
 // K-D tree traversal: front to back with a stack of far children (Havran's
 // TA_rec, as in pbrt-v3's KdTreeAccel::Intersect), mailboxed.
+#include <type_traits>
+
 #include "core/accel/kdtree/kdtree.h"
 #include "core/accel/kdtree/spatial_traversal.h"
-
-#include <type_traits>
 
 namespace accelviz {
 
 template <bool kCollect, bool kAnyHit>
 Hit KdTree::traverse(const Ray& ray, const QueryOptions& qo, RayStats* stats, VisitTrace* trace) const {
-  Hit best;
-  if (nodes_.empty() || !spatial::is_traversable(ray)) return best;
+  if (nodes_.empty() || !spatial::is_traversable(ray)) return Hit{};
 
   // 1. Clip the ray to the root box (robust slab test).
   SlabInterval iv;
   const bool in_box = intersect_slab(bounds_, ray, iv);
-  if constexpr (kCollect) {
-    if (stats) ++stats->box_tests;
-    if (!in_box) {
-      if (stats) ++stats->nodes_missed;
-      if (trace) trace->steps.push_back({VisitStep::Kind::node_missed, 0, iv.t_entry, iv.t_exit});
-    }
-  }
-  if (!in_box) return best;
+  spatial::record_root_test<kCollect>(in_box, iv.t_entry, iv.t_exit, stats, trace);
+  if (!in_box) return Hit{};
 
   struct Entry {
     std::uint32_t node;
@@ -31,10 +24,7 @@ Hit KdTree::traverse(const Ray& ray, const QueryOptions& qo, RayStats* stats, Vi
   Entry stack[kKdMaxDepth + 1];
   int sp = 0;
 
-  const WatertightRay wr(ray.direction);
-  float tmax = ray.tmax;  // shrinks to the closest candidate
-  spatial::Mailbox mailbox;
-  [[maybe_unused]] spatial::TestedSetFor<kCollect> tested;
+  spatial::CellPrimTests<kCollect, kAnyHit> prims(ray, qo.triangle_test, opts_.mailboxing, tris_, stats, trace);
 
   std::uint32_t node = 0;
   float t0 = iv.t_entry, t1 = iv.t_exit;
@@ -70,30 +60,7 @@ Hit KdTree::traverse(const Ray& ray, const QueryOptions& qo, RayStats* stats, Vi
     //    beyond this leaf's exit is kept but does not end the search.
     if (reached_leaf) {
       const KdNode& leaf = nodes_[node];
-      const std::uint32_t* ids = prim_refs_.data() + leaf.prim_offset();
-      for (std::uint32_t k = 0, cnt = leaf.prim_count(); k < cnt; ++k) {
-        const std::uint32_t id = ids[k];
-        if (opts_.mailboxing && mailbox.seen(id)) continue;
-        if constexpr (kCollect) {
-          if (stats) {
-            ++stats->prim_tests;
-            if (tested.repeat(id)) ++stats->repeated_prim_tests;
-          }
-        }
-        Hit h;
-        const bool hit = intersect_triangle(qo.triangle_test, ray, wr, tris_[id], ray.tmin, tmax, h);
-        if constexpr (kCollect) {
-          if (trace)
-            trace->steps.push_back(
-                {hit ? VisitStep::Kind::prim_hit : VisitStep::Kind::prim_miss, id, hit ? h.t : kInfinity, kInfinity});
-        }
-        if (hit) {
-          best = h;
-          best.prim = id;
-          if constexpr (kAnyHit) return best;
-          tmax = h.t;
-        }
-      }
+      if (prims.test(prim_refs_.data() + leaf.prim_offset(), leaf.prim_count())) return prims.result();
     }
 
     // 4. Next waiting node, unless it starts beyond the closest hit. The
@@ -104,7 +71,7 @@ Hit KdTree::traverse(const Ray& ray, const QueryOptions& qo, RayStats* stats, Vi
     bool resumed = false;
     while (sp > 0) {
       const Entry e = stack[--sp];
-      if (e.t0 > tmax) {
+      if (e.t0 > prims.tmax()) {
         if constexpr (kCollect) {
           if (stats) ++stats->nodes_culled;
           if (trace) trace->steps.push_back({VisitStep::Kind::node_culled, e.node, e.t0, e.t1});
@@ -119,8 +86,7 @@ Hit KdTree::traverse(const Ray& ray, const QueryOptions& qo, RayStats* stats, Vi
     }
     if (!resumed) break;
   }
-  if (best.valid()) best.ng = triangle_normal(tris_[best.prim]);
-  return best;
+  return prims.result();
 }
 
 Hit KdTree::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, VisitTrace* trace) const {

@@ -2,7 +2,8 @@
 // Traversal pieces shared by the space-partitioning structures (K-D tree,
 // uniform grid, octree, sparse voxels): how a ray segment divides at an
 // axis-aligned plane, the per-ray mailbox, the exact record of tested
-// primitives that the statistics path uses, and the padding of cells.
+// primitives that the statistics path uses, the padding of cells, the
+// record of the first box test, and the primitive tests of a cell or leaf.
 //
 // The common rule that makes all of them correct (pbrt's kd-tree, Havran's
 // TA_rec): a primitive found in a cell or leaf is kept as a candidate even
@@ -13,16 +14,18 @@
 // hit beyond the current exit must not end the search. Keeping (rather than
 // rejecting) such hits is also what makes mailboxing safe: a primitive is
 // never tested twice, so its first result must not be thrown away.
-#include "core/math/ray.h"
-
-#include <glm/glm.hpp>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <glm/glm.hpp>
+#include <span>
 #include <type_traits>
 #include <unordered_set>
+
+#include "core/accel/accel.h"
+#include "core/geometry/triangle.h"
+#include "core/math/ray.h"
 
 namespace accelviz::spatial {
 
@@ -80,8 +83,8 @@ struct SidePiece {
 ///    both inclusive, so a crossing exactly at t0 or t1 visits both sides
 ///    (the near one with an empty interval) and a primitive lying in the plane
 ///    is never skipped. slack = rel_slack·|t| absorbs rounding of t.
-inline int split_at_plane(float o, float inv_d, float plane, float t0, float t1, float rel_slack,
-                          bool in_plane_both, std::array<SidePiece, 2>& out, float* t_cross = nullptr) {
+inline int split_at_plane(float o, float inv_d, float plane, float t0, float t1, float rel_slack, bool in_plane_both,
+                          std::array<SidePiece, 2>& out, float* t_cross = nullptr) {
   if (std::isinf(inv_d)) {
     if (t_cross) *t_cross = -kInfinity;
     if (o < plane) {
@@ -148,5 +151,91 @@ struct NoTestedSet {};
 /// path (kCollect), an empty struct that compiles away otherwise.
 template <bool kCollect>
 using TestedSetFor = std::conditional_t<kCollect, TestedSet, NoTestedSet>;
+
+/// The statistics path's record of a walk's first test (the structure's box
+/// or domain, node 0): one box test, and on a miss node 0 missed over
+/// [t0, t1]. Compiles away without kCollect.
+template <bool kCollect>
+inline void record_root_test(bool hit, float t0, float t1, RayStats* stats, VisitTrace* trace) {
+  if constexpr (kCollect) {
+    if (stats) ++stats->box_tests;
+    if (!hit) {
+      if (stats) ++stats->nodes_missed;
+      if (trace) trace->steps.push_back({VisitStep::Kind::node_missed, 0, t0, t1});
+    }
+  }
+}
+
+/// The primitive tests of the K-D tree's leaves, the grid's cells and the
+/// octree's leaves, for one ray: each referenced primitive is tested against
+/// [tmin, closest candidate so far] (mailboxed when the structure asks), a
+/// hit becomes the candidate whatever cell it lies in (the file comment's
+/// rule), and the statistics path counts the tests, the repeated ones and
+/// traces each outcome.
+template <bool kCollect, bool kAnyHit>
+class CellPrimTests {
+ public:
+  CellPrimTests(const Ray& ray, TriangleTest test, bool mailboxing, std::span<const Triangle> tris, RayStats* stats,
+                VisitTrace* trace)
+      : ray_(ray), wr_(ray.direction), tris_(tris), test_(test), mailboxing_(mailboxing), tmax_(ray.tmax) {
+    if constexpr (kCollect) {
+      stats_ = stats;
+      trace_ = trace;
+    }
+  }
+
+  /// Tests the primitives ids[0 .. count). True when the walk is over: an
+  /// any-hit query found its hit.
+  bool test(const std::uint32_t* ids, std::uint32_t count) {
+    for (std::uint32_t k = 0; k < count; ++k) {
+      const std::uint32_t id = ids[k];
+      if (mailboxing_ && mailbox_.seen(id)) continue;
+      if constexpr (kCollect) {
+        if (stats_) {
+          ++stats_->prim_tests;
+          if (tested_.repeat(id)) ++stats_->repeated_prim_tests;
+        }
+      }
+      Hit h;
+      const bool hit = intersect_triangle(test_, ray_, wr_, tris_[id], ray_.tmin, tmax_, h);
+      if constexpr (kCollect) {
+        if (trace_)
+          trace_->steps.push_back(
+              {hit ? VisitStep::Kind::prim_hit : VisitStep::Kind::prim_miss, id, hit ? h.t : kInfinity, kInfinity});
+      }
+      if (hit) {
+        best_ = h;
+        best_.prim = id;
+        if constexpr (kAnyHit) return true;
+        tmax_ = h.t;
+      }
+    }
+    return false;
+  }
+
+  /// The closest candidate's distance (the ray's tmax before any hit).
+  float tmax() const { return tmax_; }
+
+  /// The hit (closest, or the any-hit query's first), with its geometric normal.
+  Hit result() const {
+    Hit h = best_;
+    if (h.valid()) h.ng = triangle_normal(tris_[h.prim]);
+    return h;
+  }
+
+ private:
+  struct NoStats {};
+  const Ray& ray_;
+  const WatertightRay wr_;
+  std::span<const Triangle> tris_;
+  TriangleTest test_;
+  bool mailboxing_;
+  float tmax_;
+  Hit best_;
+  Mailbox mailbox_;
+  [[no_unique_address]] TestedSetFor<kCollect> tested_;
+  [[no_unique_address]] std::conditional_t<kCollect, RayStats*, NoStats> stats_{};
+  [[no_unique_address]] std::conditional_t<kCollect, VisitTrace*, NoStats> trace_{};
+};
 
 }  // namespace accelviz::spatial

@@ -1,12 +1,12 @@
 // Octree traversal: a stack of (cell, segment) entries; an inner cell's
 // segment is cut at its three mid-planes to list the octants the ray passes
 // in front-to-back order, which are pushed in reverse.
+#include <algorithm>
+#include <type_traits>
+#include <utility>
+
 #include "core/accel/kdtree/spatial_traversal.h"
 #include "core/accel/octree/octree.h"
-
-#include <algorithm>
-#include <utility>
-#include <type_traits>
 
 namespace accelviz {
 
@@ -44,19 +44,12 @@ int order_octants(const Ray& ray, const Aabb& box, float t0, float t1, std::arra
 
 template <bool kCollect, bool kAnyHit>
 Hit Octree::traverse(const Ray& ray, const QueryOptions& qo, RayStats* stats, VisitTrace* trace) const {
-  Hit best;
-  if (nodes_.empty() || !spatial::is_traversable(ray)) return best;
+  if (nodes_.empty() || !spatial::is_traversable(ray)) return Hit{};
 
   SlabInterval iv;
   const bool in_box = intersect_slab(root_, ray, iv);
-  if constexpr (kCollect) {
-    if (stats) ++stats->box_tests;
-    if (!in_box) {
-      if (stats) ++stats->nodes_missed;
-      if (trace) trace->steps.push_back({VisitStep::Kind::node_missed, 0, iv.t_entry, iv.t_exit});
-    }
-  }
-  if (!in_box) return best;
+  spatial::record_root_test<kCollect>(in_box, iv.t_entry, iv.t_exit, stats, trace);
+  if (!in_box) return Hit{};
 
   struct Entry {
     std::uint32_t node;
@@ -68,17 +61,14 @@ Hit Octree::traverse(const Ray& ray, const QueryOptions& qo, RayStats* stats, Vi
   int sp = 0;
   stack[sp++] = {0, iv.t_entry, iv.t_exit, root_};
 
-  const WatertightRay wr(ray.direction);
-  float tmax = ray.tmax;
-  spatial::Mailbox mailbox;
-  [[maybe_unused]] spatial::TestedSetFor<kCollect> tested;
+  spatial::CellPrimTests<kCollect, kAnyHit> prims(ray, qo.triangle_test, opts_.mailboxing, tris_, stats, trace);
 
   while (sp > 0) {
     const Entry e = stack[--sp];
     // A cell entered beyond the closest hit cannot hold a nearer one. (Not
     // the end of the search: a ray lying in a mid-plane leaves siblings with
     // equal segments, so the stack is not strictly sorted by entry.)
-    if (e.t0 > tmax) {
+    if (e.t0 > prims.tmax()) {
       if constexpr (kCollect) {
         if (stats) ++stats->nodes_culled;
         if (trace) trace->steps.push_back({VisitStep::Kind::node_culled, e.node, e.t0, e.t1});
@@ -111,33 +101,9 @@ Hit Octree::traverse(const Ray& ray, const QueryOptions& qo, RayStats* stats, Vi
     }
     // Leaf: test against [tmin, closest so far]; a hit beyond this cell's
     // exit is kept as a candidate but does not end the search.
-    const std::uint32_t* ids = prim_refs_.data() + n.index;
-    for (std::uint32_t k = 0; k < n.count; ++k) {
-      const std::uint32_t id = ids[k];
-      if (opts_.mailboxing && mailbox.seen(id)) continue;
-      if constexpr (kCollect) {
-        if (stats) {
-          ++stats->prim_tests;
-          if (tested.repeat(id)) ++stats->repeated_prim_tests;
-        }
-      }
-      Hit h;
-      const bool hit = intersect_triangle(qo.triangle_test, ray, wr, tris_[id], ray.tmin, tmax, h);
-      if constexpr (kCollect) {
-        if (trace)
-          trace->steps.push_back(
-              {hit ? VisitStep::Kind::prim_hit : VisitStep::Kind::prim_miss, id, hit ? h.t : kInfinity, kInfinity});
-      }
-      if (hit) {
-        best = h;
-        best.prim = id;
-        if constexpr (kAnyHit) return best;
-        tmax = h.t;
-      }
-    }
+    if (prims.test(prim_refs_.data() + n.index, n.count)) return prims.result();
   }
-  if (best.valid()) best.ng = triangle_normal(tris_[best.prim]);
-  return best;
+  return prims.result();
 }
 
 Hit Octree::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, VisitTrace* trace) const {

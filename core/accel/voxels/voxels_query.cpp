@@ -9,12 +9,12 @@
 // the octants visited are the dense march's voxels grouped into blocks, and
 // the entry distance, face and index of the first occupied voxel come out
 // bit for bit the same.
-#include "core/accel/kdtree/spatial_traversal.h"
-#include "core/accel/voxels/voxels.h"
-
 #include <array>
 #include <cmath>
 #include <cstdint>
+
+#include "core/accel/kdtree/spatial_traversal.h"
+#include "core/accel/voxels/voxels.h"
 
 namespace accelviz {
 
@@ -28,8 +28,8 @@ namespace {
 // the dense one sees even where crossings tie in float.
 struct Event {
   float t;
-  int axis;             // -1: the segment's start, 3: its end
-  std::int64_t order;   // plane index along the ray (negated for a negative direction)
+  int axis;            // -1: the segment's start, 3: its end
+  std::int64_t order;  // plane index along the ray (negated for a negative direction)
 };
 bool before(const Event& a, const Event& b) {
   if (a.t != b.t) return a.t < b.t;
@@ -96,13 +96,7 @@ Hit Voxels::traverse(const Ray& ray, RayStats* stats, VisitTrace* trace) const {
   if (root_ == Root::empty || !spatial::is_traversable(ray)) return hit;
   VoxelSegment seg;
   const bool in_domain = voxel_segment(domain_, ray, seg);
-  if constexpr (kCollect) {
-    if (stats) ++stats->box_tests;
-    if (!in_domain) {
-      if (stats) ++stats->nodes_missed;
-      if (trace) trace->steps.push_back({VisitStep::Kind::node_missed, 0, seg.t0, seg.t1});
-    }
-  }
+  spatial::record_root_test<kCollect>(in_domain, seg.t0, seg.t1, stats, trace);
   if (!in_domain) return hit;
 
   struct Entry {
@@ -117,8 +111,11 @@ Hit Voxels::traverse(const Ray& ray, RayStats* stats, VisitTrace* trace) const {
   Event line{seg.line_t, seg.axis, 0};
   if (seg.axis >= 0 && ray.inv_dir[seg.axis] < 0.0f) line.order = -static_cast<std::int64_t>(domain_.resolution);
   const Piece whole{0, {seg.t0, -1, 0}, {seg.t1, 3, 0}, line};
-  stack[sp++] = {root_ == Root::interior ? static_cast<std::uint32_t>(nodes_.size() - 1) : 0u, root_ == Root::full,
-                 {0, 0, 0}, domain_.resolution, whole};
+  stack[sp++] = {root_ == Root::interior ? static_cast<std::uint32_t>(nodes_.size() - 1) : 0u,
+                 root_ == Root::full,
+                 {0, 0, 0},
+                 domain_.resolution,
+                 whole};
 
   while (sp > 0) {
     Entry e = stack[--sp];
