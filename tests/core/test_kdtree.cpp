@@ -13,60 +13,17 @@
 #include "core/accel/brute_force.h"
 #include "core/accel/kdtree/kdtree.h"
 #include "core/geometry/tri_box_overlap.h"
+#include "tests/core/spatial_test_scenes.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_kdtree {
 
 using namespace accelviz;
+using namespace accelviz::test_scenes;
 
 namespace {
 
-struct Rng {
-  std::uint64_t s;
-  double next() {
-    s = s * 6364136223846793005ull + 1442695040888963407ull;
-    return static_cast<double>(s >> 11) * (1.0 / 9007199254740992.0);
-  }
-  float range(float a, float b) { return a + (b - a) * static_cast<float>(next()); }
-  glm::vec3 in_box(const glm::vec3& lo, const glm::vec3& hi) {
-    return {range(lo.x, hi.x), range(lo.y, hi.y), range(lo.z, hi.z)};
-  }
-  glm::vec3 unit() {
-    for (;;) {
-      const glm::vec3 v(range(-1, 1), range(-1, 1), range(-1, 1));
-      const float l = glm::length(v);
-      if (l > 0.05f && l <= 1.0f) return v / l;
-    }
-  }
-};
-
 using Scene = std::vector<Triangle>;
-
-Scene soup(std::uint64_t seed, int n, float size) {
-  Rng rng{seed};
-  Scene s;
-  for (int i = 0; i < n; ++i) {
-    const glm::vec3 c = rng.in_box(glm::vec3(-1), glm::vec3(1));
-    s.push_back({c + size * rng.unit(), c + size * rng.unit(), c + size * rng.unit()});
-  }
-  return s;
-}
-
-void quad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
-  s.push_back({a, b, c});
-  s.push_back({a, c, d});
-}
-
-void box(Scene& s, const glm::vec3& lo, const glm::vec3& hi) {
-  const glm::vec3 p[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {lo.x, hi.y, lo.z},
-                          {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}};
-  quad(s, p[0], p[1], p[2], p[3]);
-  quad(s, p[4], p[5], p[6], p[7]);
-  quad(s, p[0], p[1], p[5], p[4]);
-  quad(s, p[3], p[2], p[6], p[7]);
-  quad(s, p[0], p[3], p[7], p[4]);
-  quad(s, p[1], p[2], p[6], p[5]);
-}
 
 // Axis-aligned boxes side by side on a lattice: faces in shared planes.
 Scene lattice() {

@@ -12,45 +12,17 @@
 #include "core/accel/kdtree/spatial_traversal.h"
 #include "core/accel/octree/octree.h"
 #include "core/geometry/tri_box_overlap.h"
+#include "tests/core/spatial_test_scenes.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_octree {
 
 using namespace accelviz;
+using namespace accelviz::test_scenes;
 
 namespace {
 
-struct Rng {
-  std::uint64_t s;
-  double next() {
-    s = s * 6364136223846793005ull + 1442695040888963407ull;
-    return static_cast<double>(s >> 11) * (1.0 / 9007199254740992.0);
-  }
-  float range(float a, float b) { return a + (b - a) * static_cast<float>(next()); }
-  glm::vec3 in_box(const glm::vec3& lo, const glm::vec3& hi) {
-    return {range(lo.x, hi.x), range(lo.y, hi.y), range(lo.z, hi.z)};
-  }
-  glm::vec3 unit() {
-    for (;;) {
-      const glm::vec3 v(range(-1, 1), range(-1, 1), range(-1, 1));
-      const float l = glm::length(v);
-      if (l > 0.05f && l <= 1.0f) return v / l;
-    }
-  }
-};
-
 using Scene = std::vector<Triangle>;
-
-Scene soup(std::uint64_t seed, int n, float size, const glm::vec3& lo = glm::vec3(-1),
-           const glm::vec3& hi = glm::vec3(1)) {
-  Rng rng{seed};
-  Scene s;
-  for (int i = 0; i < n; ++i) {
-    const glm::vec3 c = rng.in_box(lo, hi);
-    s.push_back({c + size * rng.unit(), c + size * rng.unit(), c + size * rng.unit()});
-  }
-  return s;
-}
 
 struct Cell {
   std::uint32_t index;

@@ -24,33 +24,15 @@
 #include "core/accel/kdtree/kdtree.h"
 #include "core/accel/octree/octree.h"
 #include "core/util/parallel.h"
+#include "tests/core/spatial_test_scenes.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_spatial_differential {
 
 using namespace accelviz;
+using namespace accelviz::test_scenes;
 
 namespace {
-
-struct Rng {
-  std::uint64_t s;
-  double next() {
-    s = s * 6364136223846793005ull + 1442695040888963407ull;
-    return static_cast<double>(s >> 11) * (1.0 / 9007199254740992.0);
-  }
-  float range(float a, float b) { return a + (b - a) * static_cast<float>(next()); }
-  int below(int n) { return static_cast<int>(next() * n) % n; }
-  glm::vec3 in_box(const glm::vec3& lo, const glm::vec3& hi) {
-    return {range(lo.x, hi.x), range(lo.y, hi.y), range(lo.z, hi.z)};
-  }
-  glm::vec3 unit() {
-    for (;;) {
-      const glm::vec3 v(range(-1, 1), range(-1, 1), range(-1, 1));
-      const float l = glm::length(v);
-      if (l > 0.05f && l <= 1.0f) return v / l;
-    }
-  }
-};
 
 using Scene = std::vector<Triangle>;
 
@@ -60,7 +42,7 @@ Triangle random_triangle(Rng& rng, const glm::vec3& c, float size) {
 
 // Random soup: sizes spread over two decades, a few big triangles crossing
 // many cells.
-Scene soup(std::uint64_t seed, int n) {
+Scene mixed_soup(std::uint64_t seed, int n) {
   Rng rng{seed};
   Scene s;
   for (int i = 0; i < n; ++i) {
@@ -68,24 +50,6 @@ Scene soup(std::uint64_t seed, int n) {
     s.push_back(random_triangle(rng, rng.in_box(glm::vec3(-1), glm::vec3(1)), size));
   }
   return s;
-}
-
-// Quad (a, b, c, d in order) as two triangles.
-void quad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
-  s.push_back({a, b, c});
-  s.push_back({a, c, d});
-}
-
-// Axis-aligned box as 12 triangles.
-void box(Scene& s, const glm::vec3& lo, const glm::vec3& hi) {
-  const glm::vec3 p[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {lo.x, hi.y, lo.z},
-                          {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}};
-  quad(s, p[0], p[1], p[2], p[3]);
-  quad(s, p[4], p[5], p[6], p[7]);
-  quad(s, p[0], p[1], p[5], p[4]);
-  quad(s, p[3], p[2], p[6], p[7]);
-  quad(s, p[0], p[3], p[7], p[4]);
-  quad(s, p[1], p[2], p[6], p[5]);
 }
 
 // A dense small cluster (the teapot) inside a huge sparse box of big
@@ -171,7 +135,7 @@ Scene flat_wall() {
 // A soup where a third of the triangles are points or segments.
 Scene with_degenerate_triangles(std::uint64_t seed) {
   Rng rng{seed};
-  Scene s = soup(seed, 300);
+  Scene s = mixed_soup(seed, 300);
   for (std::size_t i = 0; i < s.size(); i += 3) {
     if (rng.next() < 0.5)
       s[i].v2 = s[i].v1;  // segment
@@ -376,10 +340,10 @@ void check(const Scene& scene, std::uint64_t seed, int rays, bool use_moller_tru
 }  // namespace
 
 TEST(SpatialDifferential, RandomSoup) {
-  check(soup(1, 2000), 101, 30000);
+  check(mixed_soup(1, 2000), 101, 30000);
 }
 TEST(SpatialDifferential, RandomSoupSecondSeed) {
-  check(soup(2, 800), 102, 30000);
+  check(mixed_soup(2, 800), 102, 30000);
 }
 TEST(SpatialDifferential, TeapotInStadium) {
   check(teapot_in_stadium(3), 103, 30000);

@@ -10,25 +10,17 @@
 #include <vector>
 
 #include "core/geometry/tri_box_overlap.h"
+#include "tests/core/spatial_test_scenes.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_tri_box_overlap {
 
 using namespace accelviz;
+using test_scenes::Rng;
 
 namespace {
 
 const Aabb kUnit{{0, 0, 0}, {1, 1, 1}};
-
-struct Lcg {
-  std::uint64_t s;
-  double next() {
-    s = s * 6364136223846793005ull + 1442695040888963407ull;
-    return static_cast<double>(s >> 11) * (1.0 / 9007199254740992.0);
-  }
-  float range(float a, float b) { return a + (b - a) * static_cast<float>(next()); }
-  glm::vec3 vec(float a, float b) { return {range(a, b), range(a, b), range(a, b)}; }
-};
 
 // Reference: is the triangle's clipped polygon against [lo, hi] non-empty?
 // Plain Sutherland-Hodgman in long double, written independently of the
@@ -153,7 +145,7 @@ TEST(TriBoxOverlap, NonFiniteVerticesNeverOverlap) {
 }
 
 TEST(TriBoxOverlap, RandomAgainstSamplingAndClipping) {
-  Lcg rng{12345};
+  Rng rng{12345};
   int overlaps = 0, separations = 0, checked_by_sampling = 0;
   for (int it = 0; it < 20000; ++it) {
     const glm::vec3 c = rng.vec(-1, 1);
@@ -189,7 +181,7 @@ TEST(TriBoxOverlap, RandomAgainstSamplingAndClipping) {
 TEST(TriBoxOverlap, RandomTouchingCases) {
   // Triangles built to touch the box exactly: a vertex on a face, corner or
   // edge of the box, the rest outside.
-  Lcg rng{777};
+  Rng rng{777};
   for (int it = 0; it < 5000; ++it) {
     const Aabb box{{0, 0, 0}, {1, 1, 1}};
     glm::vec3 p = rng.vec(0, 1);
@@ -250,7 +242,7 @@ TEST(ClippedTriangleBounds, ClipsToTheTrianglePartInside) {
 }
 
 TEST(ClippedTriangleBounds, RandomContainsEverySampleInside) {
-  Lcg rng{99};
+  Rng rng{99};
   for (int it = 0; it < 3000; ++it) {
     const glm::vec3 c = rng.vec(-1, 1);
     const glm::vec3 h = rng.vec(0.05f, 0.5f);

@@ -10,37 +10,19 @@
 
 #include "core/accel/voxels/dense_voxels.h"
 #include "core/accel/voxels/voxels.h"
+#include "tests/core/spatial_test_scenes.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_voxels {
 
 using namespace accelviz;
+using namespace accelviz::test_scenes;
 
 namespace {
 
-struct Rng {
-  std::uint64_t s;
-  double next() {
-    s = s * 6364136223846793005ull + 1442695040888963407ull;
-    return static_cast<double>(s >> 11) * (1.0 / 9007199254740992.0);
-  }
-  float range(float a, float b) { return a + (b - a) * static_cast<float>(next()); }
-  int below(int n) { return static_cast<int>(next() * n) % n; }
-  glm::vec3 in_box(const glm::vec3& lo, const glm::vec3& hi) {
-    return {range(lo.x, hi.x), range(lo.y, hi.y), range(lo.z, hi.z)};
-  }
-  glm::vec3 unit() {
-    for (;;) {
-      const glm::vec3 v(range(-1, 1), range(-1, 1), range(-1, 1));
-      const float l = glm::length(v);
-      if (l > 0.05f && l <= 1.0f) return v / l;
-    }
-  }
-};
-
 using Scene = std::vector<Triangle>;
 
-Scene soup(std::uint64_t seed, int n, float max_size) {
+Scene varied_soup(std::uint64_t seed, int n, float max_size) {
   Rng rng{seed};
   Scene s;
   for (int i = 0; i < n; ++i) {
@@ -49,11 +31,6 @@ Scene soup(std::uint64_t seed, int n, float max_size) {
     s.push_back({c + size * rng.unit(), c + size * rng.unit(), c + size * rng.unit()});
   }
   return s;
-}
-
-void quad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
-  s.push_back({a, b, c});
-  s.push_back({a, c, d});
 }
 
 // A closed sphere-like surface (octahedron subdivided and pushed out) plus
@@ -180,7 +157,7 @@ TEST(Voxels, NameAndStats) {
 
 TEST(Voxels, OccupancyEqualsIndependentDenseVoxelization) {
   for (int level : {0, 1, 3, 5, 7}) {
-    for (const Scene& s : {soup(1, 300, 0.3f), sphere_and_floor(), flat_wall()}) {
+    for (const Scene& s : {varied_soup(1, 300, 0.3f), sphere_and_floor(), flat_wall()}) {
       const Voxels v(s, VoxelOptions{level});
       const DenseVoxelGrid sparse = v.to_dense();
       const DenseVoxelGrid ref = voxelize_dense(s, v.domain());
@@ -223,7 +200,7 @@ TEST(Voxels, EverySurfaceSampleLiesInAnOccupiedVoxel) {
 TEST(Voxels, FullBlocksCollapse) {
   // A thick random soup at level 2: every voxel ends up occupied, so the
   // whole domain collapses into a full root with no nodes at all.
-  const Scene s = soup(3, 4000, 0.4f);
+  const Scene s = varied_soup(3, 4000, 0.4f);
   const Voxels v(s, VoxelOptions{2});
   ASSERT_EQ(v.occupied_count(), 64u);
   EXPECT_EQ(v.root(), Voxels::Root::full);
@@ -347,10 +324,10 @@ TEST(VoxelsDifferential, MarchEqualsDenseReference) {
   int bad = 0;
   bad += compare_with_dense(sphere_and_floor(), 7, 11, 30000);
   bad += compare_with_dense(sphere_and_floor(), 4, 12, 15000);
-  bad += compare_with_dense(soup(2, 500, 0.2f), 6, 13, 25000);
-  bad += compare_with_dense(soup(4, 60, 0.8f), 8, 14, 15000);
+  bad += compare_with_dense(varied_soup(2, 500, 0.2f), 6, 13, 25000);
+  bad += compare_with_dense(varied_soup(4, 60, 0.8f), 8, 14, 15000);
   bad += compare_with_dense(flat_wall(), 5, 15, 10000);
-  bad += compare_with_dense(soup(3, 4000, 0.4f), 4, 16, 10000);
+  bad += compare_with_dense(varied_soup(3, 4000, 0.4f), 4, 16, 10000);
   EXPECT_EQ(bad, 0);
 }
 }  // namespace unity_test_voxels
