@@ -109,7 +109,7 @@ inline std::uint32_t ceil_log2(std::size_t n) {
 
 class Builder {
  public:
-  Builder(const SplitParams& params, SplitFn split, std::span<BuildPrim> prims, unsigned threads,
+  Builder(const SplitParams& params, Splitter split, std::span<BuildPrim> prims, unsigned threads,
           const ProgressCallback& progress)
       : params_(params), split_(split), prims_(prims), max_threads_(threads), progress_(progress) {
     report_step_ = std::max<std::uint64_t>(1, prims.size() / 128);
@@ -133,7 +133,7 @@ class Builder {
       split_object_median(range, w.centroid_bounds, s);
     } else {
       const ThreadLoan loan(*this, scratch, n);
-      const SplitOutcome r = split_(params_, range, w.bounds, w.centroid_bounds, scratch, s);
+      const SplitOutcome r = split_.split(params_, range, w.bounds, w.centroid_bounds, scratch, s);
       if (r == SplitOutcome::leaf) {
         make_leaf(w, out, slot);
         return;
@@ -237,7 +237,7 @@ class Builder {
     SplitScratch& scratch;
     ThreadLoan(Builder& b, SplitScratch& s, std::size_t n) : builder(b), scratch(s) {
       scratch.helpers = 0;
-      if (b.split_ != split_binned_sah || n < kParallelSplitMinPrims) return;
+      if (!b.split_.uses_helpers || n < kParallelSplitMinPrims) return;
       while (scratch.helpers + 1 < n / kParallelSplitGrain && b.try_acquire_thread()) ++scratch.helpers;
     }
     ~ThreadLoan() {
@@ -257,7 +257,7 @@ class Builder {
   void release_thread() { active_threads_.fetch_sub(1); }
 
   const SplitParams params_;
-  const SplitFn split_;
+  const Splitter split_;
   std::span<BuildPrim> prims_;
   const unsigned max_threads_;
   const ProgressCallback& progress_;
@@ -311,10 +311,11 @@ BvhTopology build_bvh_records(std::span<BuildPrim> prims, const Aabb& root_bound
       params.morton = morton_frame(root_centroids);
       lbvh_sort(prims, params.morton, resolve_threads(opts.threads));
     }
-    const SplitFn split = opts.splitter == BvhSplitter::binned_sah  ? split_binned_sah
-                          : opts.splitter == BvhSplitter::exact_sah ? split_exact_sah
-                          : opts.splitter == BvhSplitter::lbvh      ? split_lbvh
-                                                                    : split_median;
+    // Only the binned SAH bins on lent threads (bin_primitives_parallel).
+    const Splitter split = opts.splitter == BvhSplitter::binned_sah  ? Splitter{split_binned_sah, true}
+                           : opts.splitter == BvhSplitter::exact_sah ? Splitter{split_exact_sah}
+                           : opts.splitter == BvhSplitter::lbvh      ? Splitter{split_lbvh}
+                                                                     : Splitter{split_median};
     Builder builder(params, split, prims, resolve_threads(opts.threads), progress);
     // At most 2n - 1 nodes: reserving them all spares the regrowth copies.
     // No shrink_to_fit after: pages never written are never touched (not

@@ -77,6 +77,14 @@ struct SplitScratch {
 using SplitFn = SplitOutcome (*)(const SplitParams& params, std::span<BuildPrim> prims, const Aabb& bounds,
                                  const Aabb& centroid_bounds, SplitScratch& scratch, SplitResult& out);
 
+/// A splitter as the builder drives it: the function, and whether it puts
+/// threads lent for one split (SplitScratch::helpers) to use; the builder
+/// lends none to one that does not.
+struct Splitter {
+  SplitFn split;
+  bool uses_helpers = false;
+};
+
 SplitOutcome split_binned_sah(const SplitParams& params, std::span<BuildPrim> prims, const Aabb& bounds,
                               const Aabb& centroid_bounds, SplitScratch& scratch, SplitResult& out);
 SplitOutcome split_exact_sah(const SplitParams& params, std::span<BuildPrim> prims, const Aabb& bounds,
