@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -505,12 +506,16 @@ TEST(BvhBuild, SimdBinningAgreesWithScalarTwin) {
   std::mt19937 rng(30);
   for (int round = 0; round < 50; ++round) {
     const int buckets = 2 + static_cast<int>(rng() % 255);
-    std::vector<bvh_detail::BuildPrim> prims(500);
+    std::vector<bvh_detail::BuildPrim> prims(500 + round % 2);  // even and odd counts
     for (std::uint32_t i = 0; i < prims.size(); ++i) {
       const glm::vec3 a(uniform(rng), uniform(rng), uniform(rng)), b(uniform(rng), uniform(rng), uniform(rng));
       prims[i] = {(a + b) * 0.5f, i, Aabb{glm::min(a, b), glm::max(a, b)}};
       if (i % 17 == 0) prims[i].centroid.x = -1.0f;  // below the origin: bucket 0
       if (i % 19 == 0) prims[i].centroid.y = 5.0f;   // beyond the top: bucket B-1
+      // Signed-zero ties in the bounds: the bins must keep the same zero's sign as the scalar pass.
+      if (i % 7 == 0) prims[i].bounds.lo.x = (i % 14 == 0) ? 0.0f : -0.0f;
+      if (i % 11 == 0) prims[i].bounds.hi.z = (i % 22 == 0) ? -0.0f : 0.0f;
+      if (i % 7 == 0 || i % 11 == 0) prims[i].bounds.lo = glm::min(prims[i].bounds.lo, prims[i].bounds.hi);
     }
     const glm::vec3 origin(0.0f);
     const float k[3] = {static_cast<float>(buckets), static_cast<float>(buckets) * 0.9f, static_cast<float>(buckets)};
@@ -522,9 +527,9 @@ TEST(BvhBuild, SimdBinningAgreesWithScalarTwin) {
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < buckets; ++b) {
         ASSERT_EQ(simd.count[a][b], scalar.count[a][b]) << a << " " << b;
-        for (int l = 0; l < 3; ++l) {
-          ASSERT_EQ(simd.lo[a][b][l], scalar.lo[a][b][l]);
-          ASSERT_EQ(simd.hi[a][b][l], scalar.hi[a][b][l]);
+        for (int l = 0; l < 3; ++l) {  // bit for bit (-0 and +0 differ)
+          ASSERT_EQ(std::bit_cast<std::uint32_t>(simd.lo[a][b][l]), std::bit_cast<std::uint32_t>(scalar.lo[a][b][l]));
+          ASSERT_EQ(std::bit_cast<std::uint32_t>(simd.hi[a][b][l]), std::bit_cast<std::uint32_t>(scalar.hi[a][b][l]));
         }
       }
     // Every primitive lands where bucket_of puts it.
