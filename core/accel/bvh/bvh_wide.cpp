@@ -65,8 +65,12 @@ void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide, int me
     leaf_like[i] =
         binary[i].count > 0 ||
         (merge_blocks > 0 && sub.blocks[i] <= static_cast<std::uint32_t>(merge_blocks) && sub.count[i] <= 255u);
+  // Each wide node takes the children of one binary inner node: at most
+  // binary.size() / 2 + 1 of them, W source entries each. Reserved pages that
+  // are never written are never touched (HugePageVector), so the worst case
+  // costs address space only.
   wide.nodes.reserve(binary.size() / 2 + 1);
-  wide.source.reserve(2 * binary.size() + 4);
+  wide.source.reserve(static_cast<std::size_t>(W) * (binary.size() / 2 + 1));
 
   // Work list of (wide node to fill, binary node whose children it takes).
   std::vector<std::pair<std::uint32_t, std::uint32_t>> work;
