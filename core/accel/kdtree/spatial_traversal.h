@@ -177,12 +177,14 @@ class CellPrimTests {
  public:
   CellPrimTests(const Ray& ray, TriangleTest test, bool mailboxing, std::span<const Triangle> tris, RayStats* stats,
                 VisitTrace* trace)
-      : ray_(ray), wr_(ray.direction), tris_(tris), test_(test), mailboxing_(mailboxing), tmax_(ray.tmax) {
-    if constexpr (kCollect) {
-      stats_ = stats;
-      trace_ = trace;
-    }
-  }
+      : ray_(ray),
+        wr_(ray.direction),
+        tris_(tris),
+        test_(test),
+        mailboxing_(mailboxing),
+        tmax_(ray.tmax),
+        stats_(stats),
+        trace_(trace) {}
 
   /// Tests the primitives ids[0 .. count). True when the walk is over: an
   /// any-hit query found its hit.
@@ -216,15 +218,17 @@ class CellPrimTests {
   /// The closest candidate's distance (the ray's tmax before any hit).
   float tmax() const { return tmax_; }
 
-  /// The hit (closest, or the any-hit query's first), with its geometric normal.
+  /// The hit: the closest one with its geometric normal, or the any-hit
+  /// query's first (callers ask only whether there is one: no normal).
   Hit result() const {
     Hit h = best_;
-    if (h.valid()) h.ng = triangle_normal(tris_[h.prim]);
+    if constexpr (!kAnyHit) {
+      if (h.valid()) h.ng = triangle_normal(tris_[h.prim]);
+    }
     return h;
   }
 
  private:
-  struct NoStats {};
   const Ray& ray_;
   const WatertightRay wr_;
   std::span<const Triangle> tris_;
@@ -234,8 +238,8 @@ class CellPrimTests {
   Hit best_;
   Mailbox mailbox_;
   [[no_unique_address]] TestedSetFor<kCollect> tested_;
-  [[no_unique_address]] std::conditional_t<kCollect, RayStats*, NoStats> stats_{};
-  [[no_unique_address]] std::conditional_t<kCollect, VisitTrace*, NoStats> trace_{};
+  RayStats* stats_;  ///< read only on the statistics path (kCollect)
+  VisitTrace* trace_;
 };
 
 }  // namespace accelviz::spatial
