@@ -8,7 +8,9 @@
 // come from the last build); per ray set, closest-hit and any-hit throughput
 // on one thread and on all threads, each the median of `repeat` timed passes
 // without counters, the structures again taking turns within each round so
-// that a change of machine load falls on all of them alike; then one
+// that a change of machine load falls on all of them alike; for the
+// structures that walk packets (Bvh, Embree) also closest and any hit in
+// packets of eight consecutive rays on one thread; then one
 // instrumented pass for the mean node visits and primitive tests per ray,
 // kept out of the timings. `warmup` untimed rounds (builds, passes) may come
 // before the timed ones.
@@ -50,6 +52,8 @@ struct RaySet {
 
 struct QueryFigures {
   double closest_1t = 0, closest_nt = 0, any_1t = 0, any_nt = 0;   ///< Mrays/s, medians
+  bool packets = false;                                            ///< the structure walks packets (has_packets)
+  double closest_packet_1t = 0, any_packet_1t = 0;                 ///< Mrays/s in packets of 8, one thread, medians
   double closest_nodes = 0, closest_prims = 0, closest_boxes = 0;  ///< per ray, instrumented pass
   double any_nodes = 0, any_prims = 0, any_boxes = 0;
   double hit_fraction = 0, occluded_fraction = 0;
@@ -111,6 +115,28 @@ std::vector<QueryFigures> measure_in_turns(const std::vector<std::unique_ptr<Acc
          [&](std::size_t i) { trace_any(*accels[i], rays, occluded, q, 1u); });
   figure("any hit, " + threads, &QueryFigures::any_nt,
          [&](std::size_t i) { trace_any(*accels[i], rays, occluded, q, all); });
+  // Packets of eight consecutive rays, one thread, for the structures that
+  // walk packets (the others would only repeat their per-ray figures).
+  std::vector<const Accelerator*> with_packets;
+  std::vector<std::size_t> index;
+  for (std::size_t i = 0; i < accels.size(); ++i)
+    if (accels[i]->has_packets()) {
+      with_packets.push_back(accels[i].get());
+      index.push_back(i);
+      f[i].packets = true;
+    }
+  if (!with_packets.empty()) {
+    const auto packet_figure = [&](const std::string& what, double QueryFigures::*field, auto&& pass) {
+      progress.begin(label + ": " + what);
+      const std::vector<double> m = timed_medians_in_turns(with_packets.size(), warmup, repeat, n, pass);
+      for (std::size_t k = 0; k < index.size(); ++k) f[index[k]].*field = m[k];
+      progress.end();
+    };
+    packet_figure("closest hit, packets of 8, 1 thread", &QueryFigures::closest_packet_1t,
+                  [&](std::size_t k) { trace_closest_packets(*with_packets[k], rays, hits, q, BatchOptions{1u}); });
+    packet_figure("any hit, packets of 8, 1 thread", &QueryFigures::any_packet_1t,
+                  [&](std::size_t k) { trace_any_packets(*with_packets[k], rays, occluded, q, BatchOptions{1u}); });
+  }
   return f;
 }
 
@@ -150,7 +176,7 @@ void count_per_ray(const Accelerator& accel, const std::vector<Ray>& rays, const
 }
 
 nlohmann::json query_json(const QueryFigures& f) {
-  return {
+  nlohmann::json j = {
       {"closest_mrays_1t", f.closest_1t},
       {"closest_mrays_nt", f.closest_nt},
       {"any_mrays_1t", f.any_1t},
@@ -164,6 +190,11 @@ nlohmann::json query_json(const QueryFigures& f) {
       {"hit_fraction", f.hit_fraction},
       {"occluded_fraction", f.occluded_fraction},
   };
+  if (f.packets) {
+    j["closest_packet_mrays_1t"] = f.closest_packet_1t;
+    j["any_packet_mrays_1t"] = f.any_packet_1t;
+  }
+  return j;
 }
 
 double ratio(double ours, double theirs) {
@@ -346,6 +377,10 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
                                   {"closest_mrays_nt", ratio(a.closest_nt, b.closest_nt)},
                                   {"any_mrays_1t", ratio(a.any_1t, b.any_1t)},
                                   {"any_mrays_nt", ratio(a.any_nt, b.any_nt)}};
+        if (a.packets && b.packets) {
+          rr[r.queries[k].first]["closest_packet_mrays_1t"] = ratio(a.closest_packet_1t, b.closest_packet_1t);
+          rr[r.queries[k].first]["any_packet_mrays_1t"] = ratio(a.any_packet_1t, b.any_packet_1t);
+        }
       }
       j["ratios_vs_embree"][r.name] = rr;
     }
@@ -389,6 +424,10 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
         std::printf(" %10s %10s\n", "n/a", "n/a");
       }
     }
+    for (const auto& [set, f] : r.queries)
+      if (f.packets)
+        std::printf("  %-8s packets of 8, 1T: closest %.2f, any %.2f Mrays/s\n", set.c_str(), f.closest_packet_1t,
+                    f.any_packet_1t);
   }
   if (embree) {
     std::printf("\nratios ours/embree (build and memory: lower is better; Mrays/s: higher is better)\n");
@@ -403,6 +442,9 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
         std::printf("    %-8s closest 1T %.2f, closest %uT %.2f, any 1T %.2f, any %uT %.2f\n",
                     r.queries[k].first.c_str(), ratio(a.closest_1t, b.closest_1t), all,
                     ratio(a.closest_nt, b.closest_nt), ratio(a.any_1t, b.any_1t), all, ratio(a.any_nt, b.any_nt));
+        if (a.packets && b.packets)
+          std::printf("    %-8s packets of 8, 1T: closest %.2f, any %.2f\n", r.queries[k].first.c_str(),
+                      ratio(a.closest_packet_1t, b.closest_packet_1t), ratio(a.any_packet_1t, b.any_packet_1t));
       }
     }
   }

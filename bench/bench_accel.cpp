@@ -10,7 +10,9 @@
 // scene's framing camera, their diffuse bounces and shadow rays to a
 // synthetic light (core/query/ray_sets.h), generated once from our BVH's
 // hits. items_per_second is rays/s; compare our row with Embree's on the
-// same ray set, as a ratio (docs/performance.md).
+// same ray set, as a ratio (docs/performance.md). TraceClosestPackets8 and
+// TraceAnyPackets8: the same rays in packets of eight (Embree: rtcIntersect8,
+// rtcOccluded8).
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>
@@ -80,15 +82,20 @@ void build(benchmark::State& state, const std::string& name) {
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * n));  // triangles/s
 }
 
-/// Single-thread closest hit (any = false) or any hit; range(0) = ray set.
-void trace(benchmark::State& state, const std::string& name, bool any) {
+/// Single-thread closest hit (any = false) or any hit; range(0) = ray set;
+/// packets: in packets of eight consecutive rays (trace_*_packets).
+void trace(benchmark::State& state, const std::string& name, bool any, bool packets) {
   const std::vector<Ray>& rays = fixture().rays[state.range(0)];
   state.SetLabel(kSetNames[state.range(0)]);
   const auto accel = make(name, 0);
   std::vector<Hit> hits(rays.size());
   std::vector<std::uint8_t> occluded(rays.size());
   for (auto _ : state) {
-    if (any)
+    if (packets && any)
+      trace_any_packets(*accel, rays, occluded, QueryOptions{}, BatchOptions{1u});
+    else if (packets)
+      trace_closest_packets(*accel, rays, hits, QueryOptions{}, BatchOptions{1u});
+    else if (any)
       trace_any(*accel, rays, occluded, QueryOptions{}, 1u);
     else
       trace_closest(*accel, rays, hits, QueryOptions{}, 1u);
@@ -106,14 +113,18 @@ void register_all() {
         ->Arg(2)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
-    benchmark::RegisterBenchmark(("TraceClosest/" + n).c_str(), trace, n, false)
-        ->DenseRange(0, 2)
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();  // the batch may trace on a worker thread: wall time, not this thread's CPU time
-    benchmark::RegisterBenchmark(("TraceAny/" + n).c_str(), trace, n, true)
-        ->DenseRange(0, 2)
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();  // the batch may trace on a worker thread: wall time, not this thread's CPU time
+    for (bool packets : {false, true}) {
+      if (packets && n == "lbvh") continue;  // the same packet walk as bvh over another tree
+      const std::string suffix = packets ? "Packets8/" : "/";
+      benchmark::RegisterBenchmark(("TraceClosest" + suffix + n).c_str(), trace, n, false, packets)
+          ->DenseRange(0, 2)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();  // the batch may trace on a worker thread: wall time, not this thread's CPU time
+      benchmark::RegisterBenchmark(("TraceAny" + suffix + n).c_str(), trace, n, true, packets)
+          ->DenseRange(0, 2)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
+    }
   }
 }
 

@@ -22,4 +22,27 @@ void Accelerator::closest_hits_span(std::span<const Ray> rays, std::span<Hit> hi
   }
 }
 
+void Accelerator::closest_hits_packets(std::span<const Ray> rays, std::span<Hit> hits, const QueryOptions& opts) const {
+  if (hits.size() != rays.size())
+    throw std::invalid_argument("closest_hits_packets: " + name() + ": the hit span differs in size from the ray span");
+  closest_packets_span(rays, hits, opts);
+}
+
+void Accelerator::any_hits_packets(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                                   const QueryOptions& opts) const {
+  if (occluded.size() != rays.size())
+    throw std::invalid_argument("any_hits_packets: " + name() +
+                                ": the occluded span differs in size from the ray span");
+  any_packets_span(rays, occluded, opts);
+}
+
+void Accelerator::closest_packets_span(std::span<const Ray> rays, std::span<Hit> hits, const QueryOptions& opts) const {
+  for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = closest_hit(rays[i], opts);
+}
+
+void Accelerator::any_packets_span(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                                   const QueryOptions& opts) const {
+  for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = any_hit(rays[i], opts) ? 1 : 0;
+}
+
 }  // namespace accelviz

@@ -128,12 +128,36 @@ class Accelerator {
   void closest_hits(std::span<const Ray> rays, std::span<Hit> hits, const QueryOptions& opts,
                     std::span<RayStats> stats = {}) const;
 
+  /// Rays per packet of the packet queries.
+  static constexpr std::size_t kPacketWidth = 8;
+
+  /// True when the structure walks packets of rays together (Bvh's wide fast
+  /// path, Embree's rtcIntersect8/rtcOccluded8); the others answer the
+  /// packet queries one ray at a time.
+  virtual bool has_packets() const { return false; }
+
+  /// Packet queries, counter-free: rays[8k .. 8k+8) form packet k (the last
+  /// may be shorter), walked together where has_packets(). hits[i] is the
+  /// closest hit of rays[i], as closest_hit(rays[i], opts) finds it, except
+  /// that of two triangles hit at exactly the same t either may be reported
+  /// (packets visit leaves in another order); occluded[i] = 1 when anything
+  /// lies on rays[i]. Options the fast path ignores (back_to_front, xray)
+  /// are ignored here too. Packets pay for coherent rays (neighbouring primary
+  /// rays) and cost for incoherent ones: bench reports both. Throws
+  /// std::invalid_argument when the output differs in size from rays.
+  void closest_hits_packets(std::span<const Ray> rays, std::span<Hit> hits, const QueryOptions& opts) const;
+  void any_hits_packets(std::span<const Ray> rays, std::span<std::uint8_t> occluded, const QueryOptions& opts) const;
+
   virtual const BuildStats& build_stats() const = 0;
 
  protected:
   /// closest_hits after its size checks; the default calls closest_hit per ray.
   virtual void closest_hits_span(std::span<const Ray> rays, std::span<Hit> hits, const QueryOptions& opts,
                                  std::span<RayStats> stats) const;
+  /// The packet queries after their size checks; the defaults answer per ray.
+  virtual void closest_packets_span(std::span<const Ray> rays, std::span<Hit> hits, const QueryOptions& opts) const;
+  virtual void any_packets_span(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                                const QueryOptions& opts) const;
 };
 
 }  // namespace accelviz

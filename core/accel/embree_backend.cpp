@@ -204,11 +204,94 @@ Hit EmbreeAccelerator::closest_hit(const Ray& ray, const QueryOptions&, RayStats
   hit.t = rh.ray.tfar;
   hit.u = rh.hit.u;  // Embree's barycentrics follow the same convention: p = (1-u-v)v0 + u v1 + v v2
   hit.v = rh.hit.v;
+  hit.ng = normal_of(hit.prim);
+  return hit;
+}
+
+glm::vec3 EmbreeAccelerator::normal_of(std::uint32_t prim) const {
   // Our unit normal of (v1-v0)x(v2-v0), the same for every structure (Embree's
   // Ng is unnormalised and of the opposite orientation).
-  const float* v = impl_->vertices.data() + 9 * static_cast<std::size_t>(hit.prim);
-  hit.ng = triangle_normal({{v[0], v[1], v[2]}, {v[3], v[4], v[5]}, {v[6], v[7], v[8]}});
-  return hit;
+  const float* v = impl_->vertices.data() + 9 * static_cast<std::size_t>(prim);
+  return triangle_normal({{v[0], v[1], v[2]}, {v[3], v[4], v[5]}, {v[6], v[7], v[8]}});
+}
+
+bool EmbreeAccelerator::has_packets() const {
+  return rtcGetDeviceProperty(impl_->device.get(), RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) != 0;
+}
+
+namespace {
+
+/// Lane l of an RTCRay8 from `ray` (fill_ray's fields); valid[l] = -1.
+void fill_lane(RTCRay8& r, int l, const Ray& ray) {
+  r.org_x[l] = ray.origin.x;
+  r.org_y[l] = ray.origin.y;
+  r.org_z[l] = ray.origin.z;
+  r.tnear[l] = ray.tmin;
+  r.dir_x[l] = ray.direction.x;
+  r.dir_y[l] = ray.direction.y;
+  r.dir_z[l] = ray.direction.z;
+  r.time[l] = 0.0f;
+  r.tfar[l] = ray.tmax;
+  r.mask[l] = 0xFFFFFFFFu;
+  r.id[l] = 0;
+  r.flags[l] = 0;
+}
+
+}  // namespace
+
+void EmbreeAccelerator::closest_packets_span(std::span<const Ray> rays, std::span<Hit> hits,
+                                             const QueryOptions& opts) const {
+  if (!has_packets()) {
+    Accelerator::closest_packets_span(rays, hits, opts);
+    return;
+  }
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  for (std::size_t b = 0; b < rays.size(); b += 8) {
+    const int count = static_cast<int>(std::min<std::size_t>(8, rays.size() - b));
+    alignas(32) int valid[8];
+    RTCRayHit8 rh;
+    for (int l = 0; l < 8; ++l) {
+      valid[l] = l < count ? -1 : 0;
+      if (l < count) fill_lane(rh.ray, l, rays[b + l]);
+      rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.primID[l] = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect8(valid, impl_->scene, &context, &rh);
+    for (int l = 0; l < count; ++l) {
+      Hit hit;
+      if (rh.hit.geomID[l] != RTC_INVALID_GEOMETRY_ID) {
+        hit.prim = rh.hit.primID[l];
+        hit.t = rh.ray.tfar[l];
+        hit.u = rh.hit.u[l];
+        hit.v = rh.hit.v[l];
+        hit.ng = normal_of(hit.prim);
+      }
+      hits[b + l] = hit;
+    }
+  }
+}
+
+void EmbreeAccelerator::any_packets_span(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                                         const QueryOptions& opts) const {
+  if (!has_packets()) {
+    Accelerator::any_packets_span(rays, occluded, opts);
+    return;
+  }
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  for (std::size_t b = 0; b < rays.size(); b += 8) {
+    const int count = static_cast<int>(std::min<std::size_t>(8, rays.size() - b));
+    alignas(32) int valid[8];
+    RTCRay8 r;
+    for (int l = 0; l < 8; ++l) {
+      valid[l] = l < count ? -1 : 0;
+      if (l < count) fill_lane(r, l, rays[b + l]);
+    }
+    rtcOccluded8(valid, impl_->scene, &context, &r);
+    for (int l = 0; l < count; ++l) occluded[b + l] = r.tfar[l] == -kInfinity ? 1 : 0;
+  }
 }
 
 bool EmbreeAccelerator::any_hit(const Ray& ray, const QueryOptions&, RayStats*) const {

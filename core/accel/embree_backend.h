@@ -56,8 +56,19 @@ class EmbreeAccelerator final : public Accelerator {
                   VisitTrace* trace = nullptr) const override;
   bool any_hit(const Ray& ray, const QueryOptions& opts, RayStats* stats = nullptr) const override;
   const BuildStats& build_stats() const override { return stats_; }
+  /// rtcIntersect8/rtcOccluded8 where this Embree build traces packets of
+  /// eight natively (RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED).
+  bool has_packets() const override;
+
+ protected:
+  void closest_packets_span(std::span<const Ray> rays, std::span<Hit> hits, const QueryOptions& opts) const override;
+  void any_packets_span(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                        const QueryOptions& opts) const override;
 
  private:
+  /// Our unit normal of triangle `prim` (as closest_hit reports it).
+  glm::vec3 normal_of(std::uint32_t prim) const;
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
   BuildStats stats_;

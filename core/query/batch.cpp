@@ -83,4 +83,31 @@ bool trace_any(const Accelerator& accel, std::span<const Ray> rays, std::span<st
                    [&](std::size_t i, RayStats* s) { occluded[i] = accel.any_hit(rays[i], query, s) ? 1 : 0; });
 }
 
+namespace {
+
+/// batch with its chunk rounded up to whole packets.
+BatchOptions packet_chunks(BatchOptions batch) {
+  constexpr std::size_t w = Accelerator::kPacketWidth;
+  batch.chunk = (std::max<std::size_t>(batch.chunk, 1) + w - 1) / w * w;
+  return batch;
+}
+
+}  // namespace
+
+bool trace_closest_packets(const Accelerator& accel, std::span<const Ray> rays, std::span<Hit> hits,
+                           const QueryOptions& query, const BatchOptions& batch) {
+  check_sizes(rays.size(), hits.size(), 0, "trace_closest_packets");
+  return for_each_chunk(rays.size(), packet_chunks(batch), [&](std::size_t begin, std::size_t end) {
+    accel.closest_hits_packets(rays.subspan(begin, end - begin), hits.subspan(begin, end - begin), query);
+  });
+}
+
+bool trace_any_packets(const Accelerator& accel, std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                       const QueryOptions& query, const BatchOptions& batch) {
+  check_sizes(rays.size(), occluded.size(), 0, "trace_any_packets");
+  return for_each_chunk(rays.size(), packet_chunks(batch), [&](std::size_t begin, std::size_t end) {
+    accel.any_hits_packets(rays.subspan(begin, end - begin), occluded.subspan(begin, end - begin), query);
+  });
+}
+
 }  // namespace accelviz

@@ -37,6 +37,14 @@ bool trace_closest(const Accelerator& accel, std::span<const Ray> rays, std::spa
 bool trace_any(const Accelerator& accel, std::span<const Ray> rays, std::span<std::uint8_t> occluded,
                const QueryOptions& query, const BatchOptions& batch, std::span<RayStats> stats = {});
 
+/// The packet queries (Accelerator::closest_hits_packets, any_hits_packets)
+/// over all threads: chunks are whole packets of eight consecutive rays, so
+/// the packets are the same for every thread count. Counter-free.
+bool trace_closest_packets(const Accelerator& accel, std::span<const Ray> rays, std::span<Hit> hits,
+                           const QueryOptions& query, const BatchOptions& batch);
+bool trace_any_packets(const Accelerator& accel, std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                       const QueryOptions& query, const BatchOptions& batch);
+
 /// Shorthands with only a thread count.
 inline bool trace_closest(const Accelerator& accel, std::span<const Ray> rays, std::span<Hit> hits,
                           const QueryOptions& query, unsigned threads, std::span<RayStats> stats = {}) {

@@ -96,6 +96,33 @@ TEST(Embree, ClosestAndAnyHitAgreeWithBruteForce) {
   EXPECT_LT(ties, 5);
 }
 
+TEST(Embree, PacketsAgreeWithSingleRays) {
+  // rtcIntersect8/rtcOccluded8 (the reference for our packet figures) on
+  // random rays (incoherent, idle lanes at the end) and camera rays
+  // (coherent) against rtcIntersect1/rtcOccluded1.
+  const std::vector<Triangle> tris = random_soup(3000, 13);
+  std::vector<Ray> rays = random_rays(2001, 14);
+  const std::vector<Ray> camera = primary_rays(frame_bounds(Aabb{glm::vec3(-1.2f), glm::vec3(1.2f)}, 1.0f), 40, 40);
+  rays.insert(rays.end(), camera.begin(), camera.end());
+  const EmbreeAccelerator embree(tris);
+  std::vector<Hit> packet(rays.size());
+  std::vector<std::uint8_t> occluded(rays.size());
+  embree.closest_hits_packets(rays, packet, {});
+  embree.any_hits_packets(rays, occluded, {});
+  int hits = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const Hit single = embree.closest_hit(rays[i], {});
+    ASSERT_EQ(packet[i].valid(), single.valid()) << "ray " << i;
+    if (single.valid()) {
+      ++hits;
+      EXPECT_TRUE(same_t(packet[i].t, single.t)) << "ray " << i << ": " << packet[i].t << " vs " << single.t;
+    }
+    EXPECT_EQ(occluded[i] != 0, embree.any_hit(rays[i], {})) << "ray " << i;
+  }
+  EXPECT_GT(hits, 500);
+  EXPECT_LT(hits, static_cast<int>(rays.size()));
+}
+
 // Embree as a second oracle on the real meshes of ../shared/assets (skipped
 // where they are absent): our BVH (watertight test, the fast path) and
 // Embree in robust mode (its watertight mode) give the same closest hit

@@ -649,7 +649,13 @@ void walk_counted_batch(const BvhView& bvh, std::span<const Ray> rays, std::span
 #define ACCELVIZ_BVH_WIDE8 1
 #endif
 
-/// The 4-wide SSE traversal (bvh_wide_traverse.inl with W = 4).
+/// Eight lanes of the packet walk (bvh_packet_traverse.inl): GCC vectors,
+/// two SSE registers each in the 4-wide code, one AVX register in the 8-wide.
+static_assert(Accelerator::kPacketWidth == 8);
+using PacketF = float __attribute__((vector_size(32)));
+using PacketI = std::int32_t __attribute__((vector_size(32)));
+
+/// The 4-wide SSE traversal (bvh_wide_traverse.inl with W = 4) and its packet walk.
 namespace wide4 {
 constexpr int kWidth = 4;
 using WideSlabRayW = bvh_detail::WideSlabRay;
@@ -657,7 +663,21 @@ using WideSlabRayW = bvh_detail::WideSlabRay;
                                                    float tmax, float* te) {
   return bvh_detail::wide_slab_test(n, r, tmin, tmax, te);
 }
+/// Bit l: lane l of a comparison result (all ones or zero) is set.
+[[gnu::always_inline]] inline int packet_mask(const PacketI& m) {
+#ifdef ACCELVIZ_BVH_SLAB_SSE2
+  using Half = std::int32_t __attribute__((vector_size(16)));
+  const Half lo = __builtin_shufflevector(m, m, 0, 1, 2, 3), hi = __builtin_shufflevector(m, m, 4, 5, 6, 7);
+  return _mm_movemask_ps(reinterpret_cast<__m128>(lo)) | (_mm_movemask_ps(reinterpret_cast<__m128>(hi)) << 4);
+#else
+  int bits = 0;
+  for (int l = 0; l < 8; ++l) bits |= (m[l] != 0 ? 1 : 0) << l;
+  return bits;
+#endif
+}
 #include "core/accel/bvh/bvh_wide_traverse.inl"
+// (after the single-ray walk: the packet walk uses its LeafRay and walk_wide)
+#include "core/accel/bvh/bvh_packet_traverse.inl"
 }  // namespace wide4
 
 #ifdef ACCELVIZ_BVH_WIDE8
@@ -672,7 +692,12 @@ using WideSlabRayW = bvh_detail::WideSlabRay8;
                                                    float tmax, float* te) {
   return bvh_detail::wide_slab_test8(n, r, tmin, tmax, te);
 }
+[[gnu::always_inline]] inline int packet_mask(const PacketI& m) {
+  return _mm256_movemask_ps(reinterpret_cast<__m256>(m));
+}
 #include "core/accel/bvh/bvh_wide_traverse.inl"
+// (after the single-ray walk: the packet walk uses its LeafRay and walk_wide)
+#include "core/accel/bvh/bvh_packet_traverse.inl"
 }  // namespace wide8
 #pragma GCC pop_options
 #endif
@@ -702,6 +727,37 @@ Hit dispatch_wide8([[maybe_unused]] const bvh_detail::WideBvh8& wide, [[maybe_un
 #else
   return Hit{};  // never built without AVX2 support (Bvh checks cpu_has_wide8)
 #endif
+}
+
+/// The packet walk (4-wide SSE) for the query options.
+template <bool AnyHit>
+void dispatch_packets(const bvh_detail::WideBvh& wide, const BvhView& v, std::span<const Ray> rays, Hit* out,
+                      const QueryOptions& qo) {
+  using wide4::traverse_packets;
+  const bool wt = qo.triangle_test == TriangleTest::watertight;
+  if (qo.ordered)
+    wt ? traverse_packets<AnyHit, true, TriangleTest::watertight>(wide, v, rays, out)
+       : traverse_packets<AnyHit, true, TriangleTest::moller_trumbore>(wide, v, rays, out);
+  else
+    wt ? traverse_packets<AnyHit, false, TriangleTest::watertight>(wide, v, rays, out)
+       : traverse_packets<AnyHit, false, TriangleTest::moller_trumbore>(wide, v, rays, out);
+}
+
+/// The packet walk (8-wide AVX2) for the query options.
+template <bool AnyHit>
+void dispatch_packets8([[maybe_unused]] const bvh_detail::WideBvh8& wide, [[maybe_unused]] const BvhView& v,
+                       [[maybe_unused]] std::span<const Ray> rays, [[maybe_unused]] Hit* out,
+                       [[maybe_unused]] const QueryOptions& qo) {
+#ifdef ACCELVIZ_BVH_WIDE8
+  using wide8::traverse_packets;
+  const bool wt = qo.triangle_test == TriangleTest::watertight;
+  if (qo.ordered)
+    wt ? traverse_packets<AnyHit, true, TriangleTest::watertight>(wide, v, rays, out)
+       : traverse_packets<AnyHit, true, TriangleTest::moller_trumbore>(wide, v, rays, out);
+  else
+    wt ? traverse_packets<AnyHit, false, TriangleTest::watertight>(wide, v, rays, out)
+       : traverse_packets<AnyHit, false, TriangleTest::moller_trumbore>(wide, v, rays, out);
+#endif  // never built without AVX2 support (Bvh checks cpu_has_wide8)
 }
 
 template <bool AnyHit, bool Collect>
@@ -753,6 +809,38 @@ void Bvh::closest_hits_span(std::span<const Ray> rays, std::span<Hit> hits, cons
   else
     wt ? walk_counted_batch<false, TriangleTest::watertight>(v, rays, hits, stats)
        : walk_counted_batch<false, TriangleTest::moller_trumbore>(v, rays, hits, stats);
+}
+
+void Bvh::closest_packets_span(std::span<const Ray> rays, std::span<Hit> hits, const QueryOptions& qo) const {
+  if (!has_packets()) {
+    Accelerator::closest_packets_span(rays, hits, qo);
+    return;
+  }
+  const BvhView v{nodes_.data(), blocks_.data(), leaf_block_.data(), prim_indices_.data(), nodes_.size()};
+  if (wide8_)
+    dispatch_packets8<false>(*wide8_, v, rays, hits.data(), qo);
+  else
+    dispatch_packets<false>(*wide_, v, rays, hits.data(), qo);
+  for (Hit& h : hits)
+    if (h.valid()) h.prim = prim_indices_[h.prim];
+}
+
+void Bvh::any_packets_span(std::span<const Ray> rays, std::span<std::uint8_t> occluded, const QueryOptions& qo) const {
+  if (!has_packets()) {
+    Accelerator::any_packets_span(rays, occluded, qo);
+    return;
+  }
+  const BvhView v{nodes_.data(), blocks_.data(), leaf_block_.data(), prim_indices_.data(), nodes_.size()};
+  // In blocks of 64 rays: eight packets' results at a time on the stack.
+  Hit h[64];
+  for (std::size_t b = 0; b < rays.size(); b += 64) {
+    const std::span<const Ray> part = rays.subspan(b, std::min<std::size_t>(64, rays.size() - b));
+    if (wide8_)
+      dispatch_packets8<true>(*wide8_, v, part, h, qo);
+    else
+      dispatch_packets<true>(*wide_, v, part, h, qo);
+    for (std::size_t i = 0; i < part.size(); ++i) occluded[b + i] = h[i].valid() ? 1 : 0;
+  }
 }
 
 bool Bvh::any_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats) const {

@@ -110,6 +110,9 @@ class Bvh final : public Accelerator {
                   VisitTrace* trace = nullptr) const override;
   bool any_hit(const Ray& ray, const QueryOptions& opts, RayStats* stats = nullptr) const override;
   const BuildStats& build_stats() const override { return stats_; }
+  /// Packets walk the wide copy (bvh_packet_traverse.inl); without one
+  /// (wide_traversal off) the packet queries answer per ray.
+  bool has_packets() const override { return wide_ != nullptr || wide8_ != nullptr; }
 
   std::span<const BvhNode> nodes() const { return nodes_; }
   /// Leaf ranges index this array; its values are primitive ids in scene order.
@@ -135,6 +138,9 @@ class Bvh final : public Accelerator {
   /// path per ray.
   void closest_hits_span(std::span<const Ray> rays, std::span<Hit> hits, const QueryOptions& qo,
                          std::span<RayStats> stats) const override;
+  void closest_packets_span(std::span<const Ray> rays, std::span<Hit> hits, const QueryOptions& qo) const override;
+  void any_packets_span(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                        const QueryOptions& qo) const override;
 
  private:
   /// With compute_epo: epo (and epo_ms) over `triangles` in scene order.

@@ -109,7 +109,8 @@ void refit_tri4_blocks(const TriAt& tri, Blocks& blocks) {
 /// Per-ray constants of the four-lane test.
 struct Tri4Ray {
   __m128 ox, oy, oz, sx, sy, sz;
-  int kx, ky, kz;
+  int kx = 0, ky = 1, kz = 2;
+  Tri4Ray() = default;  ///< unset; assign before use
   explicit Tri4Ray(const InlineWatertightRay& r)
       : ox(_mm_set1_ps(r.ox)),
         oy(_mm_set1_ps(r.oy)),
@@ -196,6 +197,7 @@ struct Tri4Result {
 /// Per-ray constants of the four-lane Moller-Trumbore test.
 struct Tri4MtRay {
   __m128 ox, oy, oz, dx, dy, dz;
+  Tri4MtRay() = default;  ///< unset; assign before use
   explicit Tri4MtRay(const Ray& r)
       : ox(_mm_set1_ps(r.origin.x)),
         oy(_mm_set1_ps(r.origin.y)),

@@ -4,6 +4,135 @@
 // WideSlabRayW and wide_slab_test_w (the box test of that width).
 // No includes here: the file is pasted inside a namespace.
 
+/// One ray's side of a leaf: its triangle-test constants (the watertight
+/// ones set up at its first leaf: many rays never reach one) and the loop
+/// over a leaf slot's triangle blocks. The single-ray walk below has one; the
+/// packet walk (bvh_packet_traverse.inl) one per lane, so both test a leaf's
+/// triangles with the same code, in the same order, with the same results.
+template <TriangleTest Test>
+struct LeafRay {
+  const Ray* ray = nullptr;
+  InlineWatertightRay wr;
+  bool wr_ready = Test != TriangleTest::watertight;
+#ifdef ACCELVIZ_BVH_TRI4_SSE2
+  bvh_detail::Tri4Ray tr4;
+  bvh_detail::Tri4MtRay tm4;
+#endif
+
+  LeafRay() = default;
+  [[gnu::always_inline]] explicit LeafRay(const Ray& r) {
+    reset(r);
+  }
+
+  /// Starts over for ray `r` (the packet walk reuses its lanes in place).
+  [[gnu::always_inline]] void reset(const Ray& r) {
+    ray = &r;
+    wr_ready = Test != TriangleTest::watertight;
+#ifdef ACCELVIZ_BVH_TRI4_SSE2
+    if constexpr (Test == TriangleTest::moller_trumbore) tm4 = bvh_detail::Tri4MtRay(r);
+#endif
+  }
+
+  /// Tests leaf slot (first block `child`, `meta` blocks) in lane order.
+  /// Closest hit: keeps the first found at the smallest t in best (with its
+  /// normal) and lowers `closest`; returns false. Any hit: returns true at
+  /// the first hit (in best). best.prim is the leaf position.
+  template <bool AnyHit>
+  [[gnu::always_inline]] bool test(const BvhView& bvh, std::uint32_t child, std::uint32_t meta, float tmin,
+                                   float& closest, Hit& best) {
+    const Ray& r = *ray;
+    const auto take = [&](bool hit, const Hit& h, std::uint32_t k, const Triangle& tri) {
+      if (!hit) return false;
+      if constexpr (AnyHit) {
+        best = h;
+        best.prim = k;
+        return true;
+      }
+      if (h.t < best.t) {
+        best = h;
+        best.prim = k;
+        best.ng = triangle_normal(tri);
+        closest = h.t;
+      }
+      return false;
+    };
+    if (!wr_ready) {
+      wr = InlineWatertightRay(r);
+      wr_ready = true;
+#ifdef ACCELVIZ_BVH_TRI4_SSE2
+      if constexpr (Test == TriangleTest::watertight) tr4 = bvh_detail::Tri4Ray(wr);
+#endif
+    }
+#ifdef ACCELVIZ_BVH_TRI4_SSE2
+    if constexpr (Test == TriangleTest::watertight) {
+      // Watertight leaves, four triangles per test (bvh_tri4.h). Lanes in
+      // slot order are the leaf's triangles in order: the same sequence of
+      // tests and acceptances as the scalar loop below.
+      const bvh_detail::TriBlock4* const end = bvh.blocks + child + meta;
+      for (const bvh_detail::TriBlock4* blk = bvh.blocks + child; blk != end; ++blk) {
+        const int valid = bvh_detail::tri4_used_lanes(*blk);
+        bvh_detail::Tri4Result res;
+        bvh_detail::intersect_tri4(*blk, tr4, tmin, res);
+        int lanes = (res.candidate | res.special) & valid;
+        while (lanes != 0) {
+          const int l = std::countr_zero(static_cast<unsigned>(lanes));
+          lanes &= lanes - 1;
+          const std::uint32_t k = blk->pos[l];
+          const Triangle tri = bvh_detail::tri4_triangle(*blk, static_cast<std::uint32_t>(l));
+          Hit h;
+          bool hit;
+          if ((res.special >> l) & 1) {
+            hit = intersect_watertight(r, wr.wr, tri, tmin, closest, h);
+          } else {
+            hit = bvh_detail::tri4_accept(res, l, closest);
+            h.t = res.t[l];
+            h.u = res.u[l];
+            h.v = res.v[l];
+          }
+          if (take(hit, h, k, tri)) return true;
+        }
+      }
+      return false;
+    } else if constexpr (Test == TriangleTest::moller_trumbore) {
+      // Moller-Trumbore leaves, four triangles per test: lanes in order, each
+      // accepted against the closest hit so far, as the scalar loop below
+      // would (t <= tmax is the scalar test's last check).
+      const bvh_detail::TriBlock4* const end = bvh.blocks + child + meta;
+      for (const bvh_detail::TriBlock4* blk = bvh.blocks + child; blk != end; ++blk) {
+        const int valid = bvh_detail::tri4_used_lanes(*blk);
+        bvh_detail::Tri4MtResult res;
+        bvh_detail::intersect_tri4_mt(*blk, tm4, tmin, res);
+        int lanes = res.candidate & valid;
+        while (lanes != 0) {
+          const int l = std::countr_zero(static_cast<unsigned>(lanes));
+          lanes &= lanes - 1;
+          if (!(res.t[l] <= closest)) continue;
+          Hit h;
+          h.t = res.t[l];
+          h.u = res.u[l];
+          h.v = res.v[l];
+          if (take(true, h, blk->pos[l], bvh_detail::tri4_triangle(*blk, static_cast<std::uint32_t>(l)))) return true;
+        }
+      }
+      return false;
+    } else
+#endif
+    {
+      // A wide leaf slot names its first block and its block count; the
+      // leaf's triangles are its blocks' used lanes in order.
+      for (std::uint32_t j = 0; j < 4 * meta; ++j) {
+        const bvh_detail::TriBlock4& blk = bvh.blocks[child + (j >> 2)];
+        if (blk.pos[j & 3] == bvh_detail::kTri4Empty) continue;
+        const Triangle tri = bvh_detail::tri4_triangle(blk, j & 3);
+        Hit h;
+        const bool hit = test_triangle<Test>(r, wr, tri, tmin, closest, h);
+        if (take(hit, h, blk.pos[j & 3], tri)) return true;
+      }
+      return false;
+    }
+  }
+};
+
 /// Fast-path traversal of the W-wide copy (no statistics). Same contract as
 /// traverse<AnyHit, Ordered, false, Test>: hits on the same triangles, ties
 /// kept by "first found at the smallest t".
@@ -13,50 +142,26 @@
 ///  - Unordered: slot order.
 /// Stack: at most W - 1 entries per wide level, and a wide path is no longer
 /// than the binary one (kBvhMaxDepth).
+///
+/// walk_wide is that walk from slot (child, meta) on (0, 0: the root), with
+/// the closest hit so far in closest/best (its leaf tests by `leaf`): what
+/// traverse_wide runs from the root, and the packet walk for a lane that
+/// goes on alone. Returns true when an any-hit walk found a hit.
 template <bool AnyHit, bool Ordered, TriangleTest Test>
-Hit traverse_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& bvh, const Ray& ray) {
+[[gnu::always_inline]] inline bool walk_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& bvh,
+                                             const Ray& ray, LeafRay<Test>& leaf, std::uint32_t child,
+                                             std::uint32_t meta, float& closest, Hit& best) {
   using WideNode = bvh_detail::WideNodeT<kWidth>;
   const WideNode* wide = wide_bvh.nodes.data();
-  Hit best;
   const WideSlabRayW wrw(ray);
   const float tmin = ray.tmin;
-  float closest = ray.tmax;
-  InlineWatertightRay wr;
-  bool wr_ready = Test != TriangleTest::watertight;
-#ifdef ACCELVIZ_BVH_TRI4_SSE2
-  // Watertight leaves: four triangles per test (bvh_tri4.h).
-  constexpr bool kTri4 = Test == TriangleTest::watertight;
-  bvh_detail::Tri4Ray tr4(wr);
-  // Moller-Trumbore leaves: the same, four triangles per test.
-  constexpr bool kTri4Mt = Test == TriangleTest::moller_trumbore;
-  const bvh_detail::Tri4MtRay tm4(ray);
-#endif
 
   struct Entry {
     std::uint32_t child, meta;
     float t_entry;
   };
   Entry stack[(kWidth - 1) * kBvhMaxDepth + 1];
-  // A triangle test's outcome for leaf position k: any hit ends the walk
-  // (returns true); closest hit keeps the first found at the smallest t.
-  // `tri`: the triangle (for the closest hit's normal).
-  const auto take = [&](bool hit, const Hit& h, std::uint32_t k, const Triangle& tri) {
-    if (!hit) return false;
-    if constexpr (AnyHit) {
-      best = h;
-      best.prim = k;
-      return true;
-    }
-    if (h.t < best.t) {
-      best = h;
-      best.prim = k;
-      best.ng = triangle_normal(tri);
-      closest = h.t;
-    }
-    return false;
-  };
   unsigned sp = 0;
-  std::uint32_t child = 0, meta = 0;  // the wide root
   for (;;) {
     if (meta == 0) {
       const WideNode& n = wide[child];
@@ -106,77 +211,11 @@ Hit traverse_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& b
         meta = n.meta[slot[0]];
         continue;
       }
-    } else {
-      if (!wr_ready) {
-        wr = InlineWatertightRay(ray);
-        wr_ready = true;
-#ifdef ACCELVIZ_BVH_TRI4_SSE2
-        if constexpr (kTri4) tr4 = bvh_detail::Tri4Ray(wr);
-#endif
-      }
-#ifdef ACCELVIZ_BVH_TRI4_SSE2
-      if constexpr (kTri4) {
-        // Lanes in slot order are the leaf's triangles in order: the same
-        // sequence of tests and acceptances as the scalar loop below.
-        const bvh_detail::TriBlock4* const end = bvh.blocks + child + meta;
-        for (const bvh_detail::TriBlock4* blk = bvh.blocks + child; blk != end; ++blk) {
-          const int valid = bvh_detail::tri4_used_lanes(*blk);
-          bvh_detail::Tri4Result r;
-          bvh_detail::intersect_tri4(*blk, tr4, tmin, r);
-          int lanes = (r.candidate | r.special) & valid;
-          while (lanes != 0) {
-            const int l = std::countr_zero(static_cast<unsigned>(lanes));
-            lanes &= lanes - 1;
-            const std::uint32_t k = blk->pos[l];
-            const Triangle tri = bvh_detail::tri4_triangle(*blk, static_cast<std::uint32_t>(l));
-            Hit h;
-            bool hit;
-            if ((r.special >> l) & 1) {
-              hit = intersect_watertight(ray, wr.wr, tri, tmin, closest, h);
-            } else {
-              hit = bvh_detail::tri4_accept(r, l, closest);
-              h.t = r.t[l];
-              h.u = r.u[l];
-              h.v = r.v[l];
-            }
-            if (take(hit, h, k, tri)) return best;
-          }
-        }
-      } else if constexpr (kTri4Mt) {
-        // Lanes in order, each accepted against the closest hit so far, as
-        // the scalar loop below would (t <= tmax is the scalar test's last check).
-        const bvh_detail::TriBlock4* const end = bvh.blocks + child + meta;
-        for (const bvh_detail::TriBlock4* blk = bvh.blocks + child; blk != end; ++blk) {
-          const int valid = bvh_detail::tri4_used_lanes(*blk);
-          bvh_detail::Tri4MtResult r;
-          bvh_detail::intersect_tri4_mt(*blk, tm4, tmin, r);
-          int lanes = r.candidate & valid;
-          while (lanes != 0) {
-            const int l = std::countr_zero(static_cast<unsigned>(lanes));
-            lanes &= lanes - 1;
-            if (!(r.t[l] <= closest)) continue;
-            Hit h;
-            h.t = r.t[l];
-            h.u = r.u[l];
-            h.v = r.v[l];
-            if (take(true, h, blk->pos[l], bvh_detail::tri4_triangle(*blk, static_cast<std::uint32_t>(l)))) return best;
-          }
-        }
-      } else
-#endif
-        // A wide leaf slot names its first block and its block count; the
-        // leaf's triangles are its blocks' used lanes in order.
-        for (std::uint32_t j = 0; j < 4 * meta; ++j) {
-          const bvh_detail::TriBlock4& blk = bvh.blocks[child + (j >> 2)];
-          if (blk.pos[j & 3] == bvh_detail::kTri4Empty) continue;
-          const Triangle tri = bvh_detail::tri4_triangle(blk, j & 3);
-          Hit h;
-          const bool hit = test_triangle<Test>(ray, wr, tri, tmin, closest, h);
-          if (take(hit, h, blk.pos[j & 3], tri)) return best;
-        }
+    } else if (leaf.template test<AnyHit>(bvh, child, meta, tmin, closest, best)) {
+      return true;
     }
     for (;;) {
-      if (sp == 0) return best;
+      if (sp == 0) return false;
       const Entry e = stack[--sp];
       if (!AnyHit && e.t_entry > closest) continue;
       child = e.child;
@@ -184,4 +223,13 @@ Hit traverse_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& b
       break;
     }
   }
+}
+
+template <bool AnyHit, bool Ordered, TriangleTest Test>
+Hit traverse_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& bvh, const Ray& ray) {
+  Hit best;
+  float closest = ray.tmax;
+  LeafRay<Test> leaf(ray);
+  walk_wide<AnyHit, Ordered, Test>(wide_bvh, bvh, ray, leaf, 0, 0, closest, best);
+  return best;
 }

@@ -1,0 +1,226 @@
+// Packet traversal of the wide BVH: eight rays walk the tree together (Wald,
+// Slusallek, Benthin & Wagner 2001; on wide trees as Embree's rtcIntersect8).
+// Included by bvh.cpp right after bvh_wide_traverse.inl, in the same two
+// namespaces: once for the 4-wide SSE nodes, once compiled for AVX2 over the
+// 8-wide nodes. The includer defines, before the include: kWidth,
+// PacketF/PacketI (8-lane GCC vectors of float and int32) and packet_mask
+// (bit l = lane l of a comparison result).
+// No includes here: the file is pasted inside a namespace.
+//
+// Each box of a wide node is tested against all eight rays with one set of
+// vector operations (ray-parallel: lane l is ray l), instead of each ray
+// testing all boxes (box-parallel: the single-ray walk above). A node is
+// fetched once for the packet, and the walk's decisions (mask, order, push,
+// pop) are made once per node for all its rays. It pays when the rays of a
+// packet visit mostly the same nodes: primary rays of neighbouring pixels.
+// Incoherent rays (diffuse bounces) visit the union of their paths with
+// most lanes idle; bench reports both so the difference can be seen.
+//
+// The results are the single-ray walk's: each lane's box test is
+// intersect_slab's arithmetic on its own ray (near and far planes chosen by
+// that ray's direction signs, max/min ignoring NaN in the same operand
+// order, the exit padded by the same factor), so a lane enters exactly the
+// boxes its ray would enter at the same closest distance; leaves are tested
+// per lane by LeafRay, the single-ray walk's own leaf code. Only the order of
+// the leaves can differ (children are ordered by their nearest lane), which
+// can change which of two triangles at exactly the same t is reported.
+
+/// Smallest lane (the packet's nearest entry into a box; +inf lanes are idle).
+[[gnu::always_inline]] inline float packet_min(const PacketF& v) {
+  float m = v[0];
+  for (int l = 1; l < 8; ++l) m = v[l] < m ? v[l] : m;
+  return m;
+}
+
+/// A subtree entered by at most this many lanes is walked by each of them
+/// alone (walk_wide), as Embree's hybrid traversal switches to single rays.
+/// 4 of 8: on the bunny and the dragon, 1 left diffuse rays at 0.86-0.90x
+/// of single rays, 3-6 at 0.94-1.04x, primary rays the same for all
+/// (docs/performance.md, "Packet queries").
+constexpr int kAloneLanes = 4;
+
+/// Walks rays[0 .. count) (count 1..8) through the W-wide copy together and
+/// writes each ray's result to out[l]: the hit the single-ray walk
+/// traverse_wide<AnyHit, Ordered, Test> returns (best.prim a leaf position).
+///  - Ordered (closest hit): a node's hit children are visited nearest first
+///    by their packet's smallest entry distance; the others are pushed with
+///    each lane's entry distance, and on pop a lane whose entry lies beyond
+///    its closest hit drops out (the node is skipped when none is left).
+///  - Any hit: slot order (sorting by the nearest lane was slower on the
+///    bunny's any hits, 0.85-0.86x instead of 0.90-0.94x of Embree on
+///    diffuse and shadow rays); a lane that finds a hit drops out (its box tests
+///    always miss from then on), the walk ends when all lanes have.
+template <bool AnyHit, bool Ordered, TriangleTest Test>
+void traverse_packet(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& bvh, const Ray* rays, int count,
+                     Hit* out) {
+  using WideNode = bvh_detail::WideNodeT<kWidth>;
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  const WideNode* wide = wide_bvh.nodes.data();
+  // Lane l: ray l. Unused lanes (count < 8) get an empty interval
+  // [+inf, -inf], so no box test ever hits in them.
+  const PacketF zero{}, inf = kInf - zero, minus_inf = -kInf - zero;
+  PacketF org[3], inv[3], tmin = inf, closest = minus_inf;
+  PacketI neg[3];
+  for (int a = 0; a < 3; ++a) {
+    org[a] = zero;
+    inv[a] = zero;
+    neg[a] = PacketI{};
+  }
+  LeafRay<Test> leaf[8];
+  Hit best[8];
+  for (int l = 0; l < count; ++l) {
+    const Ray& r = rays[l];
+    for (int a = 0; a < 3; ++a) {
+      org[a][l] = r.origin[a];
+      inv[a][l] = r.inv_dir[a];
+      neg[a][l] = r.inv_dir[a] < 0.0f ? -1 : 0;  // as intersect_slab: hi is the near plane
+    }
+    tmin[l] = r.tmin;
+    closest[l] = r.tmax;
+    leaf[l].reset(r);
+  }
+  // Coherent packets (primary rays of neighbouring pixels) have the same
+  // direction signs in every lane: then each axis's near and far rows of the
+  // node are the same for all lanes, as in the single-ray test, and the
+  // per-lane plane selection is skipped.
+  bool uniform = true;
+  int near_row[3], far_row[3];
+  for (int a = 0; a < 3; ++a) {
+    const bool first_neg = neg[a][0] != 0;
+    for (int l = 1; l < count; ++l) uniform = uniform && (neg[a][l] != 0) == first_neg;
+    near_row[a] = first_neg ? 3 + a : a;
+    far_row[a] = first_neg ? a : 3 + a;
+  }
+  const PacketI lane_bit = {1, 2, 4, 8, 16, 32, 64, 128};
+  const int live = (1 << count) - 1;
+  int done = 0;  // any hit: lanes that found one
+
+  struct alignas(32) Entry {
+    PacketF t_entry;  ///< per lane; +inf where the lane missed the box
+    std::uint32_t child, meta;
+    int lanes;  ///< lanes that hit the box
+  };
+  Entry stack[(kWidth - 1) * kBvhMaxDepth + 1];
+  unsigned sp = 0;
+  std::uint32_t child = 0, meta = 0;  // the wide root
+  int lanes = live;                   // lanes that enter the current node
+  for (;;) {
+    if (meta == 0 && std::popcount(static_cast<unsigned>(lanes)) <= kAloneLanes) {
+      // Few lanes left in this subtree (incoherent rays part early): each
+      // walks it alone, single-ray style, instead of dragging idle lanes.
+      for (int ls = lanes; ls != 0; ls &= ls - 1) {
+        const int l = std::countr_zero(static_cast<unsigned>(ls));
+        float c = closest[l];
+        if (walk_wide<AnyHit, Ordered, Test>(wide_bvh, bvh, rays[l], leaf[l], child, meta, c, best[l])) {
+          done |= 1 << l;
+          closest[l] = -kInf;
+        } else if constexpr (!AnyHit) {
+          closest[l] = c;
+        }
+      }
+      if (AnyHit && done == live) break;
+    } else if (meta == 0) {
+      const WideNode& n = wide[child];
+      // Lanes not entering this node get an empty interval, as unused lanes.
+      const PacketF tmax = (PacketI{} + lanes) & lane_bit ? closest : minus_inf;
+      int slot[kWidth], hit_lanes[kWidth], k = 0;
+      PacketF te[kWidth];
+      float key[kWidth];
+      for (int s = 0; s < kWidth; ++s) {
+        if (n.meta[s] == bvh_detail::kWideEmpty) continue;
+        PacketF t0 = tmin, t1 = tmax;
+        for (int a = 0; a < 3; ++a) {
+          // x - (+0) is x for every float (-0 and NaN too): an exact broadcast.
+          PacketF near_plane, far_plane;
+          if (uniform) {
+            near_plane = n.bounds[near_row[a]][s] - zero;
+            far_plane = n.bounds[far_row[a]][s] - zero;
+          } else {
+            const PacketF lo = n.bounds[a][s] - zero, hi = n.bounds[3 + a][s] - zero;
+            near_plane = neg[a] ? hi : lo;
+            far_plane = neg[a] ? lo : hi;
+          }
+          const PacketF tn = (near_plane - org[a]) * inv[a];
+          const PacketF tf = ((far_plane - org[a]) * inv[a]) * kSlabExitScale;
+          t0 = tn > t0 ? tn : t0;  // maxps(tn, t0): NaN keeps t0
+          t1 = tf < t1 ? tf : t1;  // minps(tf, t1): NaN keeps t1
+        }
+        const PacketI hit = t0 <= t1;
+        const int m = packet_mask(hit) & lanes;
+        if (m == 0) continue;
+        slot[k] = s;
+        hit_lanes[k] = m;
+        te[k] = hit ? t0 : inf;
+        if constexpr (Ordered && !AnyHit) key[k] = packet_min(te[k]);
+        ++k;
+      }
+      if (k != 0) {
+        int order[kWidth];
+        for (int i = 0; i < k; ++i) order[i] = i;
+        if constexpr (Ordered && !AnyHit) {
+          // Insertion sort by the packet's nearest entry; ties keep slot order.
+          for (int i = 1; i < k; ++i) {
+            const int v = order[i];
+            int j = i;
+            while (j > 0 && key[order[j - 1]] > key[v]) {
+              order[j] = order[j - 1];
+              --j;
+            }
+            order[j] = v;
+          }
+        }
+        for (int j = k - 1; j >= 1; --j) {
+          const int i = order[j];
+          const std::uint32_t c = n.child[slot[i]], m = n.meta[slot[i]];
+          const char* p =
+              m == 0 ? reinterpret_cast<const char*>(wide + c) : reinterpret_cast<const char*>(bvh.blocks + c);
+          __builtin_prefetch(p);
+          __builtin_prefetch(p + 64);
+          __builtin_prefetch(p + 128);
+          if (m == 0) __builtin_prefetch(p + 192);
+          stack[sp++] = {te[i], c, m, hit_lanes[i]};
+        }
+        child = n.child[slot[order[0]]];
+        meta = n.meta[slot[order[0]]];
+        lanes = hit_lanes[order[0]];
+        continue;
+      }
+    } else {
+      for (int ls = lanes; ls != 0; ls &= ls - 1) {
+        const int l = std::countr_zero(static_cast<unsigned>(ls));
+        float c = closest[l];
+        if (leaf[l].template test<AnyHit>(bvh, child, meta, tmin[l], c, best[l])) {
+          done |= 1 << l;
+          closest[l] = -kInf;  // its box tests miss from now on
+        } else if constexpr (!AnyHit) {
+          closest[l] = c;
+        }
+      }
+      if (AnyHit && done == live) break;
+    }
+    bool more = false;
+    while (sp != 0) {
+      const Entry& e = stack[--sp];
+      const int m = e.lanes & packet_mask(e.t_entry <= closest);
+      if (m == 0) continue;  // every lane's entry lies beyond its closest hit (or it is done)
+      child = e.child;
+      meta = e.meta;
+      lanes = m;
+      more = true;
+      break;
+    }
+    if (!more) break;
+  }
+  for (int l = 0; l < count; ++l) out[l] = best[l];
+}
+
+/// traverse_packet over a span, in packets of eight consecutive rays (the
+/// last one shorter).
+template <bool AnyHit, bool Ordered, TriangleTest Test>
+void traverse_packets(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& bvh, std::span<const Ray> rays,
+                      Hit* out) {
+  for (std::size_t b = 0; b < rays.size(); b += 8) {
+    const int count = static_cast<int>(std::min<std::size_t>(8, rays.size() - b));
+    traverse_packet<AnyHit, Ordered, Test>(wide_bvh, bvh, rays.data() + b, count, out + b);
+  }
+}
