@@ -34,9 +34,10 @@
 
 /// A subtree entered by at most this many lanes is walked by each of them
 /// alone (walk_wide), as Embree's hybrid traversal switches to single rays.
-/// 4 of 8: on the bunny and the dragon, 1 left diffuse rays at 0.86-0.90x
-/// of single rays, 3-6 at 0.94-1.04x, primary rays the same for all
-/// (docs/performance.md, "Packet queries").
+/// Diffuse rays in packets, against the same rays one at a time (bunny and
+/// dragon, three alternated rounds): never alone 0.84-0.97x, alone at one
+/// lane 0.92-1.01x, at up to three or four 0.94-1.05x; primary rays the same
+/// for all (docs/performance.md, "Packet queries").
 constexpr int kAloneLanes = 4;
 
 /// Walks rays[0 .. count) (count 1..8) through the W-wide copy together and
