@@ -135,6 +135,52 @@ TEST(BvhPackets, SharedMeshesCameraRaysAnswerAsSingleRays) {
   if (tested == 0) GTEST_SKIP() << "no mesh of " << ACCELVIZ_SHARED_ASSETS << " present";
 }
 
+TEST(BvhPackets, ParallelRaysThroughSharedEdgesAndVerticesInOneLeaf) {
+  // Packets of parallel rays (one sheared axis set for all lanes: the
+  // ray-parallel triangle test) aimed exactly at the shared edges and the
+  // shared vertex of a fan of eight triangles kept in one leaf, so the packet
+  // and the single ray test the same triangles in the same order: the very
+  // same triangle, t, u and v, including the lanes whose edge function is
+  // exactly zero (answered by the scalar test, as for a single ray).
+  std::vector<Triangle> fan;
+  const glm::vec3 c(0.0f, 0.0f, 0.0f);
+  const glm::vec3 rim[8] = {{1, 0, 0},  {1, 1, 0},   {0, 1, 0},  {-1, 1, 0},
+                            {-1, 0, 0}, {-1, -1, 0}, {0, -1, 0}, {1, -1, 0}};
+  for (int i = 0; i < 8; ++i) fan.push_back({c, rim[i], rim[(i + 1) % 8]});
+  BvhOptions o;
+  o.compute_epo = false;
+  o.max_leaf_size = 16;
+  const Bvh bvh(fan, o);
+  std::vector<Ray> rays;
+  for (const glm::vec3 d : {glm::vec3(0, 0, -1), glm::vec3(0.25f, 0.125f, -1), glm::vec3(-0.5f, 0.25f, -1)})
+    for (int y = -8; y <= 8; ++y)
+      for (int x = -8; x <= 8; ++x) {
+        // Points on the axes, the diagonals and the rim's edges (multiples of 1/8).
+        const glm::vec3 target(x / 8.0f, y / 8.0f, 0.0f);
+        rays.emplace_back(target - d, d);
+      }
+  for (TriangleTest test : {TriangleTest::watertight, TriangleTest::moller_trumbore}) {
+    QueryOptions q;
+    q.triangle_test = test;
+    std::vector<Hit> packet(rays.size());
+    std::vector<std::uint8_t> occluded(rays.size());
+    bvh.closest_hits_packets(rays, packet, q);
+    bvh.any_hits_packets(rays, occluded, q);
+    std::size_t hits = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      const Hit single = bvh.closest_hit(rays[i], q);
+      ASSERT_EQ(packet[i].prim, single.prim) << "ray " << i;
+      ASSERT_EQ(occluded[i] != 0, bvh.any_hit(rays[i], q)) << "ray " << i;
+      if (!single.valid()) continue;
+      ++hits;
+      EXPECT_EQ(packet[i].t, single.t) << "ray " << i;
+      EXPECT_EQ(packet[i].u, single.u) << "ray " << i;
+      EXPECT_EQ(packet[i].v, single.v) << "ray " << i;
+    }
+    EXPECT_GT(hits, rays.size() / 2);
+  }
+}
+
 TEST(BvhPackets, EveryPacketLengthAndOffset) {
   // Spans of 1..19 rays starting anywhere: short last packets, idle lanes.
   const std::vector<Triangle> tris = test_scenes::soup(23, 2000, 0.06f);

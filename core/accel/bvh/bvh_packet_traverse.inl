@@ -40,6 +40,96 @@
 /// for all (docs/performance.md, "Packet queries").
 constexpr int kAloneLanes = 4;
 
+/// One triangle against the packet's lanes at once (ray-parallel), the
+/// single-ray four-lane tests of bvh_tri4.h with the roles swapped: each
+/// lane does its ray's operations of intersect_tri4 (watertight; all lanes
+/// must share the sheared axes kx, ky, kz) or intersect_tri4_mt, in the same
+/// order, so each lane's T, det, t, u, v, candidate and special bits are bit
+/// for bit those the ray's own test gives for this triangle. tmax is applied
+/// afterwards lane by lane, as the single-ray leaf loop does.
+struct PacketTriRays {
+  PacketF ox, oy, oz, sx, sy, sz;  ///< watertight: origin[kx], [ky], [kz] and the shear, per lane
+  int kx = 0, ky = 1, kz = 2;
+  PacketF org[3], dir[3];  ///< Moller-Trumbore: origin and direction per lane
+};
+struct PacketTriResult {
+  PacketF T, det, t, u, v;
+  int candidate = 0, special = 0;
+};
+
+/// Block lane j of `b` against the packet: intersect_tri4's operations per ray.
+[[gnu::always_inline]] inline void packet_tri_watertight(const bvh_detail::TriBlock4& b, int j, const PacketTriRays& r,
+                                                         const PacketF& tmin, PacketTriResult& out) {
+  const PacketF Ax = b.v[0 + r.kx][j] - r.ox, Ay = b.v[0 + r.ky][j] - r.oy, Az = b.v[0 + r.kz][j] - r.oz;
+  const PacketF Bx = b.v[3 + r.kx][j] - r.ox, By = b.v[3 + r.ky][j] - r.oy, Bz = b.v[3 + r.kz][j] - r.oz;
+  const PacketF Cx = b.v[6 + r.kx][j] - r.ox, Cy = b.v[6 + r.ky][j] - r.oy, Cz = b.v[6 + r.kz][j] - r.oz;
+  const PacketF ax = Ax - r.sx * Az, ay = Ay - r.sy * Az;
+  const PacketF bx = Bx - r.sx * Bz, by = By - r.sy * Bz;
+  const PacketF cx = Cx - r.sx * Cz, cy = Cy - r.sy * Cz;
+  const PacketF U = cx * by - cy * bx;
+  const PacketF V = ax * cy - ay * cx;
+  const PacketF W = bx * ay - by * ax;
+  const PacketF det = (U + V) + W;
+  // x - x is 0 for finite x, NaN (compares false) for inf and NaN.
+  const PacketI special = (U == 0.0f) | (V == 0.0f) | (W == 0.0f) | ~((det - det) == 0.0f);
+  const PacketI any_neg = (U < 0.0f) | (V < 0.0f) | (W < 0.0f);
+  const PacketI any_pos = (U > 0.0f) | (V > 0.0f) | (W > 0.0f);
+  PacketI ok = ~(any_neg & any_pos) & (det != 0.0f);
+  if (packet_mask(ok | special) == 0) {
+    out.candidate = out.special = 0;
+    return;
+  }
+  const PacketF low = 1e-30f - PacketF{};
+  const PacketI tiny_det = ok & ((PacketF)((PacketI)det & 0x7FFFFFFF) < low);  // |det| (vector casts: the bits)
+  const PacketF az = r.sz * Az, bz = r.sz * Bz, cz = r.sz * Cz;
+  const PacketF T = (U * az + V * bz) + W * cz;
+  const PacketI bad_T = ~((T - T) == 0.0f) | (((PacketF)((PacketI)T & 0x7FFFFFFF) < low) & (T != 0.0f));
+  const PacketI special_late = ~tiny_det & (ok & bad_T);
+  const PacketI late = tiny_det | special_late;
+  ok = ~late & ok;
+  const PacketF tmin_det = tmin * det;
+  const PacketI pos = det > 0.0f;
+  ok = ok & ((pos & (T >= tmin_det)) | (~pos & (T <= tmin_det)));
+  const PacketF rcp = 1.0f / det;
+  const PacketF t = T * rcp;
+  ok = ok & (t >= tmin);
+  out.T = T;
+  out.det = det;
+  out.t = t;
+  out.u = V * rcp;
+  out.v = W * rcp;
+  const int sp = packet_mask(special);
+  out.special = sp | (packet_mask(late) & ~sp);
+  out.candidate = packet_mask(ok) & ~sp;
+}
+
+/// Block lane j of `b` against the packet: intersect_tri4_mt's operations per ray.
+[[gnu::always_inline]] inline void packet_tri_mt(const bvh_detail::TriBlock4& b, int j, const PacketTriRays& r,
+                                                 const PacketF& tmin, PacketTriResult& out) {
+  const float v0x = b.v[0][j], v0y = b.v[1][j], v0z = b.v[2][j];
+  const float e1x = b.v[3][j] - v0x, e1y = b.v[4][j] - v0y, e1z = b.v[5][j] - v0z;
+  const float e2x = b.v[6][j] - v0x, e2y = b.v[7][j] - v0y, e2z = b.v[8][j] - v0z;
+  const PacketF &dx = r.dir[0], &dy = r.dir[1], &dz = r.dir[2];
+  const PacketF px = dy * e2z - e2y * dz;
+  const PacketF py = dz * e2x - e2z * dx;
+  const PacketF pz = dx * e2y - e2x * dy;
+  const PacketF det = (e1x * px + e1y * py) + e1z * pz;
+  const PacketF inv = 1.0f / det;
+  const PacketF sx = r.org[0] - v0x, sy = r.org[1] - v0y, sz = r.org[2] - v0z;
+  const PacketF u = ((sx * px + sy * py) + sz * pz) * inv;
+  const PacketF qx = sy * e1z - e1y * sz;
+  const PacketF qy = sz * e1x - e1z * sx;
+  const PacketF qz = sx * e1y - e1x * sy;
+  const PacketF v = ((dx * qx + dy * qy) + dz * qz) * inv;
+  const PacketF t = ((e2x * qx + e2y * qy) + e2z * qz) * inv;
+  const PacketI reject = (det == 0.0f) | (u < 0.0f) | (u > 1.0f) | (v < 0.0f) | ((u + v) > 1.0f);
+  out.t = t;
+  out.u = u;
+  out.v = v;
+  out.candidate = packet_mask(~reject & (t >= tmin));
+  out.special = 0;
+}
+
 /// Walks rays[0 .. count) (count 1..8) through the W-wide copy together and
 /// writes each ray's result to out[l]: the hit the single-ray walk
 /// traverse_wide<AnyHit, Ordered, Test> returns (best.prim a leaf position).
@@ -93,6 +183,9 @@ void traverse_packet(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView
     far_row[a] = first_neg ? a : 3 + a;
   }
   const PacketI lane_bit = {1, 2, 4, 8, 16, 32, 64, 128};
+  PacketTriRays tri;  // the ray-parallel triangle test's constants, set at the first leaf
+  int tri_mode = -1;  // -1: not yet set up; 1: ray-parallel leaves; 0: lane by lane
+
   const int live = (1 << count) - 1;
   int done = 0;  // any hit: lanes that found one
 
@@ -187,16 +280,97 @@ void traverse_packet(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView
         continue;
       }
     } else {
-      for (int ls = lanes; ls != 0; ls &= ls - 1) {
-        const int l = std::countr_zero(static_cast<unsigned>(ls));
-        float c = closest[l];
-        if (leaf[l].template test<AnyHit>(bvh, child, meta, tmin[l], c, best[l])) {
-          done |= 1 << l;
-          closest[l] = -kInf;  // its box tests miss from now on
-        } else if constexpr (!AnyHit) {
-          closest[l] = c;
+      if (tri_mode < 0) {
+        // First leaf of this packet: set up the ray-parallel triangle test
+        // when every lane's watertight set-up shears the same axes.
+        tri_mode = 1;
+        for (int l = 0; l < count; ++l) {
+          leaf[l].prepare();
+          if constexpr (Test == TriangleTest::watertight) {
+            const WatertightRay& w = leaf[l].wr.wr;
+            const WatertightRay& w0 = leaf[0].wr.wr;
+            if (w.kx != w0.kx || w.ky != w0.ky || w.kz != w0.kz) tri_mode = 0;
+            tri.ox[l] = leaf[l].wr.ox;
+            tri.oy[l] = leaf[l].wr.oy;
+            tri.oz[l] = leaf[l].wr.oz;
+            tri.sx[l] = w.sx;
+            tri.sy[l] = w.sy;
+            tri.sz[l] = w.sz;
+          } else {
+            for (int a = 0; a < 3; ++a) tri.dir[a][l] = rays[l].direction[a];
+          }
         }
+        if constexpr (Test == TriangleTest::watertight) {
+          tri.kx = leaf[0].wr.wr.kx;
+          tri.ky = leaf[0].wr.wr.ky;
+          tri.kz = leaf[0].wr.wr.kz;
+        } else {
+          for (int a = 0; a < 3; ++a) tri.org[a] = org[a];
+        }
+        if constexpr (Test != TriangleTest::watertight && Test != TriangleTest::moller_trumbore) tri_mode = 0;
       }
+      if (tri_mode == 1 && std::popcount(static_cast<unsigned>(lanes)) > 1) {
+        // Each triangle once for all lanes; per lane the single-ray leaf
+        // loop's order (blocks, then lanes of a block) and acceptance.
+        int act = lanes;
+        const bvh_detail::TriBlock4* const end = bvh.blocks + child + meta;
+        for (const bvh_detail::TriBlock4* blk = bvh.blocks + child; blk != end && act != 0; ++blk) {
+          const int valid = bvh_detail::tri4_used_lanes(*blk);
+          for (int j = 0; j < 4 && act != 0; ++j) {
+            if (((valid >> j) & 1) == 0) continue;
+            PacketTriResult res;
+            if constexpr (Test == TriangleTest::watertight)
+              packet_tri_watertight(*blk, j, tri, tmin, res);
+            else
+              packet_tri_mt(*blk, j, tri, tmin, res);
+            int ls = (res.candidate | res.special) & act;
+            if (ls == 0) continue;
+            const Triangle t3 = bvh_detail::tri4_triangle(*blk, static_cast<std::uint32_t>(j));
+            for (; ls != 0; ls &= ls - 1) {
+              const int l = std::countr_zero(static_cast<unsigned>(ls));
+              const float cl = closest[l];
+              Hit h;
+              bool hit;
+              if ((res.special >> l) & 1) {
+                hit = intersect_watertight(rays[l], leaf[l].wr.wr, t3, tmin[l], cl, h);
+              } else {
+                if constexpr (Test == TriangleTest::watertight) {
+                  const float det = res.det[l], T = res.T[l];
+                  hit = !(det > 0.0f ? T > cl * det : T < cl * det) && res.t[l] <= cl;
+                } else {
+                  hit = res.t[l] <= cl;
+                }
+                h.t = res.t[l];
+                h.u = res.u[l];
+                h.v = res.v[l];
+              }
+              if (!hit) continue;
+              if constexpr (AnyHit) {
+                best[l] = h;
+                best[l].prim = blk->pos[j];
+                done |= 1 << l;
+                closest[l] = -kInf;
+                act &= ~(1 << l);
+              } else if (h.t < best[l].t) {
+                best[l] = h;
+                best[l].prim = blk->pos[j];
+                best[l].ng = triangle_normal(t3);
+                closest[l] = h.t;
+              }
+            }
+          }
+        }
+      } else
+        for (int ls = lanes; ls != 0; ls &= ls - 1) {
+          const int l = std::countr_zero(static_cast<unsigned>(ls));
+          float c = closest[l];
+          if (leaf[l].template test<AnyHit>(bvh, child, meta, tmin[l], c, best[l])) {
+            done |= 1 << l;
+            closest[l] = -kInf;  // its box tests miss from now on
+          } else if constexpr (!AnyHit) {
+            closest[l] = c;
+          }
+        }
       if (AnyHit && done == live) break;
     }
     bool more = false;

@@ -33,6 +33,16 @@ struct LeafRay {
 #endif
   }
 
+  /// Sets the watertight constants up (once; many rays never reach a leaf).
+  [[gnu::always_inline]] void prepare() {
+    if (wr_ready) return;
+    wr = InlineWatertightRay(*ray);
+    wr_ready = true;
+#ifdef ACCELVIZ_BVH_TRI4_SSE2
+    if constexpr (Test == TriangleTest::watertight) tr4 = bvh_detail::Tri4Ray(wr);
+#endif
+  }
+
   /// Tests leaf slot (first block `child`, `meta` blocks) in lane order.
   /// Closest hit: keeps the first found at the smallest t in best (with its
   /// normal) and lowers `closest`; returns false. Any hit: returns true at
@@ -56,13 +66,7 @@ struct LeafRay {
       }
       return false;
     };
-    if (!wr_ready) {
-      wr = InlineWatertightRay(r);
-      wr_ready = true;
-#ifdef ACCELVIZ_BVH_TRI4_SSE2
-      if constexpr (Test == TriangleTest::watertight) tr4 = bvh_detail::Tri4Ray(wr);
-#endif
-    }
+    prepare();
 #ifdef ACCELVIZ_BVH_TRI4_SSE2
     if constexpr (Test == TriangleTest::watertight) {
       // Watertight leaves, four triangles per test (bvh_tri4.h). Lanes in
