@@ -47,10 +47,11 @@ constexpr int kAloneLanes = 4;
 /// order, so each lane's T, det, t, u, v, candidate and special bits are bit
 /// for bit those the ray's own test gives for this triangle. tmax is applied
 /// afterwards lane by lane, as the single-ray leaf loop does.
+/// Lanes without a ray stay 0 (their results are never read).
 struct PacketTriRays {
-  PacketF ox, oy, oz, sx, sy, sz;  ///< watertight: origin[kx], [ky], [kz] and the shear, per lane
+  PacketF ox{}, oy{}, oz{}, sx{}, sy{}, sz{};  ///< watertight: origin[kx], [ky], [kz] and the shear, per lane
   int kx = 0, ky = 1, kz = 2;
-  PacketF org[3], dir[3];  ///< Moller-Trumbore: origin and direction per lane
+  PacketF org[3]{}, dir[3]{};  ///< Moller-Trumbore: origin and direction per lane
 };
 struct PacketTriResult {
   PacketF T, det, t, u, v;
