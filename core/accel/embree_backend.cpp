@@ -237,6 +237,19 @@ void fill_lane(RTCRay8& r, int l, const Ray& ray) {
   r.flags[l] = 0;
 }
 
+/// Calls trace(first, count, valid) for each packet of eight consecutive
+/// rays of n (the last may be shorter), with Embree's validity mask:
+/// valid[l] = -1 for the count lanes that carry a ray, 0 for the others.
+template <class Trace>
+void for_each_packet8(std::size_t n, Trace&& trace) {
+  for (std::size_t first = 0; first < n; first += 8) {
+    const int count = static_cast<int>(std::min<std::size_t>(8, n - first));
+    alignas(32) int valid[8];
+    for (int l = 0; l < 8; ++l) valid[l] = l < count ? -1 : 0;
+    trace(first, count, valid);
+  }
+}
+
 }  // namespace
 
 void EmbreeAccelerator::closest_packets_span(std::span<const Ray> rays, std::span<Hit> hits,
@@ -247,12 +260,9 @@ void EmbreeAccelerator::closest_packets_span(std::span<const Ray> rays, std::spa
   }
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  for (std::size_t b = 0; b < rays.size(); b += 8) {
-    const int count = static_cast<int>(std::min<std::size_t>(8, rays.size() - b));
-    alignas(32) int valid[8];
+  for_each_packet8(rays.size(), [&](std::size_t b, int count, const int* valid) {
     RTCRayHit8 rh;
     for (int l = 0; l < 8; ++l) {
-      valid[l] = l < count ? -1 : 0;
       if (l < count) fill_lane(rh.ray, l, rays[b + l]);
       rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
       rh.hit.primID[l] = RTC_INVALID_GEOMETRY_ID;
@@ -270,7 +280,7 @@ void EmbreeAccelerator::closest_packets_span(std::span<const Ray> rays, std::spa
       }
       hits[b + l] = hit;
     }
-  }
+  });
 }
 
 void EmbreeAccelerator::any_packets_span(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
@@ -281,17 +291,12 @@ void EmbreeAccelerator::any_packets_span(std::span<const Ray> rays, std::span<st
   }
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  for (std::size_t b = 0; b < rays.size(); b += 8) {
-    const int count = static_cast<int>(std::min<std::size_t>(8, rays.size() - b));
-    alignas(32) int valid[8];
+  for_each_packet8(rays.size(), [&](std::size_t b, int count, const int* valid) {
     RTCRay8 r;
-    for (int l = 0; l < 8; ++l) {
-      valid[l] = l < count ? -1 : 0;
-      if (l < count) fill_lane(r, l, rays[b + l]);
-    }
+    for (int l = 0; l < count; ++l) fill_lane(r, l, rays[b + l]);
     rtcOccluded8(valid, impl_->scene, &context, &r);
     for (int l = 0; l < count; ++l) occluded[b + l] = r.tfar[l] == -kInfinity ? 1 : 0;
-  }
+  });
 }
 
 bool EmbreeAccelerator::any_hit(const Ray& ray, const QueryOptions&, RayStats*) const {

@@ -702,28 +702,30 @@ using WideSlabRayW = bvh_detail::WideSlabRay8;
 #pragma GCC pop_options
 #endif
 
-template <bool AnyHit>
-Hit dispatch_wide(const bvh_detail::WideBvh& wide, const BvhView& v, const Ray& ray, const QueryOptions& qo) {
-  using wide4::traverse_wide;
+/// Runs walk.template operator()<Ordered, Test>() for the query's ordering
+/// and triangle test: each choice is made once per query, not per node.
+template <class Walk>
+decltype(auto) with_query_choices(const QueryOptions& qo, Walk&& walk) {
   const bool wt = qo.triangle_test == TriangleTest::watertight;
   if (qo.ordered)
-    return wt ? traverse_wide<AnyHit, true, TriangleTest::watertight>(wide, v, ray)
-              : traverse_wide<AnyHit, true, TriangleTest::moller_trumbore>(wide, v, ray);
-  return wt ? traverse_wide<AnyHit, false, TriangleTest::watertight>(wide, v, ray)
-            : traverse_wide<AnyHit, false, TriangleTest::moller_trumbore>(wide, v, ray);
+    return wt ? walk.template operator()<true, TriangleTest::watertight>()
+              : walk.template operator()<true, TriangleTest::moller_trumbore>();
+  return wt ? walk.template operator()<false, TriangleTest::watertight>()
+            : walk.template operator()<false, TriangleTest::moller_trumbore>();
+}
+
+template <bool AnyHit>
+Hit dispatch_wide(const bvh_detail::WideBvh& wide, const BvhView& v, const Ray& ray, const QueryOptions& qo) {
+  return with_query_choices(
+      qo, [&]<bool Ordered, TriangleTest Test>() { return wide4::traverse_wide<AnyHit, Ordered, Test>(wide, v, ray); });
 }
 
 template <bool AnyHit>
 Hit dispatch_wide8([[maybe_unused]] const bvh_detail::WideBvh8& wide, [[maybe_unused]] const BvhView& v,
                    [[maybe_unused]] const Ray& ray, [[maybe_unused]] const QueryOptions& qo) {
 #ifdef ACCELVIZ_BVH_WIDE8
-  using wide8::traverse_wide;
-  const bool wt = qo.triangle_test == TriangleTest::watertight;
-  if (qo.ordered)
-    return wt ? traverse_wide<AnyHit, true, TriangleTest::watertight>(wide, v, ray)
-              : traverse_wide<AnyHit, true, TriangleTest::moller_trumbore>(wide, v, ray);
-  return wt ? traverse_wide<AnyHit, false, TriangleTest::watertight>(wide, v, ray)
-            : traverse_wide<AnyHit, false, TriangleTest::moller_trumbore>(wide, v, ray);
+  return with_query_choices(
+      qo, [&]<bool Ordered, TriangleTest Test>() { return wide8::traverse_wide<AnyHit, Ordered, Test>(wide, v, ray); });
 #else
   return Hit{};  // never built without AVX2 support (Bvh checks cpu_has_wide8)
 #endif
@@ -733,14 +735,9 @@ Hit dispatch_wide8([[maybe_unused]] const bvh_detail::WideBvh8& wide, [[maybe_un
 template <bool AnyHit>
 void dispatch_packets(const bvh_detail::WideBvh& wide, const BvhView& v, std::span<const Ray> rays, Hit* out,
                       const QueryOptions& qo) {
-  using wide4::traverse_packets;
-  const bool wt = qo.triangle_test == TriangleTest::watertight;
-  if (qo.ordered)
-    wt ? traverse_packets<AnyHit, true, TriangleTest::watertight>(wide, v, rays, out)
-       : traverse_packets<AnyHit, true, TriangleTest::moller_trumbore>(wide, v, rays, out);
-  else
-    wt ? traverse_packets<AnyHit, false, TriangleTest::watertight>(wide, v, rays, out)
-       : traverse_packets<AnyHit, false, TriangleTest::moller_trumbore>(wide, v, rays, out);
+  with_query_choices(qo, [&]<bool Ordered, TriangleTest Test>() {
+    wide4::traverse_packets<AnyHit, Ordered, Test>(wide, v, rays, out);
+  });
 }
 
 /// The packet walk (8-wide AVX2) for the query options.
@@ -749,25 +746,16 @@ void dispatch_packets8([[maybe_unused]] const bvh_detail::WideBvh8& wide, [[mayb
                        [[maybe_unused]] std::span<const Ray> rays, [[maybe_unused]] Hit* out,
                        [[maybe_unused]] const QueryOptions& qo) {
 #ifdef ACCELVIZ_BVH_WIDE8
-  using wide8::traverse_packets;
-  const bool wt = qo.triangle_test == TriangleTest::watertight;
-  if (qo.ordered)
-    wt ? traverse_packets<AnyHit, true, TriangleTest::watertight>(wide, v, rays, out)
-       : traverse_packets<AnyHit, true, TriangleTest::moller_trumbore>(wide, v, rays, out);
-  else
-    wt ? traverse_packets<AnyHit, false, TriangleTest::watertight>(wide, v, rays, out)
-       : traverse_packets<AnyHit, false, TriangleTest::moller_trumbore>(wide, v, rays, out);
+  with_query_choices(qo, [&]<bool Ordered, TriangleTest Test>() {
+    wide8::traverse_packets<AnyHit, Ordered, Test>(wide, v, rays, out);
+  });
 #endif  // never built without AVX2 support (Bvh checks cpu_has_wide8)
 }
 
 template <bool AnyHit, bool Collect>
 Hit dispatch(const BvhView& v, const Ray& ray, const QueryOptions& qo, const Collector& c) {
-  const bool wt = qo.triangle_test == TriangleTest::watertight;
-  if (qo.ordered)
-    return wt ? traverse<AnyHit, true, Collect, TriangleTest::watertight>(v, ray, c)
-              : traverse<AnyHit, true, Collect, TriangleTest::moller_trumbore>(v, ray, c);
-  return wt ? traverse<AnyHit, false, Collect, TriangleTest::watertight>(v, ray, c)
-            : traverse<AnyHit, false, Collect, TriangleTest::moller_trumbore>(v, ray, c);
+  return with_query_choices(
+      qo, [&]<bool Ordered, TriangleTest Test>() { return traverse<AnyHit, Ordered, Collect, Test>(v, ray, c); });
 }
 
 }  // namespace
