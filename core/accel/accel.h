@@ -139,8 +139,10 @@ class Accelerator {
   /// Packet queries, counter-free: rays[8k .. 8k+8) form packet k (the last
   /// may be shorter), walked together where has_packets(). hits[i] is the
   /// closest hit of rays[i], as closest_hit(rays[i], opts) finds it, except
-  /// that of two triangles hit at exactly the same t either may be reported
-  /// (packets visit leaves in another order); occluded[i] = 1 when anything
+  /// that of two triangles hit at the same t, or within a few ulps of each
+  /// other, either may be reported (packets visit leaves in another order,
+  /// and which of two such hits wins depends on the order: bvh.md, Traversal,
+  /// Packets); occluded[i] = 1 when anything
   /// lies on rays[i]. Options the fast path ignores (back_to_front, xray)
   /// are ignored here too. Packets pay for coherent rays (neighbouring primary
   /// rays) and cost for incoherent ones: bench reports both. Throws
