@@ -20,10 +20,12 @@
 // intersect_slab's arithmetic on its own ray (near and far planes chosen by
 // that ray's direction signs, max/min ignoring NaN in the same operand
 // order, the exit padded by the same factor), so a lane enters exactly the
-// boxes its ray would enter at the same closest distance; leaves are tested
-// per lane by LeafRay, the single-ray walk's own leaf code. Only the order of
-// the leaves can differ (children are ordered by their nearest lane), which
-// can change which of two triangles at exactly the same t is reported.
+// boxes its ray would enter at the same closest distance; a leaf's triangles
+// are tested against all lanes at once with each lane's own arithmetic
+// (packet_tri_watertight, packet_tri_mt), or lane by lane with the
+// single-ray walk's leaf code (LeafRay). Only the order of the leaves can
+// differ (children are ordered by their nearest lane), which can change which
+// of two hits at the same t, or a few ulps apart, is reported.
 
 /// Smallest lane (the packet's nearest entry into a box; +inf lanes are idle).
 [[gnu::always_inline]] inline float packet_min(const PacketF& v) {
@@ -80,7 +82,7 @@ struct PacketTriResult {
     out.candidate = out.special = 0;
     return;
   }
-  const PacketF low = 1e-30f - PacketF{};
+  const PacketF low = kWatertightLowRange - PacketF{};
   const PacketI tiny_det = ok & ((PacketF)((PacketI)det & 0x7FFFFFFF) < low);  // |det| (vector casts: the bits)
   const PacketF az = r.sz * Az, bz = r.sz * Bz, cz = r.sz * Cz;
   const PacketF T = (U * az + V * bz) + W * cz;
@@ -308,7 +310,6 @@ void traverse_packet(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView
         } else {
           for (int a = 0; a < 3; ++a) tri.org[a] = org[a];
         }
-        if constexpr (Test != TriangleTest::watertight && Test != TriangleTest::moller_trumbore) tri_mode = 0;
       }
       if (tri_mode == 1 && std::popcount(static_cast<unsigned>(lanes)) > 1) {
         // Each triangle once for all lanes; per lane the single-ray leaf
@@ -335,12 +336,10 @@ void traverse_packet(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView
               if ((res.special >> l) & 1) {
                 hit = intersect_watertight(rays[l], leaf[l].wr.wr, t3, tmin[l], cl, h);
               } else {
-                if constexpr (Test == TriangleTest::watertight) {
-                  const float det = res.det[l], T = res.T[l];
-                  hit = !(det > 0.0f ? T > cl * det : T < cl * det) && res.t[l] <= cl;
-                } else {
-                  hit = res.t[l] <= cl;
-                }
+                if constexpr (Test == TriangleTest::watertight)
+                  hit = bvh_detail::watertight_accept_tmax(res.det[l], res.T[l], res.t[l], cl);
+                else
+                  hit = res.t[l] <= cl;  // Moller-Trumbore's last check
                 h.t = res.t[l];
                 h.u = res.u[l];
                 h.v = res.v[l];

@@ -104,6 +104,15 @@ void refit_tri4_blocks(const TriAt& tri, Blocks& blocks) {
     }
 }
 
+/// The watertight test's tmax-dependent acceptance of a candidate from its
+/// figures (det, T, t = T/det), as the scalar test applies it last: the
+/// four-lane test's lanes (tri4_accept) and the packet walk's lanes
+/// (bvh_packet_traverse.inl) replay it per candidate in leaf order.
+[[gnu::always_inline]] inline bool watertight_accept_tmax(float det, float T, float t, float tmax) {
+  if (det > 0.0f ? T > tmax * det : T < tmax * det) return false;
+  return t <= tmax;
+}
+
 #ifdef ACCELVIZ_BVH_TRI4_SSE2
 
 /// Per-ray constants of the four-lane test.
@@ -256,9 +265,7 @@ struct Tri4MtResult {
 
 /// The scalar test's tmax-dependent acceptance of candidate lane l.
 [[gnu::always_inline]] inline bool tri4_accept(const Tri4Result& r, int l, float tmax) {
-  const float det = r.det[l], T = r.T[l];
-  if (det > 0.0f ? T > tmax * det : T < tmax * det) return false;
-  return r.t[l] <= tmax;
+  return watertight_accept_tmax(r.det[l], r.T[l], r.t[l], tmax);
 }
 
 #endif  // ACCELVIZ_BVH_TRI4_SSE2
