@@ -37,7 +37,7 @@ void Accelerator::any_hits_packets(std::span<const Ray> rays, std::span<std::uin
 }
 
 void Accelerator::closest_packets_span(std::span<const Ray> rays, std::span<Hit> hits, const QueryOptions& opts) const {
-  for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = closest_hit(rays[i], opts);
+  closest_hits_span(rays, hits, opts, {});  // per ray, counter-free
 }
 
 void Accelerator::any_packets_span(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
