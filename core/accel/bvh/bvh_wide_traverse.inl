@@ -4,43 +4,50 @@
 // WideSlabRayW and wide_slab_test_w (the box test of that width).
 // No includes here: the file is pasted inside a namespace.
 
-/// One ray's side of a leaf: its triangle-test constants (the watertight
-/// ones set up at its first leaf: many rays never reach one) and the loop
-/// over a leaf slot's triangle blocks. The single-ray walk below has one; the
-/// packet walk (bvh_packet_traverse.inl) one per lane, so both test a leaf's
-/// triangles with the same code, in the same order, with the same results.
+/// One ray's side of a leaf: its triangle-test constants (set up at its
+/// first leaf: many rays never reach one) and the loop over a leaf slot's
+/// triangle blocks. The single-ray walk below has one; the packet walk
+/// (bvh_packet_traverse.inl) one per lane, so both test a leaf's triangles
+/// with the same code, in the same order, with the same results.
 template <TriangleTest Test>
 struct LeafRay {
   const Ray* ray = nullptr;
   InlineWatertightRay wr;
-  bool wr_ready = Test != TriangleTest::watertight;
+  bool ready = false;  ///< the constants below are set up for *ray
 #ifdef ACCELVIZ_BVH_TRI4_SSE2
   bvh_detail::Tri4Ray tr4;
   bvh_detail::Tri4MtRay tm4;
 #endif
 
   LeafRay() = default;
+  /// A single ray: Moller-Trumbore's constants right away (cheap, and the
+  /// single-ray any hits of the fast mode measured 2-5 % slower when they
+  /// waited for the first leaf), the watertight ones at the first leaf.
   [[gnu::always_inline]] explicit LeafRay(const Ray& r) {
     reset(r);
+    if constexpr (Test == TriangleTest::moller_trumbore) prepare();
   }
 
   /// Starts over for ray `r` (the packet walk reuses its lanes in place).
   [[gnu::always_inline]] void reset(const Ray& r) {
     ray = &r;
-    wr_ready = Test != TriangleTest::watertight;
-#ifdef ACCELVIZ_BVH_TRI4_SSE2
-    if constexpr (Test == TriangleTest::moller_trumbore) tm4 = bvh_detail::Tri4MtRay(r);
-#endif
+    ready = false;
   }
 
-  /// Sets the watertight constants up (once; many rays never reach a leaf).
+  /// Sets the triangle test's constants up (once per ray).
   [[gnu::always_inline]] void prepare() {
-    if (wr_ready) return;
-    wr = InlineWatertightRay(*ray);
-    wr_ready = true;
+    if (ready) return;
+    ready = true;
+    if constexpr (Test == TriangleTest::watertight) {
+      wr = InlineWatertightRay(*ray);
 #ifdef ACCELVIZ_BVH_TRI4_SSE2
-    if constexpr (Test == TriangleTest::watertight) tr4 = bvh_detail::Tri4Ray(wr);
+      tr4 = bvh_detail::Tri4Ray(wr);
 #endif
+    } else {
+#ifdef ACCELVIZ_BVH_TRI4_SSE2
+      tm4 = bvh_detail::Tri4MtRay(*ray);
+#endif
+    }
   }
 
   /// Tests leaf slot (first block `child`, `meta` blocks) in lane order.
