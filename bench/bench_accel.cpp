@@ -9,7 +9,10 @@
 // builtin:teapot?size=100000. Rays: 256x256 primary rays through the
 // scene's framing camera, their diffuse bounces and shadow rays to a
 // synthetic light (core/query/ray_sets.h), generated once from our BVH's
-// hits. items_per_second is rays/s; compare our row with Embree's on the
+// hits, and `miss`: as many rays that start outside a sphere around the
+// scene's bounds and point away from it (every structure rejects them at
+// its root: their rate is the fixed cost of one query, the call, the ray's
+// set-up and the root test). items_per_second is rays/s; compare our row with Embree's on the
 // same ray set, as a ratio (docs/performance.md). TraceClosestPackets8 and
 // TraceAnyPackets8: the same rays in packets of eight (Embree: rtcIntersect8,
 // rtcOccluded8).
@@ -34,7 +37,7 @@ using namespace accelviz;
 
 struct Fixture {
   Scene scene;
-  std::vector<Ray> rays[3];  // primary, diffuse, shadow
+  std::vector<Ray> rays[4];  // primary, diffuse, shadow, miss
 
   Fixture() {
     const char* env = std::getenv("ACCELVIZ_BENCH_SCENE");
@@ -50,6 +53,13 @@ struct Fixture {
     rays[1] = diffuse_rays(scene.triangles, rays[0], hits, 1);
     const Light light = synthetic_bench_light(scene.bounds());
     rays[2] = shadow_rays(scene.triangles, rays[0], hits, std::span<const Light>(&light, 1));
+    // Radially outward from beyond the bounding sphere, in the primary rays'
+    // directions: they never enter the bounds.
+    const Aabb b = scene.bounds();
+    const glm::vec3 center = (b.lo + b.hi) * 0.5f;
+    const float radius = glm::length(b.hi - b.lo);
+    rays[3].reserve(rays[0].size());
+    for (const Ray& r : rays[0]) rays[3].emplace_back(center + (1.5f * radius) * r.direction, r.direction);
   }
 };
 
@@ -58,7 +68,7 @@ const Fixture& fixture() {
   return f;
 }
 
-const char* kSetNames[3] = {"primary", "diffuse", "shadow"};
+const char* kSetNames[4] = {"primary", "diffuse", "shadow", "miss"};
 
 std::unique_ptr<Accelerator> make(const std::string& name, unsigned threads) {
   StructureOptions so;
@@ -82,7 +92,8 @@ void build(benchmark::State& state, const std::string& name) {
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * n));  // triangles/s
 }
 
-/// Single-thread closest hit (any = false) or any hit; range(0) = ray set;
+/// Single-thread closest hit (any = false) or any hit; range(0) = ray set
+/// (0 primary, 1 diffuse, 2 shadow, 3 miss);
 /// packets: in packets of eight consecutive rays (trace_*_packets).
 void trace(benchmark::State& state, const std::string& name, bool any, bool packets) {
   const std::vector<Ray>& rays = fixture().rays[state.range(0)];
@@ -117,11 +128,11 @@ void register_all() {
       if (packets && n == "lbvh") continue;  // the same packet walk as bvh over another tree
       const std::string suffix = packets ? "Packets8/" : "/";
       benchmark::RegisterBenchmark(("TraceClosest" + suffix + n).c_str(), trace, n, false, packets)
-          ->DenseRange(0, 2)
+          ->DenseRange(0, 3)
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime();  // the batch may trace on a worker thread: wall time, not this thread's CPU time
       benchmark::RegisterBenchmark(("TraceAny" + suffix + n).c_str(), trace, n, true, packets)
-          ->DenseRange(0, 2)
+          ->DenseRange(0, 3)
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime();
     }
