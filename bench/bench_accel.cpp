@@ -16,10 +16,19 @@
 // same ray set, as a ratio (docs/performance.md). TraceClosestPackets8 and
 // TraceAnyPackets8: the same rays in packets of eight (Embree: rtcIntersect8,
 // rtcOccluded8).
+//
+// ACCELVIZ_BENCH_PAIRING: which of our triangle tests meets which Embree
+// mode (the pairs of `accelviz bench`): unset or `default`, our watertight
+// test against Embree's default mode; `robust`, watertight against Embree's
+// robust mode (`bench --embree-robust`); `fast`, Moller-Trumbore against
+// Embree's default mode (`bench --triangle-test fast`).
 #include <benchmark/benchmark.h>
 
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -68,12 +77,37 @@ const Fixture& fixture() {
   return f;
 }
 
+/// ACCELVIZ_BENCH_PAIRING, read once.
+struct Pairing {
+  bool embree_robust = false;
+  TriangleTest ours = TriangleTest::watertight;
+};
+
+const Pairing& pairing() {
+  static const Pairing p = [] {
+    const char* env = std::getenv("ACCELVIZ_BENCH_PAIRING");
+    Pairing r;
+    if (env == nullptr || *env == '\0' || std::strcmp(env, "default") == 0) return r;
+    if (std::strcmp(env, "robust") == 0) {
+      r.embree_robust = true;
+    } else if (std::strcmp(env, "fast") == 0) {
+      r.ours = TriangleTest::moller_trumbore;
+    } else {
+      throw std::invalid_argument(std::string("ACCELVIZ_BENCH_PAIRING: expected default, robust or fast, got '") + env +
+                                  "'");
+    }
+    return r;
+  }();
+  return p;
+}
+
 const char* kSetNames[4] = {"primary", "diffuse", "shadow", "miss"};
 
 std::unique_ptr<Accelerator> make(const std::string& name, unsigned threads) {
   StructureOptions so;
   so.threads = threads;
   so.bvh.compute_epo = false;
+  so.embree.robust = pairing().embree_robust;
   if (name == "lbvh") {
     so.bvh.splitter = BvhSplitter::lbvh;
     return build_accelerator("bvh", fixture().scene.triangles, so);
@@ -101,15 +135,17 @@ void trace(benchmark::State& state, const std::string& name, bool any, bool pack
   const auto accel = make(name, 0);
   std::vector<Hit> hits(rays.size());
   std::vector<std::uint8_t> occluded(rays.size());
+  QueryOptions q;
+  q.triangle_test = pairing().ours;
   for (auto _ : state) {
     if (packets && any)
-      trace_any_packets(*accel, rays, occluded, QueryOptions{}, BatchOptions{1u});
+      trace_any_packets(*accel, rays, occluded, q, BatchOptions{1u});
     else if (packets)
-      trace_closest_packets(*accel, rays, hits, QueryOptions{}, BatchOptions{1u});
+      trace_closest_packets(*accel, rays, hits, q, BatchOptions{1u});
     else if (any)
-      trace_any(*accel, rays, occluded, QueryOptions{}, 1u);
+      trace_any(*accel, rays, occluded, q, 1u);
     else
-      trace_closest(*accel, rays, hits, QueryOptions{}, 1u);
+      trace_closest(*accel, rays, hits, q, 1u);
     benchmark::ClobberMemory();
   }
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * rays.size()));  // rays/s
@@ -144,6 +180,12 @@ void register_all() {
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  try {
+    pairing();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "accelviz_gbench: %s\n", e.what());
+    return 1;
+  }
   register_all();
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
