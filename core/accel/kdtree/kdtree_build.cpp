@@ -1,6 +1,7 @@
 // K-D tree construction: SAH over the exact event sweep (Wald & Havran 2006),
 // with perfect splits (triangles clipped to the node box, Havran 2000).
 #include "core/accel/kdtree/kdtree.h"
+#include "core/accel/kdtree/spatial_build.h"
 #include "core/geometry/tri_box_overlap.h"
 #include "core/util/timing.h"
 
@@ -102,7 +103,7 @@ class KdBuilder {
     std::vector<std::uint32_t>().swap(prims);
     std::vector<Aabb>().swap(cb);
 
-    sah_sum_ += static_cast<double>(opts_.cost_traversal) * area;
+    tally_.inner(static_cast<double>(opts_.cost_traversal) * area);
     const double total = static_cast<double>(lp.size() + rp.size());
     const double wl = total > 0.0 ? weight * static_cast<double>(lp.size()) / total : weight * 0.5;
     build(lp, lcb, left_box, depth + 1, wl);
@@ -111,10 +112,7 @@ class KdBuilder {
     build(rp, rcb, right_box, depth + 1, weight - wl);
   }
 
-  double sah_sum_ = 0.0;
-  std::uint64_t leaves_ = 0, empty_leaves_ = 0;
-  std::uint32_t deepest_ = 0;
-  double depth_sum_ = 0.0;
+  spatial::TreeTally tally_;
 
  private:
   Aabb child_bounds(std::uint32_t prim, const Aabb& parent_cb, const Aabb& child_box) const {
@@ -136,20 +134,9 @@ class KdBuilder {
     if (prims.size() >= (1u << 30)) throw std::length_error("kdtree: leaf with more than 2^30 primitives");
     nodes_[index] = KdNode::leaf(static_cast<std::uint32_t>(refs_.size()), static_cast<std::uint32_t>(prims.size()));
     refs_.insert(refs_.end(), prims.begin(), prims.end());
-    sah_sum_ += static_cast<double>(opts_.cost_intersect) * static_cast<double>(prims.size()) * box.half_area();
-    ++leaves_;
-    if (prims.empty()) ++empty_leaves_;
-    deepest_ = std::max(deepest_, static_cast<std::uint32_t>(depth));
-    depth_sum_ += depth;
-    report(weight);
-  }
-
-  void report(double weight) {
-    done_ += weight;
-    if (progress_ && done_ - reported_ >= 0.01) {
-      reported_ = done_;
-      if (!progress_(std::min(done_, 1.0))) throw BuildCancelled();
-    }
+    tally_.leaf(prims.size(), depth,
+                static_cast<double>(opts_.cost_intersect) * static_cast<double>(prims.size()) * box.half_area());
+    progress_.add(weight);
   }
 
   // The exact SAH sweep over the primitives' clipped-bound events, per axis.
@@ -213,11 +200,10 @@ class KdBuilder {
   std::span<const Triangle> tris_;
   const KdTreeOptions& opts_;
   int max_depth_;
-  const ProgressCallback& progress_;
+  spatial::BuildProgress progress_;
   std::vector<KdNode>& nodes_;
   std::vector<std::uint32_t>& refs_;
   std::vector<std::uint64_t> events_;  // scratch, reused by every node (used before recursing)
-  double done_ = 0.0, reported_ = 0.0;
 };
 
 }  // namespace
@@ -251,17 +237,9 @@ KdTree::KdTree(std::span<const Triangle> triangles, const KdTreeOptions& opts, c
   prim_refs_.shrink_to_fit();
 
   stats_.build_ms = ms_since(t_start);
-  stats_.node_count = nodes_.size();
-  stats_.leaf_count = builder.leaves_;
-  stats_.max_depth = builder.deepest_;
-  stats_.avg_leaf_depth = builder.leaves_ ? builder.depth_sum_ / static_cast<double>(builder.leaves_) : 0.0;
   stats_.memory_bytes = nodes_.size() * sizeof(KdNode) + prim_refs_.size() * sizeof(std::uint32_t);
-  const double root_area = bounds_.half_area();
-  stats_.sah_cost = root_area > 0.0 ? builder.sah_sum_ / root_area
-                                    : static_cast<double>(opts_.cost_intersect) * static_cast<double>(n);
-  stats_.extra["references"] = static_cast<double>(prim_refs_.size());
-  stats_.extra["duplication"] = n ? static_cast<double>(prim_refs_.size()) / static_cast<double>(n) : 0.0;
-  stats_.extra["empty_leaves"] = static_cast<double>(builder.empty_leaves_);
+  builder.tally_.fill(stats_, nodes_.size(), prim_refs_.size(), n, bounds_.half_area(),
+                      static_cast<double>(opts_.cost_intersect) * static_cast<double>(n));
   stats_.extra["max_depth_limit"] = max_depth;
   if (progress && !progress(1.0)) throw BuildCancelled();
 }

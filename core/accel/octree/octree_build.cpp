@@ -1,5 +1,6 @@
 // Octree construction: top-down, each cell's triangles filtered into the
 // eight octants by the exact triangle-box overlap test.
+#include "core/accel/kdtree/spatial_build.h"
 #include "core/accel/kdtree/spatial_traversal.h"
 #include "core/accel/octree/octree.h"
 #include "core/geometry/tri_box_overlap.h"
@@ -83,7 +84,7 @@ class OctreeBuilder {
     const std::uint32_t base = static_cast<std::uint32_t>(nodes_.size());
     nodes_.resize(nodes_.size() + 8);
     nodes_[node] = {base, OctreeNode::kInner};
-    sah_sum_ += box.half_area();
+    tally_.inner(box.half_area());
     std::size_t total = 0;
     for (const auto& c : child) total += c.size();
     for (int o = 0; o < 8; ++o) {
@@ -92,10 +93,7 @@ class OctreeBuilder {
     }
   }
 
-  double sah_sum_ = 0.0;
-  std::uint64_t leaves_ = 0, empty_leaves_ = 0;
-  std::uint32_t deepest_ = 0;
-  double depth_sum_ = 0.0;
+  spatial::TreeTally tally_;
 
  private:
   Aabb bounds_of(std::uint32_t id) const { return tris_[id].bounds(); }
@@ -105,25 +103,16 @@ class OctreeBuilder {
     if (refs_.size() + prims.size() >= 0xFFFFFFFFull) throw std::length_error("octree: more than 2^32-1 references");
     nodes_[node] = {static_cast<std::uint32_t>(refs_.size()), static_cast<std::uint32_t>(prims.size())};
     refs_.insert(refs_.end(), prims.begin(), prims.end());
-    sah_sum_ += static_cast<double>(prims.size()) * box.half_area();
-    ++leaves_;
-    if (prims.empty()) ++empty_leaves_;
-    deepest_ = std::max(deepest_, static_cast<std::uint32_t>(depth));
-    depth_sum_ += depth;
-    done_ += weight;
-    if (progress_ && done_ - reported_ >= 0.01) {
-      reported_ = done_;
-      if (!progress_(std::min(done_, 1.0))) throw BuildCancelled();
-    }
+    tally_.leaf(prims.size(), depth, static_cast<double>(prims.size()) * box.half_area());
+    progress_.add(weight);
   }
 
   std::span<const Triangle> tris_;
   const OctreeOptions& opts_;
   float pad_;
-  const ProgressCallback& progress_;
+  spatial::BuildProgress progress_;
   std::vector<OctreeNode>& nodes_;
   std::vector<std::uint32_t>& refs_;
-  double done_ = 0.0, reported_ = 0.0;
 };
 
 }  // namespace
@@ -170,16 +159,8 @@ Octree::Octree(std::span<const Triangle> triangles, const OctreeOptions& opts, c
   prim_refs_.shrink_to_fit();
 
   stats_.build_ms = ms_since(t_start);
-  stats_.node_count = nodes_.size();
-  stats_.leaf_count = builder.leaves_;
-  stats_.max_depth = builder.deepest_;
-  stats_.avg_leaf_depth = builder.leaves_ ? builder.depth_sum_ / static_cast<double>(builder.leaves_) : 0.0;
   stats_.memory_bytes = nodes_.size() * sizeof(OctreeNode) + prim_refs_.size() * sizeof(std::uint32_t);
-  const double root_area = root_.half_area();
-  stats_.sah_cost = root_area > 0.0 ? builder.sah_sum_ / root_area : static_cast<double>(n);
-  stats_.extra["references"] = static_cast<double>(prim_refs_.size());
-  stats_.extra["duplication"] = n ? static_cast<double>(prim_refs_.size()) / static_cast<double>(n) : 0.0;
-  stats_.extra["empty_leaves"] = static_cast<double>(builder.empty_leaves_);
+  builder.tally_.fill(stats_, nodes_.size(), prim_refs_.size(), n, root_.half_area(), static_cast<double>(n));
   if (progress && !progress(1.0)) throw BuildCancelled();
 }
 

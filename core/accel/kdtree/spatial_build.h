@@ -1,0 +1,69 @@
+#pragma once
+// Book-keeping shared by the top-down builders of the space-partitioning
+// trees (K-D tree, octree): the SAH sum, the leaves and their depths, and the
+// build's progress as a share of the whole, gathered while the nodes are made.
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+
+#include "core/accel/accel.h"
+
+namespace accelviz::spatial {
+
+/// What a top-down build counts as it makes nodes.
+struct TreeTally {
+  double sah_sum = 0.0;  ///< inner nodes' C_trav·A plus leaves' C_isect·n·A (half areas A)
+  std::uint64_t leaves = 0, empty_leaves = 0;
+  std::uint32_t deepest = 0;
+  double depth_sum = 0.0;
+
+  /// An inner node whose SAH term is `sah_term`.
+  void inner(double sah_term) { sah_sum += sah_term; }
+
+  /// A leaf of `prims` references at `depth` whose SAH term is `sah_term`.
+  void leaf(std::size_t prims, int depth, double sah_term) {
+    sah_sum += sah_term;
+    ++leaves;
+    if (prims == 0) ++empty_leaves;
+    deepest = std::max(deepest, static_cast<std::uint32_t>(depth));
+    depth_sum += depth;
+  }
+
+  /// The tree's share of `stats`: nodes, leaves, depths, the SAH cost (the sum
+  /// over the root's half area; `flat_root_cost` when the root has none), and
+  /// the references against the `prims` primitives (extras "references",
+  /// "duplication", "empty_leaves").
+  void fill(BuildStats& stats, std::size_t nodes, std::size_t refs, std::size_t prims, double root_half_area,
+            double flat_root_cost) const {
+    stats.node_count = nodes;
+    stats.leaf_count = leaves;
+    stats.max_depth = deepest;
+    stats.avg_leaf_depth = leaves ? depth_sum / static_cast<double>(leaves) : 0.0;
+    stats.sah_cost = root_half_area > 0.0 ? sah_sum / root_half_area : flat_root_cost;
+    stats.extra["references"] = static_cast<double>(refs);
+    stats.extra["duplication"] = prims ? static_cast<double>(refs) / static_cast<double>(prims) : 0.0;
+    stats.extra["empty_leaves"] = static_cast<double>(empty_leaves);
+  }
+};
+
+/// Progress of a top-down build: each finished leaf adds its share of the
+/// whole (its weight); the callback hears of every further 1 % and may
+/// cancel the build (BuildCancelled).
+class BuildProgress {
+ public:
+  explicit BuildProgress(const ProgressCallback& callback) : callback_(callback) {}
+
+  void add(double weight) {
+    done_ += weight;
+    if (callback_ && done_ - reported_ >= 0.01) {
+      reported_ = done_;
+      if (!callback_(std::min(done_, 1.0))) throw BuildCancelled();
+    }
+  }
+
+ private:
+  const ProgressCallback& callback_;
+  double done_ = 0.0, reported_ = 0.0;
+};
+
+}  // namespace accelviz::spatial
