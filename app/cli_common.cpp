@@ -117,6 +117,14 @@ TriangleTest parse_triangle_test(const std::string& name) {
   throw UsageError("triangle test '" + name + "': expected watertight or fast");
 }
 
+CLI::Option* add_triangle_test_option(CLI::App* sub, std::string& value, const char* help) {
+  return sub
+      ->add_option("--triangle-test", value,
+                   help ? help : "Ray-triangle test: watertight (Woop et al. 2013) or fast (Moller-Trumbore)")
+      ->check(CLI::IsMember({"watertight", "fast"}))
+      ->capture_default_str();
+}
+
 Scene load_scene_noting_warnings(const std::string& spec, bool quiet) {
   Scene scene = load_scene(spec);
   if (!quiet && !scene.report.warnings.empty())

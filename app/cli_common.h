@@ -85,6 +85,9 @@ struct StructureCli {
 /// camera_from_spec with a bad spec reported as a usage error.
 Camera camera_for(const std::string& spec, const Scene& scene, const ImageSize& size);
 
+/// Adds --triangle-test (watertight | fast, the names parse_triangle_test
+/// reads) to `sub`, stored in `value`; `help` replaces the usual help text.
+CLI::Option* add_triangle_test_option(CLI::App* sub, std::string& value, const char* help = nullptr);
 /// --triangle-test watertight|fast.
 TriangleTest parse_triangle_test(const std::string& name);
 

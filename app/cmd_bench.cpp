@@ -488,10 +488,7 @@ Command add_bench_command(CLI::App& parent, const GlobalOptions& global) {
   sub->add_option("--camera", o->camera,
                   "View: ex,ey,ez,tx,ty,tz[,fovdeg] or gltf:N; default: the scene's first camera, else a framing view");
   sub->add_option("--seed", o->seed, "Seed of the diffuse ray directions")->capture_default_str();
-  sub->add_option("--triangle-test", o->triangle_test,
-                  "Ray-triangle test: watertight (Woop et al. 2013) or fast (Moller-Trumbore)")
-      ->check(CLI::IsMember({"watertight", "fast"}))
-      ->capture_default_str();
+  add_triangle_test_option(sub, o->triangle_test);
   sub->add_flag("--no-epo", o->no_epo, "Skip the BVH's EPO figure (one extra pass per triangle)");
   o->structure_opts.add_to(sub);
   return {sub, [o, &global] { return run_bench(*o, global); }};

@@ -150,9 +150,7 @@ Command add_calibrate_command(CLI::App& parent, const GlobalOptions& global) {
       ->check(size_validator())
       ->capture_default_str();
   sub->add_option("--threads,-j", o->threads, "--scene: build and trace threads (0: all)")->capture_default_str();
-  sub->add_option("--triangle-test", o->triangle_test, "--scene: which test's constant to build with and trace")
-      ->check(CLI::IsMember({"watertight", "fast"}))
-      ->capture_default_str();
+  add_triangle_test_option(sub, o->triangle_test, "--scene: which test's constant to build with and trace");
   return {sub, [o, &global] { return run_calibrate(*o, global); }};
 }
 

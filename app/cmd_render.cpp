@@ -252,10 +252,7 @@ Command add_render_command(CLI::App& parent, const GlobalOptions& global) {
       ->capture_default_str();
   sub->add_option("--threads,-j", o->threads, "Threads for building and tracing (0: all hardware threads)")
       ->capture_default_str();
-  sub->add_option("--triangle-test", o->triangle_test,
-                  "Ray-triangle test: watertight (Woop et al. 2013) or fast (Moller-Trumbore)")
-      ->check(CLI::IsMember({"watertight", "fast"}))
-      ->capture_default_str();
+  add_triangle_test_option(sub, o->triangle_test);
   sub->add_flag("--force,-f", o->force, "Overwrite an existing output file");
   sub->add_option("--order", o->order,
                   "Child order of the traversal (BVH): front-to-back, back-to-front (the worst order), unordered")
