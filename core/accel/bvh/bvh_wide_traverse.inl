@@ -51,24 +51,27 @@ struct LeafRay {
     }
   }
 
-  /// Records a hit of lane l of block `blk` at (t, u, v) in best, field by
-  /// field (best.prim: the lane's leaf position). Closest hit also takes the
-  /// triangle's normal and lowers `closest`. Assembling a Hit and copying
-  /// it stalled: the copy's 16-byte loads waited for the narrower stores that
-  /// had just filled it (store forwarding; 6 % of the kitchen's single-ray
-  /// any-hit walk), as did gathering the lane's Triangle where only the
-  /// normal or the scalar test needs it.
+  /// A hit at (t, u, v) of lane l of block `blk`, found in leaf order. Any
+  /// hit records it and returns true (the walk is over); closest hit records
+  /// it, with the triangle's normal, when it is nearer than best, and lowers
+  /// `closest`. The fields go to best one by one (best.prim: the lane's leaf
+  /// position): a Hit assembled and copied stalled, the copy's 16-byte loads
+  /// waiting for the narrower stores that had just filled it (6 % of the
+  /// kitchen's single-ray any-hit walk); and the lane's Triangle is gathered
+  /// only for the normal (and by the scalar test where that runs).
   template <bool AnyHit>
-  [[gnu::always_inline]] static void record(const bvh_detail::TriBlock4& blk, int l, float t, float u, float v,
-                                            float& closest, Hit& best) {
+  [[gnu::always_inline]] static bool take(const bvh_detail::TriBlock4& blk, int l, float t, float u, float v,
+                                          float& closest, Hit& best) {
+    if constexpr (!AnyHit) {
+      if (!(t < best.t)) return false;
+      best.ng = triangle_normal(bvh_detail::tri4_triangle(blk, static_cast<std::uint32_t>(l)));
+      closest = t;
+    }
     best.t = t;
     best.u = u;
     best.v = v;
     best.prim = blk.pos[l];
-    if constexpr (!AnyHit) {
-      best.ng = triangle_normal(bvh_detail::tri4_triangle(blk, static_cast<std::uint32_t>(l)));
-      closest = t;
-    }
+    return AnyHit;
   }
 
   /// Tests leaf slot (first block `child`, `meta` blocks) in lane order.
@@ -109,12 +112,7 @@ struct LeafRay {
             u = res.u[l];
             v = res.v[l];
           }
-          if (!hit) continue;
-          if constexpr (AnyHit) {
-            record<true>(*blk, l, t, u, v, closest, best);
-            return true;
-          }
-          if (t < best.t) record<false>(*blk, l, t, u, v, closest, best);
+          if (hit && take<AnyHit>(*blk, l, t, u, v, closest, best)) return true;
         }
       }
       return false;
@@ -132,11 +130,7 @@ struct LeafRay {
           lanes &= lanes - 1;
           const float t = res.t[l];
           if (!(t <= closest)) continue;
-          if constexpr (AnyHit) {
-            record<true>(*blk, l, t, res.u[l], res.v[l], closest, best);
-            return true;
-          }
-          if (t < best.t) record<false>(*blk, l, t, res.u[l], res.v[l], closest, best);
+          if (take<AnyHit>(*blk, l, t, res.u[l], res.v[l], closest, best)) return true;
         }
       }
       return false;
@@ -149,14 +143,10 @@ struct LeafRay {
         for (int l = 0; l < 4; ++l) {
           if (blk->pos[l] == bvh_detail::kTri4Empty) continue;
           Hit h;
-          if (!test_triangle<Test>(r, wr, bvh_detail::tri4_triangle(*blk, static_cast<std::uint32_t>(l)), tmin, closest,
-                                   h))
-            continue;
-          if constexpr (AnyHit) {
-            record<true>(*blk, l, h.t, h.u, h.v, closest, best);
+          if (test_triangle<Test>(r, wr, bvh_detail::tri4_triangle(*blk, static_cast<std::uint32_t>(l)), tmin, closest,
+                                  h) &&
+              take<AnyHit>(*blk, l, h.t, h.u, h.v, closest, best))
             return true;
-          }
-          if (h.t < best.t) record<false>(*blk, l, h.t, h.u, h.v, closest, best);
         }
       return false;
     }
