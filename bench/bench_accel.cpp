@@ -12,8 +12,8 @@
 // hits, and `miss`: as many rays that start outside a sphere around the
 // scene's bounds and point away from it (every structure rejects them at
 // its root: their rate is the fixed cost of one query, the call, the ray's
-// set-up and the root test). items_per_second is rays/s; compare our row with Embree's on the
-// same ray set, as a ratio (docs/performance.md). TraceClosestPackets8 and
+// set-up and the root test). items_per_second is rays/s; compare our row
+// with Embree's on the same ray set, as a ratio (docs/performance.md). TraceClosestPackets8 and
 // TraceAnyPackets8: the same rays in packets of eight (Embree: rtcIntersect8,
 // rtcOccluded8).
 //
@@ -62,13 +62,14 @@ struct Fixture {
     rays[1] = diffuse_rays(scene.triangles, rays[0], hits, 1);
     const Light light = synthetic_bench_light(scene.bounds());
     rays[2] = shadow_rays(scene.triangles, rays[0], hits, std::span<const Light>(&light, 1));
-    // Radially outward from beyond the bounding sphere, in the primary rays'
-    // directions: they never enter the bounds.
+    // Radially outward in the primary rays' directions from 1.5 diagonals
+    // off the centre, beyond the bounds' circumsphere (half a diagonal):
+    // they never enter the bounds.
     const Aabb b = scene.bounds();
     const glm::vec3 center = (b.lo + b.hi) * 0.5f;
-    const float radius = glm::length(b.hi - b.lo);
+    const float diagonal = glm::length(b.hi - b.lo);
     rays[3].reserve(rays[0].size());
-    for (const Ray& r : rays[0]) rays[3].emplace_back(center + (1.5f * radius) * r.direction, r.direction);
+    for (const Ray& r : rays[0]) rays[3].emplace_back(center + (1.5f * diagonal) * r.direction, r.direction);
   }
 };
 
