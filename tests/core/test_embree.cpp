@@ -57,16 +57,16 @@ std::vector<Ray> random_rays(std::size_t n, std::uint32_t seed) {
   return rays;
 }
 
-bool same_t(float a, float b) {
-  return std::abs(a - b) <= 1e-4f * std::max(1.0f, std::abs(b));
+/// a and b agree to `rel` of b (absolute below 1).
+bool same_t(float a, float b, float rel = 1e-4f) {
+  return std::abs(a - b) <= rel * std::max(1.0f, std::abs(b));
 }
 
 /// A packet query's hit against the same structure's one-ray hit: both
 /// miss, or both hit within a few ulps (leaves may be visited in another
 /// order).
 bool same_hit_as_single(const Hit& packet, const Hit& single) {
-  return packet.valid() == single.valid() &&
-         (!packet.valid() || std::abs(packet.t - single.t) <= 1e-6f * std::max(1.0f, std::abs(single.t)));
+  return packet.valid() == single.valid() && (!packet.valid() || same_t(packet.t, single.t, 1e-6f));
 }
 
 }  // namespace
