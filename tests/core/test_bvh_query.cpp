@@ -296,6 +296,21 @@ TEST(BvhWide, EveryWidthAnswersLikeTheBinaryTree) {
   EXPECT_THROW(Bvh(tris, bad), std::invalid_argument);
 }
 
+#ifdef ACCELVIZ_NO_SIMD
+// The nosimd preset (scripts/test.sh): every test of this build runs the
+// scalar twins, so the SIMD paths must really be compiled out, in the tests'
+// headers and in the core library (cpu_has_wide8 is compiled there).
+TEST(BvhWide, ScalarBuildHasNoSimdPath) {
+#if defined(ACCELVIZ_BVH_TRI4_SSE2) || defined(ACCELVIZ_BVH_WIDE8_AVX2)
+  FAIL() << "ACCELVIZ_NO_SIMD is defined but a SIMD path is compiled in";
+#endif
+  EXPECT_FALSE(bvh_detail::cpu_has_wide8());
+  BvhOptions o = quiet();
+  o.wide_width = 8;
+  EXPECT_EQ(Bvh(soup(100, 7), o).build_stats().extra.at("wide_width"), 4.0);
+}
+#endif
+
 TEST(BvhWide, CollapseKeepsEveryLeafOnceWithItsBox) {
   for (int leaf : {1, 4}) {
     const auto tris = soup(3000, 20 + leaf);
