@@ -14,8 +14,10 @@
 #include "core/analysis/heatmap.h"
 #include "core/query/camera.h"
 #include "core/scene/load.h"
+#ifdef ACCELVIZ_HAVE_UI
 #include "ui/gl/osmesa_context.h"
 #include "ui/render/gpu_trace.h"
+#endif
 
 namespace accelviz::cli {
 
@@ -111,6 +113,7 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
   HeatmapFigures fig;
   MetricImage img;
   nlohmann::json gpu_figures;
+#ifdef ACCELVIZ_HAVE_UI
   if (o.device == "gpu") {
     // Headless GL 4.5 (OSMesa); the image size of the context is irrelevant:
     // the compute shader writes a storage buffer.
@@ -127,7 +130,9 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
     progress.end(std::to_string(static_cast<long long>(fig.render_ms)) + " ms");
     gpu_figures = {
         {"gpu_renderer", context.info().renderer}, {"gpu_setup_ms", setup_ms}, {"gpu_readback_ms", raw.readback_ms}};
-  } else {
+  } else
+#endif
+  {
     progress.begin("rendering " + o.metric);
     ho.progress = progress.callback();
     img = render_metric(*accel, camera, ho, &fig);
@@ -169,10 +174,14 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
 
 int run_render(const RenderOptions& o, const GlobalOptions& global) {
   if (o.device == "gpu") {
+#ifndef ACCELVIZ_HAVE_UI
+    throw UsageError("--device gpu needs the renderer, and this build has none (configure with ACCELVIZ_BUILD_UI=ON)");
+#else
     if (const std::string why = gpu_trace_unsupported(o.structure); !why.empty())
       throw UsageError("--device gpu: " + why);
     if (o.compare) throw UsageError("--device gpu: --compare traces on the CPU only");
     if (o.view != "heatmap") throw UsageError("--device gpu needs --view heatmap");
+#endif
   }
   if (o.compare) {
     if (o.view != "heatmap") throw UsageError("--compare needs --view heatmap");

@@ -6,9 +6,9 @@
 // script), 2 for a usage error.
 #include "app/cli_common.h"
 #include "core/scene/load.h"
+#include "core/util/one_line.h"
 #ifdef ACCELVIZ_HAVE_UI
 #include "app/gui/gui.h"
-#include "core/util/one_line.h"
 #endif
 
 #include <CLI/CLI.hpp>

@@ -3,9 +3,10 @@
 #   1. Release build, whole suite (core unit + differential tests, CLI tests,
 #      headless GL tests through OSMesa, GUI tests under Xvfb once they exist).
 #   1b. libFuzzer targets for the loaders, bounded time (skip with ACCELVIZ_SKIP_FUZZ=1).
-#   1c. The core's scalar code paths (ACCELVIZ_NO_SIMD: binning, box and
-#      triangle tests without SSE2/AVX2), core unit and differential tests
-#      (skip with ACCELVIZ_SKIP_NOSIMD=1).
+#   1c. A build without the renderer on the core's scalar code paths
+#      (ACCELVIZ_BUILD_UI=OFF, ACCELVIZ_NO_SIMD: binning, box and triangle
+#      tests without SSE2/AVX2): core and CLI tests (skip with
+#      ACCELVIZ_SKIP_NOSIMD=1).
 #   2. Debug + AddressSanitizer + UndefinedBehaviorSanitizer build, whole suite
 #      again (skip with ACCELVIZ_SKIP_SANITIZERS=1 for a quick local run).
 set -euo pipefail
@@ -28,7 +29,7 @@ if [ "${ACCELVIZ_SKIP_FUZZ:-0}" != "1" ]; then
 fi
 
 if [ "${ACCELVIZ_SKIP_NOSIMD:-0}" != "1" ]; then
-  echo "== scalar (ACCELVIZ_NO_SIMD) build: core tests"
+  echo "== no-renderer build on the scalar code paths (preset nosimd): core and CLI tests"
   cmake --preset nosimd >/dev/null
   cmake --build --preset nosimd -j "$jobs"
   ctest --preset nosimd -j "$jobs"
