@@ -227,6 +227,31 @@ template <TriangleTest Test>
     return bvh_detail::intersect_moller_trumbore_inline(ray, tri, tmin, tmax, h);
 }
 
+/// A hit at (t, u, v) on lane l of triangle block `blk`, found in leaf order,
+/// into `best` (best.prim: the lane's leaf position). Any hit records it and
+/// returns true (the walk is over); closest hit records it with the
+/// triangle's normal when it is nearer than best (first found wins ties, as
+/// in BruteForce) and lowers `closest`, and returns false. Every walk's leaf
+/// test ends here: the binary walk (traverse), the heatmap's counted walk and
+/// the wide walk (LeafRay). The fields go to best one by one: a Hit assembled
+/// and copied stalled, the copy's 16-byte loads waiting for the narrower
+/// stores that had just filled it (6 % of the kitchen's single-ray any-hit
+/// walk); and the lane's Triangle is gathered only for the normal.
+template <bool AnyHit>
+[[gnu::always_inline]] inline bool take_hit(const bvh_detail::TriBlock4& blk, int l, float t, float u, float v,
+                                            float& closest, Hit& best) {
+  if constexpr (!AnyHit) {
+    if (!(t < best.t)) return false;
+    best.ng = triangle_normal(bvh_detail::tri4_triangle(blk, static_cast<std::uint32_t>(l)));
+    closest = t;
+  }
+  best.t = t;
+  best.u = u;
+  best.v = v;
+  best.prim = blk.pos[l];
+  return AnyHit;
+}
+
 /// Leaves of the subtree at `node` whose boxes (and their ancestors' boxes
 /// below `node`) the ray crosses in [tmin, tmax]: what a full traversal of
 /// that subtree would enter. `node` itself was already tested when pushed.
@@ -365,8 +390,7 @@ Hit traverse(const BvhView& bvh, const Ray& ray, const Collector& c) {
         }
         if constexpr (AnyHit) {
           if (hit) {
-            best = h;
-            best.prim = k;
+            take_hit<true>(blk[j >> 2], static_cast<int>(j & 3), h.t, h.u, h.v, closest, best);
             if constexpr (Collect) {
               // Leaves the early exit never reached: those below the pending stack entries that the ray crosses.
               for (unsigned i = 0; i < sp; ++i)
@@ -374,11 +398,8 @@ Hit traverse(const BvhView& bvh, const Ray& ray, const Collector& c) {
             }
             return best;
           }
-        } else if (hit && h.t < best.t) {  // first found wins ties, as in BruteForce
-          best = h;
-          best.prim = k;
-          best.ng = triangle_normal(tri);
-          closest = h.t;
+        } else if (hit) {
+          take_hit<false>(blk[j >> 2], static_cast<int>(j & 3), h.t, h.u, h.v, closest, best);
         }
       }
     }
@@ -527,15 +548,6 @@ class CountedWalk {
     float t_entry;
   };
 
-  void take(std::uint32_t k, const Hit& h, const Triangle& tri) {
-    if (h.t < best_.t) {  // first found wins ties, as in traverse
-      best_ = h;
-      best_.prim = k;
-      best_.ng = triangle_normal(tri);
-      closest_ = h.t;
-    }
-  }
-
   [[gnu::always_inline]] void leaf(const BvhView& bvh, const BvhNode& n) {
     const Ray& ray = *ray_;
     const float tmin = ray.tmin;
@@ -552,27 +564,23 @@ class CountedWalk {
         while (lanes != 0) {
           const int l = std::countr_zero(static_cast<unsigned>(lanes));
           lanes &= lanes - 1;
-          const Triangle tri = bvh_detail::tri4_triangle(*blk, static_cast<std::uint32_t>(l));
-          Hit h;
-          bool hit;
           if ((r.special >> l) & 1) {
-            hit = intersect_watertight(ray, wr_.wr, tri, tmin, closest_, h);
-          } else {
-            hit = bvh_detail::tri4_accept(r, l, closest_);
-            h.t = r.t[l];
-            h.u = r.u[l];
-            h.v = r.v[l];
+            Hit h;
+            if (intersect_watertight(ray, wr_.wr, bvh_detail::tri4_triangle(*blk, static_cast<std::uint32_t>(l)), tmin,
+                                     closest_, h))
+              take_hit<false>(*blk, l, h.t, h.u, h.v, closest_, best_);
+          } else if (bvh_detail::tri4_accept(r, l, closest_)) {
+            take_hit<false>(*blk, l, r.t[l], r.u[l], r.v[l], closest_, best_);
           }
-          if (hit) take(blk->pos[l], h, tri);
         }
       }
       return;
     }
 #endif
     for (std::uint32_t j = 0; j < n.count; ++j) {
-      const Triangle tri = bvh_detail::tri4_triangle(blk[j >> 2], j & 3);
       Hit h;
-      if (test_triangle<Test>(ray, wr_, tri, tmin, closest_, h)) take(n.index + j, h, tri);
+      if (test_triangle<Test>(ray, wr_, bvh_detail::tri4_triangle(blk[j >> 2], j & 3), tmin, closest_, h))
+        take_hit<false>(blk[j >> 2], static_cast<int>(j & 3), h.t, h.u, h.v, closest_, best_);
     }
   }
 

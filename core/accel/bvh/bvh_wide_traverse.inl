@@ -51,29 +51,6 @@ struct LeafRay {
     }
   }
 
-  /// A hit at (t, u, v) of lane l of block `blk`, found in leaf order. Any
-  /// hit records it and returns true (the walk is over); closest hit records
-  /// it, with the triangle's normal, when it is nearer than best, and lowers
-  /// `closest`. The fields go to best one by one (best.prim: the lane's leaf
-  /// position): a Hit assembled and copied stalled, the copy's 16-byte loads
-  /// waiting for the narrower stores that had just filled it (6 % of the
-  /// kitchen's single-ray any-hit walk); and the lane's Triangle is gathered
-  /// only for the normal (and by the scalar test where that runs).
-  template <bool AnyHit>
-  [[gnu::always_inline]] static bool take(const bvh_detail::TriBlock4& blk, int l, float t, float u, float v,
-                                          float& closest, Hit& best) {
-    if constexpr (!AnyHit) {
-      if (!(t < best.t)) return false;
-      best.ng = triangle_normal(bvh_detail::tri4_triangle(blk, static_cast<std::uint32_t>(l)));
-      closest = t;
-    }
-    best.t = t;
-    best.u = u;
-    best.v = v;
-    best.prim = blk.pos[l];
-    return AnyHit;
-  }
-
   /// Tests leaf slot (first block `child`, `meta` blocks) in lane order.
   /// Closest hit: keeps the first found at the smallest t in best (with its
   /// normal) and lowers `closest`; returns false. Any hit: returns true at
@@ -112,7 +89,7 @@ struct LeafRay {
             u = res.u[l];
             v = res.v[l];
           }
-          if (hit && take<AnyHit>(*blk, l, t, u, v, closest, best)) return true;
+          if (hit && take_hit<AnyHit>(*blk, l, t, u, v, closest, best)) return true;
         }
       }
       return false;
@@ -130,7 +107,7 @@ struct LeafRay {
           lanes &= lanes - 1;
           const float t = res.t[l];
           if (!(t <= closest)) continue;
-          if (take<AnyHit>(*blk, l, t, res.u[l], res.v[l], closest, best)) return true;
+          if (take_hit<AnyHit>(*blk, l, t, res.u[l], res.v[l], closest, best)) return true;
         }
       }
       return false;
@@ -145,7 +122,7 @@ struct LeafRay {
           Hit h;
           if (test_triangle<Test>(r, wr, bvh_detail::tri4_triangle(*blk, static_cast<std::uint32_t>(l)), tmin, closest,
                                   h) &&
-              take<AnyHit>(*blk, l, h.t, h.u, h.v, closest, best))
+              take_hit<AnyHit>(*blk, l, h.t, h.u, h.v, closest, best))
             return true;
         }
       return false;
