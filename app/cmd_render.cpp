@@ -175,7 +175,7 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
 int run_render(const RenderOptions& o, const GlobalOptions& global) {
   if (o.device == "gpu") {
 #ifndef ACCELVIZ_HAVE_UI
-    throw UsageError("--device gpu needs the renderer, and this build has none (configure with ACCELVIZ_BUILD_UI=ON)");
+    throw UsageError(needs_renderer("--device gpu"));
 #else
     if (const std::string why = gpu_trace_unsupported(o.structure); !why.empty())
       throw UsageError("--device gpu: " + why);
@@ -191,6 +191,7 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
     return run_render_compare(job, global);
   }
   check_output_path(o.out, o.force);  // before any long work
+  if (o.view == "raster" && !raster_available()) throw UsageError(needs_renderer("--view raster"));
   if (o.view == "raster") return run_render_raster(o, global);
   if (o.raster.box_depth >= 0 || o.raster.leaves || !o.ray_pixel.empty() || o.raster.blend > 0.0f || o.raster.wireframe)
     throw UsageError("--depth, --depth-last, --leaves, --ray-pixel, --blend and --wireframe need --view raster");

@@ -121,7 +121,7 @@ bool raster_available() { return false; }
 void render_raster(const Scene&, const Accelerator&, const Camera&, const ImageSize&, const RasterOptions&,
                    const std::string&, const std::string&, float, const QueryOptions&, float, float, unsigned,
                    const std::string&, bool, nlohmann::json&) {
-  throw UsageError("--view raster needs the renderer, and this build has none (configure with ACCELVIZ_BUILD_UI=ON)");
+  throw UsageError(needs_renderer("--view raster"));
 }
 
 #endif

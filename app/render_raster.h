@@ -23,6 +23,12 @@ struct RasterOptions {
 /// True when this binary was built with the renderer.
 bool raster_available();
 
+/// The one-line error of an option (`what`) that needs the renderer in a
+/// build without it.
+inline std::string needs_renderer(const std::string& what) {
+  return what + " needs the renderer, and this build has none (configure with ACCELVIZ_BUILD_UI=ON)";
+}
+
 /// Draws the raster view and writes `out`; fills `figures`. Throws on failure.
 void render_raster(const Scene& scene, const Accelerator& accel, const Camera& camera, const ImageSize& size,
                    const RasterOptions& ro, const std::string& metric, const std::string& colormap, float fixed_max,
