@@ -291,12 +291,7 @@ void traverse_packet(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView
         for (int j = k - 1; j >= 1; --j) {
           const int i = order[j];
           const std::uint32_t c = n.child[slot[i]], m = n.meta[slot[i]];
-          const char* p =
-              m == 0 ? reinterpret_cast<const char*>(wide + c) : reinterpret_cast<const char*>(bvh.blocks + c);
-          __builtin_prefetch(p);
-          __builtin_prefetch(p + 64);
-          __builtin_prefetch(p + 128);
-          if (m == 0) __builtin_prefetch(p + 192);
+          prefetch_slot(wide, bvh, c, m);
           stack[sp++] = {te[i], c, m, hit_lanes[i]};
         }
         child = n.child[slot[order[0]]];

@@ -146,6 +146,23 @@ struct LeafRay {
 /// the closest hit so far in closest/best (its leaf tests by `leaf`): what
 /// traverse_wide runs from the root, and the packet walk for a lane that
 /// goes on alone. Returns true when an any-hit walk found a hit.
+/// Starts fetching what slot (c, m) leads to: a wide node (four cache lines)
+/// or a leaf slot's triangle blocks (the first 256 bytes: one block of 160
+/// and the start of a merged slot's second). The walks call it for every
+/// child they will visit, the one they go to next included (as Embree's
+/// walk does): that child's loads then overlap the rest of this step (the
+/// next node's child line is otherwise read only after its box test, a
+/// leaf's blocks after the leaf test's set-up).
+template <class WideNode>
+[[gnu::always_inline]] inline void prefetch_slot(const WideNode* wide, const BvhView& bvh, std::uint32_t c,
+                                                 std::uint32_t m) {
+  const char* p = m == 0 ? reinterpret_cast<const char*>(wide + c) : reinterpret_cast<const char*>(bvh.blocks + c);
+  __builtin_prefetch(p);
+  __builtin_prefetch(p + 64);
+  __builtin_prefetch(p + 128);
+  __builtin_prefetch(p + 192);
+}
+
 template <bool AnyHit, bool Ordered, TriangleTest Test>
 [[gnu::always_inline]] inline bool walk_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& bvh,
                                              const Ray& ray, LeafRay<Test>& leaf, std::uint32_t child,
@@ -171,6 +188,7 @@ template <bool AnyHit, bool Ordered, TriangleTest Test>
           const int s = std::countr_zero(static_cast<unsigned>(mask));
           child = n.child[s];
           meta = n.meta[s];
+          prefetch_slot(wide, bvh, child, meta);
           continue;
         }
         int slot[kWidth], k = 0;
@@ -203,21 +221,16 @@ template <bool AnyHit, bool Ordered, TriangleTest Test>
             slot[j] = v;
           }
         }
-        // The pushed children are visited later: start fetching them now
-        // (a node is four cache lines, a triangle block three), so that deep
-        // walks through large trees overlap the memory latency (as Embree).
+        // The pushed children are visited later: start fetching them now, so
+        // that deep walks through large trees overlap the memory latency.
         for (int j = k - 1; j >= 1; --j) {
           const std::uint32_t c = n.child[slot[j]], m = n.meta[slot[j]];
-          const char* p =
-              m == 0 ? reinterpret_cast<const char*>(wide + c) : reinterpret_cast<const char*>(bvh.blocks + c);
-          __builtin_prefetch(p);
-          __builtin_prefetch(p + 64);
-          __builtin_prefetch(p + 128);
-          if (m == 0) __builtin_prefetch(p + 192);
+          prefetch_slot(wide, bvh, c, m);
           stack[sp++] = {c, m, te[slot[j]]};
         }
         child = n.child[slot[0]];
         meta = n.meta[slot[0]];
+        prefetch_slot(wide, bvh, child, meta);
         continue;
       }
     } else if (leaf.template test<AnyHit>(bvh, child, meta, tmin, closest, best)) {
