@@ -130,22 +130,6 @@ struct LeafRay {
   }
 };
 
-/// Fast-path traversal of the W-wide copy (no statistics). Same contract as
-/// traverse<AnyHit, Ordered, false, Test>: hits on the same triangles, ties
-/// kept by "first found at the smallest t".
-///  - Ordered: hit children sorted by entry distance, nearest taken, the
-///    others pushed farthest first; on pop a child whose entry lies beyond
-///    the closest hit is skipped.
-///  - Unordered: slot order.
-///  - Any hit (either mode): the last hit slot first, then the others from
-///    the last down (Embree's any-hit order).
-/// Stack: at most W - 1 entries per wide level, and a wide path is no longer
-/// than the binary one (kBvhMaxDepth).
-///
-/// walk_wide is that walk from slot (child, meta) on (0, 0: the root), with
-/// the closest hit so far in closest/best (its leaf tests by `leaf`): what
-/// traverse_wide runs from the root, and the packet walk for a lane that
-/// goes on alone. Returns true when an any-hit walk found a hit.
 /// Starts fetching what slot (c, m) leads to: a wide node (four cache lines)
 /// or a leaf slot's triangle blocks (the first 256 bytes: one block of 160
 /// and the start of a merged slot's second). The walks call it for every
@@ -163,6 +147,22 @@ template <class WideNode>
   __builtin_prefetch(p + 192);
 }
 
+/// Fast-path traversal of the W-wide copy (no statistics). Same contract as
+/// traverse<AnyHit, Ordered, false, Test>: hits on the same triangles, ties
+/// kept by "first found at the smallest t".
+///  - Ordered: hit children sorted by entry distance, nearest taken, the
+///    others pushed farthest first; on pop a child whose entry lies beyond
+///    the closest hit is skipped.
+///  - Unordered: slot order.
+///  - Any hit (either mode): the last hit slot first, then the others from
+///    the last down (Embree's any-hit order).
+/// Stack: at most W - 1 entries per wide level, and a wide path is no longer
+/// than the binary one (kBvhMaxDepth).
+///
+/// walk_wide is that walk from slot (child, meta) on (0, 0: the root), with
+/// the closest hit so far in closest/best (its leaf tests by `leaf`): what
+/// traverse_wide runs from the root, and the packet walk for a lane that
+/// goes on alone. Returns true when an any-hit walk found a hit.
 template <bool AnyHit, bool Ordered, TriangleTest Test>
 [[gnu::always_inline]] inline bool walk_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& bvh,
                                              const Ray& ray, LeafRay<Test>& leaf, std::uint32_t child,
