@@ -13,9 +13,9 @@
 // scene's bounds and point away from it (every structure rejects them at
 // its root: their rate is the fixed cost of one query, the call, the ray's
 // set-up and the root test). items_per_second is rays/s; compare our row
-// with Embree's on the same ray set, as a ratio (docs/performance.md). TraceClosestPackets8 and
-// TraceAnyPackets8: the same rays in packets of eight (Embree: rtcIntersect8,
-// rtcOccluded8).
+// with Embree's on the same ray set, as a ratio (docs/performance.md).
+// TraceClosestPackets8 and TraceAnyPackets8: the same rays in packets of
+// eight (Embree: rtcIntersect8, rtcOccluded8).
 //
 // ACCELVIZ_BENCH_PAIRING: which of our triangle tests meets which Embree
 // mode (the pairs of `accelviz bench`): unset or `default`, our watertight
