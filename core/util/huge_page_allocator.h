@@ -19,8 +19,17 @@
 // (2026-12-02): touching 36 MiB took 92-117 ms with 4 KiB pages and 2.4-2.6 ms
 // with huge pages, and the dragon's one-thread build fell from ~640 to ~370 ms
 // (docs/performance.md, "Page faults").
+//
+// Freed arrays of 2 MiB or more are kept (up to kKeptBytes in all) and handed
+// to the next allocation of about their size, so that a rebuild (a slider in
+// the GUI, a sweep, a benchmark's loop) writes into pages that are already
+// mapped instead of having the kernel map and zero them again: the dragon's
+// build spent about a tenth of its time in the kernel's page clearing when
+// every build started from fresh memory (docs/performance.md).
+#include <array>
 #include <cstddef>
 #include <cstdlib>
+#include <mutex>
 #include <new>
 #include <type_traits>
 #include <utility>
@@ -34,6 +43,92 @@ namespace accelviz {
 
 inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
 
+namespace huge_page_detail {
+
+/// Freed huge-page regions kept for reuse, oldest first.
+struct KeptRegions {
+  static constexpr std::size_t kKeptBytes = std::size_t{1} << 30;  ///< at most this much kept in all
+  static constexpr int kSlots = 16;
+  std::mutex mutex;
+  std::array<void*, kSlots> ptr{};
+  std::array<std::size_t, kSlots> bytes{};
+  int count = 0;
+  std::size_t total = 0;
+
+  void remove(int i) {
+    total -= bytes[i];
+    for (int j = i + 1; j < count; ++j) {
+      ptr[j - 1] = ptr[j];
+      bytes[j - 1] = bytes[j];
+    }
+    --count;
+  }
+};
+
+/// The process's kept regions. Never destroyed, so that arrays freed during
+/// static destruction still find it (the regions stay reachable through it).
+inline KeptRegions& kept_regions() {
+  static KeptRegions* const kept = new KeptRegions;
+  return *kept;
+}
+
+/// The smallest kept region of `bytes` to 2 x `bytes`, taken out of the
+/// kept set; nullptr if none. Its memory holds whatever its last user wrote.
+inline void* take_region(std::size_t bytes) {
+  KeptRegions& k = kept_regions();
+  const std::lock_guard lock(k.mutex);
+  int best = -1;
+  for (int i = 0; i < k.count; ++i)
+    if (k.bytes[i] >= bytes && k.bytes[i] / 2 <= bytes && (best < 0 || k.bytes[i] < k.bytes[best])) best = i;
+  if (best < 0) return nullptr;
+  void* const p = k.ptr[best];
+  k.remove(best);
+  return p;
+}
+
+/// Keeps region p (at least `bytes` long) for reuse, freeing the oldest kept
+/// regions where the new one would not fit otherwise; frees p itself if it
+/// alone is larger than KeptRegions::kKeptBytes.
+inline void keep_region(void* p, std::size_t bytes) {
+  if (bytes > KeptRegions::kKeptBytes) {
+    std::free(p);
+    return;
+  }
+  KeptRegions& k = kept_regions();
+  void* freed[KeptRegions::kSlots];
+  int nfreed = 0;
+  {
+    const std::lock_guard lock(k.mutex);
+    while (k.count == KeptRegions::kSlots || k.total + bytes > KeptRegions::kKeptBytes) {
+      freed[nfreed++] = k.ptr[0];
+      k.remove(0);
+    }
+    k.ptr[k.count] = p;
+    k.bytes[k.count] = bytes;
+    ++k.count;
+    k.total += bytes;
+  }
+  for (int i = 0; i < nfreed; ++i) std::free(freed[i]);
+}
+
+/// Bytes kept now.
+inline std::size_t kept_bytes() {
+  KeptRegions& k = kept_regions();
+  const std::lock_guard lock(k.mutex);
+  return k.total;
+}
+
+/// Frees every kept region (gives their memory back to the system).
+inline void release_kept_regions() {
+  KeptRegions& k = kept_regions();
+  const std::lock_guard lock(k.mutex);
+  for (int i = 0; i < k.count; ++i) std::free(k.ptr[i]);
+  k.count = 0;
+  k.total = 0;
+}
+
+}  // namespace huge_page_detail
+
 template <class T>
 struct HugePageAllocator {
   using value_type = T;
@@ -43,11 +138,16 @@ struct HugePageAllocator {
   HugePageAllocator(const HugePageAllocator<U>&) noexcept {}
 
   static bool huge(std::size_t n) { return n * sizeof(T) >= kHugePageBytes; }
+  /// A huge array's region: whole huge pages.
+  static std::size_t region_bytes(std::size_t n) {
+    return (n * sizeof(T) + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
+  }
 
   T* allocate(std::size_t n) {
     if (n > static_cast<std::size_t>(-1) / sizeof(T)) throw std::bad_array_new_length();
     if (!huge(n)) return static_cast<T*>(::operator new (n * sizeof(T), std::align_val_t{alignof(T)}));
-    const std::size_t bytes = (n * sizeof(T) + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
+    const std::size_t bytes = region_bytes(n);
+    if (void* kept = huge_page_detail::take_region(bytes)) return static_cast<T*>(kept);
     void* p = std::aligned_alloc(kHugePageBytes, bytes);
     if (p == nullptr) throw std::bad_alloc();
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
@@ -73,7 +173,7 @@ struct HugePageAllocator {
       ::operator delete (p, std::align_val_t{alignof(T)});
       return;
     }
-    std::free(p);
+    huge_page_detail::keep_region(p, region_bytes(n));
   }
 
   template <class U>

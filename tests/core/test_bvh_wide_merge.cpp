@@ -138,4 +138,50 @@ TEST(HugePageAllocator, LargeArraysSitOnHugePageBoundariesSmallOnesAreOrdinary) 
   EXPECT_TRUE(big.empty());
 }
 
+TEST(HugePageAllocator, FreedLargeArraysAreReusedForArraysOfAboutTheirSize) {
+  huge_page_detail::release_kept_regions();
+  const std::size_t n = 2 * kHugePageBytes / sizeof(float);  // two huge pages
+  const float* first = nullptr;
+  {
+    HugePageVector<float> a(n, 1.0f);
+    first = a.data();
+  }
+  EXPECT_EQ(huge_page_detail::kept_bytes(), 2 * kHugePageBytes);
+  {
+    HugePageVector<float> b(n - 5);  // the same two pages: the kept region
+    EXPECT_EQ(b.data(), first);
+    EXPECT_EQ(huge_page_detail::kept_bytes(), 0u);
+    HugePageVector<float> c(5 * n);  // more than the kept region: fresh memory
+    EXPECT_NE(c.data(), first);
+  }
+  EXPECT_EQ(huge_page_detail::kept_bytes(), 12 * kHugePageBytes);  // b's two pages and c's ten
+  {
+    // One page: b's two pages are at most twice that, c's ten are not.
+    HugePageVector<float> d(n / 2);
+    EXPECT_EQ(d.data(), first);
+    EXPECT_EQ(huge_page_detail::kept_bytes(), 10 * kHugePageBytes);
+    HugePageVector<float> e(n / 2);  // nothing near one page is left: fresh memory
+    EXPECT_EQ(huge_page_detail::kept_bytes(), 10 * kHugePageBytes);
+    EXPECT_NE(e.data(), first);
+  }
+  huge_page_detail::release_kept_regions();
+  EXPECT_EQ(huge_page_detail::kept_bytes(), 0u);
+}
+
+TEST(HugePageAllocator, KeptRegionsAreBoundedInCountAndBytes) {
+  huge_page_detail::release_kept_regions();
+  using huge_page_detail::KeptRegions;
+  {
+    std::vector<HugePageVector<char>> arrays;
+    for (int i = 0; i < KeptRegions::kSlots + 4; ++i) arrays.emplace_back(kHugePageBytes);
+  }
+  // Only the newest kSlots regions are kept; the oldest were freed.
+  EXPECT_EQ(huge_page_detail::kept_bytes(), KeptRegions::kSlots * kHugePageBytes);
+  // A region larger than the whole budget is freed at once, and the others stay.
+  huge_page_detail::keep_region(std::malloc(16), KeptRegions::kKeptBytes + kHugePageBytes);
+  EXPECT_EQ(huge_page_detail::kept_bytes(), KeptRegions::kSlots * kHugePageBytes);
+  huge_page_detail::release_kept_regions();
+  EXPECT_EQ(huge_page_detail::kept_bytes(), 0u);
+}
+
 }  // namespace unity_test_bvh_wide_merge
