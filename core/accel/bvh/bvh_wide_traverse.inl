@@ -191,25 +191,31 @@ template <bool AnyHit, bool Ordered, TriangleTest Test>
           prefetch_slot(wide, bvh, child, meta);
           continue;
         }
-        int slot[kWidth], k = 0;
         if constexpr (AnyHit) {
           // Any hit: any occluder ends the walk; no sort (it bought little
           // and cost a data-dependent shuffle per node), the last hit slot
           // first, as Embree's any-hit walk: measured better than slot order
           // on shadow and primary rays from two opposite cameras
-          // (docs/performance.md, "Any hit: last slot first").
-          while (mask != 0) {
-            const int s = 31 - std::countl_zero(static_cast<unsigned>(mask));
-            slot[k++] = s;
-            mask &= ~(1 << s);
+          // (docs/performance.md, "Any hit: last slot first"). So the lower
+          // slots are pushed lowest first (popped highest first) in one
+          // pass, and the walk goes on to the last.
+          const int last = 31 - std::countl_zero(static_cast<unsigned>(mask));
+          for (mask &= ~(1 << last); mask != 0; mask &= mask - 1) {
+            const int s = std::countr_zero(static_cast<unsigned>(mask));
+            prefetch_slot(wide, bvh, n.child[s], n.meta[s]);
+            stack[sp++] = {n.child[s], n.meta[s], te[s]};
           }
-        } else {
-          while (mask != 0) {
-            slot[k++] = std::countr_zero(static_cast<unsigned>(mask));
-            mask &= mask - 1;
-          }
+          child = n.child[last];
+          meta = n.meta[last];
+          prefetch_slot(wide, bvh, child, meta);
+          continue;
         }
-        if constexpr (Ordered && !AnyHit) {
+        int slot[kWidth], k = 0;
+        while (mask != 0) {
+          slot[k++] = std::countr_zero(static_cast<unsigned>(mask));
+          mask &= mask - 1;
+        }
+        if constexpr (Ordered) {
           // Insertion sort by entry distance; equal distances keep slot order.
           for (int i = 1; i < k; ++i) {
             const int v = slot[i];
