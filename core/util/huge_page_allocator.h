@@ -20,7 +20,7 @@
 // with huge pages, and the dragon's one-thread build fell from ~640 to ~370 ms
 // (docs/performance.md, "Page faults").
 //
-// Freed arrays of 2 MiB or more are kept (up to kKeptBytes in all) and handed
+// Freed arrays of 2 to 64 MiB are kept (up to kKeptBytes in all) and handed
 // to the next allocation of about their size, so that a rebuild (a slider in
 // the GUI, a sweep, a benchmark's loop) writes into pages that are already
 // mapped instead of having the kernel map and zero them again: the dragon's
@@ -47,7 +47,8 @@ namespace huge_page_detail {
 
 /// Freed huge-page regions kept for reuse, oldest first.
 struct KeptRegions {
-  static constexpr std::size_t kKeptBytes = std::size_t{1} << 30;  ///< at most this much kept in all
+  static constexpr std::size_t kKeptBytes = std::size_t{512} << 20;       ///< at most this much kept in all
+  static constexpr std::size_t kKeptRegionBytes = std::size_t{64} << 20;  ///< larger regions are freed at once
   static constexpr int kSlots = 16;
   std::mutex mutex;
   std::array<void*, kSlots> ptr{};
@@ -87,10 +88,12 @@ inline void* take_region(std::size_t bytes) {
 }
 
 /// Keeps region p (at least `bytes` long) for reuse, freeing the oldest kept
-/// regions where the new one would not fit otherwise; frees p itself if it
-/// alone is larger than KeptRegions::kKeptBytes.
+/// regions where the new one would not fit otherwise; frees p itself if it is
+/// larger than KeptRegions::kKeptRegionBytes (keeping regions of hundreds of
+/// MiB made the 10M-triangle soup's builds about a fifth slower, measured,
+/// cause not found; docs/performance.md).
 inline void keep_region(void* p, std::size_t bytes) {
-  if (bytes > KeptRegions::kKeptBytes) {
+  if (bytes > KeptRegions::kKeptRegionBytes) {
     std::free(p);
     return;
   }

@@ -177,9 +177,20 @@ TEST(HugePageAllocator, KeptRegionsAreBoundedInCountAndBytes) {
   }
   // Only the newest kSlots regions are kept; the oldest were freed.
   EXPECT_EQ(huge_page_detail::kept_bytes(), KeptRegions::kSlots * kHugePageBytes);
-  // A region larger than the whole budget is freed at once, and the others stay.
-  huge_page_detail::keep_region(std::malloc(16), KeptRegions::kKeptBytes + kHugePageBytes);
+  // A region larger than kKeptRegionBytes is freed at once, and the others stay.
+  huge_page_detail::keep_region(std::malloc(16), KeptRegions::kKeptRegionBytes + kHugePageBytes);
   EXPECT_EQ(huge_page_detail::kept_bytes(), KeptRegions::kSlots * kHugePageBytes);
+  huge_page_detail::release_kept_regions();
+  EXPECT_EQ(huge_page_detail::kept_bytes(), 0u);
+  // The largest kept regions, more than the byte budget holds (never touched:
+  // address space only): the newest that fit are kept.
+  const std::size_t fit = KeptRegions::kKeptBytes / KeptRegions::kKeptRegionBytes;
+  {
+    std::vector<HugePageVector<char>> arrays;
+    for (std::size_t i = 0; i < fit + 2; ++i) arrays.emplace_back(KeptRegions::kKeptRegionBytes);
+  }
+  EXPECT_EQ(huge_page_detail::kept_bytes(), fit * KeptRegions::kKeptRegionBytes);
+  EXPECT_LE(huge_page_detail::kept_bytes(), KeptRegions::kKeptBytes);
   huge_page_detail::release_kept_regions();
   EXPECT_EQ(huge_page_detail::kept_bytes(), 0u);
 }
