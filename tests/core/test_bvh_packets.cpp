@@ -181,6 +181,79 @@ TEST(BvhPackets, ParallelRaysThroughSharedEdgesAndVerticesInOneLeaf) {
   }
 }
 
+TEST(BvhPackets, LanesOfMixedShearAxesAndSignsAnswerAsSingleRays) {
+  // The ray-parallel watertight test needs every lane to shear the same axes
+  // (same dominant axis, same sign along it); the packet's set-up decides
+  // that for all lanes at once. Packets of eight rays aimed at one point of
+  // a fan kept in one leaf (so all lanes reach the leaf together): lanes with
+  // different dominant axes, the same axis with both signs, ties between
+  // axes (x or y over z only when strictly larger), and uniform packets
+  // along x and along y. Each lane answers as its ray alone, bit for bit.
+  std::vector<Triangle> fan;
+  const glm::vec3 c(0.0f, 0.0f, 0.0f);
+  const glm::vec3 rim[8] = {{1, 0, 0},  {1, 1, 0},   {0, 1, 0},  {-1, 1, 0},
+                            {-1, 0, 0}, {-1, -1, 0}, {0, -1, 0}, {1, -1, 0}};
+  for (int i = 0; i < 8; ++i) fan.push_back({c, rim[i], rim[(i + 1) % 8]});
+  BvhOptions o;
+  o.compute_epo = false;
+  o.max_leaf_size = 16;
+  const Bvh bvh(fan, o);
+  using D = glm::vec3;
+  const std::vector<std::vector<D>> patterns = {
+      {D(0, 0, -1), D(0.25f, 0.125f, -1), D(1, 0.1f, -0.5f), D(0.1f, -1, -0.5f), D(-1, 0.2f, -0.3f), D(0.3f, 1, -0.2f),
+       D(1, 0, -1), D(1, 1, -1)},  // lane 0 along -z, others along x or y, every z component negative
+      {D(1, 0.1f, -0.5f), D(0.2f, 0.1f, -1), D(0.5f, -1, 0.4f), D(2, 0.5f, -1), D(0.1f, 0.1f, 1), D(1, 0.9f, 0.1f),
+       D(0.3f, 1.5f, -0.7f), D(1, 0, 0.25f)},  // lane 0 along +x, others along y or z, every x component positive
+      {D(0, 0, -1), D(0.1f, 0, -1), D(0, 0.1f, -1), D(0.2f, 0.1f, -1), D(0, 0, 1), D(0.1f, 0, 1), D(0, 0.1f, 1),
+       D(-0.2f, 0.1f, 1)},  // along z, both signs
+      {D(1, 0.1f, -0.5f), D(1, -0.2f, 0.5f), D(2, 0.5f, -1), D(1, 0, -0.25f), D(1.5f, 0.3f, 0.7f), D(1, -0.9f, 0.1f),
+       D(1, 0.5f, -0.9f), D(3, 1, 1)},  // along +x everywhere
+      {D(0.1f, -1, 0.5f), D(-0.2f, -1, -0.5f), D(0.5f, -2, 1), D(0, -1, 0.25f), D(0.3f, -1.5f, -0.7f),
+       D(-0.9f, -1, 0.1f), D(0.5f, -1, -0.9f), D(1, -3, 1)},  // along -y everywhere
+      {D(1, 0, -1), D(0, 1, -1), D(1, 1, -1), D(-1, -1, -1), D(-1, 0, -1), D(0, -1, -1), D(1, -1, -1),
+       D(-1, 1, -1)},  // ties: z wins (x or y only when strictly larger)
+      {D(1, 0, -1), D(0, 1, -1), D(1, 1, -1), D(-1, -1, 1), D(-1, 0, 1), D(0, -1, 1), D(1, 1, 1),
+       D(-1, 1, -1)},  // ties, both signs
+  };
+  // Targets on the grid of eighths (edges, diagonals, the shared vertex) and
+  // jittered off it; directions as written and normalised (inexact floats:
+  // a lane sheared along another lane's axes would round differently).
+  std::vector<Ray> rays;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> jitter(-0.06f, 0.06f);
+  for (const std::vector<D>& pattern : patterns)
+    for (bool exact : {true, false})
+      for (int y = -8; y <= 8; y += 2)
+        for (int x = -8; x <= 8; x += 2) {
+          const glm::vec3 target(x / 8.0f + (exact ? 0.0f : jitter(rng)), y / 8.0f + (exact ? 0.0f : jitter(rng)),
+                                 0.0f);
+          for (const D& d : pattern) {
+            const glm::vec3 dir = exact ? d : glm::normalize(d);
+            rays.emplace_back(target - 1.37f * dir, dir);
+          }
+        }
+  for (TriangleTest test : {TriangleTest::watertight, TriangleTest::moller_trumbore}) {
+    QueryOptions q;
+    q.triangle_test = test;
+    std::vector<Hit> packet(rays.size());
+    std::vector<std::uint8_t> occluded(rays.size());
+    bvh.closest_hits_packets(rays, packet, q);
+    bvh.any_hits_packets(rays, occluded, q);
+    std::size_t hits = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      const Hit single = bvh.closest_hit(rays[i], q);
+      ASSERT_EQ(packet[i].prim, single.prim) << "ray " << i;
+      ASSERT_EQ(occluded[i] != 0, bvh.any_hit(rays[i], q)) << "ray " << i;
+      if (!single.valid()) continue;
+      ++hits;
+      EXPECT_EQ(packet[i].t, single.t) << "ray " << i;
+      EXPECT_EQ(packet[i].u, single.u) << "ray " << i;
+      EXPECT_EQ(packet[i].v, single.v) << "ray " << i;
+    }
+    EXPECT_GT(hits, rays.size() / 2);
+  }
+}
+
 TEST(BvhPackets, EveryPacketLengthAndOffset) {
   // Spans of 1..19 rays starting anywhere: short last packets, idle lanes.
   const std::vector<Triangle> tris = test_scenes::soup(23, 2000, 0.06f);
