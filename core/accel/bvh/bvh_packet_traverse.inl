@@ -385,7 +385,7 @@ void traverse_packet(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView
               if ((res.special >> l) & 1) {
                 leaf[l].prepare();
                 Hit h;
-                hit = intersect_watertight(rays[l], leaf[l].wr.wr, t3, tmin[l], cl, h);
+                hit = intersect_watertight(rays[l], leaf[l].wr_.v.wr, t3, tmin[l], cl, h);
                 ht = h.t;
                 hu = h.u;
                 hv = h.v;

@@ -23,6 +23,16 @@
 
 namespace accelviz::bvh_detail {
 
+/// Storage for a T that is left unset until assigned (a union with an empty
+/// constructor skips T's default member initialisers): the walks' per-ray
+/// triangle constants are assigned at the ray's first leaf, and many rays
+/// never reach one. T must be trivially copyable and destructible.
+template <class T>
+union Unset {
+  Unset() {}
+  T v;
+};
+
 /// Per-ray constants of the inline watertight test.
 struct InlineWatertightRay {
   WatertightRay wr;

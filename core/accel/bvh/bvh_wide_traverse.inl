@@ -11,15 +11,18 @@
 /// with the same code, in the same order, with the same results.
 template <TriangleTest Test>
 struct LeafRay {
-  const Ray* ray = nullptr;
-  InlineWatertightRay wr;
-  bool ready = false;  ///< the constants below are set up for *ray
+  const Ray* ray;
+  bool ready;  ///< the constants below are set up for *ray
+  // Unset until prepare(): their default member initialisers were stores on
+  // every query and every packet lane (4 % of the kitchen's primary any-hit
+  // packets).
+  bvh_detail::Unset<InlineWatertightRay> wr_;
 #ifdef ACCELVIZ_BVH_TRI4_SSE2
-  bvh_detail::Tri4Ray tr4;
-  bvh_detail::Tri4MtRay tm4;
+  bvh_detail::Unset<bvh_detail::Tri4Ray> tr4_;
+  bvh_detail::Unset<bvh_detail::Tri4MtRay> tm4_;
 #endif
 
-  LeafRay() = default;
+  LeafRay() = default;  ///< unset; reset() before use
   /// A single ray: Moller-Trumbore's constants right away (cheap; the
   /// bunny's single-ray any hits in the fast mode measured a few per cent
   /// slower, two rounds, when they waited for the first leaf), the
@@ -40,13 +43,13 @@ struct LeafRay {
     if (ready) return;
     ready = true;
     if constexpr (Test == TriangleTest::watertight) {
-      wr = InlineWatertightRay(*ray);
+      wr_.v = InlineWatertightRay(*ray);
 #ifdef ACCELVIZ_BVH_TRI4_SSE2
-      tr4 = bvh_detail::Tri4Ray(wr);
+      tr4_.v = bvh_detail::Tri4Ray(wr_.v);
 #endif
     } else {
 #ifdef ACCELVIZ_BVH_TRI4_SSE2
-      tm4 = bvh_detail::Tri4MtRay(*ray);
+      tm4_.v = bvh_detail::Tri4MtRay(*ray);
 #endif
     }
   }
@@ -69,7 +72,7 @@ struct LeafRay {
       for (const bvh_detail::TriBlock4* blk = bvh.blocks + child; blk != end; ++blk) {
         const int valid = bvh_detail::tri4_used_lanes(*blk);
         bvh_detail::Tri4Result res;
-        bvh_detail::intersect_tri4(*blk, tr4, tmin, res);
+        bvh_detail::intersect_tri4(*blk, tr4_.v, tmin, res);
         int lanes = (res.candidate | res.special) & valid;
         while (lanes != 0) {
           const int l = std::countr_zero(static_cast<unsigned>(lanes));
@@ -78,8 +81,8 @@ struct LeafRay {
           bool hit;
           if ((res.special >> l) & 1) {
             Hit h;
-            hit = intersect_watertight(r, wr.wr, bvh_detail::tri4_triangle(*blk, static_cast<std::uint32_t>(l)), tmin,
-                                       closest, h);
+            hit = intersect_watertight(r, wr_.v.wr, bvh_detail::tri4_triangle(*blk, static_cast<std::uint32_t>(l)),
+                                       tmin, closest, h);
             t = h.t;
             u = h.u;
             v = h.v;
@@ -100,7 +103,7 @@ struct LeafRay {
       for (const bvh_detail::TriBlock4* blk = bvh.blocks + child; blk != end; ++blk) {
         const int valid = bvh_detail::tri4_used_lanes(*blk);
         bvh_detail::Tri4MtResult res;
-        bvh_detail::intersect_tri4_mt(*blk, tm4, tmin, res);
+        bvh_detail::intersect_tri4_mt(*blk, tm4_.v, tmin, res);
         int lanes = res.candidate & valid;
         while (lanes != 0) {
           const int l = std::countr_zero(static_cast<unsigned>(lanes));
@@ -120,8 +123,8 @@ struct LeafRay {
         for (int l = 0; l < 4; ++l) {
           if (blk->pos[l] == bvh_detail::kTri4Empty) continue;
           Hit h;
-          if (test_triangle<Test>(r, wr, bvh_detail::tri4_triangle(*blk, static_cast<std::uint32_t>(l)), tmin, closest,
-                                  h) &&
+          if (test_triangle<Test>(r, wr_.v, bvh_detail::tri4_triangle(*blk, static_cast<std::uint32_t>(l)), tmin,
+                                  closest, h) &&
               take_hit<AnyHit>(*blk, l, h.t, h.u, h.v, closest, best))
             return true;
         }
