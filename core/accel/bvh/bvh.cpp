@@ -11,6 +11,7 @@
 
 #include <bit>
 #include <chrono>
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 
@@ -683,6 +684,20 @@ using WideSlabRayW = bvh_detail::WideSlabRay;
   return bits;
 #endif
 }
+/// A full packet's rays R[0..8) into lanes (the packet walk's set-up).
+[[gnu::always_inline]] inline void load_packet(const Ray* R, PacketF org[3], PacketF dir[3], PacketF inv[3],
+                                               PacketF& tmin, PacketF& tmax) {
+  for (int a = 0; a < 3; ++a) {
+    org[a] = PacketF{R[0].origin[a], R[1].origin[a], R[2].origin[a], R[3].origin[a],
+                     R[4].origin[a], R[5].origin[a], R[6].origin[a], R[7].origin[a]};
+    dir[a] = PacketF{R[0].direction[a], R[1].direction[a], R[2].direction[a], R[3].direction[a],
+                     R[4].direction[a], R[5].direction[a], R[6].direction[a], R[7].direction[a]};
+    inv[a] = PacketF{R[0].inv_dir[a], R[1].inv_dir[a], R[2].inv_dir[a], R[3].inv_dir[a],
+                     R[4].inv_dir[a], R[5].inv_dir[a], R[6].inv_dir[a], R[7].inv_dir[a]};
+  }
+  tmin = PacketF{R[0].tmin, R[1].tmin, R[2].tmin, R[3].tmin, R[4].tmin, R[5].tmin, R[6].tmin, R[7].tmin};
+  tmax = PacketF{R[0].tmax, R[1].tmax, R[2].tmax, R[3].tmax, R[4].tmax, R[5].tmax, R[6].tmax, R[7].tmax};
+}
 #include "core/accel/bvh/bvh_wide_traverse.inl"
 // (after the single-ray walk: the packet walk uses its LeafRay and walk_wide)
 #include "core/accel/bvh/bvh_packet_traverse.inl"
@@ -702,6 +717,40 @@ using WideSlabRayW = bvh_detail::WideSlabRay8;
 }
 [[gnu::always_inline]] inline int packet_mask(const PacketI& m) {
   return _mm256_movemask_ps(reinterpret_cast<__m256>(m));
+}
+/// Four consecutive floats of each ray, starting `at` floats into it, as
+/// four vectors (lane l: ray l): one 4x4 transposition per 128-bit half,
+/// rays 0-3 in the low half and 4-7 in the high one.
+[[gnu::always_inline]] inline void transpose_rays(const Ray* R, int at, __m256 out[4]) {
+  __m256 row[4];
+  for (int l = 0; l < 4; ++l)
+    row[l] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(&R[l].origin.x + at)),
+                                  _mm_loadu_ps(&R[l + 4].origin.x + at), 1);
+  const __m256 t0 = _mm256_unpacklo_ps(row[0], row[1]), t1 = _mm256_unpacklo_ps(row[2], row[3]);
+  const __m256 t2 = _mm256_unpackhi_ps(row[0], row[1]), t3 = _mm256_unpackhi_ps(row[2], row[3]);
+  out[0] = _mm256_shuffle_ps(t0, t1, 0x44);
+  out[1] = _mm256_shuffle_ps(t0, t1, 0xEE);
+  out[2] = _mm256_shuffle_ps(t2, t3, 0x44);
+  out[3] = _mm256_shuffle_ps(t2, t3, 0xEE);
+}
+static_assert(sizeof(Ray) == 44 && offsetof(Ray, tmin) == 12 && offsetof(Ray, direction) == 16 &&
+              offsetof(Ray, tmax) == 28 && offsetof(Ray, inv_dir) == 32);
+/// A full packet's rays R[0..8) into lanes (the packet walk's set-up): three
+/// transpositions of four floats per ray (origin and tmin, direction and
+/// tmax, then tmax again and inv_dir: every load stays inside its ray)
+/// instead of eleven vectors gathered lane by lane (5 % of the kitchen's
+/// primary any-hit packets).
+[[gnu::always_inline]] inline void load_packet(const Ray* R, PacketF org[3], PacketF dir[3], PacketF inv[3],
+                                               PacketF& tmin, PacketF& tmax) {
+  __m256 v[4];
+  transpose_rays(R, 0, v);
+  for (int a = 0; a < 3; ++a) org[a] = reinterpret_cast<PacketF>(v[a]);
+  tmin = reinterpret_cast<PacketF>(v[3]);
+  transpose_rays(R, 4, v);
+  for (int a = 0; a < 3; ++a) dir[a] = reinterpret_cast<PacketF>(v[a]);
+  tmax = reinterpret_cast<PacketF>(v[3]);
+  transpose_rays(R, 7, v);
+  for (int a = 0; a < 3; ++a) inv[a] = reinterpret_cast<PacketF>(v[a + 1]);
 }
 #include "core/accel/bvh/bvh_wide_traverse.inl"
 // (after the single-ray walk: the packet walk uses its LeafRay and walk_wide)

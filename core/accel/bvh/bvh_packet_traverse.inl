@@ -157,41 +157,36 @@ void traverse_packet(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView
   // Lane l: ray l. Unused lanes (count < 8) get an empty interval
   // [+inf, -inf], so no box test ever hits in them.
   const PacketF zero{}, inf = kInf - zero, minus_inf = -kInf - zero;
-  PacketF org[3], inv[3], tmin = inf, closest = minus_inf;
+  PacketF org[3], dir[3], inv[3], tmin = inf, closest = minus_inf;
   PacketI neg[3];
-  for (int a = 0; a < 3; ++a) {
-    org[a] = zero;
-    inv[a] = zero;
-    neg[a] = PacketI{};
-  }
   LeafRay<Test> leaf[8];
   Hit* const best = out;  // each lane's hit so far, kept in place
   if (count == 8) {
-    // A full packet is gathered in registers: writing lanes one by one into
-    // memory and loading them as vectors stalled on store forwarding (about 12 %
-    // of the kitchen's any-hit packet walk).
-    const Ray* const R = rays;
-    for (int a = 0; a < 3; ++a) {
-      org[a] = PacketF{R[0].origin[a], R[1].origin[a], R[2].origin[a], R[3].origin[a],
-                       R[4].origin[a], R[5].origin[a], R[6].origin[a], R[7].origin[a]};
-      inv[a] = PacketF{R[0].inv_dir[a], R[1].inv_dir[a], R[2].inv_dir[a], R[3].inv_dir[a],
-                       R[4].inv_dir[a], R[5].inv_dir[a], R[6].inv_dir[a], R[7].inv_dir[a]};
-      neg[a] = inv[a] < 0.0f;  // as intersect_slab: hi is the near plane
-    }
-    tmin = PacketF{R[0].tmin, R[1].tmin, R[2].tmin, R[3].tmin, R[4].tmin, R[5].tmin, R[6].tmin, R[7].tmin};
-    closest = PacketF{R[0].tmax, R[1].tmax, R[2].tmax, R[3].tmax, R[4].tmax, R[5].tmax, R[6].tmax, R[7].tmax};
+    // A full packet is loaded in registers (load_packet, defined by the
+    // includer): writing lanes one by one into memory and loading them as
+    // vectors stalled on store forwarding (about 12 % of the kitchen's
+    // any-hit packet walk).
+    load_packet(rays, org, dir, inv, tmin, closest);
   } else {
+    // Lanes without a ray: a zero origin and inv_dir, ray 0's direction
+    // (their results are never read).
+    for (int a = 0; a < 3; ++a) {
+      org[a] = zero;
+      inv[a] = zero;
+      dir[a] = rays[0].direction[a] - zero;
+    }
     for (int l = 0; l < count; ++l) {
       const Ray& r = rays[l];
       for (int a = 0; a < 3; ++a) {
         org[a][l] = r.origin[a];
+        dir[a][l] = r.direction[a];
         inv[a][l] = r.inv_dir[a];
-        neg[a][l] = r.inv_dir[a] < 0.0f ? -1 : 0;
       }
       tmin[l] = r.tmin;
       closest[l] = r.tmax;
     }
   }
+  for (int a = 0; a < 3; ++a) neg[a] = inv[a] < 0.0f;  // as intersect_slab: hi is the near plane
   for (int l = 0; l < count; ++l) {
     best[l] = Hit{};
     leaf[l].reset(rays[l]);
@@ -308,19 +303,7 @@ void traverse_packet(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView
       if (tri_mode < 0) {
         // First leaf of this packet: set up the ray-parallel triangle test
         // (for the watertight test only when every lane's set-up shears the
-        // same axes), for all lanes at once. Lanes without a ray repeat ray
-        // 0's direction (their results are never read).
-        PacketF dir[3];
-        for (int a = 0; a < 3; ++a) {
-          if (count == 8) {
-            const Ray* const R = rays;
-            dir[a] = PacketF{R[0].direction[a], R[1].direction[a], R[2].direction[a], R[3].direction[a],
-                             R[4].direction[a], R[5].direction[a], R[6].direction[a], R[7].direction[a]};
-          } else {
-            dir[a] = rays[0].direction[a] - zero;
-            for (int l = 1; l < count; ++l) dir[a][l] = rays[l].direction[a];
-          }
-        }
+        // same axes), for all lanes at once.
         tri_mode = 1;
         if constexpr (Test == TriangleTest::watertight) {
           // WatertightRay's selections lane by lane (the same comparisons
