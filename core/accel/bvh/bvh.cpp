@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 #include "core/accel/bvh/bvh_build.h"
 #include "core/accel/bvh/bvh_slab.h"
@@ -784,8 +785,26 @@ Hit dispatch_wide8([[maybe_unused]] const bvh_detail::WideBvh8& wide, [[maybe_un
   return with_query_choices(
       qo, [&]<bool Ordered, TriangleTest Test>() { return wide8::traverse_wide<AnyHit, Ordered, Test>(wide, v, ray); });
 #else
-  return Hit{};  // never built without AVX2 support (Bvh checks cpu_has_wide8)
+  return Hit{};    // never built without AVX2 support (Bvh checks cpu_has_wide8)
 #endif
+}
+
+/// The single-ray any-hit walk of the W-wide copy for the query's triangle
+/// test (any hit ignores the ordering).
+template <class WideBvhW>
+bool dispatch_occluded(const WideBvhW& wide, const BvhView& v, const Ray& ray, const QueryOptions& qo) {
+  const bool wt = qo.triangle_test == TriangleTest::watertight;
+  if constexpr (std::is_same_v<WideBvhW, bvh_detail::WideBvh>) {
+    return wt ? wide4::occluded_wide<TriangleTest::watertight>(wide, v, ray)
+              : wide4::occluded_wide<TriangleTest::moller_trumbore>(wide, v, ray);
+  } else {
+#ifdef ACCELVIZ_BVH_WIDE8
+    return wt ? wide8::occluded_wide<TriangleTest::watertight>(wide, v, ray)
+              : wide8::occluded_wide<TriangleTest::moller_trumbore>(wide, v, ray);
+#else
+    return false;  // never built without AVX2 support (Bvh checks cpu_has_wide8)
+#endif
+  }
 }
 
 /// The packet walk (4-wide SSE) for the query options.
@@ -817,14 +836,15 @@ Hit dispatch(const BvhView& v, const Ray& ray, const QueryOptions& qo, const Col
 
 }  // namespace
 
-Hit Bvh::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, VisitTrace* trace) const {
-  const BvhView v{nodes_.data(), blocks_.data(), leaf_block_.data(), prim_indices_.data(), nodes_.size()};
+namespace {
+
+/// Bvh::closest_hit's walks with statistics or a trace, out of line: inlined,
+/// their locals made every query's stack frame about 2 KiB and its prologue
+/// save six registers.
+[[gnu::noinline]] Hit closest_hit_collected(const BvhView& v, const Ray& ray, const QueryOptions& qo, RayStats* stats,
+                                            VisitTrace* trace) {
   Hit h;
-  if (stats == nullptr && trace == nullptr && !qo.back_to_front && !qo.xray) {
-    h = wide8_  ? dispatch_wide8<false>(*wide8_, v, ray, qo)
-        : wide_ ? dispatch_wide<false>(*wide_, v, ray, qo)
-                : dispatch<false, false>(v, ray, qo, Collector{nullptr, nullptr});
-  } else if (stats != nullptr && trace == nullptr && !qo.back_to_front && !qo.xray) {
+  if (stats != nullptr && trace == nullptr && !qo.back_to_front && !qo.xray) {
     const bool wt = qo.triangle_test == TriangleTest::watertight;
     if (qo.ordered)
       h = wt ? traverse_counted<true, TriangleTest::watertight>(v, ray, *stats)
@@ -836,6 +856,33 @@ Hit Bvh::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, Vi
     RayStats local;
     h = dispatch<false, true>(v, ray, qo, Collector{stats ? stats : &local, trace, qo.back_to_front, qo.xray});
   }
+  return h;
+}
+
+/// Bvh::any_hit's walk with statistics or back-to-front order, out of line
+/// (as closest_hit_collected).
+[[gnu::noinline]] bool any_hit_collected(const BvhView& v, const Ray& ray, const QueryOptions& qo, RayStats* stats) {
+  RayStats local;
+  return dispatch<true, true>(v, ray, qo, Collector{stats ? stats : &local, nullptr, qo.back_to_front, false}).valid();
+}
+
+/// The binary walk without statistics (no wide copy), out of line likewise.
+template <bool AnyHit>
+[[gnu::noinline]] Hit binary_fast(const BvhView& v, const Ray& ray, const QueryOptions& qo) {
+  return dispatch<AnyHit, false>(v, ray, qo, Collector{nullptr, nullptr});
+}
+
+}  // namespace
+
+Hit Bvh::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, VisitTrace* trace) const {
+  const BvhView v{nodes_.data(), blocks_.data(), leaf_block_.data(), prim_indices_.data(), nodes_.size()};
+  Hit h;
+  if (stats == nullptr && trace == nullptr && !qo.back_to_front && !qo.xray) [[likely]]
+    h = wide8_  ? dispatch_wide8<false>(*wide8_, v, ray, qo)
+        : wide_ ? dispatch_wide<false>(*wide_, v, ray, qo)
+                : binary_fast<false>(v, ray, qo);
+  else
+    h = closest_hit_collected(v, ray, qo, stats, trace);
   if (h.valid()) h.prim = prim_indices_[h.prim];  // the traversals set ng
   return h;
 }
@@ -890,12 +937,11 @@ void Bvh::any_packets_span(std::span<const Ray> rays, std::span<std::uint8_t> oc
 
 bool Bvh::any_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats) const {
   const BvhView v{nodes_.data(), blocks_.data(), leaf_block_.data(), prim_indices_.data(), nodes_.size()};
-  if (stats == nullptr && !qo.back_to_front)
-    return wide8_  ? dispatch_wide8<true>(*wide8_, v, ray, qo).valid()
-           : wide_ ? dispatch_wide<true>(*wide_, v, ray, qo).valid()
-                   : dispatch<true, false>(v, ray, qo, Collector{nullptr, nullptr}).valid();
-  RayStats local;
-  return dispatch<true, true>(v, ray, qo, Collector{stats ? stats : &local, nullptr, qo.back_to_front, false}).valid();
+  if (stats == nullptr && !qo.back_to_front) [[likely]]
+    return wide8_  ? dispatch_occluded(*wide8_, v, ray, qo)
+           : wide_ ? dispatch_occluded(*wide_, v, ray, qo)
+                   : binary_fast<true>(v, ray, qo).valid();
+  return any_hit_collected(v, ray, qo, stats);
 }
 
 }  // namespace accelviz

@@ -264,3 +264,14 @@ Hit traverse_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& b
   walk_wide<AnyHit, Ordered, Test>(wide_bvh, bvh, ray, leaf, 0, 0, closest, best);
   return best;
 }
+
+/// traverse_wide<true, false, Test>(...).valid() without the Hit: the leaf
+/// test's stores into a local that nothing reads, and a bool returned in a
+/// register (Bvh::any_hit's single-ray query).
+template <TriangleTest Test>
+bool occluded_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& bvh, const Ray& ray) {
+  Hit best;
+  float closest = ray.tmax;
+  LeafRay<Test> leaf(ray);
+  return walk_wide<true, false, Test>(wide_bvh, bvh, ray, leaf, 0, 0, closest, best);
+}
