@@ -175,10 +175,16 @@ template <bool AnyHit, bool Ordered, TriangleTest Test>
   const WideSlabRayW wrw(ray);
   const float tmin = ray.tmin;
 
-  struct Entry {
+  // Closest hit keeps each pushed child's entry distance (a pop beyond the
+  // closest hit is skipped); any hit ends at its first hit and needs none.
+  struct ClosestEntry {
     std::uint32_t child, meta;
     float t_entry;
   };
+  struct AnyEntry {
+    std::uint32_t child, meta;
+  };
+  using Entry = std::conditional_t<AnyHit, AnyEntry, ClosestEntry>;
   Entry stack[(kWidth - 1) * kBvhMaxDepth + 1];
   unsigned sp = 0;
   for (;;) {
@@ -206,41 +212,42 @@ template <bool AnyHit, bool Ordered, TriangleTest Test>
           for (mask &= ~(1 << last); mask != 0; mask &= mask - 1) {
             const int s = std::countr_zero(static_cast<unsigned>(mask));
             prefetch_slot(wide, bvh, n.child[s], n.meta[s]);
-            stack[sp++] = {n.child[s], n.meta[s], te[s]};
+            stack[sp++] = {n.child[s], n.meta[s]};
           }
           child = n.child[last];
           meta = n.meta[last];
           prefetch_slot(wide, bvh, child, meta);
           continue;
-        }
-        int slot[kWidth], k = 0;
-        while (mask != 0) {
-          slot[k++] = std::countr_zero(static_cast<unsigned>(mask));
-          mask &= mask - 1;
-        }
-        if constexpr (Ordered) {
-          // Insertion sort by entry distance; equal distances keep slot order.
-          for (int i = 1; i < k; ++i) {
-            const int v = slot[i];
-            int j = i;
-            while (j > 0 && te[slot[j - 1]] > te[v]) {
-              slot[j] = slot[j - 1];
-              --j;
-            }
-            slot[j] = v;
+        } else {
+          int slot[kWidth], k = 0;
+          while (mask != 0) {
+            slot[k++] = std::countr_zero(static_cast<unsigned>(mask));
+            mask &= mask - 1;
           }
+          if constexpr (Ordered) {
+            // Insertion sort by entry distance; equal distances keep slot order.
+            for (int i = 1; i < k; ++i) {
+              const int v = slot[i];
+              int j = i;
+              while (j > 0 && te[slot[j - 1]] > te[v]) {
+                slot[j] = slot[j - 1];
+                --j;
+              }
+              slot[j] = v;
+            }
+          }
+          // The pushed children are visited later: start fetching them now, so
+          // that deep walks through large trees overlap the memory latency.
+          for (int j = k - 1; j >= 1; --j) {
+            const std::uint32_t c = n.child[slot[j]], m = n.meta[slot[j]];
+            prefetch_slot(wide, bvh, c, m);
+            stack[sp++] = {c, m, te[slot[j]]};
+          }
+          child = n.child[slot[0]];
+          meta = n.meta[slot[0]];
+          prefetch_slot(wide, bvh, child, meta);
+          continue;
         }
-        // The pushed children are visited later: start fetching them now, so
-        // that deep walks through large trees overlap the memory latency.
-        for (int j = k - 1; j >= 1; --j) {
-          const std::uint32_t c = n.child[slot[j]], m = n.meta[slot[j]];
-          prefetch_slot(wide, bvh, c, m);
-          stack[sp++] = {c, m, te[slot[j]]};
-        }
-        child = n.child[slot[0]];
-        meta = n.meta[slot[0]];
-        prefetch_slot(wide, bvh, child, meta);
-        continue;
       }
     } else if (leaf.template test<AnyHit>(bvh, child, meta, tmin, closest, best)) {
       return true;
@@ -248,7 +255,8 @@ template <bool AnyHit, bool Ordered, TriangleTest Test>
     for (;;) {
       if (sp == 0) return false;
       const Entry e = stack[--sp];
-      if (!AnyHit && e.t_entry > closest) continue;
+      if constexpr (!AnyHit)
+        if (e.t_entry > closest) continue;
       child = e.child;
       meta = e.meta;
       break;
