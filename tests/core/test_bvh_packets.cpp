@@ -11,6 +11,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <random>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -57,6 +59,51 @@ std::size_t count_mismatches(const Accelerator& accel, std::span<const Ray> rays
                     << int(occluded[i]) << ", single prim " << single.prim << " t " << single.t;
   }
   return bad;
+}
+
+/// Eight triangles around the origin in the z = 0 plane (shared edges along
+/// the axes and the diagonals, one shared vertex), for a BVH that keeps them
+/// in one leaf (fan_options): every packet lane reaches the same leaf.
+std::vector<Triangle> fan_of_eight() {
+  std::vector<Triangle> fan;
+  const glm::vec3 c(0.0f, 0.0f, 0.0f);
+  const glm::vec3 rim[8] = {{1, 0, 0},  {1, 1, 0},   {0, 1, 0},  {-1, 1, 0},
+                            {-1, 0, 0}, {-1, -1, 0}, {0, -1, 0}, {1, -1, 0}};
+  for (int i = 0; i < 8; ++i) fan.push_back({c, rim[i], rim[(i + 1) % 8]});
+  return fan;
+}
+
+BvhOptions fan_options() {
+  BvhOptions o;
+  o.compute_epo = false;
+  o.max_leaf_size = 16;
+  return o;
+}
+
+/// Packets against single rays with both triangle tests: the very same
+/// triangle, t, u and v for every ray (the leaf's triangles are tested in the
+/// same order), and most rays must hit.
+void expect_packets_equal_single_rays(const Bvh& bvh, std::span<const Ray> rays) {
+  for (TriangleTest test : {TriangleTest::watertight, TriangleTest::moller_trumbore}) {
+    QueryOptions q;
+    q.triangle_test = test;
+    std::vector<Hit> packet(rays.size());
+    std::vector<std::uint8_t> occluded(rays.size());
+    bvh.closest_hits_packets(rays, packet, q);
+    bvh.any_hits_packets(rays, occluded, q);
+    std::size_t hits = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      const Hit single = bvh.closest_hit(rays[i], q);
+      ASSERT_EQ(packet[i].prim, single.prim) << "ray " << i;
+      ASSERT_EQ(occluded[i] != 0, bvh.any_hit(rays[i], q)) << "ray " << i;
+      if (!single.valid()) continue;
+      ++hits;
+      EXPECT_EQ(packet[i].t, single.t) << "ray " << i;
+      EXPECT_EQ(packet[i].u, single.u) << "ray " << i;
+      EXPECT_EQ(packet[i].v, single.v) << "ray " << i;
+    }
+    EXPECT_GT(hits, rays.size() / 2);
+  }
 }
 
 /// Camera rays at two distances over `tris`: whole views and close-ups, so
@@ -142,15 +189,7 @@ TEST(BvhPackets, ParallelRaysThroughSharedEdgesAndVerticesInOneLeaf) {
   // and the single ray test the same triangles in the same order: the very
   // same triangle, t, u and v, including the lanes whose edge function is
   // exactly zero (answered by the scalar test, as for a single ray).
-  std::vector<Triangle> fan;
-  const glm::vec3 c(0.0f, 0.0f, 0.0f);
-  const glm::vec3 rim[8] = {{1, 0, 0},  {1, 1, 0},   {0, 1, 0},  {-1, 1, 0},
-                            {-1, 0, 0}, {-1, -1, 0}, {0, -1, 0}, {1, -1, 0}};
-  for (int i = 0; i < 8; ++i) fan.push_back({c, rim[i], rim[(i + 1) % 8]});
-  BvhOptions o;
-  o.compute_epo = false;
-  o.max_leaf_size = 16;
-  const Bvh bvh(fan, o);
+  const Bvh bvh(fan_of_eight(), fan_options());
   std::vector<Ray> rays;
   for (const glm::vec3 d : {glm::vec3(0, 0, -1), glm::vec3(0.25f, 0.125f, -1), glm::vec3(-0.5f, 0.25f, -1)})
     for (int y = -8; y <= 8; ++y)
@@ -159,26 +198,7 @@ TEST(BvhPackets, ParallelRaysThroughSharedEdgesAndVerticesInOneLeaf) {
         const glm::vec3 target(x / 8.0f, y / 8.0f, 0.0f);
         rays.emplace_back(target - d, d);
       }
-  for (TriangleTest test : {TriangleTest::watertight, TriangleTest::moller_trumbore}) {
-    QueryOptions q;
-    q.triangle_test = test;
-    std::vector<Hit> packet(rays.size());
-    std::vector<std::uint8_t> occluded(rays.size());
-    bvh.closest_hits_packets(rays, packet, q);
-    bvh.any_hits_packets(rays, occluded, q);
-    std::size_t hits = 0;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-      const Hit single = bvh.closest_hit(rays[i], q);
-      ASSERT_EQ(packet[i].prim, single.prim) << "ray " << i;
-      ASSERT_EQ(occluded[i] != 0, bvh.any_hit(rays[i], q)) << "ray " << i;
-      if (!single.valid()) continue;
-      ++hits;
-      EXPECT_EQ(packet[i].t, single.t) << "ray " << i;
-      EXPECT_EQ(packet[i].u, single.u) << "ray " << i;
-      EXPECT_EQ(packet[i].v, single.v) << "ray " << i;
-    }
-    EXPECT_GT(hits, rays.size() / 2);
-  }
+  expect_packets_equal_single_rays(bvh, rays);
 }
 
 TEST(BvhPackets, LanesOfMixedShearAxesAndSignsAnswerAsSingleRays) {
@@ -189,15 +209,7 @@ TEST(BvhPackets, LanesOfMixedShearAxesAndSignsAnswerAsSingleRays) {
   // different dominant axes, the same axis with both signs, ties between
   // axes (x or y over z only when strictly larger), and uniform packets
   // along x and along y. Each lane answers as its ray alone, bit for bit.
-  std::vector<Triangle> fan;
-  const glm::vec3 c(0.0f, 0.0f, 0.0f);
-  const glm::vec3 rim[8] = {{1, 0, 0},  {1, 1, 0},   {0, 1, 0},  {-1, 1, 0},
-                            {-1, 0, 0}, {-1, -1, 0}, {0, -1, 0}, {1, -1, 0}};
-  for (int i = 0; i < 8; ++i) fan.push_back({c, rim[i], rim[(i + 1) % 8]});
-  BvhOptions o;
-  o.compute_epo = false;
-  o.max_leaf_size = 16;
-  const Bvh bvh(fan, o);
+  const Bvh bvh(fan_of_eight(), fan_options());
   using D = glm::vec3;
   const std::vector<std::vector<D>> patterns = {
       {D(0, 0, -1), D(0.25f, 0.125f, -1), D(1, 0.1f, -0.5f), D(0.1f, -1, -0.5f), D(-1, 0.2f, -0.3f), D(0.3f, 1, -0.2f),
@@ -232,26 +244,7 @@ TEST(BvhPackets, LanesOfMixedShearAxesAndSignsAnswerAsSingleRays) {
             rays.emplace_back(target - 1.37f * dir, dir);
           }
         }
-  for (TriangleTest test : {TriangleTest::watertight, TriangleTest::moller_trumbore}) {
-    QueryOptions q;
-    q.triangle_test = test;
-    std::vector<Hit> packet(rays.size());
-    std::vector<std::uint8_t> occluded(rays.size());
-    bvh.closest_hits_packets(rays, packet, q);
-    bvh.any_hits_packets(rays, occluded, q);
-    std::size_t hits = 0;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-      const Hit single = bvh.closest_hit(rays[i], q);
-      ASSERT_EQ(packet[i].prim, single.prim) << "ray " << i;
-      ASSERT_EQ(occluded[i] != 0, bvh.any_hit(rays[i], q)) << "ray " << i;
-      if (!single.valid()) continue;
-      ++hits;
-      EXPECT_EQ(packet[i].t, single.t) << "ray " << i;
-      EXPECT_EQ(packet[i].u, single.u) << "ray " << i;
-      EXPECT_EQ(packet[i].v, single.v) << "ray " << i;
-    }
-    EXPECT_GT(hits, rays.size() / 2);
-  }
+  expect_packets_equal_single_rays(bvh, rays);
 }
 
 TEST(BvhPackets, EveryPacketLengthAndOffset) {
