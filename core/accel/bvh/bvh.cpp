@@ -739,8 +739,8 @@ static_assert(sizeof(Ray) == 44 && offsetof(Ray, tmin) == 12 && offsetof(Ray, di
 /// A full packet's rays R[0..8) into lanes (the packet walk's set-up): three
 /// transpositions of four floats per ray (origin and tmin, direction and
 /// tmax, then tmax again and inv_dir: every load stays inside its ray)
-/// instead of eleven vectors gathered lane by lane (5 % of the kitchen's
-/// primary any-hit packets).
+/// instead of eleven vectors gathered lane by lane (4 % of the kitchen's
+/// primary any-hit packets' instructions).
 [[gnu::always_inline]] inline void load_packet(const Ray* R, PacketF org[3], PacketF dir[3], PacketF inv[3],
                                                PacketF& tmin, PacketF& tmax) {
   __m256 v[4];
@@ -833,10 +833,6 @@ Hit dispatch(const BvhView& v, const Ray& ray, const QueryOptions& qo, const Col
   return with_query_choices(
       qo, [&]<bool Ordered, TriangleTest Test>() { return traverse<AnyHit, Ordered, Collect, Test>(v, ray, c); });
 }
-
-}  // namespace
-
-namespace {
 
 /// Bvh::closest_hit's walks with statistics or a trace, out of line: inlined,
 /// their locals made every query's stack frame about 2 KiB and its prologue
