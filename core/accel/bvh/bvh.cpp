@@ -772,18 +772,18 @@ decltype(auto) with_query_choices(const QueryOptions& qo, Walk&& walk) {
             : walk.template operator()<false, TriangleTest::moller_trumbore>();
 }
 
-template <bool AnyHit>
+/// The single-ray closest-hit walk of the 4-wide copy for the query options.
 Hit dispatch_wide(const bvh_detail::WideBvh& wide, const BvhView& v, const Ray& ray, const QueryOptions& qo) {
   return with_query_choices(
-      qo, [&]<bool Ordered, TriangleTest Test>() { return wide4::traverse_wide<AnyHit, Ordered, Test>(wide, v, ray); });
+      qo, [&]<bool Ordered, TriangleTest Test>() { return wide4::traverse_wide<false, Ordered, Test>(wide, v, ray); });
 }
 
-template <bool AnyHit>
+/// The single-ray closest-hit walk of the 8-wide copy for the query options.
 Hit dispatch_wide8([[maybe_unused]] const bvh_detail::WideBvh8& wide, [[maybe_unused]] const BvhView& v,
                    [[maybe_unused]] const Ray& ray, [[maybe_unused]] const QueryOptions& qo) {
 #ifdef ACCELVIZ_BVH_WIDE8
   return with_query_choices(
-      qo, [&]<bool Ordered, TriangleTest Test>() { return wide8::traverse_wide<AnyHit, Ordered, Test>(wide, v, ray); });
+      qo, [&]<bool Ordered, TriangleTest Test>() { return wide8::traverse_wide<false, Ordered, Test>(wide, v, ray); });
 #else
   return Hit{};    // never built without AVX2 support (Bvh checks cpu_has_wide8)
 #endif
@@ -874,8 +874,8 @@ Hit Bvh::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, Vi
   const BvhView v{nodes_.data(), blocks_.data(), leaf_block_.data(), prim_indices_.data(), nodes_.size()};
   Hit h;
   if (stats == nullptr && trace == nullptr && !qo.back_to_front && !qo.xray) [[likely]]
-    h = wide8_  ? dispatch_wide8<false>(*wide8_, v, ray, qo)
-        : wide_ ? dispatch_wide<false>(*wide_, v, ray, qo)
+    h = wide8_  ? dispatch_wide8(*wide8_, v, ray, qo)
+        : wide_ ? dispatch_wide(*wide_, v, ray, qo)
                 : binary_fast<false>(v, ray, qo);
   else
     h = closest_hit_collected(v, ray, qo, stats, trace);
