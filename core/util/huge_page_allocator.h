@@ -55,6 +55,10 @@ struct KeptRegions {
   std::array<std::size_t, kSlots> bytes{};
   int count = 0;
   std::size_t total = 0;
+  /// Regions handed out by take_region with their true size, which can be up
+  /// to twice the request's: keep_region records that size when they come
+  /// back, so that `total` (and the kKeptBytes budget) counts what is held.
+  std::vector<std::pair<void*, std::size_t>> lent;
 
   void remove(int i) {
     total -= bytes[i];
@@ -83,6 +87,7 @@ inline void* take_region(std::size_t bytes) {
     if (k.bytes[i] >= bytes && k.bytes[i] / 2 <= bytes && (best < 0 || k.bytes[i] < k.bytes[best])) best = i;
   if (best < 0) return nullptr;
   void* const p = k.ptr[best];
+  k.lent.emplace_back(p, k.bytes[best]);
   k.remove(best);
   return p;
 }
@@ -102,6 +107,13 @@ inline void keep_region(void* p, std::size_t bytes) {
   int nfreed = 0;
   {
     const std::lock_guard lock(k.mutex);
+    for (std::size_t i = 0; i < k.lent.size(); ++i)
+      if (k.lent[i].first == p) {  // a reused region: its true size
+        bytes = k.lent[i].second;
+        k.lent[i] = k.lent.back();
+        k.lent.pop_back();
+        break;
+      }
     while (k.count == KeptRegions::kSlots || k.total + bytes > KeptRegions::kKeptBytes) {
       freed[nfreed++] = k.ptr[0];
       k.remove(0);

@@ -168,6 +168,30 @@ TEST(HugePageAllocator, FreedLargeArraysAreReusedForArraysOfAboutTheirSize) {
   EXPECT_EQ(huge_page_detail::kept_bytes(), 0u);
 }
 
+TEST(HugePageAllocator, AReusedRegionIsKeptAtItsTrueSize) {
+  huge_page_detail::release_kept_regions();
+  const std::size_t page_floats = kHugePageBytes / sizeof(float);
+  const float* first = nullptr;
+  { first = HugePageVector<float>(4 * page_floats).data(); }
+  EXPECT_EQ(huge_page_detail::kept_bytes(), 4 * kHugePageBytes);
+  {
+    // Three pages' request: the kept four-page region (at most twice that).
+    HugePageVector<float> a(3 * page_floats);
+    EXPECT_EQ(a.data(), first);
+    EXPECT_EQ(huge_page_detail::kept_bytes(), 0u);
+  }
+  // Freed again, it counts its four pages, not the request's three.
+  EXPECT_EQ(huge_page_detail::kept_bytes(), 4 * kHugePageBytes);
+  {
+    // So a four-page request can take it again.
+    HugePageVector<float> b(4 * page_floats);
+    EXPECT_EQ(b.data(), first);
+  }
+  EXPECT_EQ(huge_page_detail::kept_bytes(), 4 * kHugePageBytes);
+  huge_page_detail::release_kept_regions();
+  EXPECT_EQ(huge_page_detail::kept_bytes(), 0u);
+}
+
 TEST(HugePageAllocator, KeptRegionsAreBoundedInCountAndBytes) {
   huge_page_detail::release_kept_regions();
   using huge_page_detail::KeptRegions;
