@@ -775,7 +775,7 @@ decltype(auto) with_query_choices(const QueryOptions& qo, Walk&& walk) {
 /// The single-ray closest-hit walk of the 4-wide copy for the query options.
 Hit dispatch_wide(const bvh_detail::WideBvh& wide, const BvhView& v, const Ray& ray, const QueryOptions& qo) {
   return with_query_choices(
-      qo, [&]<bool Ordered, TriangleTest Test>() { return wide4::traverse_wide<false, Ordered, Test>(wide, v, ray); });
+      qo, [&]<bool Ordered, TriangleTest Test>() { return wide4::traverse_wide<Ordered, Test>(wide, v, ray); });
 }
 
 /// The single-ray closest-hit walk of the 8-wide copy for the query options.
@@ -783,7 +783,7 @@ Hit dispatch_wide8([[maybe_unused]] const bvh_detail::WideBvh8& wide, [[maybe_un
                    [[maybe_unused]] const Ray& ray, [[maybe_unused]] const QueryOptions& qo) {
 #ifdef ACCELVIZ_BVH_WIDE8
   return with_query_choices(
-      qo, [&]<bool Ordered, TriangleTest Test>() { return wide8::traverse_wide<false, Ordered, Test>(wide, v, ray); });
+      qo, [&]<bool Ordered, TriangleTest Test>() { return wide8::traverse_wide<Ordered, Test>(wide, v, ray); });
 #else
   return Hit{};    // never built without AVX2 support (Bvh checks cpu_has_wide8)
 #endif

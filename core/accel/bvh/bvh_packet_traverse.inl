@@ -138,7 +138,8 @@ struct PacketTriResult {
 
 /// Walks rays[0 .. count) (count 1..8) through the W-wide copy together and
 /// writes each ray's result to out[l]: the hit the single-ray walk
-/// traverse_wide<AnyHit, Ordered, Test> returns (best.prim a leaf position).
+/// (traverse_wide<Ordered, Test>, or occluded_wide<Test> for any hit) finds
+/// (best.prim a leaf position).
 ///  - Ordered (closest hit): a node's hit children are visited nearest first
 ///    by their packet's smallest entry distance; the others are pushed with
 ///    each lane's entry distance, and on pop a lane whose entry lies beyond

@@ -264,18 +264,19 @@ template <bool AnyHit, bool Ordered, TriangleTest Test>
   }
 }
 
-template <bool AnyHit, bool Ordered, TriangleTest Test>
+/// Bvh::closest_hit's single-ray walk from the root.
+template <bool Ordered, TriangleTest Test>
 Hit traverse_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& bvh, const Ray& ray) {
   Hit best;
   float closest = ray.tmax;
   LeafRay<Test> leaf(ray);
-  walk_wide<AnyHit, Ordered, Test>(wide_bvh, bvh, ray, leaf, 0, 0, closest, best);
+  walk_wide<false, Ordered, Test>(wide_bvh, bvh, ray, leaf, 0, 0, closest, best);
   return best;
 }
 
-/// traverse_wide<true, false, Test>(...).valid() without the Hit: the leaf
-/// test's stores into a local that nothing reads, and a bool returned in a
-/// register (Bvh::any_hit's single-ray query).
+/// Bvh::any_hit's single-ray walk from the root (any hit ignores the
+/// ordering): whether a hit exists, with the leaf test's stores into a local
+/// that nothing reads and a bool returned in a register.
 template <TriangleTest Test>
 bool occluded_wide(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView& bvh, const Ray& ray) {
   Hit best;
