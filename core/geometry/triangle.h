@@ -2,6 +2,7 @@
 // Ray-triangle intersection: watertight (default) and Moller-Trumbore (fast).
 #include <cmath>
 #include <glm/glm.hpp>
+#include <type_traits>
 
 #include "core/geometry/hit.h"
 #include "core/math/aabb.h"
@@ -40,6 +41,36 @@ struct WatertightRay {
   explicit WatertightRay(const glm::vec3& dir);
 };
 
+/// The axis that the watertight set-up makes z, from |d.x|, |d.y|, |d.z|: the
+/// largest, the first of equal maxima (x over y, and x or y over z only when
+/// strictly larger), by selections without branches, into z. F is float
+/// (Z int), or a GCC vector of floats for the packet walk's lanes (Z the
+/// matching int vector): one source for both, so every lane picks the axes
+/// its single ray would. (References, not values: a 32-byte vector passed by
+/// value in SSE-only code draws GCC's -Wpsabi warning.)
+template <class F, class Z>
+[[gnu::always_inline]] inline void watertight_z_axis(const F& ax, const F& ay, const F& az, Z& z) {
+  const F axy = ay < ax ? ax : ay;  // the larger of x and y (x only when strictly larger)
+  Z kxy, xy_not_above_z;            // 1 where the comparison is false
+  if constexpr (std::is_same_v<F, float>) {
+    kxy = static_cast<int>(!(ax > ay));
+    xy_not_above_z = static_cast<int>(!(axy > az));
+  } else {  // vector comparisons give -1 (true) or 0 per lane
+    kxy = (ax > ay) + 1;
+    xy_not_above_z = (axy > az) + 1;
+  }
+  z = kxy + (2 - kxy) * xy_not_above_z;
+}
+
+/// The axes that become x and y for z (before the winding swap): (z + 1) % 3
+/// and (z + 2) % 3, from 2-bit tables (0->1, 1->2, 2->0 and 0->2, 1->0, 2->1).
+[[gnu::always_inline]] inline int watertight_x_axis(int z) {
+  return (0x09 >> (2 * z)) & 3;
+}
+[[gnu::always_inline]] inline int watertight_y_axis(int z) {
+  return (0x12 >> (2 * z)) & 3;
+}
+
 // Inline and free of data-dependent branches: rays of a diffuse bounce pick
 // their dominant axis and its sign at random, and the branchy form (glm::abs
 // and nested selections) mispredicted several times per ray on every
@@ -48,14 +79,10 @@ struct WatertightRay {
 // glm::abs order the same values; the divisions take the same operands).
 inline WatertightRay::WatertightRay(const glm::vec3& dir) {
   const float* d = &dir.x;
-  const float ax = std::fabs(d[0]), ay = std::fabs(d[1]), az = std::fabs(d[2]);
-  // Dominant axis becomes z (first of equal maxima: x over y, and x/y over z only when strictly larger).
-  const float axy = ay < ax ? ax : ay;           // the larger of x and y (x only when strictly larger)
-  const int kxy = static_cast<int>(!(ax > ay));  // its axis
-  const int z = kxy + (2 - kxy) * static_cast<int>(!(axy > az));
+  int z;
+  watertight_z_axis(std::fabs(d[0]), std::fabs(d[1]), std::fabs(d[2]), z);
   // Keep the winding: swap x/y when dir[kz] < 0.
-  const int x = (0x09 >> (2 * z)) & 3;  // (z + 1) % 3 from a 2-bit table: 0->1, 1->2, 2->0
-  const int y = (0x12 >> (2 * z)) & 3;  // (z + 2) % 3: 0->2, 1->0, 2->1
+  const int x = watertight_x_axis(z), y = watertight_y_axis(z);
   const float dz = d[z];
   const int swap = -static_cast<int>(dz < 0.0f);  // all ones or zero
   kz = z;

@@ -313,16 +313,15 @@ void traverse_packet(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView
           // scalar one).
           const PacketF ax = (PacketF)((PacketI)dir[0] & 0x7FFFFFFF), ay = (PacketF)((PacketI)dir[1] & 0x7FFFFFFF),
                         az = (PacketF)((PacketI)dir[2] & 0x7FFFFFFF);  // std::fabs: the bits
-          const PacketF axy = ay < ax ? ax : ay;
-          const PacketI kxy = (ax > ay) + 1;  // comparisons give -1 (true) or 0
-          const PacketI z = kxy + (2 - kxy) * ((axy > az) + 1);
+          PacketI z;
+          watertight_z_axis(ax, ay, az, z);
           const int kz = z[0];
           const PacketF dz = dir[kz];
           const int negative = packet_mask(dz < 0.0f) & live;
           if ((packet_mask(z == kz) & live) != live || (negative != 0 && negative != live)) {
             tri_mode = 0;  // lanes shear different axes: each tests alone
           } else {
-            const int x = (0x09 >> (2 * kz)) & 3, y = (0x12 >> (2 * kz)) & 3;
+            const int x = watertight_x_axis(kz), y = watertight_y_axis(kz);
             tri.kz = kz;
             tri.kx = negative != 0 ? y : x;  // keep the winding: swap x and y when dir[kz] < 0
             tri.ky = negative != 0 ? x : y;
