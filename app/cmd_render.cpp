@@ -15,7 +15,8 @@
 #include "core/query/camera.h"
 #include "core/scene/load.h"
 #ifdef ACCELVIZ_HAVE_UI
-#include "ui/gl/osmesa_context.h"
+#include "ui/gl/egl_context.h"
+#include "ui/gl/headless.h"
 #include "ui/render/gpu_trace.h"
 #endif
 
@@ -43,7 +44,8 @@ struct RenderOptions {
   std::string view = "heatmap";
   RasterOptions raster;
   std::string ray_pixel;
-  std::string device = "cpu";  ///< where the heatmap's rays are traced: cpu, gpu (OSMesa compute shader, bvh only)
+  std::string device = "cpu";     ///< where the heatmap's rays are traced: cpu, gpu (compute shader, bvh only)
+  std::optional<std::string> gl;  ///< --device gpu's context: auto (default: EGL on a GPU, else OSMesa), egl, osmesa
 };
 
 /// --ray-pixel "X,Y".
@@ -115,10 +117,11 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
   nlohmann::json gpu_figures;
 #ifdef ACCELVIZ_HAVE_UI
   if (o.device == "gpu") {
-    // Headless GL 4.5 (OSMesa); the image size of the context is irrelevant:
-    // the compute shader writes a storage buffer.
+    // Headless GL 4.5 (--gl: EGL on a GPU or OSMesa); the image size of the
+    // context is irrelevant: the compute shader writes a storage buffer.
     progress.begin("compiling the trace shader, uploading the bvh");
-    OsMesaContext context(1, 1);
+    const std::unique_ptr<GlContext> gl = make_headless_context(1, 1, o.gl.value_or("auto"));
+    const GlContext& context = *gl;
     const auto t_setup = Clock::now();
     GpuBvhTracer tracer;
     tracer.upload(dynamic_cast<const Bvh&>(*accel));
@@ -128,8 +131,12 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
     GpuTraceResult raw;
     img = gpu_render_metric(tracer, camera, ho, &fig, &raw);
     progress.end(std::to_string(static_cast<long long>(fig.render_ms)) + " ms");
-    gpu_figures = {
-        {"gpu_renderer", context.info().renderer}, {"gpu_setup_ms", setup_ms}, {"gpu_readback_ms", raw.readback_ms}};
+    gpu_figures = {{"gpu_renderer", context.info().renderer},
+                   {"gpu_context", context.kind()},
+                   {"gpu_setup_ms", setup_ms},
+                   {"gpu_readback_ms", raw.readback_ms}};
+    if (const auto* egl = dynamic_cast<const EglContext*>(&context))
+      gpu_figures["gpu_device_file"] = egl->device_file();
   } else
 #endif
   {
@@ -173,6 +180,7 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
 }
 
 int run_render(const RenderOptions& o, const GlobalOptions& global) {
+  if (o.gl && o.device != "gpu") throw UsageError("--gl needs --device gpu");
   if (o.device == "gpu") {
 #ifndef ACCELVIZ_HAVE_UI
     throw UsageError(needs_renderer("--device gpu"));
@@ -295,9 +303,13 @@ Command add_render_command(CLI::App& parent, const GlobalOptions& global) {
   sub->add_flag("--wireframe", o->raster.wireframe, "raster: draw triangle edges over the mesh");
   sub->add_option("--device", o->device,
                   "Where the heatmap's rays are traced: cpu (all threads), gpu (an OpenGL 4.5 compute shader "
-                  "through headless OSMesa; --structure bvh only; same counts as the CPU)")
+                  "in a headless context, see --gl; --structure bvh only; same counts as the CPU)")
       ->check(CLI::IsMember({"cpu", "gpu"}))
       ->capture_default_str();
+  sub->add_option("--gl", o->gl,
+                  "--device gpu's headless OpenGL context: auto (the default: EGL on a GPU when the machine has "
+                  "one, else OSMesa), egl (EGL on a device: a GPU, else Mesa's software device), osmesa (llvmpipe)")
+      ->check(CLI::IsMember({"auto", "egl", "osmesa"}));
   o->structure_opts.add_to(sub);
   return {sub, [o, &global] { return run_render(*o, global); }};
 }

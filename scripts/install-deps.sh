@@ -13,6 +13,8 @@ PACKAGES=(
   libcli11-dev
   # ui: window, headless GL, loader generator, panels
   libglfw3-dev libosmesa6-dev python3-glad libimgui-dev
+  # ui: headless GL on a device (a GPU; Mesa's software device in CI)
+  libegl-dev
   # reference backend (Embree 3) and benchmarks / tests
   libembree-dev libbenchmark-dev libgtest-dev libgmock-dev
   # GUI tests in a real window

@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
 # accelviz render --device gpu: the heatmap traced by the compute shader
-# (headless OSMesa, llvmpipe). The PNG is byte-identical to the CPU's (same
-# counts per pixel, same colour map and legend), the figures say which device
-# traced, and a structure other than bvh is a one-line usage error.
+# in a headless context (--gl: auto, the default, is EGL on a GPU or else
+# OSMesa; egl is EGL on a device, here Mesa's software device; osmesa). On
+# llvmpipe the PNG is byte-identical to the CPU's (same counts per pixel, same
+# colour map and legend) whichever context traced; the figures say which
+# device and context traced; a structure other than bvh, --gl without
+# --device gpu and an unknown --gl are one-line usage errors.
 set -euo pipefail
 accelviz="$(realpath "$1")"
 tmp=$(mktemp -d)
@@ -23,9 +26,31 @@ assert g["device"] == "gpu" and c["device"] == "cpu", (g["device"], c["device"])
 assert g["rays"] == 64 * 48 and g["hits"] == c["hits"] > 0, (g["hits"], c["hits"])
 assert g["mean"] == c["mean"] and g["max"] == c["max"], (g["mean"], c["mean"])
 assert g["render_ms"] > 0 and "gpu_renderer" in g and "gpu_setup_ms" in g
-print("gpu figures ok:", g["gpu_renderer"], g["render_ms"], "ms")
+print("gpu figures ok:", g["gpu_renderer"], g["gpu_context"], g["render_ms"], "ms")
 PY
 done
+
+# Each context by name: the same picture; the figures name the context.
+for gl in egl osmesa; do
+  out=$("$accelviz" -q render "$scene" --metric nodes --size 64x48 --device gpu --gl $gl --out "$tmp/gpu-$gl.png")
+  cmp "$tmp/cpu-nodes.png" "$tmp/gpu-$gl.png" || { echo "FAIL: --gl $gl: picture differs from the CPU's"; exit 1; }
+  python3 - "$(sed -n 2p <<<"$out")" "$gl" <<'PY'
+import json, sys
+g, want = json.loads(sys.argv[1]), sys.argv[2]
+assert g["gpu_context"] == want, (g["gpu_context"], want)
+assert ("gpu_device_file" in g) == (want == "egl"), g
+print("--gl", want, "ok:", g["gpu_renderer"], g.get("gpu_device_file", ""))
+PY
+done
+if "$accelviz" -q render "$scene" --size 32x24 --gl egl --out "$tmp/cpu-gl.png" 2>"$tmp/err"; then
+  echo "FAIL: --gl without --device gpu succeeded"; exit 1
+fi
+cat "$tmp/err"
+grep -q -- "--gl needs --device gpu" "$tmp/err" || { echo "FAIL: --gl message"; exit 1; }
+[ "$(wc -l <"$tmp/err")" -eq 1 ] && [ ! -e "$tmp/cpu-gl.png" ] || { echo "FAIL: --gl: not one line, or a file"; exit 1; }
+if "$accelviz" -q render "$scene" --size 32x24 --device gpu --gl glx --out "$tmp/glx.png" 2>/dev/null; then
+  echo "FAIL: --gl glx accepted"; exit 1
+fi
 
 # Only the BVH is traced on the GPU: a usage error naming the option, no file.
 if "$accelviz" -q render "$scene" --size 32x24 --device gpu --structure grid --out "$tmp/grid.png" 2>"$tmp/err"; then

@@ -3,7 +3,9 @@
 // the process.
 #include "gl_fixture.h"
 
+#include "ui/gl/egl_context.h"
 #include "ui/gl/gl.h"
+#include "ui/gl/headless.h"
 #include "ui/gl/shader.h"
 
 #include <cstdio>
@@ -61,6 +63,81 @@ TEST(OsMesaContext, TwoContextsTakeTurns) {
   EXPECT_EQ(ra->read_pixels().at(3, 3), glm::u8vec4(255, 0, 0, 255));
   ra.reset();
   check_gl_errors("renderer teardown");
+}
+
+// The EGL side: a 4.5 core context on a device without any surface (a GPU
+// where there is one; in CI, Mesa's software device), GL loaded through
+// eglGetProcAddress.
+TEST(EglContext, GivesAnOpenGl45CoreContextOnADevice) {
+  EglContext ctx(64, 48, EglContext::Devices::any);
+  const GlInfo& info = ctx.info();
+  EXPECT_GE(info.major * 10 + info.minor, 45) << info.version;
+  EXPECT_TRUE(info.core_profile) << info.version;
+  EXPECT_EQ(query_gl_info().renderer, info.renderer);
+  EXPECT_EQ(ctx.kind(), "egl");
+  EXPECT_EQ(ctx.width(), 64);
+  EXPECT_EQ(ctx.height(), 48);
+  // Mesa's software device renders with llvmpipe; a GPU's driver names the GPU.
+  EXPECT_EQ(ctx.software(), info.renderer.find("llvmpipe") != std::string::npos) << info.renderer;
+  EXPECT_NE(glad_glDispatchCompute, nullptr);
+  EXPECT_THROW(EglContext(0, 5), GlError);
+}
+
+TEST(EglContext, TakesTurnsWithOsMesaAndDrawsInItsFramebuffer) {
+  // The glad table is refilled on every switch between the two libraries'
+  // entry points: each renderer draws and reads back in its own context.
+  EglContext e(16, 16);
+  auto re = std::make_unique<Renderer>();
+  RenderView view;
+  view.background = {0.0f, 1.0f, 0.0f};
+  re->render(view, 8, 8);
+  {
+    OsMesaContext o(16, 16);
+    Renderer ro;
+    view.background = {0.0f, 0.0f, 1.0f};
+    ro.render(view, 8, 8);
+    EXPECT_EQ(ro.read_pixels().at(3, 3), glm::u8vec4(0, 0, 255, 255));
+  }
+  e.make_current();
+  EXPECT_EQ(re->read_pixels().at(3, 3), glm::u8vec4(0, 255, 0, 255));
+  EglContext second(8, 8);  // a second context on the same device shares its display
+  second.make_current();
+  {
+    Renderer r2;
+    view.background = {1.0f, 0.0f, 0.0f};
+    r2.render(view, 4, 4);
+    EXPECT_EQ(r2.read_pixels().at(1, 1), glm::u8vec4(255, 0, 0, 255));
+  }
+  e.make_current();  // still usable after the second one's renderer is gone
+  EXPECT_EQ(re->read_pixels().at(3, 3), glm::u8vec4(0, 255, 0, 255));
+  re.reset();
+  check_gl_errors("egl renderer teardown");
+}
+
+TEST(EglContext, HardwareOnlyTakesAGpuOrSaysThereIsNone) {
+  try {
+    EglContext ctx(16, 16, EglContext::Devices::hardware_only);
+    EXPECT_FALSE(ctx.software()) << ctx.info().renderer;
+    EXPECT_EQ(ctx.info().renderer.find("llvmpipe"), std::string::npos) << ctx.info().renderer;
+  } catch (const GlError& e) {
+    // No GPU here (CI): one line that says so.
+    const std::string what = e.what();
+    EXPECT_NE(what.find("EGL"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+}
+
+TEST(HeadlessContext, PicksTheContextByName) {
+  EXPECT_EQ(make_headless_context(8, 8, "osmesa")->kind(), "osmesa");
+  EXPECT_EQ(make_headless_context(8, 8, "egl")->kind(), "egl");
+  // auto: EGL only on a GPU, else OSMesa (llvmpipe either way in CI).
+  const auto a = make_headless_context(8, 8, "auto");
+  if (a->kind() == "egl")
+    EXPECT_FALSE(dynamic_cast<const EglContext&>(*a).software());
+  else
+    EXPECT_EQ(a->kind(), "osmesa");
+  EXPECT_GE(a->info().major * 10 + a->info().minor, 45);
+  EXPECT_THROW(make_headless_context(8, 8, "glx"), std::invalid_argument);
 }
 
 TEST(GlErrors, CheckNamesTheErrorAndThePass) {

@@ -18,6 +18,7 @@
 #include "core/analysis/heatmap.h"
 #include "core/query/camera.h"
 #include "core/scene/load.h"
+#include "ui/gl/egl_context.h"
 #include "ui/gl/osmesa_context.h"
 #include "ui/render/gpu_trace.h"
 
@@ -69,8 +70,19 @@ class GpuTrace : public ::testing::Test {
     return hits;
   }
 
-  std::unique_ptr<OsMesaContext> context_;
+  std::unique_ptr<GlContext> context_;
   std::unique_ptr<GpuBvhTracer> tracer_;
+};
+
+/// The same checks in an EGL context on a device (`render --device gpu
+/// --gl egl`, and `auto` on a machine with a GPU): a GPU where there is one,
+/// else Mesa's software device (llvmpipe), as in CI.
+class GpuTraceEgl : public GpuTrace {
+ protected:
+  void SetUp() override {
+    context_ = std::make_unique<EglContext>(64, 48, EglContext::Devices::any);
+    tracer_ = std::make_unique<GpuBvhTracer>();
+  }
 };
 
 TEST_F(GpuTrace, TeapotStadiumMatchesTheCpuPerPixel) {
@@ -290,6 +302,41 @@ TEST_F(GpuTrace, RejectsBadInputAndNamesUnsupportedStructures) {
     EXPECT_EQ(r.stats[i].nodes_visited, 0u);
     EXPECT_EQ(r.stats[i].box_tests, 0u);
   }
+}
+
+// Through EGL: the same scenes and traversal choices as the OSMesa tests
+// above give the CPU's counts, hits and distances pixel for pixel.
+TEST_F(GpuTraceEgl, TeapotStadiumAndSoupMatchTheCpuPerPixel) {
+  {
+    const Scene scene = load_scene("builtin:teapot-stadium?size=3000");
+    const Bvh bvh(scene.triangles);
+    const Camera cam = frame_bounds(scene.bounds(), 64.0f / 48.0f);
+    EXPECT_GT(expect_equal(bvh, cam, 64, 48, QueryOptions{}, "egl: teapot-stadium"), 0u);
+  }
+  const Scene scene = load_scene("builtin:soup?size=1500");
+  BvhOptions bo;
+  bo.max_leaf_size = 2;
+  const Bvh bvh(scene.triangles, bo);
+  const Camera cam = look_at({0.5f, 0.55f, 1.6f}, {0.5f, 0.5f, 0.5f}, 0.9f);
+  QueryOptions q;
+  EXPECT_GT(expect_equal(bvh, cam, 48, 40, q, "egl: soup, watertight"), 0u);
+  q.back_to_front = true;
+  expect_equal(bvh, cam, 48, 40, q, "egl: soup, back to front");
+  q.back_to_front = false;
+  q.triangle_test = TriangleTest::moller_trumbore;
+  expect_equal(bvh, cam, 48, 40, q, "egl: soup, Moller-Trumbore");
+}
+
+TEST_F(GpuTraceEgl, DegenerateViewsMatch) {
+  const int w = 33, h = 25;  // odd: the centre row and column have direction components of 0
+  const Scene scene = load_scene("builtin:flat-wall?size=400");
+  const Bvh bvh(scene.triangles);
+  const glm::vec3 c = scene.bounds().center();
+  EXPECT_GT(expect_equal(bvh, look_at(c + glm::vec3(0.0f, 0.0f, 2.0f), c, 1.2f), w, h, QueryOptions{},
+                         "egl: flat-wall, head-on along -z"),
+            0u);
+  expect_equal(bvh, look_at(c + glm::vec3(0.0f, -3.0f, 0.0f), c, 1.2f), w, h, QueryOptions{},
+               "egl: flat-wall, eye in its plane");
 }
 
 }  // namespace gpu_trace_test
