@@ -42,6 +42,16 @@ TEST(OsMesaContext, RejectsAnEmptyImageSize) {
   EXPECT_THROW(OsMesaContext(0, 10), GlError);
 }
 
+/// Pixel (3, 3) of an 8×8 picture of `background` drawn by a renderer made,
+/// used and destroyed in the current context.
+glm::u8vec4 drawn_background(const glm::vec3& background) {
+  Renderer r;
+  RenderView view;
+  view.background = background;
+  r.render(view, 8, 8);
+  return r.read_pixels().at(3, 3);
+}
+
 TEST(OsMesaContext, TwoContextsTakeTurns) {
   // GL objects belong to their context: each renderer is used and destroyed
   // with its own context current.
@@ -53,12 +63,7 @@ TEST(OsMesaContext, TwoContextsTakeTurns) {
   view.background = {1.0f, 0.0f, 0.0f};
   ra->render(view, 8, 8);
   b.make_current();
-  {
-    Renderer rb;
-    view.background = {0.0f, 0.0f, 1.0f};
-    rb.render(view, 8, 8);
-    EXPECT_EQ(rb.read_pixels().at(3, 3), glm::u8vec4(0, 0, 255, 255));
-  }
+  EXPECT_EQ(drawn_background({0.0f, 0.0f, 1.0f}), glm::u8vec4(0, 0, 255, 255));
   a.make_current();
   EXPECT_EQ(ra->read_pixels().at(3, 3), glm::u8vec4(255, 0, 0, 255));
   ra.reset();
@@ -93,21 +98,13 @@ TEST(EglContext, TakesTurnsWithOsMesaAndDrawsInItsFramebuffer) {
   re->render(view, 8, 8);
   {
     OsMesaContext o(16, 16);
-    Renderer ro;
-    view.background = {0.0f, 0.0f, 1.0f};
-    ro.render(view, 8, 8);
-    EXPECT_EQ(ro.read_pixels().at(3, 3), glm::u8vec4(0, 0, 255, 255));
+    EXPECT_EQ(drawn_background({0.0f, 0.0f, 1.0f}), glm::u8vec4(0, 0, 255, 255));
   }
   e.make_current();
   EXPECT_EQ(re->read_pixels().at(3, 3), glm::u8vec4(0, 255, 0, 255));
   EglContext second(8, 8);  // a second context on the same device shares its display
   second.make_current();
-  {
-    Renderer r2;
-    view.background = {1.0f, 0.0f, 0.0f};
-    r2.render(view, 4, 4);
-    EXPECT_EQ(r2.read_pixels().at(1, 1), glm::u8vec4(255, 0, 0, 255));
-  }
+  EXPECT_EQ(drawn_background({1.0f, 0.0f, 0.0f}), glm::u8vec4(255, 0, 0, 255));
   e.make_current();  // still usable after the second one's renderer is gone
   EXPECT_EQ(re->read_pixels().at(3, 3), glm::u8vec4(0, 255, 0, 255));
   re.reset();

@@ -2,8 +2,9 @@
 // exactly what the CPU's instrumented BVH traversal counts: per pixel the
 // same nodes visited, box tests, primitive tests, culled and missed nodes,
 // the same hit primitive and the bit-identical hit distance, on llvmpipe
-// (OSMesa), for small procedural scenes including degenerate ones and rays
-// with exactly-zero direction components. Images are tiny: llvmpipe's
+// (through OSMesa and through EGL's software device), for small procedural
+// scenes including degenerate ones and rays with exactly-zero direction
+// components. Images are tiny: llvmpipe's
 // compute is slow and this also runs under ASan.
 #include <gtest/gtest.h>
 
@@ -18,17 +19,20 @@
 #include "core/analysis/heatmap.h"
 #include "core/query/camera.h"
 #include "core/scene/load.h"
-#include "ui/gl/egl_context.h"
-#include "ui/gl/osmesa_context.h"
+#include "ui/gl/headless.h"
 #include "ui/render/gpu_trace.h"
 
 namespace accelviz::test {
 namespace gpu_trace_test {
 
-class GpuTrace : public ::testing::Test {
+/// Every test runs in both headless contexts (make_headless_context's
+/// names): OSMesa, and EGL on a device (`render --device gpu --gl egl`, and
+/// `auto` on a machine with a GPU): a GPU where there is one, else Mesa's
+/// software device (llvmpipe), as in CI.
+class GpuTrace : public ::testing::TestWithParam<const char*> {
  protected:
   void SetUp() override {
-    context_ = std::make_unique<OsMesaContext>(64, 48);
+    context_ = make_headless_context(64, 48, GetParam());
     tracer_ = std::make_unique<GpuBvhTracer>();
   }
   void TearDown() override {
@@ -74,18 +78,7 @@ class GpuTrace : public ::testing::Test {
   std::unique_ptr<GpuBvhTracer> tracer_;
 };
 
-/// The same checks in an EGL context on a device (`render --device gpu
-/// --gl egl`, and `auto` on a machine with a GPU): a GPU where there is one,
-/// else Mesa's software device (llvmpipe), as in CI.
-class GpuTraceEgl : public GpuTrace {
- protected:
-  void SetUp() override {
-    context_ = std::make_unique<EglContext>(64, 48, EglContext::Devices::any);
-    tracer_ = std::make_unique<GpuBvhTracer>();
-  }
-};
-
-TEST_F(GpuTrace, TeapotStadiumMatchesTheCpuPerPixel) {
+TEST_P(GpuTrace, TeapotStadiumMatchesTheCpuPerPixel) {
   const Scene scene = load_scene("builtin:teapot-stadium?size=3000");
   const Bvh bvh(scene.triangles);
   const int w = 64, h = 48;
@@ -95,7 +88,7 @@ TEST_F(GpuTrace, TeapotStadiumMatchesTheCpuPerPixel) {
   EXPECT_LT(hits, static_cast<std::uint64_t>(w) * h);
 }
 
-TEST_F(GpuTrace, SoupMatchesForEveryTraversalChoice) {
+TEST_P(GpuTrace, SoupMatchesForEveryTraversalChoice) {
   const Scene scene = load_scene("builtin:soup?size=1500");
   BvhOptions bo;
   bo.max_leaf_size = 2;
@@ -122,7 +115,7 @@ TEST_F(GpuTrace, SoupMatchesForEveryTraversalChoice) {
 // odd-sized image have direction components of exactly 0 (inv_dir = ±inf,
 // 0·inf = NaN in the slab test), the triangles all lie in z = 0 (flat boxes),
 // and duplicated triangles make exact ties (the first found wins).
-TEST_F(GpuTrace, DegenerateScenesAndZeroDirectionComponentsMatch) {
+TEST_P(GpuTrace, DegenerateScenesAndZeroDirectionComponentsMatch) {
   const int w = 33, h = 25;
   const Camera front = look_at({0.0f, 0.0f, 3.0f}, {0.0f, 0.0f, 0.0f}, 1.2f);
   {
@@ -167,7 +160,7 @@ TEST_F(GpuTrace, DegenerateScenesAndZeroDirectionComponentsMatch) {
 // functions of exactly 0, recomputed in double), a 1e-16-sized triangle on
 // the centre ray (determinant below kWatertightLowRange: the whole test in
 // double) and a 1e20-sized one behind everything (float overflow: double).
-TEST_F(GpuTrace, WatertightSpecialCasesMatch) {
+TEST_P(GpuTrace, WatertightSpecialCasesMatch) {
   std::vector<Triangle> tris = {
       {{-1.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}},
       {{-1.0f, 0.0f, 0.0f}, {0.0f, -1.0f, 0.0f}, {1.0f, 0.0f, 0.0f}},
@@ -189,7 +182,7 @@ TEST_F(GpuTrace, WatertightSpecialCasesMatch) {
 
 // gpu_render_metric gives the MetricImage core's render_metric gives, so the
 // colour map, legend and PNG are core's and identical.
-TEST_F(GpuTrace, MetricImagesAndColourisedPicturesEqualTheCpus) {
+TEST_P(GpuTrace, MetricImagesAndColourisedPicturesEqualTheCpus) {
   const Scene scene = load_scene("builtin:teapot?size=1000");
   const Bvh bvh(scene.triangles);
   tracer_->upload(bvh);
@@ -226,7 +219,7 @@ TEST_F(GpuTrace, MetricImagesAndColourisedPicturesEqualTheCpus) {
 // dispatch wrote only its band). Band sizes are uneven and the height is not
 // a multiple of the 8-row work group; a second begin() (the view changed
 // mid-trace) starts from an untraced image again.
-TEST_F(GpuTrace, BandedTraceEqualsTheOneShotTraceBandByBand) {
+TEST_P(GpuTrace, BandedTraceEqualsTheOneShotTraceBandByBand) {
   const Scene scene = load_scene("builtin:teapot-stadium?size=2000");
   const Bvh bvh(scene.triangles);
   tracer_->upload(bvh);
@@ -285,7 +278,7 @@ TEST_F(GpuTrace, BandedTraceEqualsTheOneShotTraceBandByBand) {
   EXPECT_THROW(fresh.result(), std::logic_error);
 }
 
-TEST_F(GpuTrace, RejectsBadInputAndNamesUnsupportedStructures) {
+TEST_P(GpuTrace, RejectsBadInputAndNamesUnsupportedStructures) {
   EXPECT_THROW(tracer_->trace(Camera{}, 8, 8, QueryOptions{}), std::logic_error);  // nothing uploaded
   const Scene scene = load_scene("builtin:soup?size=10");
   const Bvh bvh(scene.triangles);
@@ -304,40 +297,8 @@ TEST_F(GpuTrace, RejectsBadInputAndNamesUnsupportedStructures) {
   }
 }
 
-// Through EGL: the same scenes and traversal choices as the OSMesa tests
-// above give the CPU's counts, hits and distances pixel for pixel.
-TEST_F(GpuTraceEgl, TeapotStadiumAndSoupMatchTheCpuPerPixel) {
-  {
-    const Scene scene = load_scene("builtin:teapot-stadium?size=3000");
-    const Bvh bvh(scene.triangles);
-    const Camera cam = frame_bounds(scene.bounds(), 64.0f / 48.0f);
-    EXPECT_GT(expect_equal(bvh, cam, 64, 48, QueryOptions{}, "egl: teapot-stadium"), 0u);
-  }
-  const Scene scene = load_scene("builtin:soup?size=1500");
-  BvhOptions bo;
-  bo.max_leaf_size = 2;
-  const Bvh bvh(scene.triangles, bo);
-  const Camera cam = look_at({0.5f, 0.55f, 1.6f}, {0.5f, 0.5f, 0.5f}, 0.9f);
-  QueryOptions q;
-  EXPECT_GT(expect_equal(bvh, cam, 48, 40, q, "egl: soup, watertight"), 0u);
-  q.back_to_front = true;
-  expect_equal(bvh, cam, 48, 40, q, "egl: soup, back to front");
-  q.back_to_front = false;
-  q.triangle_test = TriangleTest::moller_trumbore;
-  expect_equal(bvh, cam, 48, 40, q, "egl: soup, Moller-Trumbore");
-}
-
-TEST_F(GpuTraceEgl, DegenerateViewsMatch) {
-  const int w = 33, h = 25;  // odd: the centre row and column have direction components of 0
-  const Scene scene = load_scene("builtin:flat-wall?size=400");
-  const Bvh bvh(scene.triangles);
-  const glm::vec3 c = scene.bounds().center();
-  EXPECT_GT(expect_equal(bvh, look_at(c + glm::vec3(0.0f, 0.0f, 2.0f), c, 1.2f), w, h, QueryOptions{},
-                         "egl: flat-wall, head-on along -z"),
-            0u);
-  expect_equal(bvh, look_at(c + glm::vec3(0.0f, -3.0f, 0.0f), c, 1.2f), w, h, QueryOptions{},
-               "egl: flat-wall, eye in its plane");
-}
+INSTANTIATE_TEST_SUITE_P(Context, GpuTrace, ::testing::Values("osmesa", "egl"),
+                         [](const ::testing::TestParamInfo<const char*>& info) { return std::string(info.param); });
 
 }  // namespace gpu_trace_test
 }  // namespace accelviz::test
