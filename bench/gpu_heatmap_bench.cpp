@@ -27,10 +27,9 @@
 #include <cstdio>
 #include <exception>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "core/accel/bvh/bvh.h"
 #include "core/query/camera.h"
