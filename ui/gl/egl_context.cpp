@@ -71,9 +71,15 @@ EGLContext create_core_context(EGLDisplay display, std::string& why) {
       return nullptr;
     }
   }
+  // One attribute and its value per line.
+  // clang-format off
   const EGLint attribs[] = {
-      EGL_CONTEXT_MAJOR_VERSION,           4,       EGL_CONTEXT_MINOR_VERSION, 5, EGL_CONTEXT_OPENGL_PROFILE_MASK,
-      EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+      EGL_CONTEXT_MAJOR_VERSION, 4,
+      EGL_CONTEXT_MINOR_VERSION, 5,
+      EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+      EGL_NONE,
+  };
+  // clang-format on
   EGLContext ctx = eglCreateContext(display, config, EGL_NO_CONTEXT, attribs);
   if (ctx == EGL_NO_CONTEXT) why = "no OpenGL 4.5 core context (" + egl_error_name(eglGetError()) + ")";
   return ctx;
