@@ -42,6 +42,18 @@ assert ("gpu_device_file" in g) == (want == "egl"), g
 print("--gl", want, "ok:", g["gpu_renderer"], g.get("gpu_device_file", ""))
 PY
 done
+# Without any EGL (libglvnd pointed at no vendor library): --gl egl is a
+# one-line error and writes nothing; auto falls back to OSMesa.
+if __EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent.json "$accelviz" -q render "$scene" --size 32x24 --device gpu \
+  --gl egl --out "$tmp/no-egl.png" 2>"$tmp/err"; then
+  echo "FAIL: --gl egl without EGL succeeded"; exit 1
+fi
+cat "$tmp/err"
+grep -q "EGL" "$tmp/err" && [ "$(wc -l <"$tmp/err")" -eq 1 ] && [ ! -e "$tmp/no-egl.png" ] ||
+  { echo "FAIL: --gl egl without EGL: not one line naming EGL, or a file"; exit 1; }
+out=$(__EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent.json "$accelviz" -q render "$scene" --size 32x24 --device gpu \
+  --out "$tmp/auto.png")
+python3 -c "import json,sys; g=json.loads(sys.argv[1]); assert g['gpu_context']=='osmesa', g" "$(sed -n 2p <<<"$out")"
 if "$accelviz" -q render "$scene" --size 32x24 --gl egl --out "$tmp/cpu-gl.png" 2>"$tmp/err"; then
   echo "FAIL: --gl without --device gpu succeeded"; exit 1
 fi
