@@ -22,7 +22,6 @@
 // it can be carried to a GPU machine that has none of the others.
 #include <algorithm>
 #include <atomic>
-#include <bit>
 #include <chrono>
 #include <cstdio>
 #include <exception>
@@ -119,13 +118,7 @@ int main(int argc, char** argv) {
           const std::size_t i = y * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
           RayStats s;
           const Hit c = bvh.closest_hit(primary_ray(camera, x, static_cast<int>(y), width, height), query, &s);
-          const RayStats& g = last.stats[i];
-          const Hit& gh = last.hits[i];
-          const bool same = s.nodes_visited == g.nodes_visited && s.box_tests == g.box_tests &&
-                            s.prim_tests == g.prim_tests && s.nodes_culled == g.nodes_culled &&
-                            s.nodes_missed == g.nodes_missed && c.prim == gh.prim &&
-                            std::bit_cast<std::uint32_t>(c.t) == std::bit_cast<std::uint32_t>(gh.t);
-          if (!same) ++local;
+          if (!gpu_pixel_matches(last, i, s, c)) ++local;
         }
       mismatched += local;
     });

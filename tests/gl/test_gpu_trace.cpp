@@ -57,10 +57,7 @@ class GpuTrace : public ::testing::TestWithParam<const char*> {
         const Hit c = bvh.closest_hit(primary_ray(cam, x, y, w, h), q, &s);
         const RayStats& gs = g.stats[i];
         const Hit& gh = g.hits[i];
-        const bool same = s.nodes_visited == gs.nodes_visited && s.box_tests == gs.box_tests &&
-                          s.prim_tests == gs.prim_tests && s.nodes_culled == gs.nodes_culled &&
-                          s.nodes_missed == gs.nodes_missed && c.prim == gh.prim &&
-                          std::bit_cast<std::uint32_t>(c.t) == std::bit_cast<std::uint32_t>(gh.t);
+        const bool same = gpu_pixel_matches(g, i, s, c);
         if (c.valid()) ++hits;
         max_nodes = std::max<std::uint64_t>(max_nodes, s.nodes_visited);
         if (!same && mismatches++ < 5)
@@ -252,11 +249,7 @@ TEST_P(GpuTrace, BandedTraceEqualsTheOneShotTraceBandByBand) {
         const std::size_t i = static_cast<std::size_t>(y) * w + x;
         const RayStats &a = r.stats[i], &b = whole.stats[i];
         if (y < expect_done) {
-          const bool same = a.nodes_visited == b.nodes_visited && a.box_tests == b.box_tests &&
-                            a.prim_tests == b.prim_tests && a.nodes_culled == b.nodes_culled &&
-                            a.nodes_missed == b.nodes_missed && r.hits[i].prim == whole.hits[i].prim &&
-                            std::bit_cast<std::uint32_t>(r.hits[i].t) == std::bit_cast<std::uint32_t>(whole.hits[i].t);
-          wrong_traced += same ? 0 : 1;
+          wrong_traced += gpu_pixel_matches(r, i, b, whole.hits[i]) ? 0 : 1;
         } else {
           const bool untraced = a.nodes_visited == GpuBvhTracer::kUntraced && a.box_tests == GpuBvhTracer::kUntraced &&
                                 a.prim_tests == GpuBvhTracer::kUntraced && !r.hits[i].valid();

@@ -1,6 +1,7 @@
 #include "ui/render/gpu_trace.h"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -43,6 +44,13 @@ GlObject make_storage(const void* data, std::size_t bytes, const char* what) {
 }
 
 }  // namespace
+
+bool gpu_pixel_matches(const GpuTraceResult& gpu, std::size_t i, const RayStats& stats, const Hit& hit) {
+  const RayStats& g = gpu.stats[i];
+  return stats.nodes_visited == g.nodes_visited && stats.box_tests == g.box_tests && stats.prim_tests == g.prim_tests &&
+         stats.nodes_culled == g.nodes_culled && stats.nodes_missed == g.nodes_missed && hit.prim == gpu.hits[i].prim &&
+         std::bit_cast<std::uint32_t>(hit.t) == std::bit_cast<std::uint32_t>(gpu.hits[i].t);
+}
 
 std::string gpu_trace_unsupported(const std::string& structure_name) {
   if (structure_name != "bvh") return "only the bvh structure is traced on the GPU";

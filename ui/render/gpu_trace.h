@@ -37,6 +37,12 @@ struct GpuTraceResult {
   double readback_ms = 0.0;  ///< copying the per-pixel results back
 };
 
+/// Whether pixel `i` of a GPU trace has exactly these figures: the five
+/// counters, the hit primitive and a bit-identical hit distance (the CPU's,
+/// from Bvh::closest_hit with statistics for the same ray, or another
+/// trace's pixel).
+bool gpu_pixel_matches(const GpuTraceResult& gpu, std::size_t i, const RayStats& stats, const Hit& hit);
+
 /// Why the GPU cannot trace `structure_name` with `query`; empty when it can.
 /// Only the binary BVH is traced on the GPU ("--device gpu: only the bvh
 /// structure is traced on the GPU" is the CLI's wording of the first case).
