@@ -1,5 +1,6 @@
 // GPU heatmap benchmark (issue 11's GPU target: a 1M-triangle heatmap at
-// 1920x1080 in <= 16 ms on a real GPU). Traces one heatmap's primary rays in
+// 1920x1080 in <= 16 ms on a real GPU). Traces the primary rays of one
+// heatmap, seen from the scene's framing camera (frame_bounds), in
 // the compute shader (shaders/trace_bvh.comp through GpuBvhTracer, the path of
 // `render --device gpu`) in an EGL context, several times, and checks each
 // pixel's counters, hit and distance against the CPU's counted walk:
