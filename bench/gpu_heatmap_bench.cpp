@@ -24,7 +24,6 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <cstdio>
 #include <exception>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -35,16 +34,13 @@
 #include "core/query/camera.h"
 #include "core/scene/load.h"
 #include "core/util/parallel.h"
+#include "core/util/timing.h"
 #include "ui/gl/egl_context.h"
 #include "ui/render/gpu_trace.h"
 
 namespace {
 
 using namespace accelviz;
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 bool parse_size(const std::string& s, int& w, int& h) {
   const std::size_t x = s.find('x');
@@ -146,10 +142,7 @@ int main(int argc, char** argv) {
     };
     std::cout << out.dump() << "\n";
     return mismatched.load() == 0 ? 0 : 1;
-  } catch (const GlError& e) {
-    std::cerr << "accelviz_gpu_bench: " << e.what() << "\n";
-    return 2;
-  } catch (const std::exception& e) {
+  } catch (const std::exception& e) {  // GlError, ShaderError, a scene that does not load
     std::cerr << "accelviz_gpu_bench: " << e.what() << "\n";
     return 2;
   }

@@ -9,7 +9,8 @@
 
 namespace accelviz {
 
-/// The names make_headless_context takes, for help texts and checks.
+/// The names make_headless_context takes, as its error message lists them
+/// (the CLI's `--gl` choices are the same three, also in builds without ui/).
 inline constexpr std::string_view kHeadlessContextNames = "auto, egl or osmesa";
 
 /// `which`: "osmesa" (OSMesa, llvmpipe), "egl" (EGL on a device: a GPU if
