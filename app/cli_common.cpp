@@ -16,16 +16,9 @@ namespace accelviz::cli {
 namespace fs = std::filesystem;
 
 ImageSize parse_size(const std::string& text) {
-  const std::size_t x = text.find_first_of("xX");
-  auto side = [&](std::string_view s, int& out) {
-    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-    return !s.empty() && ec == std::errc() && ptr == s.data() + s.size() && out >= 1 && out <= 16384;
-  };
-  ImageSize size;
-  if (x == std::string::npos || !side(std::string_view(text).substr(0, x), size.width) ||
-      !side(std::string_view(text).substr(x + 1), size.height))
-    throw UsageError("size '" + text + "': expected WxH with each side in 1..16384, e.g. 800x600");
-  return size;
+  if (const std::optional<ImageSize> size = parse_image_size(text)) return *size;
+  throw UsageError("size '" + text + "': expected WxH with each side in 1.." + std::to_string(kMaxImageSide) +
+                   ", e.g. 800x600");
 }
 
 CLI::Validator size_validator() {

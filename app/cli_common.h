@@ -12,6 +12,7 @@
 #include "core/accel/factory.h"
 #include "core/geometry/triangle.h"
 #include "core/scene/scene.h"
+#include "core/util/image_size.h"
 #include "core/util/timing.h"
 
 namespace accelviz::cli {
@@ -53,12 +54,7 @@ class UsageError : public std::runtime_error {
 
 // ---- values ------------------------------------------------------------------
 
-struct ImageSize {
-  int width = 800;
-  int height = 600;
-};
-
-/// "800x600" (also "800X600"); each side 1..16384. Throws UsageError.
+/// parse_image_size (core/util/image_size.h), or a UsageError naming the text.
 ImageSize parse_size(const std::string& text);
 /// CLI11 validator for parse_size.
 CLI::Validator size_validator();

@@ -15,7 +15,6 @@
 #include "core/query/camera.h"
 #include "core/scene/load.h"
 #ifdef ACCELVIZ_HAVE_UI
-#include "ui/gl/egl_context.h"
 #include "ui/gl/headless.h"
 #include "ui/render/gpu_trace.h"
 #endif
@@ -135,8 +134,7 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
                    {"gpu_context", context.kind()},
                    {"gpu_setup_ms", setup_ms},
                    {"gpu_readback_ms", raw.readback_ms}};
-    if (const auto* egl = dynamic_cast<const EglContext*>(&context))
-      gpu_figures["gpu_device_file"] = egl->device_file();
+    if (context.kind() == "egl") gpu_figures["gpu_device_file"] = context.device_file();
   } else
 #endif
   {

@@ -27,12 +27,14 @@
 #include <exception>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/accel/bvh/bvh.h"
 #include "core/query/camera.h"
 #include "core/scene/load.h"
+#include "core/util/image_size.h"
 #include "core/util/parallel.h"
 #include "core/util/timing.h"
 #include "ui/gl/egl_context.h"
@@ -41,21 +43,6 @@
 namespace {
 
 using namespace accelviz;
-
-bool parse_size(const std::string& s, int& w, int& h) {
-  const std::size_t x = s.find('x');
-  if (x == std::string::npos) return false;
-  try {
-    std::size_t used = 0;
-    w = std::stoi(s.substr(0, x), &used);
-    if (used != x) return false;
-    h = std::stoi(s.substr(x + 1), &used);
-    if (used != s.size() - x - 1) return false;
-  } catch (const std::exception&) {
-    return false;
-  }
-  return w > 0 && h > 0 && w <= 16384 && h <= 16384;
-}
 
 int usage(const std::string& why) {
   std::cerr << "accelviz_gpu_bench: " << why << " (usage: accelviz_gpu_bench SCENE [WxH] [RUNS] [gpu|any])\n";
@@ -67,8 +54,14 @@ int usage(const std::string& why) {
 int main(int argc, char** argv) {
   if (argc < 2 || argc > 5) return usage("expected 1 to 4 arguments");
   const std::string spec = argv[1];
-  int width = 1920, height = 1080, runs = 10;
-  if (argc > 2 && !parse_size(argv[2], width, height)) return usage("size '" + std::string(argv[2]) + "' is not WxH");
+  ImageSize size{1920, 1080};
+  if (argc > 2) {
+    const std::optional<ImageSize> parsed = parse_image_size(argv[2]);
+    if (!parsed) return usage("size '" + std::string(argv[2]) + "' is not WxH");
+    size = *parsed;
+  }
+  const int width = size.width, height = size.height;
+  int runs = 10;
   if (argc > 3) {
     try {
       runs = std::stoi(argv[3]);

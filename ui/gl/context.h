@@ -3,9 +3,9 @@
 // window, an OSMesa headless context). The renderer only ever sees a current
 // GL 4.5 core context; it draws into its own framebuffer object, so reading
 // pixels back is the same code whichever context is underneath.
-#include "ui/gl/gl.h"
-
 #include <string_view>
+
+#include "ui/gl/gl.h"
 
 namespace accelviz {
 
@@ -29,8 +29,12 @@ class GlContext {
   /// Shows the back buffer (window); nothing to do headless.
   virtual void swap_buffers() {}
 
-  /// "glfw" or "osmesa".
+  /// "glfw", "osmesa" or "egl".
   virtual std::string_view kind() const = 0;
+
+  /// The device node the context draws on (an EGL device's DRM node), or ""
+  /// when the context names none (OSMesa, GLFW, a driver that names none).
+  virtual std::string device_file() const { return {}; }
 
   /// Version, renderer and profile as checked when the context was created.
   const GlInfo& info() const { return info_; }

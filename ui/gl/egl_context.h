@@ -36,7 +36,7 @@ class EglContext final : public GlContext {
   bool software() const { return software_; }
   /// The device's DRM node (EGL_DRM_DEVICE_FILE_EXT or its render node), or
   /// "" when the driver names none: recorded beside the GL renderer string.
-  const std::string& device_file() const { return device_file_; }
+  std::string device_file() const override { return device_file_; }
 
  private:
   void make_native_current(bool after_other_kind) override;
