@@ -375,6 +375,30 @@ TEST(BvhBuild, ZeroAreaPrimitivesAtOnePoint) {
   }
 }
 
+TEST(BvhBuild, LbvhBoxesAreTightAroundClustersItCannotCut) {
+  // The LBVH's boxes are set bottom up after the build; its nodes whose
+  // Morton codes are all equal fall back to the object median, which needs
+  // centroid bounds the LBVH's children do not carry. A soup with two such
+  // clusters (one of identical triangles, one of varied triangles sharing a
+  // centroid cell) beside ordinary primitives exercises both paths.
+  std::vector<Triangle> tris = random_soup(3000, 17);
+  for (int i = 0; i < 200; ++i) tris.push_back({{0.3f, 0.3f, 0.3f}, {0.31f, 0.3f, 0.3f}, {0.3f, 0.31f, 0.3f}});
+  for (int i = 0; i < 200; ++i) {
+    const float d = 1e-3f * static_cast<float>(i + 1);
+    tris.push_back({{0.7f - d, 0.7f, 0.7f - d}, {0.7f + d, 0.7f - d, 0.7f}, {0.7f, 0.7f + d, 0.7f + d}});
+  }
+  for (const BvhOptions& base : option_sets()) {
+    if (base.splitter != BvhSplitter::lbvh) continue;
+    SCOPED_TRACE(describe(base));
+    for (unsigned threads : {1u, 2u}) {
+      BvhOptions o = base;
+      o.threads = threads;
+      const Bvh bvh(tris, o);
+      expect_valid_tree(bvh, tris, o);
+    }
+  }
+}
+
 TEST(BvhBuild, ExponentialSpacingStaysWithinTheDepthBudget) {
   // Each SAH split peels off the farthest primitive here, which would make a
   // chain as deep as the scene is large; the depth budget switches to median

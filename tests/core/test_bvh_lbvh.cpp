@@ -86,9 +86,20 @@ TEST(BvhLbvh, SplitCutsAtTheHighestDifferingBit) {
     ASSERT_EQ((morton_code(prims[i].centroid, params.morton) >> 29) & 1u, i < out.mid ? 0u : 1u) << i;
   EXPECT_GT(out.mid, 2000u);
   EXPECT_LT(out.mid, 3000u);
-  Aabb lb, lc;
-  range_bounds(std::span<const BuildPrim>(prims).first(out.mid), lb, lc);
-  EXPECT_TRUE(lb.lo == out.bounds[0].lo && lb.hi == out.bounds[0].hi);
+  // With the sort's codes kept (as the build does) the cut is the same, on
+  // the whole range and on a sub-range.
+  SplitParams with_codes = params;
+  const auto codes = lbvh_sort(prims, params.morton, 1);  // already sorted: the same order
+  with_codes.morton_codes = codes;
+  with_codes.morton_base = prims.data();
+  SplitResult kept;
+  ASSERT_EQ(split_lbvh(with_codes, prims, b, c, scratch, kept), SplitOutcome::split);
+  EXPECT_EQ(kept.mid, out.mid);
+  const std::span<BuildPrim> left = std::span<BuildPrim>(prims).first(out.mid);
+  SplitResult sub, sub_kept;
+  ASSERT_EQ(split_lbvh(params, left, b, c, scratch, sub), SplitOutcome::split);
+  ASSERT_EQ(split_lbvh(with_codes, left, b, c, scratch, sub_kept), SplitOutcome::split);
+  EXPECT_EQ(sub_kept.mid, sub.mid);
   // All codes equal: nothing to cut.
   std::vector<BuildPrim> same(10, prims[0]);
   EXPECT_EQ(split_lbvh(params, same, b, c, scratch, out), SplitOutcome::unsplittable);

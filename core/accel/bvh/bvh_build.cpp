@@ -81,6 +81,19 @@ void range_bounds(std::span<const BuildPrim> prims, Aabb& bounds, Aabb& centroid
   centroid_bounds = c;
 }
 
+void fill_bounds_bottom_up(std::span<BvhNode> nodes, std::span<const BuildPrim> prims) {
+  for (std::size_t i = nodes.size(); i-- > 0;) {
+    BvhNode& n = nodes[i];
+    if (n.count > 0) {
+      Aabb b;
+      for (std::uint32_t k = n.index; k < n.index + n.count; ++k) b.extend(prims[k].bounds);
+      n.bounds = b;
+    } else {
+      n.bounds = Aabb::merge(nodes[n.index].bounds, nodes[n.index + 1].bounds);
+    }
+  }
+}
+
 void split_object_median(std::span<BuildPrim> prims, const Aabb& centroid_bounds, SplitResult& out) {
   const int axis = centroid_bounds.largest_axis();
   const std::size_t mid = prims.size() / 2;
@@ -125,12 +138,23 @@ class Builder {
     }
     std::span<BuildPrim> range = prims_.subspan(w.begin, n);
     SplitResult s;
+    // The object median needs the node's centroid bounds, which a
+    // bounds_after splitter's children do not carry: computed here, for the
+    // (rare) nodes that fall back to it.
+    const auto median_split = [&] {
+      Aabb centroids = w.centroid_bounds;
+      if (split_.bounds_after) {
+        Aabb unused;
+        range_bounds(range, unused, centroids);
+      }
+      split_object_median(range, centroids, s);
+    };
     // Depth budget: a node at depth d with n primitives can always finish
     // within kBvhMaxDepth when d + ceil(log2 n) <= kBvhMaxDepth and every
     // split from here on halves n; so once that sum reaches the budget, only
     // median splits are allowed. Traversal stacks rely on this bound.
     if (w.depth + ceil_log2(n) >= kBvhMaxDepth) {
-      split_object_median(range, w.centroid_bounds, s);
+      median_split();
     } else {
       const ThreadLoan loan(*this, scratch, n);
       const SplitOutcome r = split_.split(params_, range, w.bounds, w.centroid_bounds, scratch, s);
@@ -143,11 +167,11 @@ class Builder {
           make_leaf(w, out, slot);
           return;
         }
-        split_object_median(range, w.centroid_bounds, s);
+        median_split();
       }
     }
     // Every split must separate; a splitter bug must not recurse forever.
-    if (s.mid == 0 || s.mid >= n) split_object_median(range, w.centroid_bounds, s);
+    if (s.mid == 0 || s.mid >= n) median_split();
 
     const std::uint32_t mid = w.begin + static_cast<std::uint32_t>(s.mid);
     const NodeWork left{w.begin, mid, s.bounds[0], s.centroid_bounds[0], w.depth + 1};
@@ -307,14 +331,17 @@ BvhTopology build_bvh_records(std::span<BuildPrim> prims, const Aabb& root_bound
     // 2.-3. Recursive build.
     SplitParams params{opts.buckets, opts.max_leaf_size, opts.leaf_size_cap, opts.cost_traversal, opts.cost_intersect};
     params.small_node_buckets = opts.small_node_buckets;
+    HugePageVector<std::uint32_t> morton_codes;
     if (opts.splitter == BvhSplitter::lbvh) {
       params.morton = morton_frame(root_centroids);
-      lbvh_sort(prims, params.morton, resolve_threads(opts.threads));
+      morton_codes = lbvh_sort(prims, params.morton, resolve_threads(opts.threads));
+      params.morton_codes = morton_codes;
+      params.morton_base = prims.data();
     }
     // Only the binned SAH bins on lent threads (bin_primitives_parallel).
     const Splitter split = opts.splitter == BvhSplitter::binned_sah  ? Splitter{split_binned_sah, true}
                            : opts.splitter == BvhSplitter::exact_sah ? Splitter{split_exact_sah}
-                           : opts.splitter == BvhSplitter::lbvh      ? Splitter{split_lbvh}
+                           : opts.splitter == BvhSplitter::lbvh      ? Splitter{split_lbvh, false, true}
                                                                      : Splitter{split_median};
     Builder builder(params, split, prims, resolve_threads(opts.threads), progress);
     // At most 2n - 1 nodes: reserving them all spares the regrowth copies.
@@ -326,6 +353,7 @@ BvhTopology build_bvh_records(std::span<BuildPrim> prims, const Aabb& root_bound
     SplitScratch scratch;
     builder.build(NodeWork{0, static_cast<std::uint32_t>(n), root_bounds, root_centroids, 0}, topo.nodes, 0, scratch);
     builder.finish();
+    if (split.bounds_after) fill_bounds_bottom_up(topo.nodes, prims);
     topo.prim_indices.resize(n);
     parallel_for(n, resolve_threads(opts.threads), kRecordChunk, [&](std::size_t begin, std::size_t end, unsigned) {
       for (std::size_t i = begin; i < end; ++i) topo.prim_indices[i] = prims[i].id;

@@ -41,7 +41,16 @@ struct SplitParams {
   int leaf_size_cap = 16;
   float cost_traversal = 1.0f;
   float cost_intersect = 1.0f;
-  MortonFrame morton;              ///< lbvh only
+  MortonFrame morton;  ///< lbvh only
+  /// lbvh only, optional: lbvh_sort's sorted codes, morton_codes[i] being
+  /// the code of morton_base[i] (the build's whole record array), so that a
+  /// split reads codes instead of recomputing them from centroids (a random
+  /// record fetch per probe of its binary search). They stay in step with
+  /// the records: the driver reorders a range only for an object median,
+  /// on a range of equal codes (unsplittable) or under the depth budget,
+  /// below which the LBVH cuts nothing (a debug build asserts it).
+  std::span<const std::uint32_t> morton_codes;
+  const BuildPrim* morton_base = nullptr;
   bool small_node_buckets = true;  ///< binned only: binned_bucket_count's rule
 };
 
@@ -83,6 +92,11 @@ using SplitFn = SplitOutcome (*)(const SplitParams& params, std::span<BuildPrim>
 struct Splitter {
   SplitFn split;
   bool uses_helpers = false;
+  /// The split leaves SplitResult's bounds unset: the driver boxes the tree
+  /// bottom up once it is built (fill_bounds_bottom_up), O(n) in all instead
+  /// of a pass over every node's primitives at every level. For splitters
+  /// that need no bounds to choose their cut (the LBVH).
+  bool bounds_after = false;
 };
 
 SplitOutcome split_binned_sah(const SplitParams& params, std::span<BuildPrim> prims, const Aabb& bounds,
@@ -92,14 +106,17 @@ SplitOutcome split_exact_sah(const SplitParams& params, std::span<BuildPrim> pri
 SplitOutcome split_median(const SplitParams& params, std::span<BuildPrim> prims, const Aabb& bounds,
                           const Aabb& centroid_bounds, SplitScratch& scratch, SplitResult& out);
 /// LBVH (lbvh_builder.cpp): cuts a Morton-sorted range at its highest
-/// differing code bit. The range must have been sorted by lbvh_sort.
+/// differing code bit. The range must have been sorted by lbvh_sort. Sets
+/// only out.mid (a bounds_after splitter: it ignores its bounds arguments).
 SplitOutcome split_lbvh(const SplitParams& params, std::span<BuildPrim> prims, const Aabb& bounds,
                         const Aabb& centroid_bounds, SplitScratch& scratch, SplitResult& out);
 MortonFrame morton_frame(const Aabb& centroid_bounds);
 /// 30-bit Morton code of a centroid (10 bits per axis, x highest).
 std::uint32_t morton_code(const glm::vec3& centroid, const MortonFrame& frame);
-/// Sorts primitives (given in id order) by (Morton code, id): stable LSD radix sort on `threads` threads.
-void lbvh_sort(std::span<BuildPrim> prims, const MortonFrame& frame, unsigned threads);
+/// Sorts primitives (given in id order) by (Morton code, id): stable LSD
+/// radix sort on `threads` threads. Returns the sorted codes (code i is
+/// prims[i]'s after the sort).
+HugePageVector<std::uint32_t> lbvh_sort(std::span<BuildPrim> prims, const MortonFrame& frame, unsigned threads);
 
 /// Bucket contents of one binned SAH pass: bounds (lanes 0..2 used; 16-byte
 /// rows so that the SIMD pass can load and store them whole) and counts, per
@@ -249,6 +266,11 @@ BvhTopology build_bvh_from_boxes(std::size_t n, const BoundsAt& bounds_at, const
 
 /// Geometric and centroid bounds of a range.
 void range_bounds(std::span<const BuildPrim> prims, Aabb& bounds, Aabb& centroid_bounds);
+
+/// Sets every node's box from the leaves up: a leaf's is its primitives'
+/// union (prims in leaf order), an inner node's its two children's. Relies
+/// on children being stored after their parents.
+void fill_bounds_bottom_up(std::span<BvhNode> nodes, std::span<const BuildPrim> prims);
 
 /// Sort key of a centroid coordinate: NaN maps to +inf so that comparisons stay
 /// a strict weak order even on garbage input (std::sort requires one).

@@ -13,13 +13,15 @@
 //    equal is "unsplittable" and the driver falls back to its object median
 //    (or a leaf), as for the other splitters.
 //
-// Cost: O(n) for codes and sort, O(log n) per node to find the split, plus
-// the children's bounds (O(n) per tree level, shared with the other
-// splitters' driver). Quality: no SAH, so the tree is worse than binned SAH;
+// Cost: O(n) for codes and sort, O(log n) per node to find the split; the
+// boxes are set bottom up once the tree is built (O(n); the other splitters
+// need each child's box to choose its cut, a pass over its primitives per
+// tree level). Quality: no SAH, so the tree is worse than binned SAH;
 // docs/performance.md quotes both.
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cassert>
 #include <cmath>
 #include <thread>
 
@@ -65,9 +67,13 @@ MortonFrame morton_frame(const Aabb& centroid_bounds) {
   return f;
 }
 
-void lbvh_sort(std::span<BuildPrim> prims, const MortonFrame& frame, unsigned threads) {
+HugePageVector<std::uint32_t> lbvh_sort(std::span<BuildPrim> prims, const MortonFrame& frame, unsigned threads) {
   const std::size_t n = prims.size();
-  if (n < 2) return;
+  if (n < 2) {
+    HugePageVector<std::uint32_t> codes(n);
+    if (n == 1) codes[0] = morton_code(prims[0].centroid, frame);
+    return codes;
+  }
   threads = std::max(1u, std::min<unsigned>(threads, static_cast<unsigned>((n + 65535) / 65536)));
   HugePageVector<std::uint32_t> keys(n), keys_tmp(n), order(n), order_tmp(n);
   const auto chunk = [&](unsigned t) {
@@ -127,14 +133,23 @@ void lbvh_sort(std::span<BuildPrim> prims, const MortonFrame& frame, unsigned th
     for (std::size_t i = b; i < e; ++i) sorted[i] = prims[order[i]];
   });
   std::copy(sorted.begin(), sorted.end(), prims.begin());
+  return keys;
 }
 
 SplitOutcome split_lbvh(const SplitParams& params, std::span<BuildPrim> prims, const Aabb& /*bounds*/,
                         const Aabb& /*centroid_bounds*/, SplitScratch& /*scratch*/, SplitResult& out) {
   const MortonFrame& f = params.morton;
   const std::size_t n = prims.size();
-  const std::uint32_t first = morton_code(prims.front().centroid, f);
-  const std::uint32_t last = morton_code(prims.back().centroid, f);
+  // The sort's codes where the caller kept them (the build does; in step
+  // with the records, see SplitParams::morton_codes), else recomputed from
+  // the centroids.
+  const std::uint32_t* codes = nullptr;
+  if (params.morton_base != nullptr) {
+    codes = params.morton_codes.data() + (prims.data() - params.morton_base);
+    assert(codes[0] == morton_code(prims.front().centroid, f) && codes[n - 1] == morton_code(prims.back().centroid, f));
+  }
+  const auto code = [&](std::size_t i) { return codes ? codes[i] : morton_code(prims[i].centroid, f); };
+  const std::uint32_t first = code(0), last = code(n - 1);
   if (first == last) return SplitOutcome::unsplittable;
   // Highest differing bit: every code in the sorted range agrees above it;
   // the first code with that bit set starts the right child.
@@ -142,14 +157,12 @@ SplitOutcome split_lbvh(const SplitParams& params, std::span<BuildPrim> prims, c
   std::size_t lo = 0, hi = n - 1;  // codes[lo] has the bit clear, codes[hi] set
   while (hi - lo > 1) {
     const std::size_t m = lo + (hi - lo) / 2;
-    if (morton_code(prims[m].centroid, f) & bit)
+    if (code(m) & bit)
       hi = m;
     else
       lo = m;
   }
-  out.mid = hi;
-  range_bounds(prims.first(hi), out.bounds[0], out.centroid_bounds[0]);
-  range_bounds(prims.subspan(hi), out.bounds[1], out.centroid_bounds[1]);
+  out.mid = hi;  // the children's boxes come after the build (Splitter::bounds_after)
   return SplitOutcome::split;
 }
 
