@@ -130,7 +130,15 @@ HugePageVector<std::uint32_t> lbvh_sort(std::span<BuildPrim> prims, const Morton
   HugePageVector<BuildPrim> sorted(n);
   for_chunks([&](unsigned t) {
     const auto [b, e] = chunk(t);
-    for (std::size_t i = b; i < e; ++i) sorted[i] = prims[order[i]];
+    for (std::size_t i = b; i < e; ++i) {
+      // A gather at random: each record's fetch is started 16 ahead.
+      if (i + 16 < e) {
+        const BuildPrim* ahead = &prims[order[i + 16]];
+        __builtin_prefetch(ahead);
+        __builtin_prefetch(reinterpret_cast<const char*>(ahead) + sizeof(BuildPrim) - 1);
+      }
+      sorted[i] = prims[order[i]];
+    }
   });
   std::copy(sorted.begin(), sorted.end(), prims.begin());
   return keys;
