@@ -81,19 +81,6 @@ void range_bounds(std::span<const BuildPrim> prims, Aabb& bounds, Aabb& centroid
   centroid_bounds = c;
 }
 
-void fill_bounds_bottom_up(std::span<BvhNode> nodes, std::span<const BuildPrim> prims) {
-  for (std::size_t i = nodes.size(); i-- > 0;) {
-    BvhNode& n = nodes[i];
-    if (n.count > 0) {
-      Aabb b;
-      for (std::uint32_t k = n.index; k < n.index + n.count; ++k) b.extend(prims[k].bounds);
-      n.bounds = b;
-    } else {
-      n.bounds = Aabb::merge(nodes[n.index].bounds, nodes[n.index + 1].bounds);
-    }
-  }
-}
-
 void split_object_median(std::span<BuildPrim> prims, const Aabb& centroid_bounds, SplitResult& out) {
   const int axis = centroid_bounds.largest_axis();
   const std::size_t mid = prims.size() / 2;
@@ -221,6 +208,8 @@ class Builder {
       build(left, out, first_child, scratch);
       build(right, out, first_child + 1, scratch);
     }
+    // Boxed on the way back up (children done, on whichever thread built them).
+    if (split_.bounds_after) out[slot].bounds = Aabb::merge(out[first_child].bounds, out[first_child + 1].bounds);
   }
 
   /// After the build: throws what a callback threw, or BuildCancelled.
@@ -236,7 +225,12 @@ class Builder {
 
  private:
   void make_leaf(const NodeWork& w, HugePageVector<BvhNode>& out, std::uint32_t slot) {
-    out[slot] = BvhNode{w.bounds, w.begin, w.end - w.begin};
+    Aabb bounds = w.bounds;
+    if (split_.bounds_after) {
+      bounds = Aabb{};
+      for (std::uint32_t k = w.begin; k < w.end; ++k) bounds.extend(prims_[k].bounds);
+    }
+    out[slot] = BvhNode{bounds, w.begin, w.end - w.begin};
     if (!progress_) return;
     const std::uint64_t n = w.end - w.begin;
     const std::uint64_t before = placed_.fetch_add(n, std::memory_order_relaxed);
@@ -353,7 +347,6 @@ BvhTopology build_bvh_records(std::span<BuildPrim> prims, const Aabb& root_bound
     SplitScratch scratch;
     builder.build(NodeWork{0, static_cast<std::uint32_t>(n), root_bounds, root_centroids, 0}, topo.nodes, 0, scratch);
     builder.finish();
-    if (split.bounds_after) fill_bounds_bottom_up(topo.nodes, prims);
     topo.prim_indices.resize(n);
     parallel_for(n, resolve_threads(opts.threads), kRecordChunk, [&](std::size_t begin, std::size_t end, unsigned) {
       for (std::size_t i = begin; i < end; ++i) topo.prim_indices[i] = prims[i].id;

@@ -93,9 +93,10 @@ struct Splitter {
   SplitFn split;
   bool uses_helpers = false;
   /// The split leaves SplitResult's bounds unset: the driver boxes the tree
-  /// bottom up once it is built (fill_bounds_bottom_up), O(n) in all instead
-  /// of a pass over every node's primitives at every level. For splitters
-  /// that need no bounds to choose their cut (the LBVH).
+  /// bottom up as its recursion returns (a leaf from its primitives, an
+  /// inner node from its two children, on the thread that built them), O(n)
+  /// in all instead of a pass over every node's primitives at every level.
+  /// For splitters that need no bounds to choose their cut (the LBVH).
   bool bounds_after = false;
 };
 
@@ -266,11 +267,6 @@ BvhTopology build_bvh_from_boxes(std::size_t n, const BoundsAt& bounds_at, const
 
 /// Geometric and centroid bounds of a range.
 void range_bounds(std::span<const BuildPrim> prims, Aabb& bounds, Aabb& centroid_bounds);
-
-/// Sets every node's box from the leaves up: a leaf's is its primitives'
-/// union (prims in leaf order), an inner node's its two children's. Relies
-/// on children being stored after their parents.
-void fill_bounds_bottom_up(std::span<BvhNode> nodes, std::span<const BuildPrim> prims);
 
 /// Sort key of a centroid coordinate: NaN maps to +inf so that comparisons stay
 /// a strict weak order even on garbage input (std::sort requires one).
