@@ -13,10 +13,10 @@
 //    equal is "unsplittable" and the driver falls back to its object median
 //    (or a leaf), as for the other splitters.
 //
-// Cost: O(n) for codes and sort, O(log n) per node to find the split; the
-// boxes are set bottom up once the tree is built (O(n); the other splitters
-// need each child's box to choose its cut, a pass over its primitives per
-// tree level). Quality: no SAH, so the tree is worse than binned SAH;
+// Cost: O(n) for codes and sort, O(log n) per node to find the split (over
+// the sort's codes); the driver sets the boxes bottom up as its recursion
+// returns (O(n); the other splitters need each child's box to choose their
+// cut, a pass over its primitives per tree level). Quality: no SAH, so the tree is worse than binned SAH;
 // docs/performance.md quotes both.
 #include <algorithm>
 #include <array>
@@ -170,7 +170,7 @@ SplitOutcome split_lbvh(const SplitParams& params, std::span<BuildPrim> prims, c
     else
       lo = m;
   }
-  out.mid = hi;  // the children's boxes come after the build (Splitter::bounds_after)
+  out.mid = hi;  // the driver boxes the children once they are built (Splitter::bounds_after)
   return SplitOutcome::split;
 }
 
