@@ -376,7 +376,7 @@ TEST(BvhBuild, ZeroAreaPrimitivesAtOnePoint) {
 }
 
 TEST(BvhBuild, LbvhBoxesAreTightAroundClustersItCannotCut) {
-  // The LBVH's boxes are set bottom up after the build; its nodes whose
+  // The LBVH's boxes are set bottom up as the build returns; its nodes whose
   // Morton codes are all equal fall back to the object median, which needs
   // centroid bounds the LBVH's children do not carry. A soup with two such
   // clusters (one of identical triangles, one of varied triangles sharing a
