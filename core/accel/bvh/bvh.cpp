@@ -23,6 +23,7 @@
 #include "core/analysis/epo.h"
 #include "core/analysis/sah.h"
 #include "core/util/parallel.h"
+#include "core/util/prefetch.h"
 #include "core/util/timing.h"
 
 namespace accelviz {
@@ -111,11 +112,8 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
       // array: their fetches are started a few leaves ahead.
       if (j + kGatherAhead < end) {
         const BvhNode& ahead = nodes_[leaf_order[j + kGatherAhead]];
-        for (std::uint32_t k = ahead.index; k < ahead.index + ahead.count; ++k) {
-          const Triangle* t = &triangles[prim_indices_[k]];
-          __builtin_prefetch(t);
-          __builtin_prefetch(reinterpret_cast<const char*>(t) + sizeof(Triangle) - 1);
-        }
+        for (std::uint32_t k = ahead.index; k < ahead.index + ahead.count; ++k)
+          prefetch_object(&triangles[prim_indices_[k]]);
       }
       const BvhNode& leaf = nodes_[leaf_order[j]];
       bvh_detail::fill_tri4_blocks(tri_at, leaf.index, leaf.count, blocks_.data() + leaf_block_[leaf_order[j]]);

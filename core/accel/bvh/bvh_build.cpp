@@ -226,7 +226,7 @@ class Builder {
  private:
   void make_leaf(const NodeWork& w, HugePageVector<BvhNode>& out, std::uint32_t slot) {
     Aabb bounds = w.bounds;
-    if (split_.bounds_after) {
+    if (split_.bounds_after) {  // the geometric half of range_bounds (centroids are not needed here)
       bounds = Aabb{};
       for (std::uint32_t k = w.begin; k < w.end; ++k) bounds.extend(prims_[k].bounds);
     }

@@ -27,6 +27,7 @@
 
 #include "core/accel/bvh/bvh_build.h"
 #include "core/util/parallel.h"
+#include "core/util/prefetch.h"
 
 namespace accelviz::bvh_detail {
 
@@ -47,6 +48,9 @@ inline std::uint32_t quantise(float c, float lo, float scale) {
   if (!(x > 0.0f)) return 0;  // NaN and below the box
   return x >= 1023.0f ? 1023u : static_cast<std::uint32_t>(x);
 }
+
+/// The sort's record gather prefetches this many records ahead.
+constexpr std::size_t kGatherAhead = 16;
 
 }  // namespace
 
@@ -131,12 +135,8 @@ HugePageVector<std::uint32_t> lbvh_sort(std::span<BuildPrim> prims, const Morton
   for_chunks([&](unsigned t) {
     const auto [b, e] = chunk(t);
     for (std::size_t i = b; i < e; ++i) {
-      // A gather at random: each record's fetch is started 16 ahead.
-      if (i + 16 < e) {
-        const BuildPrim* ahead = &prims[order[i + 16]];
-        __builtin_prefetch(ahead);
-        __builtin_prefetch(reinterpret_cast<const char*>(ahead) + sizeof(BuildPrim) - 1);
-      }
+      // A gather at random: each record's fetch is started kGatherAhead records ahead.
+      if (i + kGatherAhead < e) prefetch_object(&prims[order[i + kGatherAhead]]);
       sorted[i] = prims[order[i]];
     }
   });
