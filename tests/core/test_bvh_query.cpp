@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -218,6 +219,110 @@ TEST(BvhSlab, EightWideAvx2TestAgreesWithScalarTwinPerSlot) {
       ASSERT_EQ(std::memcmp(&vx[s], &sx[s], 4), 0) << "case " << i << " slot " << s;
     }
   }
+}
+
+[[gnu::target("avx2")]] int wide8_fast_slab_test(const bvh_detail::WideNode8& n, const Ray& ray, float* te, float* tx,
+                                                 bool& fast) {
+  const bvh_detail::WideSlabRay8 r(ray);
+  fast = r.fast;
+  return bvh_detail::wide_slab_test8_fast(n, r, ray.tmin, ray.tmax, te, tx);
+}
+
+// The walk's shorter box test (wide_slab_test8_fast) against the scalar
+// test, on the rays it is used for: the same entry distances bit for bit, the
+// same hits but where entry and exit lie within a few ulps of each other
+// (its exit is rounded differently), exits within two ulps, empty slots
+// missed without their mask. And the rays it must not take.
+TEST(BvhSlab, EightWideFastTestHoldsToTheScalarTest) {
+  if (!bvh_detail::cpu_has_wide8()) GTEST_SKIP() << "this CPU has no AVX2";
+  std::mt19937 rng(81);
+  const float specials[] = {1.0f, -1.0f, 1e-30f, -1e-30f, 1e30f, 3e-38f, 0.5f};
+  int hits = 0, near_tie_differences = 0, touches_at_zero = 0, taken = 0;
+  const auto near_tie = [](float t0, float t1) {
+    return std::fabs(t0 - t1) <= 0x1p-21f * std::max(std::fabs(t0), std::fabs(t1));
+  };
+  for (int i = 0; i < 50000; ++i) {
+    bvh_detail::WideNode8 n;
+    for (int s = 0; s < 8; ++s) {
+      glm::vec3 a(uniform(rng), uniform(rng), uniform(rng)), b(uniform(rng), uniform(rng), uniform(rng));
+      if (i % 5 == 1) b[static_cast<int>(rng() % 3)] = a[static_cast<int>(rng() % 3)];
+      Aabb box{glm::min(a, b), glm::max(a, b)};
+      const bool empty = i % 7 == 2 && s >= 5;
+      if (empty) box = Aabb::empty();
+      for (int r = 0; r < 3; ++r) {
+        n.bounds[r][s] = box.lo[r];
+        n.bounds[3 + r][s] = box.hi[r];
+      }
+      n.child[s] = rng();
+      n.meta[s] = empty ? bvh_detail::kWideEmpty : rng() % 5;
+    }
+    glm::vec3 o(2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f);
+    glm::vec3 d = random_direction(rng);
+    for (int a = 0; a < 3; ++a) {
+      const unsigned r = rng() % 8;
+      if (r == 1) o[a] = n.bounds[a][3];      // on a face plane of slot 3
+      if (r == 2) o[a] = n.bounds[3 + a][4];  // on a face plane of slot 4
+      if (r == 3) d[a] = specials[rng() % 7];
+    }
+    const float tmin = (i % 3 == 0) ? 0.25f : (i % 3 == 1 ? 0.0f : -0.0f);
+    const Ray ray(o, d, tmin, (i % 4 == 0) ? 1.5f : kInfinity);
+    float se[8], sx[8];
+    alignas(32) float fe[8], fx[8];
+    const int scalar = bvh_detail::wide_slab_test_scalar<8>(n, ray, ray.tmin, ray.tmax, se, sx);
+    bool fast = false;
+    const int mask = wide8_fast_slab_test(n, ray, fe, fx, fast);
+    if (!fast) {
+      // Only a far factor that overflows (3e-38: |1/d| times 1 + 2γ(3) past
+      // the largest float) keeps these rays off the fast test.
+      ASSERT_TRUE(std::isinf(ray.inv_dir.x * kSlabExitScale) || std::isinf(ray.inv_dir.y * kSlabExitScale) ||
+                  std::isinf(ray.inv_dir.z * kSlabExitScale))
+          << "case " << i;
+      continue;
+    }
+    ++taken;
+    for (int s = 0; s < 8; ++s) {
+      const bool f = (mask >> s) & 1;
+      if (n.meta[s] == bvh_detail::kWideEmpty) {
+        ASSERT_FALSE(f) << "case " << i << " slot " << s << ": an empty slot hit";
+        continue;
+      }
+      const bool e = (scalar >> s) & 1;
+      hits += e ? 1 : 0;
+      ASSERT_EQ(fe[s], se[s]) << "case " << i << " slot " << s;
+      if (f != e) {
+        // An exit of -0 beside a negative one keeps a box touched at t = 0.
+        const bool touch_at_zero = f && fe[s] == 0.0f && std::signbit(fx[s]) && fx[s] == 0.0f;
+        ASSERT_TRUE(near_tie(se[s], sx[s]) || touch_at_zero)
+            << "case " << i << " slot " << s << ": " << se[s] << " " << sx[s] << " " << fx[s];
+        ++(touch_at_zero ? touches_at_zero : near_tie_differences);
+      }
+      if (e && std::isfinite(sx[s])) {
+        ASSERT_LE(std::fabs(fx[s] - sx[s]), 0x1p-22f * std::fabs(sx[s])) << "case " << i << " slot " << s;
+      }
+    }
+  }
+  EXPECT_GT(taken, 45000);
+  EXPECT_GT(hits, 10000);
+  EXPECT_LT(near_tie_differences, 50);
+  EXPECT_GT(touches_at_zero, 0);  // the origins on face planes reach the -0 exit
+}
+
+TEST(BvhSlab, EightWideFastTestIsNotTakenByRaysItCouldGetWrong) {
+  const auto fast = [](const Ray& r) {
+    if (!bvh_detail::cpu_has_wide8()) return false;
+    return bvh_detail::WideSlabRay8(r).fast;
+  };
+  if (!bvh_detail::cpu_has_wide8()) GTEST_SKIP() << "this CPU has no AVX2";
+  const glm::vec3 o(0.5f, 0.5f, 0.5f);
+  EXPECT_TRUE(fast(Ray(o, {1, 2, 3}, 0.0f, kInfinity)));
+  EXPECT_TRUE(fast(Ray(o, {1, 2, 3}, -0.0f, 1.0f)));
+  EXPECT_FALSE(fast(Ray(o, {0.0f, 2, 3}, 0.0f, kInfinity)));    // 0 · inf in a face plane
+  EXPECT_FALSE(fast(Ray(o, {1, -0.0f, 3}, 0.0f, kInfinity)));   // -0 direction
+  EXPECT_FALSE(fast(Ray(o, {1, 2, 1e-39f}, 0.0f, kInfinity)));  // 1/d past the largest float
+  EXPECT_FALSE(fast(Ray({kInfinity, 0, 0}, {1, 2, 3}, 0.0f, kInfinity)));
+  EXPECT_FALSE(fast(Ray(o, {1, 2, 3}, -1.0f, kInfinity)));  // negative tmin: integers order negatives backwards
+  EXPECT_FALSE(fast(Ray(o, {1, 2, 3}, std::numeric_limits<float>::quiet_NaN(), kInfinity)));
+  EXPECT_FALSE(fast(Ray(o, {1, 2, 3}, 0.0f, std::numeric_limits<float>::quiet_NaN())));
 }
 #endif
 

@@ -95,6 +95,8 @@ BvhTopology build_bvh(std::span<const Aabb> bounds, std::span<const glm::vec3> c
 /// once as blocks of four (bvh_tri4.h; each binary leaf starts a block),
 /// which every traversal reads: the binary one (statistics, traces) through
 /// a per-node first-block index, the wide fast path through its leaf slots.
+/// The triangles must be finite (Scene::flatten drops the others): a NaN
+/// vertex makes NaN boxes, which can hide other triangles from every walk.
 class Bvh final : public Accelerator {
  public:
   Bvh(std::span<const Triangle> triangles, const BvhOptions& opts = {}, const ProgressCallback& progress = {});
