@@ -134,23 +134,35 @@ TEST(BvhSlab, RayInAFacePlaneTouchesTheBox) {
   EXPECT_FALSE(bvh_detail::slab_test(n, bvh_detail::SlabRay(beside), 0.0f, kInfinity, t0, t1));
 }
 
+/// A wide node of random boxes in the unit cube for the box-test checks,
+/// flat ones (an axis of zero extent) in every fifth case `i`; slot s gets
+/// Aabb::empty() where empty_box(s), and is marked unused (kWideEmpty) where
+/// empty_slot(s).
+template <int W, class EmptyBox, class EmptySlot>
+bvh_detail::WideNodeT<W> random_wide_node(std::mt19937& rng, int i, const EmptyBox& empty_box,
+                                          const EmptySlot& empty_slot) {
+  bvh_detail::WideNodeT<W> n;
+  for (int s = 0; s < W; ++s) {
+    glm::vec3 a(uniform(rng), uniform(rng), uniform(rng)), b(uniform(rng), uniform(rng), uniform(rng));
+    if (i % 5 == 1) b[static_cast<int>(rng() % 3)] = a[static_cast<int>(rng() % 3)];
+    Aabb box{glm::min(a, b), glm::max(a, b)};
+    if (empty_box(s)) box = Aabb::empty();
+    for (int r = 0; r < 3; ++r) {
+      n.bounds[r][s] = box.lo[r];
+      n.bounds[3 + r][s] = box.hi[r];
+    }
+    n.child[s] = rng();
+    n.meta[s] = empty_slot(s) ? bvh_detail::kWideEmpty : rng() % 5;
+  }
+  return n;
+}
+
 TEST(BvhSlab, WideTestAgreesWithScalarTwinPerSlot) {
   std::mt19937 rng(2);
   const float specials[] = {0.0f, -0.0f, 1.0f, -1.0f, kInfinity, -kInfinity, 1e-30f};
   for (int i = 0; i < 100000; ++i) {
-    bvh_detail::WideNode n;
-    for (int s = 0; s < 4; ++s) {
-      glm::vec3 a(uniform(rng), uniform(rng), uniform(rng)), b(uniform(rng), uniform(rng), uniform(rng));
-      if (i % 5 == 1) b[static_cast<int>(rng() % 3)] = a[static_cast<int>(rng() % 3)];
-      Aabb box{glm::min(a, b), glm::max(a, b)};
-      if (i % 7 == 2 && s == 1) box = Aabb::empty();
-      for (int r = 0; r < 3; ++r) {
-        n.bounds[r][s] = box.lo[r];
-        n.bounds[3 + r][s] = box.hi[r];
-      }
-      n.child[s] = rng();
-      n.meta[s] = (i % 9 == 4 && s == 3) ? bvh_detail::kWideEmpty : rng() % 5;
-    }
+    const auto n = random_wide_node<4>(
+        rng, i, [&](int s) { return i % 7 == 2 && s == 1; }, [&](int s) { return i % 9 == 4 && s == 3; });
     glm::vec3 o(2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f);
     glm::vec3 d = random_direction(rng);
     for (int a = 0; a < 3; ++a) {
@@ -185,19 +197,8 @@ TEST(BvhSlab, EightWideAvx2TestAgreesWithScalarTwinPerSlot) {
   std::mt19937 rng(8);
   const float specials[] = {0.0f, -0.0f, 1.0f, -1.0f, kInfinity, -kInfinity, 1e-30f};
   for (int i = 0; i < 50000; ++i) {
-    bvh_detail::WideNode8 n;
-    for (int s = 0; s < 8; ++s) {
-      glm::vec3 a(uniform(rng), uniform(rng), uniform(rng)), b(uniform(rng), uniform(rng), uniform(rng));
-      if (i % 5 == 1) b[static_cast<int>(rng() % 3)] = a[static_cast<int>(rng() % 3)];
-      Aabb box{glm::min(a, b), glm::max(a, b)};
-      if (i % 7 == 2 && s == 5) box = Aabb::empty();
-      for (int r = 0; r < 3; ++r) {
-        n.bounds[r][s] = box.lo[r];
-        n.bounds[3 + r][s] = box.hi[r];
-      }
-      n.child[s] = rng();
-      n.meta[s] = (i % 9 == 4 && s >= 6) ? bvh_detail::kWideEmpty : rng() % 5;
-    }
+    const auto n = random_wide_node<8>(
+        rng, i, [&](int s) { return i % 7 == 2 && s == 5; }, [&](int s) { return i % 9 == 4 && s >= 6; });
     glm::vec3 o(2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f);
     glm::vec3 d = random_direction(rng);
     for (int a = 0; a < 3; ++a) {
@@ -242,20 +243,8 @@ TEST(BvhSlab, EightWideFastTestHoldsToTheScalarTest) {
     return std::fabs(t0 - t1) <= 0x1p-21f * std::max(std::fabs(t0), std::fabs(t1));
   };
   for (int i = 0; i < 50000; ++i) {
-    bvh_detail::WideNode8 n;
-    for (int s = 0; s < 8; ++s) {
-      glm::vec3 a(uniform(rng), uniform(rng), uniform(rng)), b(uniform(rng), uniform(rng), uniform(rng));
-      if (i % 5 == 1) b[static_cast<int>(rng() % 3)] = a[static_cast<int>(rng() % 3)];
-      Aabb box{glm::min(a, b), glm::max(a, b)};
-      const bool empty = i % 7 == 2 && s >= 5;
-      if (empty) box = Aabb::empty();
-      for (int r = 0; r < 3; ++r) {
-        n.bounds[r][s] = box.lo[r];
-        n.bounds[3 + r][s] = box.hi[r];
-      }
-      n.child[s] = rng();
-      n.meta[s] = empty ? bvh_detail::kWideEmpty : rng() % 5;
-    }
+    const auto empty = [&](int s) { return i % 7 == 2 && s >= 5; };  // box and slot
+    const auto n = random_wide_node<8>(rng, i, empty, empty);
     glm::vec3 o(2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f);
     glm::vec3 d = random_direction(rng);
     for (int a = 0; a < 3; ++a) {
