@@ -29,7 +29,6 @@
 #define ACCELVIZ_BVH_WIDE8_AVX2 1
 #endif
 
-#include <cmath>
 #include <cstddef>
 #include <limits>
 
@@ -202,14 +201,14 @@ struct WideSlabRay8 {
   [[gnu::target("avx2")]] explicit WideSlabRay8(const Ray& r) {
     // The checks branch-free on four lanes (many rays visit two or three
     // nodes: their set-up counts): (ox, oy, oz, tmin) and (tmax, ix, iy, iz)
-    // as laid out in Ray, x - x == 0 exactly for finite x.
+    // as laid out in Ray; finite_mask is bvh_tri4.h's (via bvh_wide.h).
     static_assert(offsetof(Ray, tmin) == 12 && offsetof(Ray, tmax) == 28 && offsetof(Ray, inv_dir) == 32);
     const __m128 o4 = _mm_loadu_ps(&r.origin.x);
     const __m128 i4 = _mm_loadu_ps(&r.tmax);
     const __m128 f4 = _mm_mul_ps(i4, _mm_set1_ps(kSlabExitScale));
     const __m128 zero = _mm_setzero_ps();
-    const int o_finite = _mm_movemask_ps(_mm_cmpeq_ps(_mm_sub_ps(o4, o4), zero));
-    const int f_finite = _mm_movemask_ps(_mm_cmpeq_ps(_mm_sub_ps(f4, f4), zero));
+    const int o_finite = _mm_movemask_ps(finite_mask(o4));
+    const int f_finite = _mm_movemask_ps(finite_mask(f4));
     const int tmin_ok = _mm_movemask_ps(_mm_cmpge_ps(o4, zero));  // lane 3: tmin >= 0 (false for NaN)
     const int tmax_ok = _mm_movemask_ps(_mm_cmpeq_ps(i4, i4));    // lane 0: tmax is not NaN
     fast = (o_finite & 7) == 7 && (f_finite & 14) == 14 && (tmin_ok & 8) != 0 && (tmax_ok & 1) != 0;
@@ -261,10 +260,11 @@ struct WideSlabRay8 {
 ///    padded as robustly, though not always bit for bit the same.
 ///  - No NaN can arise (finite origin and inv_far; bounds are never NaN, as
 ///    class Bvh asks finite triangles, and an empty slot's ±inf bounds give a
-///    +inf entry and a −inf exit, a miss, so empty slots need no mask), so the axes and [tmin, tmax] are reduced
-///    as signed integers (vpmaxsd, vpminsd: one cycle each against four for
-///    maxps, minps on recent Intel cores). Integers order non-negative floats
-///    as floats do and negative ones backwards (and −0 below everything):
+///    +inf entry and a −inf exit, a miss, so empty slots need no mask), so
+///    the axes and [tmin, tmax] are reduced as signed integers (vpmaxsd,
+///    vpminsd: one cycle each against four for maxps, minps on recent Intel
+///    cores). Integers order non-negative floats as floats do and negative
+///    ones backwards (and −0 below everything):
 ///    with tmin >= 0 (−0 made +0 first) the entry is the largest candidate,
 ///    >= 0, so it is intersect_slab's bit for bit, and an exit the integers
 ///    get wrong is negative, as the true one is (a miss either way), or −0
