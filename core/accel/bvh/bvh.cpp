@@ -717,10 +717,10 @@ using WideSlabRayW = bvh_detail::WideSlabRay;
 }  // namespace wide4
 
 #ifdef ACCELVIZ_BVH_WIDE8
-/// The 8-wide traversal: the same source compiled for AVX2 (every function
+/// The 8-wide traversal: the same source compiled for AVX2 and FMA (every function
 /// defined in this region gets the target), called only when the CPU has it.
 #pragma GCC push_options
-#pragma GCC target("avx2")
+#pragma GCC target("avx2,fma")
 namespace wide8 {
 constexpr int kWidth = 8;
 using WideSlabRayW = bvh_detail::WideSlabRay8;

@@ -51,7 +51,7 @@ struct BvhOptions {
   unsigned threads = 0;          ///< build threads, 0 = all hardware threads; the node array is identical for any count
   bool compute_epo = true;       ///< Bvh only: compute the EPO metric into build_stats().extra["epo"] (costs a pass over the tree per triangle)
   bool wide_traversal = true;    ///< Bvh only: uninstrumented queries walk a wide collapse of the tree (faster); statistics and traces always walk the binary tree
-  int wide_width = 0;            ///< Bvh only: width of that collapse: 0 = 8 (AVX2) where the CPU has AVX2, else 4 (SSE); 4; or 8 (falls back to 4 without AVX2)
+  int wide_width = 0;            ///< Bvh only: width of that collapse: 0 = 8 (AVX2) where the CPU has AVX2 and FMA, else 4 (SSE); 4; or 8 (falls back to 4 without them)
   int wide_merge_blocks = -1;    ///< Bvh only: the collapse makes one leaf slot of a binary subtree whose leaves fill at most this many triangle blocks (0: never; -1: 2 when the triangle blocks take 16 MiB or more, else 0); -1..63
 };
 

@@ -23,7 +23,7 @@
 
 // The 8-wide test needs AVX2 (VEX 256-bit) code in a binary built for plain
 // x86-64: GCC's target attribute compiles just those functions for AVX2, and
-// the BVH calls them only when the CPU says it has AVX2 (cpu_has_wide8).
+// the BVH calls them only when the CPU says it has AVX2 (and FMA: cpu_has_wide8).
 #if defined(ACCELVIZ_BVH_SLAB_SSE2) && defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #include <immintrin.h>
 #define ACCELVIZ_BVH_WIDE8_AVX2 1
@@ -187,37 +187,67 @@ struct WideSlabRay {
 
 #ifdef ACCELVIZ_BVH_WIDE8_AVX2
 
+/// The fast box test's paddings (wide_slab_test8_fast): inv_dir's factor
+/// 1 − 2⁻²¹, the relative part of the pad on origin · inv (four float units
+/// in the last place) and the exit's pad in units in the last place. With
+/// p = 2⁻²⁴, intersect_slab's entry is at least (plane − origin)·inv_dir
+/// times (1 − p)² and its exit at most that times (1 + p)³(1 + 2γ(3)), about
+/// 1 + 9p; the fused test's entry is at most that times (1 − 8p)(1 + p)²
+/// and its exit at least (1 − 8p)(1 − p)²(1 + 24p), about 1 + 14p.
+inline constexpr float kFastInvScale = 1.0f - 0x1p-21f;
+inline constexpr float kFastOriginPad = 0x1p-22f;
+inline constexpr int kFastExitUlps = 24;
+
 /// Per-ray constants of the eight-box tests (WideSlabRay in 256-bit lanes).
 struct WideSlabRay8 {
-  __m256 origin[3], inv_dir[3];
-  __m256 inv_far[3];  ///< inv_dir · kSlabExitScale: the far planes' factor of wide_slab_test8_fast
+  const Ray* ray;  ///< wide_slab_test8 broadcasts its origin and inv_dir at each node (few rays take it)
+  /// wide_slab_test8_fast's: a plane's distance is plane · inv − c in one
+  /// fused multiply-subtract, inv = inv_dir · kFastInvScale, c = origin · inv
+  /// rounded up past its error for the near planes (c_near) and down for
+  /// the far ones (c_far).
+  __m256 inv[3], c_near[3], c_far[3];
+  __m256i lo;  ///< tmin + 0 (a −0 made +0: as an integer −0 is the smallest value)
   int near_row[3], far_row[3];
-  /// wide_slab_test8_fast applies: origin and inv_far finite (so inv_dir is
-  /// finite and not zero: no box distance can be NaN), tmin >= 0 and tmax not
-  /// NaN. False for a ray with a ±0 (or denormal) direction component, a
-  /// non-finite origin or a negative or NaN tmin: those take wide_slab_test8.
+  /// wide_slab_test8_fast applies: both c finite (so origin and inv are: a
+  /// product with an infinite or NaN factor is not finite), tmin >= 0 and
+  /// tmax >= 0. False for a ray with a ±0 (or denormal) direction component,
+  /// a non-finite or huge origin, a negative or NaN tmin or a negative or
+  /// NaN tmax: those take wide_slab_test8.
   bool fast;
 
-  [[gnu::target("avx2")]] explicit WideSlabRay8(const Ray& r) {
-    // The checks branch-free on four lanes (many rays visit two or three
-    // nodes: their set-up counts): (ox, oy, oz, tmin) and (tmax, ix, iy, iz)
-    // as laid out in Ray; finite_mask is bvh_tri4.h's (via bvh_wide.h).
+  [[gnu::target("avx2")]] explicit WideSlabRay8(const Ray& r) : ray(&r) {
+    // On four lanes, branch-free (many rays visit two or three nodes: their
+    // set-up counts): (ox, oy, oz, tmin) and (tmax, ix, iy, iz) as laid out in
+    // Ray, the latter turned to (ix, iy, iz, tmax); finite_mask is
+    // bvh_tri4.h's (via bvh_wide.h).
     static_assert(offsetof(Ray, tmin) == 12 && offsetof(Ray, tmax) == 28 && offsetof(Ray, inv_dir) == 32);
     const __m128 o4 = _mm_loadu_ps(&r.origin.x);
-    const __m128 i4 = _mm_loadu_ps(&r.tmax);
-    const __m128 f4 = _mm_mul_ps(i4, _mm_set1_ps(kSlabExitScale));
-    const __m128 zero = _mm_setzero_ps();
-    const int o_finite = _mm_movemask_ps(finite_mask(o4));
-    const int f_finite = _mm_movemask_ps(finite_mask(f4));
-    const int tmin_ok = _mm_movemask_ps(_mm_cmpge_ps(o4, zero));  // lane 3: tmin >= 0 (false for NaN)
-    const int tmax_ok = _mm_movemask_ps(_mm_cmpeq_ps(i4, i4));    // lane 0: tmax is not NaN
-    fast = (o_finite & 7) == 7 && (f_finite & 14) == 14 && (tmin_ok & 8) != 0 && (tmax_ok & 1) != 0;
-    alignas(16) float far_factor[4];
-    _mm_store_ps(far_factor, f4);
+    const __m128 t4 = _mm_loadu_ps(&r.tmax);
+    const __m128 i4 = _mm_mul_ps(_mm_shuffle_ps(t4, t4, _MM_SHUFFLE(0, 3, 2, 1)), _mm_set1_ps(kFastInvScale));
+    // |c − origin · inv| <= 2⁻²⁴·|c| + 2⁻¹⁵⁰ (round to nearest, subnormals
+    // included); the pad 2⁻²²·|c| + 2⁻¹⁴⁷ survives the rounding of c ± pad
+    // with at least 2⁻¹⁴⁸ to spare, more than a distance intersect_slab
+    // rounds to an exit of ±0: the fast test's exit for such a box (and for
+    // a box whose far plane holds the origin) is > 0, never −0.
+    const __m128 c = _mm_mul_ps(o4, i4);
+    const __m128 abs_c = _mm_and_ps(c, _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF)));
+    const __m128 pad = _mm_add_ps(_mm_mul_ps(abs_c, _mm_set1_ps(kFastOriginPad)), _mm_set1_ps(0x1p-147f));
+    const __m128 c_up = _mm_add_ps(c, pad), c_down = _mm_sub_ps(c, pad);
+    // Both c finite in one check: their difference is not finite when
+    // either is not (or, harmlessly, when it overflows).
+    const int finite = _mm_movemask_ps(finite_mask(_mm_sub_ps(c_up, c_down)));
+    const int tmin_ok = _mm_movemask_ps(_mm_cmpge_ps(o4, _mm_setzero_ps()));  // lane 3: tmin >= 0 (false for NaN)
+    const int tmax_ok = _mm_movemask_ps(_mm_cmpge_ps(t4, _mm_setzero_ps()));  // lane 0: tmax >= 0 (not NaN)
+    fast = (finite & 7) == 7 && (tmin_ok & 8) != 0 && (tmax_ok & 1) != 0;
+    alignas(16) float v[3][4];
+    _mm_store_ps(v[0], i4);
+    _mm_store_ps(v[1], c_up);
+    _mm_store_ps(v[2], c_down);
+    lo = _mm256_castps_si256(_mm256_set1_ps(r.tmin + 0.0f));
     for (int a = 0; a < 3; ++a) {
-      origin[a] = _mm256_set1_ps(r.origin[a]);
-      inv_dir[a] = _mm256_set1_ps(r.inv_dir[a]);
-      inv_far[a] = _mm256_set1_ps(far_factor[1 + a]);
+      inv[a] = _mm256_set1_ps(v[0][a]);
+      c_near[a] = _mm256_set1_ps(v[1][a]);
+      c_far[a] = _mm256_set1_ps(v[2][a]);
       const bool neg = r.inv_dir[a] < 0.0f;  // as intersect_slab: hi is near
       near_row[a] = neg ? 3 + a : a;
       far_row[a] = neg ? a : 3 + a;
@@ -234,10 +264,10 @@ struct WideSlabRay8 {
   const __m256 scale = _mm256_set1_ps(kSlabExitScale);
   __m256 t0 = _mm256_set1_ps(tmin), t1 = _mm256_set1_ps(tmax);
   for (int a = 0; a < 3; ++a) {
-    const __m256 tn =
-        _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.bounds[r.near_row[a]]), r.origin[a]), r.inv_dir[a]);
-    const __m256 tf = _mm256_mul_ps(
-        _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.bounds[r.far_row[a]]), r.origin[a]), r.inv_dir[a]), scale);
+    const __m256 origin = _mm256_set1_ps(r.ray->origin[a]), inv_dir = _mm256_set1_ps(r.ray->inv_dir[a]);
+    const __m256 tn = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.bounds[r.near_row[a]]), origin), inv_dir);
+    const __m256 tf =
+        _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.bounds[r.far_row[a]]), origin), inv_dir), scale);
     t0 = _mm256_max_ps(tn, t0);
     t1 = _mm256_min_ps(tf, t1);
   }
@@ -252,46 +282,55 @@ struct WideSlabRay8 {
 /// with a shorter dependency chain than wide_slab_test8: the walk waits for
 /// this chain at every node (it decides which node to load next), so its
 /// latency, not its instruction count, sets the walk's pace (docs/
-/// performance.md, "A shorter box test": 3-6 % more single rays per second
-/// on the dragon, 9-11 % on the bunny, on an Intel Xeon).
-///  - Far planes times inv_far (inv_dir · kSlabExitScale, once per ray)
-///    instead of a third multiplication per plane: four roundings on
-///    (plane − origin) / direction, as in intersect_slab, so the exit is
-///    padded as robustly, though not always bit for bit the same.
-///  - No NaN can arise (finite origin and inv_far; bounds are never NaN, as
+/// performance.md, "A shorter box test" and "Fused box test").
+///  - Each plane's distance in one fused multiply-subtract, plane · inv − c
+///    (Embree's form), instead of a subtraction and a multiplication. It is
+///    made conservative against intersect_slab, not just close to it: inv
+///    is inv_dir · (1 − 2⁻²¹), c = origin · inv is rounded up past its error
+///    for the near planes and down for the far ones, and the exit is raised
+///    by kFastExitUlps units in the last place (an integer add), so every
+///    entry is at most intersect_slab's and every exit at least its (scaled
+///    by 1 + 2γ(3)): it hits every box intersect_slab hits, and a few more
+///    within a few ulps (or, for an origin far from the box compared with
+///    the box's distance, within 2⁻²² of |origin / direction|).
+///  - No NaN can arise (finite origin, inv and c; bounds are never NaN, as
 ///    class Bvh asks finite triangles, and an empty slot's ±inf bounds give a
 ///    +inf entry and a −inf exit, a miss, so empty slots need no mask), so
-///    the axes and [tmin, tmax] are reduced as signed integers (vpmaxsd,
-///    vpminsd: one cycle each against four for maxps, minps on recent Intel
-///    cores). Integers order non-negative floats as floats do and negative
-///    ones backwards (and −0 below everything):
-///    with tmin >= 0 (−0 made +0 first) the entry is the largest candidate,
-///    >= 0, so it is intersect_slab's bit for bit, and an exit the integers
-///    get wrong is negative, as the true one is (a miss either way), or −0
-///    beside a negative exit, which keeps a box touched at t = 0 only: one
-///    box more, never one fewer.
+///    the axes and [tmin, tmax] are reduced, and entry and exit compared, as
+///    signed integers (vpmaxsd, vpminsd, vpcmpgtd: one cycle each against
+///    four for maxps, minps, cmpps on recent Intel cores). Integers order
+///    non-negative floats as floats do and negative ones backwards, −0
+///    below everything: with tmin >= 0 (−0 made +0 first) a negative entry
+///    loses to tmin, as it does as a float; a negative exit, wherever the
+///    integers put it, is below the entry (>= +0), a miss as in
+///    intersect_slab; and no exit is −0 (the pad on c makes the exit of a box
+///    the origin touches positive; tmax −0 is made +0).
+/// tmin is the ray's own, set up in r (the walks never pass another).
+/// Needs FMA as well as AVX2 (cpu_has_wide8 asks both).
 /// tests/core/test_bvh_query.cpp holds it to intersect_slab.
-[[gnu::target("avx2"), gnu::always_inline]] inline int wide_slab_test8_fast(const WideNode8& node,
-                                                                            const WideSlabRay8& r, float tmin,
-                                                                            float tmax, float* t_entry,
-                                                                            float* t_exit = nullptr) {
+[[gnu::target("avx2,fma"), gnu::always_inline]] inline int wide_slab_test8_fast(const WideNode8& node,
+                                                                                const WideSlabRay8& r,
+                                                                                [[maybe_unused]] float tmin, float tmax,
+                                                                                float* t_entry,
+                                                                                float* t_exit = nullptr) {
   __m256i tn[3], tf[3];
   for (int a = 0; a < 3; ++a) {
-    tn[a] = _mm256_castps_si256(
-        _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.bounds[r.near_row[a]]), r.origin[a]), r.inv_dir[a]));
-    tf[a] = _mm256_castps_si256(
-        _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.bounds[r.far_row[a]]), r.origin[a]), r.inv_far[a]));
+    tn[a] = _mm256_castps_si256(_mm256_fmsub_ps(_mm256_load_ps(node.bounds[r.near_row[a]]), r.inv[a], r.c_near[a]));
+    tf[a] = _mm256_castps_si256(_mm256_fmsub_ps(_mm256_load_ps(node.bounds[r.far_row[a]]), r.inv[a], r.c_far[a]));
   }
-  // tmin + 0: a −0 tmin becomes +0 (as an integer, −0 is the smallest value).
-  const __m256i lo = _mm256_castps_si256(_mm256_set1_ps(tmin + 0.0f));
-  const __m256i hi = _mm256_castps_si256(_mm256_set1_ps(tmax));
-  const __m256 t0 = _mm256_castsi256_ps(_mm256_max_epi32(_mm256_max_epi32(tn[0], tn[1]), _mm256_max_epi32(tn[2], lo)));
-  const __m256 t1 = _mm256_castsi256_ps(_mm256_min_epi32(_mm256_min_epi32(tf[0], tf[1]), _mm256_min_epi32(tf[2], hi)));
-  _mm256_storeu_ps(t_entry, t0);
-  if (t_exit) _mm256_storeu_ps(t_exit, t1);
-  // Compared as floats: an exit of −0 (an origin on a far plane) is the
-  // smallest integer, but 0 <= −0 (the box is touched at t = 0).
-  return _mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ));
+  // tmin is the ray's (r.lo). tmax + 0: a −0 becomes +0; less
+  // kFastExitUlps (an integer >= −24), given back with the exit's pad below.
+  const __m256i ulps = _mm256_set1_epi32(kFastExitUlps);
+  const __m256i lo = r.lo;
+  const __m256i hi = _mm256_sub_epi32(_mm256_castps_si256(_mm256_set1_ps(tmax + 0.0f)), ulps);
+  const __m256i t0 = _mm256_max_epi32(_mm256_max_epi32(tn[0], tn[1]), _mm256_max_epi32(tn[2], lo));
+  const __m256i t1 =
+      _mm256_add_epi32(_mm256_min_epi32(_mm256_min_epi32(tf[0], tf[1]), _mm256_min_epi32(tf[2], hi)), ulps);
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(t_entry), t0);
+  if (t_exit) _mm256_storeu_si256(reinterpret_cast<__m256i*>(t_exit), t1);
+  // Compared as integers too (one cycle against four): the entry is >= +0,
+  // and the exit is never −0, so the integers order them as floats.
+  return ~_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(t0, t1))) & 0xFF;
 }
 
 #endif  // ACCELVIZ_BVH_WIDE8_AVX2

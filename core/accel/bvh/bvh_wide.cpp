@@ -175,7 +175,7 @@ int wide_slab_test_scalar(const WideNodeT<W>& node, const Ray& ray, float tmin, 
 
 bool cpu_has_wide8() {
 #if defined(ACCELVIZ_BVH_WIDE8_AVX2)
-  return __builtin_cpu_supports("avx2") != 0;
+  return __builtin_cpu_supports("avx2") != 0 && __builtin_cpu_supports("fma") != 0;
 #else
   return false;
 #endif

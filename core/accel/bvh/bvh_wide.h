@@ -1,6 +1,6 @@
 #pragma once
 // A 4- or 8-wide copy of a binary BVH, used only by the uninstrumented (fast)
-// traversal: 8-wide with AVX2 where the CPU has it (checked at run time),
+// traversal: 8-wide with AVX2 and FMA where the CPU has them (checked at run time),
 // else 4-wide with SSE.
 //
 // Why: single-ray traversal of a binary BVH is latency-bound. Every step
@@ -118,7 +118,7 @@ template <int W>
 int wide_slab_test_scalar(const WideNodeT<W>& node, const Ray& ray, float tmin, float tmax, float t_entry[W],
                           float t_exit[W]);
 
-/// True when this CPU runs the 8-wide AVX2 traversal (and this build has it).
+/// True when this CPU runs the 8-wide traversal (AVX2 and FMA; and this build has it).
 bool cpu_has_wide8();
 
 }  // namespace accelviz::bvh_detail
