@@ -319,6 +319,36 @@ TEST(BvhSlab, EightWideFastTestHoldsToTheScalarTest) {
   EXPECT_GT(zero_tmax_hits, 0);   // boxes around the origin kept by a ray [0, -0]
 }
 
+// An origin a subnormal step beyond a box's far plane, with a direction
+// that scales the step below the smallest subnormal: intersect_slab rounds
+// the exit to -0 and keeps the box (entry +0 <= -0); the fast test must keep
+// it too, with a positive exit (its integer compare would drop a -0).
+TEST(BvhSlab, EightWideFastTestKeepsABoxWhoseExitRoundsToMinusZero) {
+  if (!bvh_detail::cpu_has_wide8()) GTEST_SKIP() << "this CPU has no AVX2 and FMA";
+  bvh_detail::WideNode8 n;
+  for (int s = 0; s < 8; ++s) {
+    const Aabb box = s == 0 ? Aabb{{-1.0f, -1.0f, -1.0f}, {1e-40f, 1.0f, 1.0f}} : Aabb::empty();
+    for (int r = 0; r < 3; ++r) {
+      n.bounds[r][s] = box.lo[r];
+      n.bounds[3 + r][s] = box.hi[r];
+    }
+    n.child[s] = 0;
+    n.meta[s] = s == 0 ? 1u : bvh_detail::kWideEmpty;
+  }
+  const float ox = std::nextafter(1e-40f, 1.0f);  // one subnormal step beyond x = 1e-40
+  const Ray ray({ox, 0.0f, 0.0f}, {4.0f, 0.5f, 0.25f}, 0.0f, kInfinity);
+  float se[8], sx[8];
+  alignas(32) float fe[8], fx[8];
+  const int scalar = bvh_detail::wide_slab_test_scalar<8>(n, ray, ray.tmin, ray.tmax, se, sx);
+  ASSERT_EQ(scalar & 1, 1);
+  ASSERT_TRUE(sx[0] == 0.0f && std::signbit(sx[0])) << sx[0];  // the case this test is about
+  bool fast = false;
+  const int mask = wide8_fast_slab_test(n, ray, fe, fx, fast);
+  ASSERT_TRUE(fast);
+  EXPECT_EQ(mask & 1, 1);
+  EXPECT_GT(fx[0], 0.0f);
+}
+
 TEST(BvhSlab, EightWideFastTestIsNotTakenByRaysItCouldGetWrong) {
   if (!bvh_detail::cpu_has_wide8()) GTEST_SKIP() << "this CPU has no AVX2";
   const auto fast = [](const Ray& r) { return bvh_detail::WideSlabRay8(r).fast; };
