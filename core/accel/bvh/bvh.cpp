@@ -719,6 +719,9 @@ using WideSlabRayW = bvh_detail::WideSlabRay;
 #ifdef ACCELVIZ_BVH_WIDE8
 /// The 8-wide traversal: the same source compiled for AVX2 and FMA (every function
 /// defined in this region gets the target), called only when the CPU has it.
+/// Fused multiply-adds appear only where written as intrinsics (the fast box
+/// test): core builds with -ffp-contract=off, so the triangle tests compiled
+/// here stay bit for bit the scalar ones.
 #pragma GCC push_options
 #pragma GCC target("avx2,fma")
 namespace wide8 {
