@@ -226,7 +226,7 @@ TEST(BvhSlab, EightWideAvx2TestAgreesWithScalarTwinPerSlot) {
                                                      float* tx, bool& fast) {
   const bvh_detail::WideSlabRay8 r(ray);
   fast = r.fast;
-  return bvh_detail::wide_slab_test8_fast(n, r, ray.tmin, ray.tmax, te, tx);
+  return bvh_detail::wide_slab_test8_fast(n, r, ray.tmax, te, tx);
 }
 
 // The walk's shorter box test (wide_slab_test8_fast) against the scalar

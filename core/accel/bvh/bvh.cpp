@@ -728,12 +728,13 @@ namespace wide8 {
 constexpr int kWidth = 8;
 using WideSlabRayW = bvh_detail::WideSlabRay8;
 /// The fast test for the rays it applies to (nearly all), the exact one for
-/// the others (a ±0 direction component, a non-finite origin, tmin < 0). The
-/// choice is the same at every node of a ray, so the branch predicts.
+/// the others (WideSlabRay8::fast: a ±0 direction component, a non-finite or
+/// huge origin, a negative tmin or tmax). The choice is the same at every
+/// node of a ray, so the branch predicts.
 [[gnu::always_inline]] inline int wide_slab_test_w(const bvh_detail::WideNode8& n, const WideSlabRayW& r, float tmin,
                                                    float tmax, float* te) {
   if (r.fast) [[likely]]
-    return bvh_detail::wide_slab_test8_fast(n, r, tmin, tmax, te);
+    return bvh_detail::wide_slab_test8_fast(n, r, tmax, te);  // from the ray's own tmin, as the walk's
   return bvh_detail::wide_slab_test8(n, r, tmin, tmax, te);
 }
 [[gnu::always_inline]] inline int packet_mask(const PacketI& m) {

@@ -282,7 +282,7 @@ struct WideSlabRay8 {
 /// with a shorter dependency chain than wide_slab_test8: the walk waits for
 /// this chain at every node (it decides which node to load next), so its
 /// latency, not its instruction count, sets the walk's pace (docs/
-/// performance.md, "A shorter box test" and "Fused box test").
+/// performance.md, "A shorter box test" and "A fused box test").
 ///  - Each plane's distance in one fused multiply-subtract, plane · inv − c
 ///    (Embree's form), instead of a subtraction and a multiplication. It is
 ///    made conservative against intersect_slab, not just close to it: inv
@@ -305,12 +305,12 @@ struct WideSlabRay8 {
 ///    integers put it, is below the entry (>= +0), a miss as in
 ///    intersect_slab; and no exit is −0 (the pad on c makes the exit of a box
 ///    the origin touches positive; tmax −0 is made +0).
-/// tmin is the ray's own, set up in r (the walks never pass another).
+/// The interval starts at the ray's own tmin (r.lo: the walks never test
+/// from another) and ends at tmax.
 /// Needs FMA as well as AVX2 (cpu_has_wide8 asks both).
 /// tests/core/test_bvh_query.cpp holds it to intersect_slab.
 [[gnu::target("avx2,fma"), gnu::always_inline]] inline int wide_slab_test8_fast(const WideNode8& node,
-                                                                                const WideSlabRay8& r,
-                                                                                [[maybe_unused]] float tmin, float tmax,
+                                                                                const WideSlabRay8& r, float tmax,
                                                                                 float* t_entry,
                                                                                 float* t_exit = nullptr) {
   __m256i tn[3], tf[3];
@@ -318,12 +318,11 @@ struct WideSlabRay8 {
     tn[a] = _mm256_castps_si256(_mm256_fmsub_ps(_mm256_load_ps(node.bounds[r.near_row[a]]), r.inv[a], r.c_near[a]));
     tf[a] = _mm256_castps_si256(_mm256_fmsub_ps(_mm256_load_ps(node.bounds[r.far_row[a]]), r.inv[a], r.c_far[a]));
   }
-  // tmin is the ray's (r.lo). tmax + 0: a −0 becomes +0; less
-  // kFastExitUlps (an integer >= −24), given back with the exit's pad below.
+  // tmax + 0: a −0 becomes +0; less kFastExitUlps (an integer >= −24),
+  // given back with the exit's pad below.
   const __m256i ulps = _mm256_set1_epi32(kFastExitUlps);
-  const __m256i lo = r.lo;
   const __m256i hi = _mm256_sub_epi32(_mm256_castps_si256(_mm256_set1_ps(tmax + 0.0f)), ulps);
-  const __m256i t0 = _mm256_max_epi32(_mm256_max_epi32(tn[0], tn[1]), _mm256_max_epi32(tn[2], lo));
+  const __m256i t0 = _mm256_max_epi32(_mm256_max_epi32(tn[0], tn[1]), _mm256_max_epi32(tn[2], r.lo));
   const __m256i t1 =
       _mm256_add_epi32(_mm256_min_epi32(_mm256_min_epi32(tf[0], tf[1]), _mm256_min_epi32(tf[2], hi)), ulps);
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(t_entry), t0);
