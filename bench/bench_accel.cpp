@@ -24,12 +24,14 @@
 // Embree's default mode (`bench --triangle-test fast`).
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "core/accel/bvh/bvh.h"
@@ -156,11 +158,12 @@ void register_all() {
   std::vector<std::string> names = {"bvh", "lbvh"};
   if (kHaveEmbree) names.push_back("embree");
   for (const std::string& n : names) {
-    benchmark::RegisterBenchmark(("Build/" + n).c_str(), build, n)
-        ->Arg(1)
-        ->Arg(2)
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
+    // Threads 1, 2, 4, ... up to the machine's hardware threads, and that
+    // count itself (on 2 cores: 1 and 2; on 16: 1, 2, 4, 8, 16).
+    benchmark::internal::Benchmark* b = benchmark::RegisterBenchmark(("Build/" + n).c_str(), build, n);
+    const unsigned hw = std::max(2u, std::thread::hardware_concurrency());
+    for (unsigned t = 1; t < hw; t *= 2) b->Arg(t);
+    b->Arg(hw)->Unit(benchmark::kMillisecond)->UseRealTime();
     for (bool packets : {false, true}) {
       if (packets && n == "lbvh") continue;  // the same packet walk as bvh over another tree
       const std::string suffix = packets ? "Packets8/" : "/";

@@ -15,7 +15,10 @@
 // not), setup_ms (shader compile and upload), trace_ms of every run (dispatch
 // until the GPU finished) with their min and median, readback_ms, cpu_ms (the
 // CPU's counted walk over the same pixels on all threads) and
-// mismatched_pixels (pixels whose figures differ from the CPU's). The exit
+// mismatched_pixels (pixels whose figures differ from the CPU's), sorted by
+// what differs: mismatched_counters (a counter), mismatched_hit_prim (the hit
+// triangle), mismatched_t_only (same triangle, other distance bits; the
+// largest gap in mismatched_t_max_ulps). The exit
 // status is 0 when every pixel matched, 1 when some did not, 2 on bad
 // arguments or when no context could be made.
 //
@@ -23,9 +26,12 @@
 // it can be carried to a GPU machine that has none of the others.
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <exception>
+#include <cstdint>
 #include <iostream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -99,18 +105,40 @@ int main(int argc, char** argv) {
 
     // The CPU's counted walk over the same pixels, compared pixel by pixel.
     const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-    std::atomic<std::size_t> mismatched{0};
+    // A mismatch is also sorted by what differs, for a driver that does not
+    // keep the shader's arithmetic: a counter, the hit triangle, or (same
+    // triangle) only the distance's bits, with the largest distance in ulps.
+    std::atomic<std::size_t> mismatched{0}, counters_differ{0}, prim_differs{0}, t_differs{0};
+    std::atomic<std::uint32_t> max_t_ulps{0};
     const auto t_cpu = std::chrono::steady_clock::now();
     parallel_for(static_cast<std::size_t>(height), 0, 1, [&](std::size_t y0, std::size_t y1, unsigned) {
-      std::size_t local = 0;
+      std::size_t local = 0, local_counters = 0, local_prim = 0, local_t = 0;
+      std::uint32_t local_ulps = 0;
       for (std::size_t y = y0; y < y1; ++y)
         for (int x = 0; x < width; ++x) {
           const std::size_t i = y * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
           RayStats s;
           const Hit c = bvh.closest_hit(primary_ray(camera, x, static_cast<int>(y), width, height), query, &s);
-          if (!gpu_pixel_matches(last, i, s, c)) ++local;
+          if (gpu_pixel_matches(last, i, s, c)) continue;
+          ++local;
+          if (!gpu_pixel_matches(last, i, s, last.hits[i])) ++local_counters;  // the GPU's own hit: counters only
+          if (c.prim != last.hits[i].prim) {
+            ++local_prim;
+          } else if (std::bit_cast<std::uint32_t>(c.t) != std::bit_cast<std::uint32_t>(last.hits[i].t)) {
+            ++local_t;
+            const auto a = static_cast<std::int64_t>(std::bit_cast<std::uint32_t>(c.t));
+            const auto b = static_cast<std::int64_t>(std::bit_cast<std::uint32_t>(last.hits[i].t));
+            local_ulps = std::max(local_ulps, static_cast<std::uint32_t>(std::min<std::int64_t>(
+                                                  a > b ? a - b : b - a, std::numeric_limits<std::uint32_t>::max())));
+          }
         }
       mismatched += local;
+      counters_differ += local_counters;
+      prim_differs += local_prim;
+      t_differs += local_t;
+      std::uint32_t seen = max_t_ulps.load();
+      while (local_ulps > seen && !max_t_ulps.compare_exchange_weak(seen, local_ulps)) {
+      }
     });
     const double cpu_ms = ms_since(t_cpu);
 
@@ -132,6 +160,10 @@ int main(int argc, char** argv) {
         {"cpu_threads", resolve_threads(0)},
         {"cpu_ms", cpu_ms},
         {"mismatched_pixels", mismatched.load()},
+        {"mismatched_counters", counters_differ.load()},
+        {"mismatched_hit_prim", prim_differs.load()},
+        {"mismatched_t_only", t_differs.load()},
+        {"mismatched_t_max_ulps", max_t_ulps.load()},
     };
     std::cout << out.dump() << "\n";
     return mismatched.load() == 0 ? 0 : 1;

@@ -20,6 +20,7 @@ assert j["triangles"] > 3000, j["triangles"]
 assert len(j["trace_ms"]) == 3 and all(t > 0 for t in j["trace_ms"]), j["trace_ms"]
 assert j["trace_ms_min"] == min(j["trace_ms"]) and j["trace_ms_median"] == sorted(j["trace_ms"])[1], j
 assert j["mismatched_pixels"] == 0, j["mismatched_pixels"]
+assert (j["mismatched_counters"], j["mismatched_hit_prim"], j["mismatched_t_only"], j["mismatched_t_max_ulps"]) == (0, 0, 0, 0), j
 assert j["gpu_renderer"] and j["gpu_version"].startswith("4."), j
 assert j["gpu_software"] == ("llvmpipe" in j["gpu_renderer"]), j
 assert j["setup_ms"] > 0 and j["cpu_ms"] > 0 and j["cpu_threads"] >= 1, j

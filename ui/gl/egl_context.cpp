@@ -64,7 +64,9 @@ EGLContext create_core_context(EGLDisplay display, std::string& why) {
   }
   EGLConfig config = EGL_NO_CONFIG_KHR;
   if (!has_extension(ext, "EGL_KHR_no_config_context")) {
-    const EGLint want[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+    // Any surface type: eglChooseConfig's default asks for window surfaces,
+    // which a device's display (no window system) may have none of.
+    const EGLint want[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, 0, EGL_NONE};
     EGLint found = 0;
     if (eglChooseConfig(display, want, &config, 1, &found) != EGL_TRUE || found < 1) {
       why = "the device has no OpenGL config";
