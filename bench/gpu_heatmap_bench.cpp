@@ -15,6 +15,10 @@
 // not), setup_ms (shader compile and upload), trace_ms of every run (dispatch
 // until the GPU finished) with their min and median, readback_ms, cpu_ms (the
 // CPU's counted walk over the same pixels on all threads) and
+// heatmap_* (the whole `--metric nodes` heatmap up to its colours, min(RUNS, 5)
+// times: the median of all of it and of its trace, readback, metric image and
+// colour steps), cpu_heatmap_ms (the same heatmap made by the CPU: render_metric
+// on all threads, then colorize),
 // mismatched_pixels (pixels whose figures differ from the CPU's), sorted by
 // what differs: mismatched_counters (a counter), mismatched_hit_prim (the hit
 // triangle), mismatched_t_only (same triangle, other distance bits; the
@@ -34,10 +38,12 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "core/accel/bvh/bvh.h"
+#include "core/analysis/heatmap.h"
 #include "core/query/camera.h"
 #include "core/scene/load.h"
 #include "core/util/image_size.h"
@@ -142,6 +148,39 @@ int main(int argc, char** argv) {
     });
     const double cpu_ms = ms_since(t_cpu);
 
+    // The whole heatmap as `render --device gpu --metric nodes` makes it, a
+    // few times: trace, readback, metric image, colours (no PNG), beside the
+    // CPU's (render_metric over the same BVH on all threads, same colours).
+    HeatmapOptions hopts;
+    hopts.width = width;
+    hopts.height = height;
+    hopts.metric = HeatMetric::nodes;
+    hopts.query = query;
+    const int heat_runs = std::min(runs, 5);
+    std::vector<double> heat_ms, heat_trace, heat_readback, heat_metric, heat_colour, cpu_heat_ms;
+    GpuTraceResult g;  // reused, as the GUI reuses its readback (the first run allocates it)
+    for (int r = 0; r < heat_runs; ++r) {
+      const auto t0 = std::chrono::steady_clock::now();
+      tracer.trace(camera, width, height, query, g);
+      const auto t1 = std::chrono::steady_clock::now();
+      const MetricImage img = gpu_metric_image(g, camera, hopts, nullptr);
+      const auto t2 = std::chrono::steady_clock::now();
+      const RgbImage rgb = colorize(img, ColorizeOptions{});
+      heat_ms.push_back(ms_since(t0));
+      heat_trace.push_back(g.trace_ms);
+      heat_readback.push_back(g.readback_ms);
+      heat_metric.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
+      heat_colour.push_back(ms_since(t2));
+      const auto c0 = std::chrono::steady_clock::now();
+      const RgbImage cpu_rgb = colorize(render_metric(bvh, camera, hopts, nullptr), ColorizeOptions{});
+      cpu_heat_ms.push_back(ms_since(c0));
+      if (cpu_rgb.pixels.size() != rgb.pixels.size()) throw std::runtime_error("heatmap sizes differ");
+    }
+    const auto median = [](std::vector<double> v) {
+      std::sort(v.begin(), v.end());
+      return v[v.size() / 2];
+    };
+
     const nlohmann::json out = {
         {"scene", spec},
         {"triangles", scene.triangles.size()},
@@ -159,6 +198,15 @@ int main(int argc, char** argv) {
         {"readback_ms", last.readback_ms},
         {"cpu_threads", resolve_threads(0)},
         {"cpu_ms", cpu_ms},
+        {"heatmap_runs", heat_runs},
+        {"heatmap_ms", heat_ms},
+        {"heatmap_ms_median", median(heat_ms)},
+        {"heatmap_trace_ms_median", median(heat_trace)},
+        {"heatmap_readback_ms_median", median(heat_readback)},
+        {"heatmap_metric_ms_median", median(heat_metric)},
+        {"heatmap_colour_ms_median", median(heat_colour)},
+        {"cpu_heatmap_ms", cpu_heat_ms},
+        {"cpu_heatmap_ms_median", median(cpu_heat_ms)},
         {"mismatched_pixels", mismatched.load()},
         {"mismatched_counters", counters_differ.load()},
         {"mismatched_hit_prim", prim_differs.load()},

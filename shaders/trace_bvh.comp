@@ -86,10 +86,26 @@ float g_tmax;
 int g_kx, g_ky, g_kz;
 float g_sx, g_sy, g_sz;
 
+// Correctly rounded float division and square root. GLSL (4.50, section
+// 4.7.1) allows a float x / y 2.5 ulp of error and sqrt(x) that of
+// 1.0 / inversesqrt(x), and vendor drivers use it (reciprocal and reciprocal
+// square root approximations). Computed in double and rounded once to float,
+// each is the IEEE result the CPU computes: a double carries 53 >= 2 * 24 + 2
+// bits, so rounding a quotient or square root twice cannot differ from
+// rounding it once. Infinities, signed zeros and NaNs come out as in float.
+float div_rn(float a, float b) {
+  precise double q = double(a) / double(b);
+  return float(q);
+}
+float sqrt_rn(float a) {
+  precise double r = sqrt(double(a));
+  return float(r);
+}
+
 void make_primary_ray(int x, int y) {
   // primary_ray: pixel centre in [0, 1]^2.
-  precise float u = (float(x) + 0.5) / float(u_width);
-  precise float v = (float(y) + 0.5) / float(u_height);
+  precise float u = div_rn(float(x) + 0.5, float(u_width));
+  precise float v = div_rn(float(y) + 0.5, float(u_height));
   // camera_ray: sx = (2u - 1) * tan_half * aspect, sy = (1 - 2v) * tan_half.
   precise float sx = ((2.0 * u - 1.0) * u_tan_half) * u_aspect;
   precise float sy = (1.0 - 2.0 * v) * u_tan_half;
@@ -98,12 +114,12 @@ void make_primary_ray(int x, int y) {
                         (u_forward.z + sx * u_right.z) + sy * u_up.z);
   // glm::normalize: d * (1 / sqrt(dot(d, d))), dot = (x*x + y*y) + z*z.
   precise float dd = (d.x * d.x + d.y * d.y) + d.z * d.z;
-  precise float s = sqrt(dd);
-  precise float rs = 1.0 / s;
+  precise float s = sqrt_rn(dd);
+  precise float rs = div_rn(1.0, s);
   precise vec3 dir = vec3(d.x * rs, d.y * rs, d.z * rs);
   g_origin = u_position;
   g_dir = dir;
-  precise vec3 inv = vec3(1.0 / dir.x, 1.0 / dir.y, 1.0 / dir.z);
+  precise vec3 inv = vec3(div_rn(1.0, dir.x), div_rn(1.0, dir.y), div_rn(1.0, dir.z));
   g_inv = inv;
   g_tmin = 0.0;
   g_tmax = inf_f();
@@ -119,9 +135,9 @@ void make_watertight_ray() {
     g_kx = g_ky;
     g_ky = t;
   }
-  precise float sx = g_dir[g_kx] / g_dir[g_kz];
-  precise float sy = g_dir[g_ky] / g_dir[g_kz];
-  precise float sz = 1.0 / g_dir[g_kz];
+  precise float sx = div_rn(g_dir[g_kx], g_dir[g_kz]);
+  precise float sy = div_rn(g_dir[g_ky], g_dir[g_kz]);
+  precise float sz = div_rn(1.0, g_dir[g_kz]);
   g_sx = sx;
   g_sy = sy;
   g_sz = sz;
@@ -220,7 +236,7 @@ bool watertight(uint k, float tmin, float tmax, out float t_out) {
   } else {
     if (T > lo_s || T < hi_s) return false;
   }
-  precise float rcp = 1.0 / det;
+  precise float rcp = div_rn(1.0, det);
   precise float t = T * rcp;
   if (!(t >= tmin && t <= tmax)) return false;
   t_out = t;
@@ -236,7 +252,7 @@ bool moller_trumbore(uint k, float tmin, float tmax, out float t_out) {
   precise vec3 p = vec3(d.y * e2.z - e2.y * d.z, d.z * e2.x - e2.z * d.x, d.x * e2.y - e2.x * d.y);
   precise float det = (e1.x * p.x + e1.y * p.y) + e1.z * p.z;
   if (det == 0.0) return false;
-  precise float inv = 1.0 / det;
+  precise float inv = div_rn(1.0, det);
   precise vec3 s = g_origin - v0;
   precise float u = ((s.x * p.x + s.y * p.y) + s.z * p.z) * inv;
   if (u < 0.0 || u > 1.0) return false;

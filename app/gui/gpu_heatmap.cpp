@@ -70,7 +70,8 @@ std::shared_ptr<const HeatmapFrame> GpuHeatmap::step(double budget_ms) {
 
 std::shared_ptr<const HeatmapFrame> GpuHeatmap::finish() {
   running_ = false;
-  const GpuTraceResult raw = tracer_->result();
+  tracer_->result(raw_);  // reuses the last image's storage (the same size: no allocation)
+  const GpuTraceResult& raw = raw_;
   HeatmapFigures fig;
   auto frame = std::make_shared<HeatmapFrame>();
   frame->image = gpu_metric_image(raw, request_.camera, request_.options, &fig);

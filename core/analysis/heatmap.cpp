@@ -4,10 +4,13 @@
 #include <stb_image_write.h>
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <limits>
@@ -17,6 +20,7 @@
 #include "core/query/batch.h"
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
+#include "core/util/parallel.h"
 #include "core/util/timing.h"
 
 namespace accelviz {
@@ -122,28 +126,52 @@ MetricImage metric_image_from_hits(std::span<const Ray> rays, std::span<const Hi
   img.width = opts.width;
   img.height = opts.height;
   img.metric = opts.metric;
-  img.values.resize(rays.size());
+  const std::size_t n = hits.size();
+  if (rays.size() != n && !(rays.empty() && opts.metric != HeatMetric::shaded))
+    throw std::invalid_argument("heatmap: " + std::to_string(rays.size()) + " rays for " + std::to_string(n) + " hits");
+  img.values.resize(n);
   const RayStats none;
+  const Ray no_ray;
+  // Blocks of pixels on all threads; each block's sum, maximum and counts are
+  // then combined in block order, so the figures do not depend on the threads.
+  struct Block {
+    double sum = 0.0, max = 0.0;
+    std::uint64_t counted = 0, hits = 0;
+  };
+  constexpr std::size_t kBlock = 4096;
+  std::vector<Block> blocks((n + kBlock - 1) / kBlock);
+  parallel_for(blocks.size(), opts.threads, 4, [&](std::size_t b0, std::size_t b1, unsigned) {
+    for (std::size_t b = b0; b < b1; ++b) {
+      Block& blk = blocks[b];
+      for (std::size_t i = b * kBlock; i < std::min(n, (b + 1) * kBlock); ++i) {
+        const float v = metric_value(opts.metric, rays.empty() ? no_ray : rays[i], hits[i],
+                                     stats.empty() ? none : stats[i], opts.c_trav, opts.c_isect);
+        img.values[i] = v;
+        if (hits[i].valid()) ++blk.hits;
+        if (std::isfinite(v)) {
+          blk.sum += v;
+          blk.max = blk.counted == 0 ? v : std::max<double>(blk.max, v);
+          ++blk.counted;
+        }
+      }
+    }
+  });
   double sum = 0.0, max = 0.0;
   std::uint64_t counted = 0, hit_count = 0;
-  for (std::size_t i = 0; i < rays.size(); ++i) {
-    const float v =
-        metric_value(opts.metric, rays[i], hits[i], stats.empty() ? none : stats[i], opts.c_trav, opts.c_isect);
-    img.values[i] = v;
-    if (hits[i].valid()) ++hit_count;
-    if (std::isfinite(v)) {
-      sum += v;
-      max = counted == 0 ? v : std::max<double>(max, v);
-      ++counted;
-    }
+  for (const Block& blk : blocks) {
+    hit_count += blk.hits;
+    if (blk.counted == 0) continue;
+    sum += blk.sum;
+    max = counted == 0 ? blk.max : std::max(max, blk.max);
+    counted += blk.counted;
   }
   if (figures) {
-    figures->rays = rays.size();
+    figures->rays = n;
     figures->hits = hit_count;
     figures->mean = counted ? sum / static_cast<double>(counted) : 0.0;
     figures->max = max;
     figures->render_ms = trace_ms;
-    figures->rays_per_s = trace_ms > 0.0 ? static_cast<double>(rays.size()) / (trace_ms * 1e-3) : 0.0;
+    figures->rays_per_s = trace_ms > 0.0 ? static_cast<double>(n) / (trace_ms * 1e-3) : 0.0;
   }
   return img;
 }
@@ -338,8 +366,26 @@ RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
 
   const glm::u8vec3 panel(24, 24, 24), ink(235, 235, 235);
   RgbImage out(w + extra_w, h + extra_h, panel);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) out.set(x, y, heatmap_color(image.metric, image.at(x, y), scale_max, opts));
+  // Rows on all threads. A pixel's colour depends on its value alone, and
+  // counter metrics take few distinct values, so each band of rows keeps the
+  // colours of the last values it saw (a small table indexed by the value's
+  // bits) and computes a colour only for a value not in it.
+  parallel_for(static_cast<std::size_t>(h), 0, 8, [&](std::size_t y0, std::size_t y1, unsigned) {
+    struct Seen {
+      std::uint32_t bits = 0;
+      bool used = false;
+      glm::u8vec3 colour{0};
+    };
+    std::array<Seen, 512> seen{};
+    for (std::size_t y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        const float v = image.at(x, static_cast<int>(y));
+        const auto bits = std::bit_cast<std::uint32_t>(v);
+        Seen& e = seen[(bits ^ (bits >> 9) ^ (bits >> 18)) % seen.size()];
+        if (!e.used || e.bits != bits) e = Seen{bits, true, heatmap_color(image.metric, v, scale_max, opts)};
+        out.set(x, static_cast<int>(y), e.colour);
+      }
+  });
 
   if (legend == LegendPlacement::bottom) {
     const int y0 = h;

@@ -81,7 +81,8 @@ float metric_value(HeatMetric m, const Ray& ray, const Hit& hit, const RayStats&
 
 /// The metric image (and `figures`, when given) of traced primary rays:
 /// per pixel metric_value of its ray, hit and statistics (`stats` may be
-/// empty when the metric needs none), the mean and maximum over finite
+/// empty when the metric needs none, `rays` when it is not the shaded one:
+/// the only metric that reads the ray), the mean and maximum over finite
 /// values, and rays/s from `trace_ms`. Shared by the CPU and GPU paths.
 MetricImage metric_image_from_hits(std::span<const Ray> rays, std::span<const Hit> hits,
                                    std::span<const RayStats> stats, const HeatmapOptions& opts, double trace_ms,

@@ -2,6 +2,7 @@
 
 #include "core/geometry/shapes.h"
 #include "core/query/camera.h"
+#include "core/util/parallel.h"
 #include "core/util/random.h"
 
 #include <cmath>
@@ -59,9 +60,14 @@ std::optional<RayKind> parse_ray_kind(std::string_view name) {
 std::vector<Ray> primary_rays(const Camera& cam, int width, int height) {
   std::vector<Ray> rays;
   if (width <= 0 || height <= 0) return rays;
-  rays.reserve(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) rays.push_back(primary_ray(cam, x, y, width, height));
+  const auto w = static_cast<std::size_t>(width);
+  rays.resize(w * static_cast<std::size_t>(height));
+  // Rows on all threads: each ray depends on its pixel alone.
+  parallel_for(static_cast<std::size_t>(height), 0, 8, [&](std::size_t y0, std::size_t y1, unsigned) {
+    for (std::size_t y = y0; y < y1; ++y)
+      for (int x = 0; x < width; ++x)
+        rays[y * w + static_cast<std::size_t>(x)] = primary_ray(cam, x, static_cast<int>(y), width, height);
+  });
   return rays;
 }
 

@@ -97,9 +97,15 @@ EglContext::EglContext(int width, int height, Devices devices) : width_(width), 
       reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(eglGetProcAddress("eglQueryDeviceStringEXT"));
   const auto platform_display =
       reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
-  if (!has_extension(client, "EGL_EXT_device_enumeration") || !has_extension(client, "EGL_EXT_platform_device") ||
+  // EGL_EXT_device_base is EGL_EXT_device_enumeration and _query in one:
+  // NVIDIA's driver names only it, Mesa names all three.
+  const bool enumeration =
+      has_extension(client, "EGL_EXT_device_enumeration") || has_extension(client, "EGL_EXT_device_base");
+  if (!enumeration || !has_extension(client, "EGL_EXT_platform_device") ||
       query_devices == nullptr || device_string == nullptr || platform_display == nullptr)
-    throw GlError("EGL has no device enumeration (EGL_EXT_device_enumeration, EGL_EXT_platform_device)");
+    throw GlError(
+        "EGL has no device enumeration (EGL_EXT_device_enumeration or EGL_EXT_device_base, and "
+        "EGL_EXT_platform_device)");
 
   EGLint count = 0;
   if (query_devices(0, nullptr, &count) != EGL_TRUE || count <= 0) throw GlError("EGL lists no devices");

@@ -9,6 +9,7 @@
 
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
+#include "core/util/parallel.h"
 #include "core/util/timing.h"
 
 namespace accelviz {
@@ -75,9 +76,16 @@ void GpuBvhTracer::upload(const Bvh& bvh) {
 }
 
 GpuTraceResult GpuBvhTracer::trace(const Camera& camera, int width, int height, const QueryOptions& query) {
+  GpuTraceResult r;
+  trace(camera, width, height, query, r);
+  return r;
+}
+
+void GpuBvhTracer::trace(const Camera& camera, int width, int height, const QueryOptions& query,
+                         GpuTraceResult& into) {
   begin(camera, width, height, query);
   trace_rows(height);
-  return result();
+  result(into);
 }
 
 void GpuBvhTracer::begin(const Camera& camera, int width, int height, const QueryOptions& query) {
@@ -150,36 +158,50 @@ double GpuBvhTracer::trace_rows(int rows) {
 }
 
 GpuTraceResult GpuBvhTracer::result() const {
+  GpuTraceResult r;
+  result(r);
+  return r;
+}
+
+void GpuBvhTracer::result(GpuTraceResult& r) const {
   if (height_ <= 0) throw std::logic_error("GPU trace: result before begin");
   const std::size_t n = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
-  GpuTraceResult r;
   r.width = width_;
   r.height = height_;
   r.trace_ms = band_ms_;
   const auto t1 = std::chrono::steady_clock::now();
-  std::vector<GpuPixel> px(n);
-  glGetNamedBufferSubData(out_.id(), 0, static_cast<GLsizeiptr>(n * sizeof(GpuPixel)), px.data());
-  check_gl_errors("GPU trace readback");
-
+  // Read straight from a mapping of the output buffer (no staging copy), the
+  // pixels converted on all threads.
+  const auto* px = static_cast<const GpuPixel*>(
+      glMapNamedBufferRange(out_.id(), 0, static_cast<GLsizeiptr>(n * sizeof(GpuPixel)), GL_MAP_READ_BIT));
+  if (px == nullptr) {
+    check_gl_errors("GPU trace readback");
+    throw GlError("GPU trace readback: the output buffer could not be mapped");
+  }
   r.stats.resize(n);
   r.hits.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const GpuPixel& p = px[i];
-    RayStats& s = r.stats[i];
-    s.nodes_visited = p.nodes_visited;
-    s.box_tests = p.box_tests;
-    s.prim_tests = p.prim_tests;
-    s.nodes_culled = p.nodes_culled;
-    s.nodes_missed = p.nodes_missed;
-    Hit& h = r.hits[i];
-    if (p.prim != kInvalidId && p.prim < prim_ids_.size()) {
-      h.prim = prim_ids_[p.prim];  // as Bvh::closest_hit maps its leaf-order hit
-      h.ng = normals_[p.prim];
-      h.t = p.t;
+  parallel_for(n, 0, 16384, [&](std::size_t i0, std::size_t i1, unsigned) {
+    for (std::size_t i = i0; i < i1; ++i) {
+      const GpuPixel& p = px[i];
+      RayStats& s = r.stats[i];
+      s = RayStats{};  // every field: the storage may hold an earlier trace
+      s.nodes_visited = p.nodes_visited;
+      s.box_tests = p.box_tests;
+      s.prim_tests = p.prim_tests;
+      s.nodes_culled = p.nodes_culled;
+      s.nodes_missed = p.nodes_missed;
+      Hit& h = r.hits[i];
+      h = Hit{};
+      if (p.prim != kInvalidId && p.prim < prim_ids_.size()) {
+        h.prim = prim_ids_[p.prim];  // as Bvh::closest_hit maps its leaf-order hit
+        h.ng = normals_[p.prim];
+        h.t = p.t;
+      }
     }
-  }
+  });
+  glUnmapNamedBuffer(out_.id());
+  check_gl_errors("GPU trace readback");
   r.readback_ms = ms_since(t1);
-  return r;
 }
 
 MetricImage gpu_metric_image(const GpuTraceResult& r, const Camera& camera, const HeatmapOptions& opts,
@@ -188,8 +210,9 @@ MetricImage gpu_metric_image(const GpuTraceResult& r, const Camera& camera, cons
     throw std::invalid_argument("heatmap: the GPU trace is " + std::to_string(r.width) + "x" +
                                 std::to_string(r.height) + ", the options ask for " + std::to_string(opts.width) + "x" +
                                 std::to_string(opts.height));
-  // The rays again on the CPU, for the metrics that need the direction (shaded).
-  const std::vector<Ray> rays = primary_rays(camera, opts.width, opts.height);
+  // The rays again on the CPU, for the one metric that needs the direction (shaded).
+  const std::vector<Ray> rays =
+      opts.metric == HeatMetric::shaded ? primary_rays(camera, opts.width, opts.height) : std::vector<Ray>{};
   return metric_image_from_hits(rays, r.hits, r.stats, opts, r.trace_ms, figures);
 }
 

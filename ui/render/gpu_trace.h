@@ -68,6 +68,8 @@ class GpuBvhTracer {
   /// Throws std::invalid_argument for a non-positive size, std::logic_error
   /// before upload(). The same as begin(), trace_rows(height), result().
   GpuTraceResult trace(const Camera& camera, int width, int height, const QueryOptions& query);
+  /// The same into `into`, reusing its storage (see result(GpuTraceResult&)).
+  void trace(const Camera& camera, int width, int height, const QueryOptions& query, GpuTraceResult& into);
 
   // ---- in row bands (the GUI spreads one image over its frames) ----------
   /// Starts a banded trace of a W×H image: fixes the camera, size and query
@@ -85,6 +87,10 @@ class GpuBvhTracer {
   /// Reads the whole image back as it stands (untraced rows as begin() left
   /// them); trace_ms is the sum of the bands so far.
   GpuTraceResult result() const;
+  /// The same into `into`, reusing its vectors' storage: a 1920x1080 result
+  /// is about 140 MB, and a fresh one costs more to allocate and first touch
+  /// than the GPU takes to trace it (measured, docs/performance.md "GPU path").
+  void result(GpuTraceResult& into) const;
   /// What begin() writes into every counter of an untraced pixel.
   static constexpr std::uint32_t kUntraced = 0xFFFFFFFFu;
 
