@@ -217,9 +217,20 @@ std::optional<LegendPlacement> parse_legend_placement(std::string_view name) {
 
 float heatmap_scale_max(const MetricImage& image, float fixed_max) {
   if (fixed_max > 0.0f && std::isfinite(fixed_max)) return fixed_max;
+  // Blocks on all threads, then the largest of their maxima (the same
+  // whatever the order).
+  constexpr std::size_t kBlock = 16384;
+  std::vector<float> block_max((image.values.size() + kBlock - 1) / kBlock, 0.0f);
+  parallel_for(block_max.size(), 0, 4, [&](std::size_t b0, std::size_t b1, unsigned) {
+    for (std::size_t b = b0; b < b1; ++b) {
+      float m = 0.0f;
+      for (std::size_t i = b * kBlock; i < std::min(image.values.size(), (b + 1) * kBlock); ++i)
+        if (std::isfinite(image.values[i])) m = std::max(m, image.values[i]);
+      block_max[b] = m;
+    }
+  });
   float max = 0.0f;
-  for (float v : image.values)
-    if (std::isfinite(v)) max = std::max(max, v);
+  for (float m : block_max) max = std::max(max, m);
   return max > 0.0f ? max : 1.0f;
 }
 
@@ -365,7 +376,11 @@ RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
     extra_w = std::max(pad + bar + tick + 3 * s + widest + pad, text_width(metric_name(image.metric), s) + 2 * pad);
 
   const glm::u8vec3 panel(24, 24, 24), ink(235, 235, 235);
-  RgbImage out(w + extra_w, h + extra_h, panel);
+  RgbImage out;  // every pixel written below: the heatmap's rows on all threads, then the legend's
+  out.width = w + extra_w;
+  out.height = h + extra_h;
+  out.pixels.resize(static_cast<std::size_t>(out.width) * static_cast<std::size_t>(out.height) * 3);
+  fill_rect(out, 0, h, out.width, extra_h, panel);
   // Rows on all threads. A pixel's colour depends on its value alone, and
   // counter metrics take few distinct values, so each band of rows keeps the
   // colours of the last values it saw (a small table indexed by the value's
@@ -385,6 +400,8 @@ RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
         if (!e.used || e.bits != bits) e = Seen{bits, true, heatmap_color(image.metric, v, scale_max, opts)};
         out.set(x, static_cast<int>(y), e.colour);
       }
+    for (std::size_t y = y0; y < y1; ++y)
+      for (int x = w; x < out.width; ++x) out.set(x, static_cast<int>(y), panel);  // beside it: a right legend
   });
 
   if (legend == LegendPlacement::bottom) {

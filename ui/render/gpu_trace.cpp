@@ -96,8 +96,16 @@ void GpuBvhTracer::begin(const Camera& camera, int width, int height, const Quer
   const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   const std::size_t bytes = n * sizeof(GpuPixel);
   if (!out_ || out_bytes_ < bytes) {
+    // The shader writes `out_`, which is never mapped, so the driver can keep
+    // it in the GPU's own memory; result() copies it into `readback_`, a
+    // buffer in client memory made for reading. (Mapping `out_` itself made
+    // NVIDIA's driver move it: on an H200 the traces after the first took
+    // 7.5 ms instead of 3.5, docs/performance.md "GPU path".)
     out_ = GlObject::create(GlObject::Kind::buffer);
-    glNamedBufferStorage(out_.id(), static_cast<GLsizeiptr>(bytes), nullptr, GL_MAP_READ_BIT);
+    glNamedBufferStorage(out_.id(), static_cast<GLsizeiptr>(bytes), nullptr, 0);
+    readback_ = GlObject::create(GlObject::Kind::buffer);
+    glNamedBufferStorage(readback_.id(), static_cast<GLsizeiptr>(bytes), nullptr,
+                         GL_MAP_READ_BIT | GL_CLIENT_STORAGE_BIT);
     out_bytes_ = bytes;
   }
   // Every pixel untraced until its band runs (all bits set: counters
@@ -170,10 +178,11 @@ void GpuBvhTracer::result(GpuTraceResult& r) const {
   r.height = height_;
   r.trace_ms = band_ms_;
   const auto t1 = std::chrono::steady_clock::now();
-  // Read straight from a mapping of the output buffer (no staging copy), the
-  // pixels converted on all threads.
-  const auto* px = static_cast<const GpuPixel*>(
-      glMapNamedBufferRange(out_.id(), 0, static_cast<GLsizeiptr>(n * sizeof(GpuPixel)), GL_MAP_READ_BIT));
+  // Copied on the GPU into the client-memory buffer, read from its mapping
+  // (no copy on the CPU), the pixels converted on all threads.
+  const auto bytes = static_cast<GLsizeiptr>(n * sizeof(GpuPixel));
+  glCopyNamedBufferSubData(out_.id(), readback_.id(), 0, 0, bytes);
+  const auto* px = static_cast<const GpuPixel*>(glMapNamedBufferRange(readback_.id(), 0, bytes, GL_MAP_READ_BIT));
   if (px == nullptr) {
     check_gl_errors("GPU trace readback");
     throw GlError("GPU trace readback: the output buffer could not be mapped");
@@ -199,7 +208,7 @@ void GpuBvhTracer::result(GpuTraceResult& r) const {
       }
     }
   });
-  glUnmapNamedBuffer(out_.id());
+  glUnmapNamedBuffer(readback_.id());
   check_gl_errors("GPU trace readback");
   r.readback_ms = ms_since(t1);
 }

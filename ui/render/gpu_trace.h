@@ -98,7 +98,8 @@ class GpuBvhTracer {
   ShaderProgram program_;
   GlObject nodes_;
   GlObject tris_;
-  GlObject out_;
+  GlObject out_;       ///< what the shader writes (never mapped)
+  GlObject readback_;  ///< out_ copied into client memory, mapped by result()
   std::size_t out_bytes_ = 0;
   std::size_t node_count_ = 0;
   std::vector<std::uint32_t> prim_ids_;  ///< leaf order -> scene order
