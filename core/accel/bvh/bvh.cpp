@@ -72,6 +72,9 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
   nodes_ = std::move(topo.nodes);
   prim_indices_ = std::move(topo.prim_indices);
   stats_ = std::move(topo.stats);
+  // Where the build's time goes (the binary tree, the wide tree collapsed
+  // from it, the triangle blocks), for the build's thread scaling.
+  const double topology_ms = ms_since(t0);
   // The triangles as blocks of four, each leaf from a new block (its
   // triangles contiguous, in leaf order), the blocks in the order the wide
   // tree's leaf slots are laid out (else in node order): first the leaves in
@@ -104,6 +107,7 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
       if (nodes_[i].count > 0)
         next_block = bvh_detail::append_leaf_blocks(nodes_, i, next_block, leaf_order, leaf_block_);
   }
+  const double wide_ms = ms_since(t0) - topology_ms;
   blocks_.resize(block_count);  // default-initialised: not written here (HugePageAllocator)
   parallel_for(leaf_order.size(), opts_.threads, 4096, [&](std::size_t begin, std::size_t end, unsigned) {
     const auto tri_at = [&](std::uint32_t k) -> const Triangle& { return triangles[prim_indices_[k]]; };
@@ -129,6 +133,9 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
   stats_.extra["memory_leaf_block_index"] = static_cast<double>(leaf_block_bytes);
   stats_.memory_bytes = node_bytes + index_bytes + block_bytes + leaf_block_bytes + wide_bytes;
   stats_.build_ms = ms_since(t0);
+  stats_.extra["build_topology_ms"] = topology_ms;
+  stats_.extra["build_wide_ms"] = wide_ms;
+  stats_.extra["build_blocks_ms"] = stats_.build_ms - topology_ms - wide_ms;
   update_epo(triangles);  // sah_cost: the builder's, over these nodes
 }
 
