@@ -17,8 +17,10 @@
 //  - the same child order, stack order, culling and counters.
 // Every value is `precise` and written in the C++ evaluation order, so that
 // the compiler neither contracts a multiply and an add into an FMA nor
-// reassociates: on an IEEE implementation (llvmpipe) the results are bit for
-// bit the CPU's. tests/gl/test_gpu_trace.cpp checks that.
+// reassociates, and divisions and square roots are correctly rounded
+// (div_rn, sqrt_rn): on llvmpipe and on an NVIDIA H200 (2026-12-04) the
+// results are bit for bit the CPU's. tests/gl/test_gpu_trace.cpp checks that
+// on llvmpipe, accelviz_gpu_bench on any device.
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
 // core/accel/bvh/bvh.h BvhNode: 32 bytes, std430 with scalar members only.
