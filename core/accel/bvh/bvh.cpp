@@ -46,12 +46,12 @@ constexpr std::size_t kGatherAhead = 4;
 template <int W>
 std::size_t make_wide(std::span<const BvhNode> nodes, HugePageVector<std::uint32_t>& leaf_order,
                       std::span<std::uint32_t> leaf_block, int merge_blocks, bvh_detail::WideBvhT<W>& wide,
-                      BuildStats& stats) {
-  bvh_detail::collapse_to_wide(nodes, wide, merge_blocks);
+                      BuildStats& stats, unsigned threads) {
+  bvh_detail::collapse_to_wide(nodes, wide, merge_blocks, threads);
   stats.extra["wide_merge_blocks"] = merge_blocks;
   // The triangle blocks in the order the fast path's leaf slots are laid out
   // (a slot's binary leaves one after the other).
-  bvh_detail::lay_out_leaf_blocks(wide, nodes, leaf_order, leaf_block);
+  bvh_detail::lay_out_leaf_blocks(wide, nodes, leaf_order, leaf_block, threads);
   const std::size_t node_bytes = wide.nodes.size() * sizeof(bvh_detail::WideNodeT<W>);
   const std::size_t source_bytes = wide.source.size() * sizeof(std::uint32_t);
   stats.extra["wide_nodes"] = static_cast<double>(wide.nodes.size());
@@ -95,10 +95,10 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
                                                                               : opts_.wide_width;
     if (width == 8) {
       wide8_ = std::make_unique<bvh_detail::WideBvh8>();
-      wide_bytes = make_wide(nodes_, leaf_order, leaf_block_, merge, *wide8_, stats_);
+      wide_bytes = make_wide(nodes_, leaf_order, leaf_block_, merge, *wide8_, stats_, resolve_threads(opts_.threads));
     } else {
       wide_ = std::make_unique<bvh_detail::WideBvh>();
-      wide_bytes = make_wide(nodes_, leaf_order, leaf_block_, merge, *wide_, stats_);
+      wide_bytes = make_wide(nodes_, leaf_order, leaf_block_, merge, *wide_, stats_, resolve_threads(opts_.threads));
     }
     stats_.extra["wide_width"] = width;
   } else {

@@ -191,7 +191,15 @@ class Builder {
         worker.join();
         throw;
       }
+      // While it waits for the right subtree this thread is idle: its count
+      // goes back, so that a split elsewhere can take another thread meanwhile
+      // (else the count stays full while threads wait, and the builds of
+      // uneven SAH subtrees run on fewer threads than asked for). Counted
+      // again after; the count may pass max_threads_ by one until a worker
+      // ends, when no split can take a thread.
+      release_thread();
       worker.join();
+      active_threads_.fetch_add(1);
       if (right_error) std::rethrow_exception(right_error);
       if (cancelled_.load(std::memory_order_relaxed)) return;
       // Splice: right_nodes[0] is the right child; its descendants follow the

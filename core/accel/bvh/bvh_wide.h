@@ -85,9 +85,10 @@ inline std::uint32_t append_leaf_blocks(std::span<const BvhNode> binary, std::ui
 /// the slot's child = its first block, meta = its block count (before, a
 /// leaf slot names a leaf position and a primitive count, as collapse_to_wide
 /// leaves it).
+/// On `threads` threads (0: all); the result does not depend on them.
 template <int W>
 void lay_out_leaf_blocks(WideBvhT<W>& wide, std::span<const BvhNode> binary, HugePageVector<std::uint32_t>& leaf_order,
-                         std::span<std::uint32_t> leaf_block);
+                         std::span<std::uint32_t> leaf_block, unsigned threads = 1);
 
 /// Collapses a binary node array: each wide node takes a binary inner node's
 /// children and keeps opening the child with the largest surface area until
@@ -100,8 +101,12 @@ void lay_out_leaf_blocks(WideBvhT<W>& wide, std::span<const BvhNode> binary, Hug
 /// kept it as a leaf. The binary tree, which is built, shown and counted, is
 /// unchanged; only the fast path's copy has fewer, larger leaves (see
 /// docs/bvh.md: fewer wide nodes to fetch per ray).
+///
+/// On `threads` threads (0: all), below a frontier of subtrees; the array is
+/// the same whatever the threads: the one a single depth-first pass makes.
 template <int W>
-void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide, int merge_blocks = 0);
+void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide, int merge_blocks = 0,
+                      unsigned threads = 1);
 inline WideBvh collapse_to_wide(std::span<const BvhNode> binary) {
   WideBvh w;
   collapse_to_wide<4>(binary, w);
