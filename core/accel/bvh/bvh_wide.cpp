@@ -122,9 +122,9 @@ class Collapse {
     std::vector<std::uint32_t> frontier;
     collect_frontier(0, frontier);
     parallel_for(frontier.size(), threads_, 1, [&](std::size_t i0, std::size_t i1, unsigned) {
-      for (std::size_t i = i0; i < i1; ++i) count_below(frontier[i]);
+      for (std::size_t i = i0; i < i1; ++i) count(frontier[i], false);
     });
-    const std::uint32_t total = 1 + count_above(0);
+    const std::uint32_t total = 1 + count(0, true);
     wide_.nodes.resize(total);  // default-initialised: every node is written below
     wide_.source.resize(static_cast<std::size_t>(W) * total);
     // Pass 2: every node at its place; the frontier's subtrees on all threads.
@@ -155,25 +155,15 @@ class Collapse {
       if (!leaf_like_[slots[s]]) collect_frontier(slots[s], out);
   }
 
-  /// S(b), stored in below_[b] for b and every wide node under it.
-  std::uint32_t count_below(std::uint32_t b) {
+  /// S(b), stored in below_[b] for b and every wide node under it; `above`:
+  /// b lies above the frontier, whose counts are done.
+  std::uint32_t count(std::uint32_t b, bool above) {
+    if (above && frontier(b)) return below_[b];
     std::uint32_t slots[W];
     const int n = gather_slots<W>(binary_, leaf_like_, b, slots);
     std::uint32_t sum = 0;
     for (int s = 0; s < n; ++s)
-      if (!leaf_like_[slots[s]]) sum += 1 + count_below(slots[s]);
-    below_[b] = sum;
-    return sum;
-  }
-
-  /// S(b) above the frontier, whose counts are done.
-  std::uint32_t count_above(std::uint32_t b) {
-    if (frontier(b)) return below_[b];
-    std::uint32_t slots[W];
-    const int n = gather_slots<W>(binary_, leaf_like_, b, slots);
-    std::uint32_t sum = 0;
-    for (int s = 0; s < n; ++s)
-      if (!leaf_like_[slots[s]]) sum += 1 + count_above(slots[s]);
+      if (!leaf_like_[slots[s]]) sum += 1 + count(slots[s], above);
     below_[b] = sum;
     return sum;
   }
