@@ -1,7 +1,10 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <bit>
+#include <cstdint>
 #include <filesystem>
+#include <limits>
 
 #include "core/accel/brute_force.h"
 #include "core/accel/bvh/bvh.h"
@@ -370,6 +373,108 @@ TEST(Batch, ClosestHitsOfASpanEqualClosestHitPerRay) {
     std::vector<RayStats> short_stats(2);
     EXPECT_THROW(accel->closest_hits(rays, short_hits, {}), std::invalid_argument);
     EXPECT_THROW(accel->closest_hits(rays, fast, {}, short_stats), std::invalid_argument);
+  }
+}
+
+TEST(Heatmap, FiguresOfManyBlocksAreTheOnePassOnesOnAnyThreads) {
+  // 30,000 pixels: several of metric_image_from_hits' blocks of 4096, with
+  // hits, misses and counters that vary; the image and figures equal a plain
+  // pass over the pixels, on one thread and on three.
+  const int w = 200, h = 150;
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  std::vector<Hit> hits(n);
+  std::vector<RayStats> stats(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    stats[i].nodes_visited = static_cast<std::uint32_t>((i * 2654435761u) % 97);
+    stats[i].prim_tests = static_cast<std::uint32_t>(i % 13);
+    if (i % 7 != 0) {
+      hits[i].prim = static_cast<std::uint32_t>(i);
+      hits[i].t = 1.0f + static_cast<float>(i % 1000) * 0.37f;
+    }
+  }
+  const std::vector<Ray> rays = primary_rays(tiny_camera(), w, h);
+  for (HeatMetric metric : {HeatMetric::nodes, HeatMetric::depth, HeatMetric::cost}) {
+    double sum = 0.0, max = 0.0;
+    std::uint64_t counted = 0, hit_count = 0;
+    std::vector<float> expect(n);
+    HeatmapOptions opts;
+    opts.metric = metric;
+    opts.width = w;
+    opts.height = h;
+    opts.c_trav = 1.25f;
+    opts.c_isect = 0.75f;
+    for (std::size_t i = 0; i < n; ++i) {
+      expect[i] = metric_value(metric, rays[i], hits[i], stats[i], opts.c_trav, opts.c_isect);
+      hit_count += hits[i].valid();
+      if (std::isfinite(expect[i])) {
+        sum += expect[i];
+        max = std::max<double>(max, expect[i]);
+        ++counted;
+      }
+    }
+    for (unsigned threads : {1u, 3u}) {
+      opts.threads = threads;
+      HeatmapFigures fig;
+      // The ray is read by the shaded metric alone: without rays the others give the same.
+      const MetricImage img = metric_image_from_hits({}, hits, stats, opts, 2.0, &fig);
+      const MetricImage with_rays = metric_image_from_hits(rays, hits, stats, opts, 2.0, nullptr);
+      ASSERT_EQ(img.values.size(), n);
+      for (std::size_t i = 0; i < n; ++i) {
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(img.values[i]), std::bit_cast<std::uint32_t>(expect[i])) << i;
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(with_rays.values[i]), std::bit_cast<std::uint32_t>(expect[i])) << i;
+      }
+      EXPECT_EQ(fig.rays, n);
+      EXPECT_EQ(fig.hits, hit_count);
+      EXPECT_DOUBLE_EQ(fig.max, max);
+      EXPECT_NEAR(fig.mean, sum / static_cast<double>(counted), 1e-12 * max);
+      EXPECT_DOUBLE_EQ(fig.rays_per_s, static_cast<double>(n) / 2e-3);
+    }
+  }
+  HeatmapOptions shaded;
+  shaded.metric = HeatMetric::shaded;
+  shaded.width = w;
+  shaded.height = h;
+  EXPECT_THROW(metric_image_from_hits({}, hits, stats, shaded, 1.0, nullptr), std::invalid_argument);
+  EXPECT_THROW(metric_image_from_hits(std::span<const Ray>(rays).first(5), hits, stats, HeatmapOptions{}, 1.0, nullptr),
+               std::invalid_argument);
+}
+
+TEST(Heatmap, EveryPixelHasItsValuesColourWhateverTheValuesBefore) {
+  // colorize keeps the colours of values it has seen in a small table per band
+  // of rows: with many distinct values (table collisions), repeats, NaNs and
+  // infinities, every pixel must still have heatmap_color of its own value.
+  const int w = 301, h = 203;
+  MetricImage img;
+  img.width = w;
+  img.height = h;
+  img.metric = HeatMetric::depth;
+  img.values.resize(static_cast<std::size_t>(w) * h);
+  std::uint32_t state = 12345;
+  for (float& v : img.values) {
+    state = state * 1664525u + 1013904223u;
+    const std::uint32_t r = state >> 8;
+    v = r % 11 == 0   ? std::numeric_limits<float>::quiet_NaN()
+        : r % 13 == 0 ? std::numeric_limits<float>::infinity()
+        : r % 3 == 0  ? static_cast<float>(r % 40)                     // few values, repeated
+                      : static_cast<float>(r % 100000) * 0.001953125f;  // many
+  }
+  for (LegendPlacement legend : {LegendPlacement::bottom, LegendPlacement::right, LegendPlacement::none}) {
+    ColorizeOptions opts;
+    opts.legend = legend;
+    const RgbImage rgb = colorize(img, opts);
+    const float scale_max = heatmap_scale_max(img, opts.max);
+    float serial_max = 0.0f;
+    for (float v : img.values)
+      if (std::isfinite(v)) serial_max = std::max(serial_max, v);
+    EXPECT_EQ(scale_max, serial_max);
+    ASSERT_GE(rgb.width, w);
+    ASSERT_GE(rgb.height, h);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        ASSERT_EQ(rgb.at(x, y), heatmap_color(img.metric, img.at(x, y), scale_max, opts)) << x << "," << y;
+    // Beside and below the heatmap: the legend's panel colour or its ink, never unwritten black.
+    for (int y = 0; y < rgb.height; ++y)
+      for (int x = (y < h ? w : 0); x < rgb.width; ++x) ASSERT_NE(rgb.at(x, y), glm::u8vec3(0, 0, 0)) << x << "," << y;
   }
 }
 }  // namespace unity_test_heatmap
