@@ -32,8 +32,8 @@
 #include <atomic>
 #include <bit>
 #include <chrono>
-#include <exception>
 #include <cstdint>
+#include <exception>
 #include <iostream>
 #include <limits>
 #include <nlohmann/json.hpp>

@@ -33,7 +33,7 @@ class GpuHeatmap final : public GpuHeatmapJob {
   std::shared_ptr<const HeatmapFrame> finish();
 
   std::unique_ptr<GpuBvhTracer> tracer_;
-  GpuTraceResult raw_;  ///< the last readback, kept for its storage
+  GpuTraceResult raw_;                              ///< the last readback, kept for its storage
   std::shared_ptr<const BuiltStructure> uploaded_;  ///< held: a freed structure's address may come back
   HeatmapRequest request_;
   std::uint64_t id_ = 0;

@@ -1,11 +1,11 @@
 #include "core/query/ray_sets.h"
 
+#include <cmath>
+
 #include "core/geometry/shapes.h"
 #include "core/query/camera.h"
 #include "core/util/parallel.h"
 #include "core/util/random.h"
-
-#include <cmath>
 
 namespace accelviz {
 
@@ -44,9 +44,12 @@ glm::vec3 facing_normal(std::span<const Triangle> triangles, const Ray& ray, con
 
 std::string_view ray_kind_name(RayKind kind) {
   switch (kind) {
-    case RayKind::primary: return "primary";
-    case RayKind::diffuse: return "diffuse";
-    case RayKind::shadow: return "shadow";
+    case RayKind::primary:
+      return "primary";
+    case RayKind::diffuse:
+      return "diffuse";
+    case RayKind::shadow:
+      return "shadow";
   }
   return "primary";
 }

@@ -140,9 +140,9 @@ void check_scene(std::span<const Triangle> tris, const std::string& name) {
     reference_collapse<W>(nodes, ref, merge);
     std::vector<std::uint32_t> ref_order, ref_block(nodes.size(), 0);
     reference_layout<W>(ref, nodes, ref_order, ref_block);
-    for (unsigned threads : {1u, 2u, 3u, 8u}) {
-      const std::string what = name + " W=" + std::to_string(W) + " merge=" + std::to_string(merge) +
-                               " threads=" + std::to_string(threads);
+    for (unsigned threads : {1u, 2u, 3u, 8u, 0u}) {  // 0: all hardware threads
+      const std::string what =
+          name + " W=" + std::to_string(W) + " merge=" + std::to_string(merge) + " threads=" + std::to_string(threads);
       bvh_detail::WideBvhT<W> wide;
       bvh_detail::collapse_to_wide<W>(nodes, wide, merge, threads);
       HugePageVector<std::uint32_t> order;

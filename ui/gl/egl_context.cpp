@@ -101,8 +101,8 @@ EglContext::EglContext(int width, int height, Devices devices) : width_(width), 
   // NVIDIA's driver names only it, Mesa names all three.
   const bool enumeration =
       has_extension(client, "EGL_EXT_device_enumeration") || has_extension(client, "EGL_EXT_device_base");
-  if (!enumeration || !has_extension(client, "EGL_EXT_platform_device") ||
-      query_devices == nullptr || device_string == nullptr || platform_display == nullptr)
+  if (!enumeration || !has_extension(client, "EGL_EXT_platform_device") || query_devices == nullptr ||
+      device_string == nullptr || platform_display == nullptr)
     throw GlError(
         "EGL has no device enumeration (EGL_EXT_device_enumeration or EGL_EXT_device_base, and "
         "EGL_EXT_platform_device)");

@@ -81,8 +81,7 @@ GpuTraceResult GpuBvhTracer::trace(const Camera& camera, int width, int height, 
   return r;
 }
 
-void GpuBvhTracer::trace(const Camera& camera, int width, int height, const QueryOptions& query,
-                         GpuTraceResult& into) {
+void GpuBvhTracer::trace(const Camera& camera, int width, int height, const QueryOptions& query, GpuTraceResult& into) {
   begin(camera, width, height, query);
   trace_rows(height);
   result(into);
@@ -187,6 +186,10 @@ void GpuBvhTracer::result(GpuTraceResult& r) const {
     check_gl_errors("GPU trace readback");
     throw GlError("GPU trace readback: the output buffer could not be mapped");
   }
+  struct Unmap {  // also when the conversion throws (a thread that cannot start)
+    GLuint id;
+    ~Unmap() { glUnmapNamedBuffer(id); }
+  } unmap{readback_.id()};
   r.stats.resize(n);
   r.hits.resize(n);
   parallel_for(n, 0, 16384, [&](std::size_t i0, std::size_t i1, unsigned) {
@@ -208,7 +211,6 @@ void GpuBvhTracer::result(GpuTraceResult& r) const {
       }
     }
   });
-  glUnmapNamedBuffer(readback_.id());
   check_gl_errors("GPU trace readback");
   r.readback_ms = ms_since(t1);
 }

@@ -1,13 +1,13 @@
 // Collapse of a binary BVH into 4- or 8-wide nodes (see bvh_wide.h).
 #include "core/accel/bvh/bvh_wide.h"
 
-#include "core/accel/bvh/bvh_slab.h"
-#include "core/math/aabb.h"
-#include "core/util/parallel.h"
-
 #include <algorithm>
 #include <utility>
 #include <vector>
+
+#include "core/accel/bvh/bvh_slab.h"
+#include "core/math/aabb.h"
+#include "core/util/parallel.h"
 
 namespace accelviz::bvh_detail {
 namespace {
@@ -216,8 +216,8 @@ class Collapse {
 /// Collapse cost it a third more there): each wide node's children are put
 /// together at the array's end when the node is taken.
 template <int W>
-void collapse_serial(std::span<const BvhNode> binary, std::span<const std::uint8_t> leaf_like,
-                     const SubtreeBlocks& sub, WideBvhT<W>& wide) {
+void collapse_serial(std::span<const BvhNode> binary, std::span<const std::uint8_t> leaf_like, const SubtreeBlocks& sub,
+                     WideBvhT<W>& wide) {
   // At most binary.size() / 2 + 1 wide nodes: reserved pages that are never
   // written are never touched (HugePageVector), so this costs address space.
   wide.nodes.reserve(binary.size() / 2 + 1);
@@ -277,10 +277,10 @@ void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide, int me
     wide.source[0] = 0;
     return;
   }
-  if (threads <= 1)
+  if (resolve_threads(threads) == 1)
     collapse_serial<W>(binary, leaf_like, sub, wide);
   else
-    Collapse<W>(binary, leaf_like, sub, wide, threads).run();
+    Collapse<W>(binary, leaf_like, sub, wide, resolve_threads(threads)).run();
 }
 
 template <int W>
@@ -293,7 +293,8 @@ void lay_out_leaf_blocks(WideBvhT<W>& wide, std::span<const BvhNode> binary, Hug
   const auto is_leaf_slot = [&](std::size_t w, int s) {
     return wide.nodes[w].meta[s] != 0 && wide.nodes[w].meta[s] != kWideEmpty;
   };
-  if (threads <= 1) {  // that single pass itself
+  threads = resolve_threads(threads);
+  if (threads == 1) {  // that single pass itself
     std::uint32_t next = 0;
     for (std::size_t w = 0; w < count; ++w)
       for (int s = 0; s < W; ++s)

@@ -105,8 +105,7 @@ void lay_out_leaf_blocks(WideBvhT<W>& wide, std::span<const BvhNode> binary, Hug
 /// On `threads` threads (0: all), below a frontier of subtrees; the array is
 /// the same whatever the threads: the one a single depth-first pass makes.
 template <int W>
-void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide, int merge_blocks = 0,
-                      unsigned threads = 1);
+void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide, int merge_blocks = 0, unsigned threads = 1);
 inline WideBvh collapse_to_wide(std::span<const BvhNode> binary) {
   WideBvh w;
   collapse_to_wide<4>(binary, w);
