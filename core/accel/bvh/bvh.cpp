@@ -95,10 +95,10 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
                                                                               : opts_.wide_width;
     if (width == 8) {
       wide8_ = std::make_unique<bvh_detail::WideBvh8>();
-      wide_bytes = make_wide(nodes_, leaf_order, leaf_block_, merge, *wide8_, stats_, resolve_threads(opts_.threads));
+      wide_bytes = make_wide(nodes_, leaf_order, leaf_block_, merge, *wide8_, stats_, opts_.threads);
     } else {
       wide_ = std::make_unique<bvh_detail::WideBvh>();
-      wide_bytes = make_wide(nodes_, leaf_order, leaf_block_, merge, *wide_, stats_, resolve_threads(opts_.threads));
+      wide_bytes = make_wide(nodes_, leaf_order, leaf_block_, merge, *wide_, stats_, opts_.threads);
     }
     stats_.extra["wide_width"] = width;
   } else {

@@ -55,10 +55,6 @@ struct SubtreeBlocks {
   }
 };
 
-}  // namespace
-
-namespace {
-
 /// The binary nodes under binary inner node `b` that become one wide node's
 /// slots (the first n of `slots`): b's children, then the inner one with the
 /// largest surface area opened until there are W or only leaf-like ones,
@@ -96,6 +92,30 @@ int gather_slots(std::span<const BvhNode> binary, std::span<const std::uint8_t> 
     ++n;
   }
   return n;
+}
+
+/// One wide node from the `n` gathered `slots`: their boxes and binary
+/// sources (the other slots empty); a leaf-like slot names its first leaf
+/// position and primitive count, the k-th inner slot the wide node
+/// `inner_child(k, slot)` returns.
+template <int W, class InnerChild>
+void write_slots(std::span<const BvhNode> binary, std::span<const std::uint8_t> leaf_like, const SubtreeBlocks& sub,
+                 const std::uint32_t (&slots)[W], int n, WideNodeT<W>& node, std::uint32_t* source,
+                 InnerChild&& inner_child) {
+  node = empty_node<W>();
+  std::fill(source, source + W, kWideEmpty);
+  int k = 0;
+  for (int s = 0; s < n; ++s) {
+    source[s] = slots[s];
+    set_slot(node, s, binary[slots[s]].bounds);
+    if (leaf_like[slots[s]]) {
+      node.child[s] = sub.first[slots[s]];
+      node.meta[s] = sub.count[slots[s]];
+    } else {
+      node.child[s] = inner_child(k++, slots[s]);
+      node.meta[s] = 0;
+    }
+  }
 }
 
 /// The collapse in two passes over the binary tree, each on all threads
@@ -175,26 +195,16 @@ class Collapse {
     const int n = gather_slots<W>(binary_, leaf_like_, t.binary, slots);
     int inner = 0;
     for (int s = 0; s < n; ++s) inner += leaf_like_[slots[s]] ? 0 : 1;
-    WideNodeT<W> node = empty_node<W>();
-    std::uint32_t* source = wide_.source.data() + static_cast<std::size_t>(W) * t.wide;
-    std::fill(source, source + W, kWideEmpty);
     Task next[W];
     int k = 0;
     std::uint32_t grand = t.children + static_cast<std::uint32_t>(inner);  // the first child's children
-    for (int s = 0; s < n; ++s) {
-      source[s] = slots[s];
-      set_slot(node, s, binary_[slots[s]].bounds);
-      if (leaf_like_[slots[s]]) {
-        node.child[s] = sub_.first[slots[s]];
-        node.meta[s] = sub_.count[slots[s]];
-      } else {
-        node.child[s] = t.children + static_cast<std::uint32_t>(k);
-        node.meta[s] = 0;
-        next[k++] = Task{node.child[s], slots[s], grand};
-        grand += below_[slots[s]];
-      }
-    }
-    wide_.nodes[t.wide] = node;
+    write_slots<W>(binary_, leaf_like_, sub_, slots, n, wide_.nodes[t.wide],
+                   wide_.source.data() + static_cast<std::size_t>(W) * t.wide, [&](int i, std::uint32_t b) {
+                     next[i] = Task{t.children + static_cast<std::uint32_t>(i), b, grand};
+                     grand += below_[b];
+                     k = i + 1;
+                     return next[i].wide;
+                   });
     for (int i = 0; i < k; ++i) {
       if (defer && frontier(next[i].binary))
         defer->push_back(next[i]);
@@ -222,28 +232,27 @@ void collapse_serial(std::span<const BvhNode> binary, std::span<const std::uint8
   // written are never touched (HugePageVector), so this costs address space.
   wide.nodes.reserve(binary.size() / 2 + 1);
   wide.source.reserve(static_cast<std::size_t>(W) * (binary.size() / 2 + 1));
-  wide.nodes.push_back(empty_node<W>());
-  wide.source.insert(wide.source.end(), W, kWideEmpty);
+  wide.nodes.resize(1);  // the root, written when taken
+  wide.source.resize(W);
   std::vector<std::pair<std::uint32_t, std::uint32_t>> work{{0, 0}};  // (wide node, binary node)
   while (!work.empty()) {
     const auto [w, b] = work.back();
     work.pop_back();
     std::uint32_t slots[W];
     const int n = gather_slots<W>(binary, leaf_like, b, slots);
-    for (int s = 0; s < n; ++s) {
-      wide.source[W * w + s] = slots[s];
-      set_slot(wide.nodes[w], s, binary[slots[s]].bounds);
-      if (leaf_like[slots[s]]) {
-        wide.nodes[w].child[s] = sub.first[slots[s]];
-        wide.nodes[w].meta[s] = sub.count[slots[s]];
-      } else {
-        const auto child = static_cast<std::uint32_t>(wide.nodes.size());
-        wide.nodes.push_back(empty_node<W>());
-        wide.source.insert(wide.source.end(), W, kWideEmpty);
-        wide.nodes[w].child[s] = child;
-        wide.nodes[w].meta[s] = 0;
+    // The children's places first (the arrays grow), then the node itself.
+    std::uint32_t children[W];
+    int inner = 0;
+    for (int s = 0; s < n; ++s)
+      if (!leaf_like[slots[s]]) {
+        children[inner] = static_cast<std::uint32_t>(wide.nodes.size()) + static_cast<std::uint32_t>(inner);
+        ++inner;
       }
-    }
+    wide.nodes.resize(wide.nodes.size() + inner);
+    wide.source.resize(wide.source.size() + static_cast<std::size_t>(W) * inner);
+    write_slots<W>(binary, leaf_like, sub, slots, n, wide.nodes[w],
+                   wide.source.data() + static_cast<std::size_t>(W) * w,
+                   [&](int i, std::uint32_t) { return children[i]; });
     // Depth first, first slot first (pushed last).
     for (int s = n - 1; s >= 0; --s)
       if (wide.nodes[w].meta[s] == 0) work.push_back({wide.nodes[w].child[s], slots[s]});
@@ -286,26 +295,35 @@ void collapse_to_wide(std::span<const BvhNode> binary, WideBvhT<W>& wide, int me
 template <int W>
 void lay_out_leaf_blocks(WideBvhT<W>& wide, std::span<const BvhNode> binary, HugePageVector<std::uint32_t>& leaf_order,
                          std::span<std::uint32_t> leaf_block, unsigned threads) {
-  // The blocks and binary leaves of each wide node's leaf slots, then their
-  // running sums in node order (where a single pass in node order puts each
-  // node's first block and leaf), then every node's slots on all threads.
+  // A single pass in node order puts each leaf slot's binary leaves next,
+  // from block `next` and leaf position `at` on. On more threads, each node's
+  // blocks and leaves are counted first and their running sums give each
+  // node its `next` and `at`. Every binary leaf lies under one leaf slot, and
+  // a binary tree of n nodes has (n + 1) / 2 leaves.
   const std::size_t count = wide.nodes.size();
   const auto is_leaf_slot = [&](std::size_t w, int s) {
     return wide.nodes[w].meta[s] != 0 && wide.nodes[w].meta[s] != kWideEmpty;
   };
+  const std::size_t base = leaf_order.size();
+  leaf_order.resize(base + (binary.size() + 1) / 2);  // default-initialised: every entry is written below
+  const auto place = [&](std::size_t w, std::uint32_t next, std::size_t at) {
+    for (int s = 0; s < W; ++s)
+      if (is_leaf_slot(w, s)) {
+        const std::uint32_t first = next;
+        for_each_leaf_under(binary, wide.source[W * w + s], [&](std::uint32_t leaf) {
+          leaf_order[at++] = leaf;
+          leaf_block[leaf] = next;
+          next += tri4_block_count(binary[leaf].count);
+        });
+        wide.nodes[w].child[s] = first;
+        wide.nodes[w].meta[s] = next - first;
+      }
+    return std::pair{next, at};
+  };
   threads = resolve_threads(threads);
-  if (threads == 1) {  // that single pass itself
-    std::uint32_t next = 0;
-    for (std::size_t w = 0; w < count; ++w)
-      for (int s = 0; s < W; ++s)
-        if (is_leaf_slot(w, s)) {
-          const std::uint32_t first = next;
-          for_each_leaf_under(binary, wide.source[W * w + s], [&](std::uint32_t leaf) {
-            next = append_leaf_blocks(binary, leaf, next, leaf_order, leaf_block);
-          });
-          wide.nodes[w].child[s] = first;
-          wide.nodes[w].meta[s] = next - first;
-        }
+  if (threads == 1) {
+    std::pair<std::uint32_t, std::size_t> from{0, base};
+    for (std::size_t w = 0; w < count; ++w) from = place(w, from.first, from.second);
     return;
   }
   std::vector<std::uint32_t> first_block(count + 1), first_leaf(count + 1);
@@ -326,24 +344,8 @@ void lay_out_leaf_blocks(WideBvhT<W>& wide, std::span<const BvhNode> binary, Hug
     first_block[w + 1] += first_block[w];
     first_leaf[w + 1] += first_leaf[w];
   }
-  const std::size_t base = leaf_order.size();
-  leaf_order.resize(base + first_leaf[count]);  // default-initialised: every entry is written below
   parallel_for(count, threads, 1024, [&](std::size_t w0, std::size_t w1, unsigned) {
-    for (std::size_t w = w0; w < w1; ++w) {
-      std::uint32_t next = first_block[w];
-      std::size_t at = base + first_leaf[w];
-      for (int s = 0; s < W; ++s)
-        if (is_leaf_slot(w, s)) {
-          const std::uint32_t first = next;
-          for_each_leaf_under(binary, wide.source[W * w + s], [&](std::uint32_t leaf) {
-            leaf_order[at++] = leaf;
-            leaf_block[leaf] = next;
-            next += tri4_block_count(binary[leaf].count);
-          });
-          wide.nodes[w].child[s] = first;
-          wide.nodes[w].meta[s] = next - first;
-        }
-    }
+    for (std::size_t w = w0; w < w1; ++w) place(w, first_block[w], base + first_leaf[w]);
   });
 }
 

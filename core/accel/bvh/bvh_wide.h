@@ -67,8 +67,8 @@ void for_each_leaf_under(std::span<const BvhNode> binary, std::uint32_t node, co
 
 /// One step of laying the triangle blocks out: binary leaf `leaf` goes next
 /// in `leaf_order`, from block `next` on (leaf_block[leaf] = next). Returns
-/// the block after its last. lay_out_leaf_blocks and class Bvh without a
-/// wide copy (leaves in node order) both lay their leaves out with it.
+/// the block after its last. Class Bvh without a wide copy lays its leaves
+/// out with it, in node order (lay_out_leaf_blocks does the same per slot).
 inline std::uint32_t append_leaf_blocks(std::span<const BvhNode> binary, std::uint32_t leaf, std::uint32_t next,
                                         HugePageVector<std::uint32_t>& leaf_order,
                                         std::span<std::uint32_t> leaf_block) {
