@@ -127,13 +127,13 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
     const double setup_ms = ms_since(t_setup);
     progress.end(std::to_string(static_cast<long long>(setup_ms)) + " ms");
     progress.begin("rendering " + o.metric + " on the GPU (" + context.info().renderer + ")");
-    GpuTraceResult raw;
-    img = gpu_render_metric(tracer, camera, ho, &fig, &raw);
+    double readback_ms = 0.0;
+    img = gpu_render_metric(tracer, camera, ho, &fig, &readback_ms);
     progress.end(std::to_string(static_cast<long long>(fig.render_ms)) + " ms");
     gpu_figures = {{"gpu_renderer", context.info().renderer},
                    {"gpu_context", context.kind()},
                    {"gpu_setup_ms", setup_ms},
-                   {"gpu_readback_ms", raw.readback_ms}};
+                   {"gpu_readback_ms", readback_ms}};
     if (context.kind() == "egl") gpu_figures["gpu_device_file"] = context.device_file();
   } else
 #endif

@@ -16,8 +16,12 @@
 // until the GPU finished) with their min and median, readback_ms, cpu_ms (the
 // CPU's counted walk over the same pixels on all threads) and
 // heatmap_* (the whole `--metric nodes` heatmap up to its colours, min(RUNS, 5)
-// times: the median of all of it and of its trace, readback, metric image and
-// colour steps), cpu_heatmap_ms (the same heatmap made by the CPU: render_metric
+// times: the median of all of it and of its trace, readback (the copy and
+// mapping), metric image (read in place from the mapping, the readback
+// included) and colour steps), gui_* (the GUI's frame of the same heatmap as
+// GpuHeatmap makes it, min(RUNS, 5) times: all of it, its trace, its finish
+// (readback, metric image, pixel figures, summary) and that readback),
+// cpu_heatmap_ms (the same heatmap made by the CPU: render_metric
 // on all threads, then colorize),
 // mismatched_pixels (pixels whose figures differ from the CPU's), sorted by
 // what differs: mismatched_counters (a counter), mismatched_hit_prim (the hit
@@ -26,7 +30,7 @@
 // status is 0 when every pixel matched, 1 when some did not, 2 on bad
 // arguments or when no context could be made.
 //
-// Of the GL libraries it needs libEGL alone (no OSMesa, GLFW or window), so
+// Of the GL libraries it needs libEGL alone (no OSMesa, GLFW, ImGui or window), so
 // it can be carried to a GPU machine that has none of the others.
 #include <algorithm>
 #include <atomic>
@@ -36,12 +40,14 @@
 #include <exception>
 #include <iostream>
 #include <limits>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "app/gui/gpu_heatmap.h"
 #include "core/accel/bvh/bvh.h"
 #include "core/analysis/heatmap.h"
 #include "core/query/camera.h"
@@ -90,7 +96,8 @@ int main(int argc, char** argv) {
     if (scene.triangles.empty()) return usage(spec + ": the scene has no triangles");
     BvhOptions bo;
     bo.compute_epo = false;
-    const Bvh bvh(scene.triangles, bo);
+    const auto bvh_owned = std::make_shared<const Bvh>(scene.triangles, bo);
+    const Bvh& bvh = *bvh_owned;
     const Camera camera = frame_bounds(scene.bounds(), static_cast<float>(width) / static_cast<float>(height));
     const QueryOptions query;
 
@@ -149,8 +156,11 @@ int main(int argc, char** argv) {
     const double cpu_ms = ms_since(t_cpu);
 
     // The whole heatmap as `render --device gpu --metric nodes` makes it, a
-    // few times: trace, readback, metric image, colours (no PNG), beside the
-    // CPU's (render_metric over the same BVH on all threads, same colours).
+    // few times: trace, metric image read in place from the readback, colours
+    // (no PNG), beside the CPU's (render_metric over the same BVH on all
+    // threads, same colours). Then the GUI's frame (GpuHeatmap: trace, metric
+    // image, pixel figures and summary, as the View panel's "Trace on: GPU"
+    // makes it; the texture upload and drawing are not counted).
     HeatmapOptions hopts;
     hopts.width = width;
     hopts.height = height;
@@ -158,23 +168,42 @@ int main(int argc, char** argv) {
     hopts.query = query;
     const int heat_runs = std::min(runs, 5);
     std::vector<double> heat_ms, heat_trace, heat_readback, heat_metric, heat_colour, cpu_heat_ms;
-    GpuTraceResult g;  // reused, as the GUI reuses its readback (the first run allocates it)
+    MetricImage img;  // reused, as a GUI would reuse its storage (the first run allocates it)
     for (int r = 0; r < heat_runs; ++r) {
       const auto t0 = std::chrono::steady_clock::now();
-      tracer.trace(camera, width, height, query, g);
+      tracer.begin(camera, width, height, query);
+      tracer.trace_rows(height);
       const auto t1 = std::chrono::steady_clock::now();
-      const MetricImage img = gpu_metric_image(g, camera, hopts, nullptr);
+      heat_readback.push_back(gpu_metric_image(tracer, camera, hopts, nullptr, img));
       const auto t2 = std::chrono::steady_clock::now();
       const RgbImage rgb = colorize(img, ColorizeOptions{});
       heat_ms.push_back(ms_since(t0));
-      heat_trace.push_back(g.trace_ms);
-      heat_readback.push_back(g.readback_ms);
+      heat_trace.push_back(tracer.trace_ms());
       heat_metric.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
       heat_colour.push_back(ms_since(t2));
       const auto c0 = std::chrono::steady_clock::now();
       const RgbImage cpu_rgb = colorize(render_metric(bvh, camera, hopts, nullptr), ColorizeOptions{});
       cpu_heat_ms.push_back(ms_since(c0));
       if (cpu_rgb.pixels.size() != rgb.pixels.size()) throw std::runtime_error("heatmap sizes differ");
+    }
+    HeatmapRequest request;
+    auto built = std::make_shared<BuiltStructure>();
+    built->accel = bvh_owned;
+    request.structure = built;
+    request.camera = camera;
+    request.options = hopts;
+    GpuHeatmap gui;
+    std::vector<double> gui_ms, gui_trace, gui_finish, gui_readback;
+    std::shared_ptr<const HeatmapFrame> shown;  // held while the next is made, as the window shows it
+    for (int r = 0; r < heat_runs; ++r) {
+      const auto t0 = std::chrono::steady_clock::now();
+      std::shared_ptr<const HeatmapFrame> frame = gui.trace(request, static_cast<std::uint64_t>(r + 1));
+      gui_ms.push_back(ms_since(t0));
+      if (!frame || frame->pixels.size() != pixels) throw std::runtime_error("the GUI's GPU frame is incomplete");
+      gui_trace.push_back(gui.progress().trace_ms);
+      gui_finish.push_back(gui.last_finish_ms());
+      gui_readback.push_back(gui.last_readback_ms());
+      shown = std::move(frame);
     }
     const auto median = [](std::vector<double> v) {
       std::sort(v.begin(), v.end());
@@ -205,6 +234,11 @@ int main(int argc, char** argv) {
         {"heatmap_readback_ms_median", median(heat_readback)},
         {"heatmap_metric_ms_median", median(heat_metric)},
         {"heatmap_colour_ms_median", median(heat_colour)},
+        {"gui_frame_ms", gui_ms},
+        {"gui_frame_ms_median", median(gui_ms)},
+        {"gui_trace_ms_median", median(gui_trace)},
+        {"gui_finish_ms_median", median(gui_finish)},
+        {"gui_readback_ms_median", median(gui_readback)},
         {"cpu_heatmap_ms", cpu_heat_ms},
         {"cpu_heatmap_ms_median", median(cpu_heat_ms)},
         {"mismatched_pixels", mismatched.load()},

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "core/accel/bvh/bvh.h"
+#include "core/util/timing.h"
 
 namespace accelviz {
 namespace {
@@ -21,6 +22,9 @@ void GpuHeatmap::start(const HeatmapRequest& r, std::uint64_t id) {
   if (!bvh) throw std::invalid_argument("only the bvh structure is traced on the GPU");
   if (!tracer_) tracer_ = std::make_unique<GpuBvhTracer>();
   if (uploaded_ != r.structure) {
+    // Spare frames let go of the structure they showed (it may be freed now).
+    for (std::shared_ptr<HeatmapFrame>& f : frames_)
+      if (f && f.use_count() == 1) f->request = HeatmapRequest{};
     uploaded_.reset();
     tracer_->upload(*bvh);
     uploaded_ = r.structure;
@@ -68,29 +72,50 @@ std::shared_ptr<const HeatmapFrame> GpuHeatmap::step(double budget_ms) {
   }
 }
 
+std::shared_ptr<HeatmapFrame> GpuHeatmap::spare_frame() {
+  // A frame no one else holds any more (AppState drops the one it shows when
+  // the next arrives) is written over: same size, no allocation.
+  for (std::shared_ptr<HeatmapFrame>& f : frames_)
+    if (f && f.use_count() == 1) return f;
+  for (std::shared_ptr<HeatmapFrame>& f : frames_)
+    if (!f) return f = std::make_shared<HeatmapFrame>();
+  return std::make_shared<HeatmapFrame>();  // both still held elsewhere
+}
+
 std::shared_ptr<const HeatmapFrame> GpuHeatmap::finish() {
   running_ = false;
-  tracer_->result(raw_);  // reuses the last image's storage (the same size: no allocation)
-  const GpuTraceResult& raw = raw_;
+  const auto t0 = std::chrono::steady_clock::now();
+  std::shared_ptr<HeatmapFrame> frame = spare_frame();
+  const std::size_t n = static_cast<std::size_t>(request_.options.width) * request_.options.height;
+  frame->pixels.resize(n);
   HeatmapFigures fig;
-  auto frame = std::make_shared<HeatmapFrame>();
-  frame->image = gpu_metric_image(raw, request_.camera, request_.options, &fig);
+  // One pass over the pixels read in place: the metric image, and each
+  // block's pixel figures and their tally while the block is in cache (the
+  // tallies merged in block order, as summarise_pixels does).
+  PixelFigures* out = frame->pixels.data();
+  std::vector<PixelTally> tallies((n + kMetricBlock - 1) / kMetricBlock);
+  last_readback_ms_ =
+      gpu_metric_image(*tracer_, request_.camera, request_.options, &fig, frame->image,
+                       [&](std::size_t i0, std::span<const GpuPixel> px, std::span<const float> values) {
+                         for (std::size_t k = 0; k < px.size(); ++k) {
+                           PixelFigures& p = out[i0 + k];
+                           p = PixelFigures{};  // every field: the frame may hold an earlier image
+                           p.value = values[k];
+                           p.nodes = px[k].nodes_visited;
+                           p.prims = px[k].prim_tests;
+                           p.prim = tracer_->scene_prim(px[k]);  // as hit_of, without the normal
+                           p.t = p.prim != kInvalidId ? px[k].t : Hit{}.t;
+                           tallies[i0 / kMetricBlock].add(p);
+                         }
+                       });
   frame->id = id_;
   frame->stride = 1;
   frame->complete = true;
   frame->request = request_;
-
-  const std::size_t n = frame->image.values.size();
-  frame->pixels.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    PixelFigures& p = frame->pixels[i];
-    p.value = frame->image.values[i];
-    p.nodes = raw.stats[i].nodes_visited;
-    p.prims = raw.stats[i].prim_tests;
-    p.prim = raw.hits[i].prim;
-    p.t = raw.hits[i].t;
-  }
-  frame->summary = summarise_pixels(frame->pixels, fig.render_ms);
+  PixelTally total;
+  for (const PixelTally& t : tallies) total.merge(t);
+  frame->summary = total.summary(fig.render_ms);
+  last_finish_ms_ = ms_since(t0);
   return frame;
 }
 

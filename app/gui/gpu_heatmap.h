@@ -29,11 +29,22 @@ class GpuHeatmap final : public GpuHeatmapJob {
   /// The whole request in one go (start, then bands until done).
   std::shared_ptr<const HeatmapFrame> trace(const HeatmapRequest& r, std::uint64_t id);
 
+  /// Of the last finished frame: ms from the last band's end to the frame
+  /// (readback, metric image, pixel figures, summary), and of that the
+  /// readback's copy and mapping (GpuBvhTracer::read_pixels).
+  double last_finish_ms() const { return last_finish_ms_; }
+  double last_readback_ms() const { return last_readback_ms_; }
+
  private:
   std::shared_ptr<const HeatmapFrame> finish();
+  std::shared_ptr<HeatmapFrame> spare_frame();
 
   std::unique_ptr<GpuBvhTracer> tracer_;
-  GpuTraceResult raw_;                              ///< the last readback, kept for its storage
+  /// The last two frames made: one is shown while the other is written
+  /// (1920x1080 is 83 MB of pixel figures; a fresh one costs more to
+  /// allocate and first touch than the GPU takes to trace it).
+  std::shared_ptr<HeatmapFrame> frames_[2];
+  double last_finish_ms_ = 0.0, last_readback_ms_ = 0.0;
   std::shared_ptr<const BuiltStructure> uploaded_;  ///< held: a freed structure's address may come back
   HeatmapRequest request_;
   std::uint64_t id_ = 0;

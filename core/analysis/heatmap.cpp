@@ -122,32 +122,48 @@ MetricImage render_metric(const Accelerator& accel, const Camera& camera, const 
 MetricImage metric_image_from_hits(std::span<const Ray> rays, std::span<const Hit> hits,
                                    std::span<const RayStats> stats, const HeatmapOptions& opts, double trace_ms,
                                    HeatmapFigures* figures) {
-  MetricImage img;
-  img.width = opts.width;
-  img.height = opts.height;
-  img.metric = opts.metric;
   const std::size_t n = hits.size();
   if (rays.size() != n && !(rays.empty() && opts.metric != HeatMetric::shaded))
     throw std::invalid_argument("heatmap: " + std::to_string(rays.size()) + " rays for " + std::to_string(n) + " hits");
-  img.values.resize(n);
   const RayStats none;
   const Ray no_ray;
+  MetricImage img;
+  metric_image_by_blocks(
+      n, opts, trace_ms, figures,
+      [&](std::size_t i0, std::size_t i1, float* values) {
+        std::uint64_t hit_count = 0;
+        for (std::size_t i = i0; i < i1; ++i) {
+          values[i - i0] = metric_value(opts.metric, rays.empty() ? no_ray : rays[i], hits[i],
+                                        stats.empty() ? none : stats[i], opts.c_trav, opts.c_isect);
+          if (hits[i].valid()) ++hit_count;
+        }
+        return hit_count;
+      },
+      img);
+  return img;
+}
+
+void metric_image_by_blocks(std::size_t n, const HeatmapOptions& opts, double trace_ms, HeatmapFigures* figures,
+                            const MetricBlockFill& fill, MetricImage& into) {
+  into.width = opts.width;
+  into.height = opts.height;
+  into.metric = opts.metric;
+  into.values.resize(n);
   // Blocks of pixels on all threads; each block's sum, maximum and counts are
   // then combined in block order, so the figures do not depend on the threads.
   struct Block {
     double sum = 0.0, max = 0.0;
     std::uint64_t counted = 0, hits = 0;
   };
-  constexpr std::size_t kBlock = 4096;
-  std::vector<Block> blocks((n + kBlock - 1) / kBlock);
+  std::vector<Block> blocks((n + kMetricBlock - 1) / kMetricBlock);
   parallel_for(blocks.size(), opts.threads, 4, [&](std::size_t b0, std::size_t b1, unsigned) {
     for (std::size_t b = b0; b < b1; ++b) {
       Block& blk = blocks[b];
-      for (std::size_t i = b * kBlock; i < std::min(n, (b + 1) * kBlock); ++i) {
-        const float v = metric_value(opts.metric, rays.empty() ? no_ray : rays[i], hits[i],
-                                     stats.empty() ? none : stats[i], opts.c_trav, opts.c_isect);
-        img.values[i] = v;
-        if (hits[i].valid()) ++blk.hits;
+      const std::size_t i0 = b * kMetricBlock, i1 = std::min(n, i0 + kMetricBlock);
+      float* values = into.values.data() + i0;
+      blk.hits = fill(i0, i1, values);
+      for (std::size_t k = 0; k < i1 - i0; ++k) {
+        const float v = values[k];
         if (std::isfinite(v)) {
           blk.sum += v;
           blk.max = blk.counted == 0 ? v : std::max<double>(blk.max, v);
@@ -173,7 +189,6 @@ MetricImage metric_image_from_hits(std::span<const Ray> rays, std::span<const Hi
     figures->render_ms = trace_ms;
     figures->rays_per_s = trace_ms > 0.0 ? static_cast<double>(n) / (trace_ms * 1e-3) : 0.0;
   }
-  return img;
 }
 
 // ---- images --------------------------------------------------------------------

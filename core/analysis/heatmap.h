@@ -4,6 +4,7 @@
 // into an RGB image through a colour map with a legend bar, written as PNG.
 // The CPU twin of the GUI's heatmap view, and what `accelviz render` writes.
 #include <cstdint>
+#include <functional>
 #include <glm/glm.hpp>
 #include <optional>
 #include <span>
@@ -87,6 +88,23 @@ float metric_value(HeatMetric m, const Ray& ray, const Hit& hit, const RayStats&
 MetricImage metric_image_from_hits(std::span<const Ray> rays, std::span<const Hit> hits,
                                    std::span<const RayStats> stats, const HeatmapOptions& opts, double trace_ms,
                                    HeatmapFigures* figures);
+
+/// What fills one block of a metric image: pixels [i0, i1) get their values
+/// in values[0, i1 - i0); returns how many of them hit something. Called on
+/// all threads at once, for disjoint blocks.
+using MetricBlockFill = std::function<std::uint64_t(std::size_t i0, std::size_t i1, float* values)>;
+
+/// Pixels per block of metric_image_by_blocks (the last block may be shorter).
+inline constexpr std::size_t kMetricBlock = 4096;
+
+/// The metric image of `n` traced pixels made in blocks of kMetricBlock on
+/// all threads (opts.threads), each filled by `fill`, into `into` (its
+/// storage reused: the same size allocates nothing), with `figures` (when
+/// given) as metric_image_from_hits computes them: each block's sum,
+/// maximum and counts are combined in block order, so they do not depend on
+/// the threads. opts gives the size and metric; `n` is the pixel count.
+void metric_image_by_blocks(std::size_t n, const HeatmapOptions& opts, double trace_ms, HeatmapFigures* figures,
+                            const MetricBlockFill& fill, MetricImage& into);
 
 /// Traces one primary ray per pixel and returns the metric image.
 MetricImage render_metric(const Accelerator& accel, const Camera& camera, const HeatmapOptions& opts,

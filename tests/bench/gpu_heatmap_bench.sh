@@ -24,6 +24,12 @@ assert (j["mismatched_counters"], j["mismatched_hit_prim"], j["mismatched_t_only
 assert j["gpu_renderer"] and j["gpu_version"].startswith("4."), j
 assert j["gpu_software"] == ("llvmpipe" in j["gpu_renderer"]), j
 assert j["setup_ms"] > 0 and j["cpu_ms"] > 0 and j["cpu_threads"] >= 1, j
+# The whole heatmap (CLI path) and the GUI's frame: each part within its whole.
+assert j["heatmap_runs"] == 3 and len(j["heatmap_ms"]) == 3 and len(j["gui_frame_ms"]) == 3, j
+assert j["heatmap_ms_median"] >= j["heatmap_trace_ms_median"] > 0, j
+assert j["heatmap_metric_ms_median"] >= j["heatmap_readback_ms_median"] > 0, j
+assert j["gui_frame_ms_median"] >= j["gui_finish_ms_median"] >= j["gui_readback_ms_median"] > 0, j
+assert j["gui_trace_ms_median"] > 0 and len(j["cpu_heatmap_ms"]) == 3, j
 print("gpu bench figures ok:", j["gpu_renderer"], j["trace_ms_median"], "ms")
 PY
 

@@ -212,8 +212,8 @@ TEST_P(GpuTrace, MetricImagesAndColourisedPicturesEqualTheCpus) {
 
 // The GUI spreads an image over frames in row bands (begin, trace_rows,
 // result): after each band exactly the rows traced so far hold the one-shot
-// trace's figures, bit for bit, and every later row is still untraced (the
-// dispatch wrote only its band). Band sizes are uneven and the height is not
+// trace's figures, bit for bit, and every later row reads untraced (rows
+// an earlier trace or a band of another view wrote included). Band sizes are uneven and the height is not
 // a multiple of the 8-row work group; a second begin() (the view changed
 // mid-trace) starts from an untraced image again.
 TEST_P(GpuTrace, BandedTraceEqualsTheOneShotTraceBandByBand) {
@@ -258,7 +258,7 @@ TEST_P(GpuTrace, BandedTraceEqualsTheOneShotTraceBandByBand) {
       }
     EXPECT_EQ(wrong_traced, 0u) << "band " << bands << ": rows [0, " << expect_done << ") differ from one shot";
     EXPECT_EQ(wrong_untraced, 0u) << "band " << bands << ": rows [" << expect_done << ", " << h
-                                  << ") were written by a band that does not cover them";
+                                  << ") do not read untraced";
     EXPECT_DOUBLE_EQ(r.trace_ms, band_ms);
     if (tracer_->finished()) break;
   }

@@ -1,16 +1,15 @@
 // The mesh pass: headlight flat shading by geometric normal, the wireframe
 // overlay, and the depth-only mesh under a full-screen heatmap.
-#include "gl_fixture.h"
-
-#include "core/query/camera.h"
-#include "ui/render/camera_view.h"
-
 #include <cmath>
 #include <stdexcept>
 #include <vector>
 
+#include "core/query/camera.h"
+#include "gl_fixture.h"
+#include "ui/render/camera_view.h"
+
 namespace accelviz::test {
-namespace {
+namespace mesh_test {
 
 constexpr int kTolerance = 2;
 
@@ -179,5 +178,5 @@ TEST_F(MeshPassTest, MultisampledFrameResolvesWithSmoothEdges) {
   EXPECT_GT(partial(smooth), 20);
 }
 
-}  // namespace
+}  // namespace mesh_test
 }  // namespace accelviz::test

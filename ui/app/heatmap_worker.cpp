@@ -11,54 +11,47 @@
 #include "core/util/timing.h"
 
 namespace accelviz {
-namespace {
 
-struct Accumulator {
-  std::uint64_t rays = 0, hits = 0, valued = 0;
-  double sum_nodes = 0.0, sum_prims = 0.0, sum_instances = 0.0, sum_value = 0.0, max_value = 0.0;
-  std::uint32_t max_nodes = 0, max_prims = 0, max_instances = 0;
-  std::uint64_t shadow_rays = 0, shadowed = 0;
-  double shadow_nodes = 0.0, shadow_prims = 0.0;
-
-  void add(const PixelFigures& p) {
-    ++rays;
-    shadow_rays += p.shadow_rays;
-    shadowed += p.shadowed;
-    shadow_nodes += p.shadow_nodes;
-    shadow_prims += p.shadow_prims;
-    if (p.prim != kInvalidId) ++hits;
-    sum_nodes += p.nodes;
-    sum_prims += p.prims;
-    sum_instances += p.instances;
-    max_nodes = std::max(max_nodes, p.nodes);
-    max_prims = std::max(max_prims, p.prims);
-    max_instances = std::max(max_instances, p.instances);
-    if (!std::isnan(p.value)) {
-      ++valued;
-      sum_value += p.value;
-      max_value = std::max(max_value, static_cast<double>(p.value));
-    }
+void PixelTally::add(const PixelFigures& p) {
+  ++rays;
+  shadow_rays += p.shadow_rays;
+  shadowed += p.shadowed;
+  shadow_nodes += p.shadow_nodes;
+  shadow_prims += p.shadow_prims;
+  if (p.prim != kInvalidId) ++hits;
+  sum_nodes += p.nodes;
+  sum_prims += p.prims;
+  sum_instances += p.instances;
+  max_nodes = std::max(max_nodes, p.nodes);
+  max_prims = std::max(max_prims, p.prims);
+  max_instances = std::max(max_instances, p.instances);
+  if (!std::isnan(p.value)) {
+    ++valued;
+    sum_value += p.value;
+    max_value = std::max(max_value, static_cast<double>(p.value));
   }
-  void merge(const Accumulator& o) {
-    rays += o.rays;
-    hits += o.hits;
-    shadow_rays += o.shadow_rays;
-    shadowed += o.shadowed;
-    shadow_nodes += o.shadow_nodes;
-    shadow_prims += o.shadow_prims;
-    valued += o.valued;
-    sum_nodes += o.sum_nodes;
-    sum_prims += o.sum_prims;
-    sum_instances += o.sum_instances;
-    sum_value += o.sum_value;
-    max_value = std::max(max_value, o.max_value);
-    max_nodes = std::max(max_nodes, o.max_nodes);
-    max_prims = std::max(max_prims, o.max_prims);
-    max_instances = std::max(max_instances, o.max_instances);
-  }
-};
+}
 
-HeatmapSummary summarise(const Accumulator& a, double render_ms) {
+void PixelTally::merge(const PixelTally& o) {
+  rays += o.rays;
+  hits += o.hits;
+  shadow_rays += o.shadow_rays;
+  shadowed += o.shadowed;
+  shadow_nodes += o.shadow_nodes;
+  shadow_prims += o.shadow_prims;
+  valued += o.valued;
+  sum_nodes += o.sum_nodes;
+  sum_prims += o.sum_prims;
+  sum_instances += o.sum_instances;
+  sum_value += o.sum_value;
+  max_value = std::max(max_value, o.max_value);
+  max_nodes = std::max(max_nodes, o.max_nodes);
+  max_prims = std::max(max_prims, o.max_prims);
+  max_instances = std::max(max_instances, o.max_instances);
+}
+
+HeatmapSummary PixelTally::summary(double render_ms) const {
+  const PixelTally& a = *this;
   HeatmapSummary s;
   s.rays = a.rays;
   s.hits = a.hits;
@@ -83,12 +76,19 @@ HeatmapSummary summarise(const Accumulator& a, double render_ms) {
   return s;
 }
 
-}  // namespace
-
 HeatmapSummary summarise_pixels(std::span<const PixelFigures> pixels, double render_ms) {
-  Accumulator a;
-  for (const PixelFigures& p : pixels) a.add(p);
-  return summarise(a, render_ms);
+  // Blocks on all threads, merged in block order: the same figures whatever
+  // the threads.
+  constexpr std::size_t kBlock = 16384;
+  std::vector<PixelTally> blocks((pixels.size() + kBlock - 1) / kBlock);
+  parallel_for(blocks.size(), 0, 4, [&](std::size_t b0, std::size_t b1, unsigned) {
+    for (std::size_t b = b0; b < b1; ++b)
+      for (const PixelFigures& p : pixels.subspan(b * kBlock, std::min(kBlock, pixels.size() - b * kBlock)))
+        blocks[b].add(p);
+  });
+  PixelTally a;
+  for (const PixelTally& blk : blocks) a.merge(blk);
+  return a.summary(render_ms);
 }
 
 bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::function<bool()>& keep_going,
@@ -110,14 +110,14 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
   int coarsest = 1;
   while (coarsest * 2 <= std::max(1, r.coarsest)) coarsest *= 2;
 
-  Accumulator total;
+  PixelTally total;
   double render_ms = 0.0;
   for (int s = coarsest; s >= 1; s /= 2) {
     // Lattice s: rows y ≡ 0 (mod s). Below the coarsest level, rows that
     // were already lattice rows of 2s only need their odd multiples of s.
     std::vector<int> rows;
     for (int y = 0; y < h; y += s) rows.push_back(y);
-    std::vector<Accumulator> acc(threads);
+    std::vector<PixelTally> acc(threads);
     std::atomic<bool> stopped{false};
     const auto t0 = std::chrono::steady_clock::now();
     parallel_for(rows.size(), threads, 1, [&](std::size_t b, std::size_t e, unsigned ti) {
@@ -167,7 +167,7 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
     });
     render_ms += ms_since(t0);
     if (stopped) return false;
-    for (const Accumulator& a : acc) total.merge(a);
+    for (const PixelTally& a : acc) total.merge(a);
 
     // Every lattice point fills its s×s block; the finer lattices inside
     // the block are traced later and overwrite their own pixels then.
@@ -190,7 +190,7 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
     frame->complete = s == 1;
     frame->image = image;
     frame->pixels = pixels;
-    frame->summary = summarise(total, render_ms);
+    frame->summary = total.summary(render_ms);
     frame->request = r;
     publish(std::move(frame));
   }

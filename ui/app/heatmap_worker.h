@@ -67,6 +67,21 @@ struct HeatmapSummary {
   double mean_shadow_prims = 0.0;  ///< per shadow ray
 };
 
+/// Running totals of pixel figures: add() one pixel, merge() another tally
+/// (block tallies merged in block order give the same figures whatever the
+/// threads), summary() the HeatmapSummary of all added.
+struct PixelTally {
+  std::uint64_t rays = 0, hits = 0, valued = 0;
+  double sum_nodes = 0.0, sum_prims = 0.0, sum_instances = 0.0, sum_value = 0.0, max_value = 0.0;
+  std::uint32_t max_nodes = 0, max_prims = 0, max_instances = 0;
+  std::uint64_t shadow_rays = 0, shadowed = 0;
+  double shadow_nodes = 0.0, shadow_prims = 0.0;
+
+  void add(const PixelFigures& p);
+  void merge(const PixelTally& o);
+  HeatmapSummary summary(double render_ms) const;
+};
+
 struct HeatmapFrame {
   std::uint64_t id = 0;
   int stride = 0;                    ///< lattice spacing of this level (1 = every pixel traced)

@@ -15,18 +15,6 @@
 namespace accelviz {
 namespace {
 
-/// shaders/trace_bvh.comp PixelOut: eight 32-bit words per pixel.
-struct GpuPixel {
-  std::uint32_t nodes_visited;
-  std::uint32_t box_tests;
-  std::uint32_t prim_tests;
-  std::uint32_t nodes_culled;
-  std::uint32_t nodes_missed;
-  std::uint32_t prim;
-  float t;
-  std::uint32_t pad;
-};
-static_assert(sizeof(GpuPixel) == 32);
 static_assert(sizeof(Triangle) == 36, "the shader reads triangles as 9 packed floats");
 
 constexpr int kGroup = 8;  // local_size_x/y of trace_bvh.comp
@@ -107,11 +95,8 @@ void GpuBvhTracer::begin(const Camera& camera, int width, int height, const Quer
                          GL_MAP_READ_BIT | GL_CLIENT_STORAGE_BIT);
     out_bytes_ = bytes;
   }
-  // Every pixel untraced until its band runs (all bits set: counters
-  // kUntraced, prim kInvalidId, t a NaN).
-  const std::uint32_t untraced = kUntraced;
-  glClearNamedBufferSubData(out_.id(), GL_R32UI, 0, static_cast<GLsizeiptr>(bytes), GL_RED_INTEGER, GL_UNSIGNED_INT,
-                            &untraced);
+  // Rows not traced yet hold an earlier image: read_pixels marks them
+  // untraced when it reads them (a whole trace never clears anything).
 
   // The per-camera constants of core's camera_ray, computed by the same C++.
   const float aspect = camera_aspect(camera, width, height);
@@ -177,62 +162,114 @@ void GpuBvhTracer::result(GpuTraceResult& r) const {
   r.height = height_;
   r.trace_ms = band_ms_;
   const auto t1 = std::chrono::steady_clock::now();
+  r.stats.resize(n);
+  r.hits.resize(n);
+  read_pixels([&](std::span<const GpuPixel> px) {
+    parallel_for(n, 0, 16384, [&](std::size_t i0, std::size_t i1, unsigned) {
+      for (std::size_t i = i0; i < i1; ++i) {
+        r.stats[i] = stats_of(px[i]);  // every field: the storage may hold an earlier trace
+        r.hits[i] = hit_of(px[i]);
+      }
+    });
+  });
+  r.readback_ms = ms_since(t1);
+}
+
+double GpuBvhTracer::read_pixels(const std::function<void(std::span<const GpuPixel>)>& use) const {
+  if (height_ <= 0) throw std::logic_error("GPU trace: read before begin");
+  const std::size_t n = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
+  const auto t0 = std::chrono::steady_clock::now();
   // Copied on the GPU into the client-memory buffer, read from its mapping
-  // (no copy on the CPU), the pixels converted on all threads.
+  // (no copy on the CPU).
   const auto bytes = static_cast<GLsizeiptr>(n * sizeof(GpuPixel));
+  if (rows_done_ < height_) {
+    // Rows no band has traced: untraced (all bits set: counters kUntraced,
+    // prim kInvalidId, t a NaN).
+    const std::size_t row_bytes = static_cast<std::size_t>(width_) * sizeof(GpuPixel);
+    const std::uint32_t untraced = kUntraced;
+    glClearNamedBufferSubData(out_.id(), GL_R32UI, static_cast<GLintptr>(rows_done_ * row_bytes),
+                              static_cast<GLsizeiptr>((height_ - rows_done_) * row_bytes), GL_RED_INTEGER,
+                              GL_UNSIGNED_INT, &untraced);
+  }
   glCopyNamedBufferSubData(out_.id(), readback_.id(), 0, 0, bytes);
   const auto* px = static_cast<const GpuPixel*>(glMapNamedBufferRange(readback_.id(), 0, bytes, GL_MAP_READ_BIT));
   if (px == nullptr) {
     check_gl_errors("GPU trace readback");
     throw GlError("GPU trace readback: the output buffer could not be mapped");
   }
-  struct Unmap {  // also when the conversion throws (a thread that cannot start)
-    GLuint id;
-    ~Unmap() { glUnmapNamedBuffer(id); }
-  } unmap{readback_.id()};
-  r.stats.resize(n);
-  r.hits.resize(n);
-  parallel_for(n, 0, 16384, [&](std::size_t i0, std::size_t i1, unsigned) {
-    for (std::size_t i = i0; i < i1; ++i) {
-      const GpuPixel& p = px[i];
-      RayStats& s = r.stats[i];
-      s = RayStats{};  // every field: the storage may hold an earlier trace
-      s.nodes_visited = p.nodes_visited;
-      s.box_tests = p.box_tests;
-      s.prim_tests = p.prim_tests;
-      s.nodes_culled = p.nodes_culled;
-      s.nodes_missed = p.nodes_missed;
-      Hit& h = r.hits[i];
-      h = Hit{};
-      if (p.prim != kInvalidId && p.prim < prim_ids_.size()) {
-        h.prim = prim_ids_[p.prim];  // as Bvh::closest_hit maps its leaf-order hit
-        h.ng = normals_[p.prim];
-        h.t = p.t;
-      }
-    }
-  });
+  const double ms = ms_since(t0);
+  {
+    struct Unmap {  // also when `use` throws (a thread that cannot start)
+      GLuint id;
+      ~Unmap() { glUnmapNamedBuffer(id); }
+    } unmap{readback_.id()};
+    use(std::span<const GpuPixel>(px, n));
+  }
   check_gl_errors("GPU trace readback");
-  r.readback_ms = ms_since(t1);
+  return ms;
 }
 
-MetricImage gpu_metric_image(const GpuTraceResult& r, const Camera& camera, const HeatmapOptions& opts,
-                             HeatmapFigures* figures) {
-  if (r.width != opts.width || r.height != opts.height)
-    throw std::invalid_argument("heatmap: the GPU trace is " + std::to_string(r.width) + "x" +
-                                std::to_string(r.height) + ", the options ask for " + std::to_string(opts.width) + "x" +
-                                std::to_string(opts.height));
-  // The rays again on the CPU, for the one metric that needs the direction (shaded).
-  const std::vector<Ray> rays =
-      opts.metric == HeatMetric::shaded ? primary_rays(camera, opts.width, opts.height) : std::vector<Ray>{};
-  return metric_image_from_hits(rays, r.hits, r.stats, opts, r.trace_ms, figures);
+RayStats GpuBvhTracer::stats_of(const GpuPixel& p) {
+  RayStats s;
+  s.nodes_visited = p.nodes_visited;
+  s.box_tests = p.box_tests;
+  s.prim_tests = p.prim_tests;
+  s.nodes_culled = p.nodes_culled;
+  s.nodes_missed = p.nodes_missed;
+  return s;
+}
+
+Hit GpuBvhTracer::hit_of(const GpuPixel& p) const {
+  Hit h;
+  if (is_hit(p)) {
+    h.prim = prim_ids_[p.prim];  // as Bvh::closest_hit maps its leaf-order hit
+    h.ng = normals_[p.prim];
+    h.t = p.t;
+  }
+  return h;
+}
+
+double gpu_metric_image(const GpuBvhTracer& tracer, const Camera& camera, const HeatmapOptions& opts,
+                        HeatmapFigures* figures, MetricImage& into, const GpuBlockVisit& visit) {
+  if (tracer.rows_total() != opts.height || tracer.width() != opts.width)
+    throw std::invalid_argument("heatmap: the GPU trace is " + std::to_string(tracer.width()) + "x" +
+                                std::to_string(tracer.rows_total()) + ", the options ask for " +
+                                std::to_string(opts.width) + "x" + std::to_string(opts.height));
+  const std::size_t n = static_cast<std::size_t>(opts.width) * static_cast<std::size_t>(opts.height);
+  const bool shaded = opts.metric == HeatMetric::shaded;  // the one metric that reads the ray
+  const bool reads_hit = shaded || opts.metric == HeatMetric::depth;
+  const Ray no_ray;
+  const Hit no_hit;
+  return tracer.read_pixels([&](std::span<const GpuPixel> px) {
+    metric_image_by_blocks(
+        n, opts, tracer.trace_ms(), figures,
+        [&](std::size_t i0, std::size_t i1, float* values) {
+          std::uint64_t hit_count = 0;
+          for (std::size_t i = i0; i < i1; ++i) {
+            const Hit hit = reads_hit ? tracer.hit_of(px[i]) : no_hit;
+            const auto w = static_cast<std::size_t>(opts.width);
+            const Ray ray =
+                shaded ? primary_ray(camera, static_cast<int>(i % w), static_cast<int>(i / w), opts.width, opts.height)
+                       : no_ray;
+            values[i - i0] =
+                metric_value(opts.metric, ray, hit, GpuBvhTracer::stats_of(px[i]), opts.c_trav, opts.c_isect);
+            if (tracer.is_hit(px[i])) ++hit_count;
+          }
+          if (visit) visit(i0, px.subspan(i0, i1 - i0), std::span<const float>(values, i1 - i0));
+          return hit_count;
+        },
+        into);
+  });
 }
 
 MetricImage gpu_render_metric(GpuBvhTracer& tracer, const Camera& camera, const HeatmapOptions& opts,
-                              HeatmapFigures* figures, GpuTraceResult* raw) {
+                              HeatmapFigures* figures, double* readback_ms) {
   if (opts.width <= 0 || opts.height <= 0) throw std::invalid_argument("heatmap: image size must be positive");
-  GpuTraceResult r = tracer.trace(camera, opts.width, opts.height, opts.query);
-  MetricImage img = gpu_metric_image(r, camera, opts, figures);
-  if (raw) *raw = std::move(r);
+  tracer.begin(camera, opts.width, opts.height, opts.query);
+  tracer.trace_rows(opts.height);
+  MetricImage img;
+  const double ms = gpu_metric_image(tracer, camera, opts, figures, img);
+  if (readback_ms) *readback_ms = ms;
   return img;
 }
 

@@ -10,6 +10,8 @@
 // heatmap's metric values, colour map, legend and PNG writing are core's
 // (metric_value, colorize, write_png): only the tracing moves.
 #include <cstdint>
+#include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -21,6 +23,22 @@
 #include "ui/gl/shader.h"
 
 namespace accelviz {
+
+/// One pixel as the shader writes it (shaders/trace_bvh.comp PixelOut, eight
+/// 32-bit words): the five counters, the hit triangle in the BVH's leaf
+/// order (kInvalidId on a miss) and the hit distance. Read in place through
+/// GpuBvhTracer::read_pixels; stats_of and hit_of give core's forms.
+struct GpuPixel {
+  std::uint32_t nodes_visited;
+  std::uint32_t box_tests;
+  std::uint32_t prim_tests;
+  std::uint32_t nodes_culled;
+  std::uint32_t nodes_missed;
+  std::uint32_t prim;
+  float t;
+  std::uint32_t pad;
+};
+static_assert(sizeof(GpuPixel) == 32);
 
 /// What one GPU trace returns: per pixel, row-major from the top row, the
 /// same figures `Bvh::closest_hit(ray, query, &stats)` gives on the CPU.
@@ -73,8 +91,10 @@ class GpuBvhTracer {
 
   // ---- in row bands (the GUI spreads one image over its frames) ----------
   /// Starts a banded trace of a W×H image: fixes the camera, size and query
-  /// and marks every pixel untraced (all counters kUntraced, a miss). Throws
-  /// like trace(). A pixel traced in any band gets exactly trace()'s figures.
+  /// and marks every pixel untraced: until a band traces its row, a pixel
+  /// reads (read_pixels, result) with all counters kUntraced and a miss.
+  /// Throws like trace(). A pixel traced in any band gets exactly trace()'s
+  /// figures.
   void begin(const Camera& camera, int width, int height, const QueryOptions& query);
   /// Dispatches the next band, rows [rows_done(), rows_done() + rows)
   /// clipped to the image, and waits for it (glFinish). Returns the band's
@@ -82,16 +102,34 @@ class GpuBvhTracer {
   /// without begin(), std::invalid_argument for rows < 1, GlError.
   double trace_rows(int rows);
   int rows_done() const { return rows_done_; }
+  int width() const { return width_; }          ///< of the trace begun last
+  double trace_ms() const { return band_ms_; }  ///< its bands' wall ms so far
   int rows_total() const { return height_; }
   bool finished() const { return height_ > 0 && rows_done_ >= height_; }
-  /// Reads the whole image back as it stands (untraced rows as begin() left
-  /// them); trace_ms is the sum of the bands so far.
+  /// Reads the whole image back as it stands (rows no band traced yet read
+  /// untraced); trace_ms is the sum of the bands so far.
   GpuTraceResult result() const;
   /// The same into `into`, reusing its vectors' storage: a 1920x1080 result
   /// is about 140 MB, and a fresh one costs more to allocate and first touch
   /// than the GPU takes to trace it (measured, docs/performance.md "GPU path").
   void result(GpuTraceResult& into) const;
-  /// What begin() writes into every counter of an untraced pixel.
+  /// Reads the image as it stands in place: copies it on the GPU into a
+  /// buffer in client memory, maps that and calls `use` with its pixels
+  /// (row-major from the top row; rows no band traced yet read untraced), then
+  /// unmaps it, also when `use` throws. `use` may read them on all threads;
+  /// they are valid only during the call. Returns the ms of the copy and the
+  /// mapping (not of `use`). Throws std::logic_error before begin(), GlError.
+  double read_pixels(const std::function<void(std::span<const GpuPixel>)>& use) const;
+  /// A pixel's counters as core's RayStats (the others 0).
+  static RayStats stats_of(const GpuPixel& p);
+  /// A pixel's hit as Bvh::closest_hit gives it: prim in scene order, t, and
+  /// the triangle's triangle_normal (u, v 0); a miss is Hit{}.
+  Hit hit_of(const GpuPixel& p) const;
+  /// Whether hit_of(p) is a hit.
+  bool is_hit(const GpuPixel& p) const { return p.prim != kInvalidId && p.prim < prim_ids_.size(); }
+  /// hit_of(p).prim alone: the scene-order triangle, kInvalidId on a miss.
+  std::uint32_t scene_prim(const GpuPixel& p) const { return is_hit(p) ? prim_ids_[p.prim] : kInvalidId; }
+  /// Every counter of an untraced pixel (see begin()).
   static constexpr std::uint32_t kUntraced = 0xFFFFFFFFu;
 
  private:
@@ -110,15 +148,27 @@ class GpuBvhTracer {
   double band_ms_ = 0.0;  ///< its bands' wall ms so far
 };
 
-/// The metric image of a finished GPU trace (metric_image_from_hits over
-/// core's primary rays of `camera`); render_ms is r.trace_ms.
-MetricImage gpu_metric_image(const GpuTraceResult& r, const Camera& camera, const HeatmapOptions& opts,
-                             HeatmapFigures* figures = nullptr);
+/// Called once per block of a GPU metric image with the block's first pixel,
+/// its pixels and their values (on all threads, for disjoint blocks).
+using GpuBlockVisit =
+    std::function<void(std::size_t i0, std::span<const GpuPixel> pixels, std::span<const float> values)>;
+
+/// The metric image of the trace begun last on `tracer` (its bands so far;
+/// render_ms is their trace time), made in one pass over the pixels read in
+/// place (read_pixels: no GpuTraceResult), into `into` (storage reused):
+/// metric_value of each pixel's stats_of, hit_of and, for the shaded metric
+/// alone, core's primary_ray of `camera`, block by block on all threads
+/// (metric_image_by_blocks), `visit` (when given) called after each block.
+/// Returns read_pixels' ms. Throws std::invalid_argument when the trace's
+/// size is not opts' size, and as read_pixels.
+double gpu_metric_image(const GpuBvhTracer& tracer, const Camera& camera, const HeatmapOptions& opts,
+                        HeatmapFigures* figures, MetricImage& into, const GpuBlockVisit& visit = {});
 
 /// render_metric on the GPU: the same MetricImage (and figures; render_ms is
 /// the GPU trace time) as core's render_metric(bvh, camera, opts) gives,
-/// through metric_value. opts.threads and opts.progress are not used.
+/// through metric_value. opts.progress is not used. `readback_ms`, when
+/// given, gets read_pixels' ms.
 MetricImage gpu_render_metric(GpuBvhTracer& tracer, const Camera& camera, const HeatmapOptions& opts,
-                              HeatmapFigures* figures = nullptr, GpuTraceResult* raw = nullptr);
+                              HeatmapFigures* figures = nullptr, double* readback_ms = nullptr);
 
 }  // namespace accelviz
