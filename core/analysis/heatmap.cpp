@@ -101,22 +101,44 @@ float metric_value(HeatMetric m, const Ray& ray, const Hit& hit, const RayStats&
 MetricImage render_metric(const Accelerator& accel, const Camera& camera, const HeatmapOptions& opts,
                           HeatmapFigures* figures) {
   if (opts.width <= 0 || opts.height <= 0) throw std::invalid_argument("heatmap: image size must be positive");
-  const std::vector<Ray> rays = primary_rays(camera, opts.width, opts.height);
-  std::vector<Hit> hits(rays.size());
-  std::vector<RayStats> stats(metric_needs_stats(opts.metric) ? rays.size() : 0);
-  BatchOptions batch;
-  batch.threads = opts.threads;
-  batch.progress = opts.progress;
-  // Coherent primary rays: small chunks keep neighbouring pixels on one thread
-  // while still balancing uneven regions.
-  batch.chunk = 64;
-
+  const std::size_t n = static_cast<std::size_t>(opts.width) * static_cast<std::size_t>(opts.height);
+  const bool counted = metric_needs_stats(opts.metric);
+  // Each block's pixels traced and turned into values on the way, 64 rays at a
+  // time (one closest_hits call: a BVH walks them several rays in turns), so
+  // no image-sized array of rays, hits or counters is made: at 1920x1080 those
+  // were 200 MB to allocate and touch, more than the tracing took.
+  constexpr std::size_t kRun = 64;
+  static_assert(kMetricBlock % kRun == 0);
+  const auto w = static_cast<std::size_t>(opts.width);
+  MetricImage img;
   const auto t0 = std::chrono::steady_clock::now();
-  const bool done = trace_closest(accel, rays, hits, opts.query, batch, stats);
-  const double ms = ms_since(t0);
+  const bool done = metric_image_by_blocks(
+      n, opts, 0.0, figures,
+      [&](std::size_t i0, std::size_t i1, float* values) {
+        std::array<Ray, kRun> rays;
+        std::array<Hit, kRun> hits;
+        std::array<RayStats, kRun> stats;
+        std::uint64_t hit_count = 0;
+        for (std::size_t r0 = i0; r0 < i1; r0 += kRun) {
+          const std::size_t count = std::min(kRun, i1 - r0);
+          for (std::size_t k = 0; k < count; ++k) {
+            const std::size_t i = r0 + k;
+            rays[k] = primary_ray(camera, static_cast<int>(i % w), static_cast<int>(i / w), opts.width, opts.height);
+            stats[k] = RayStats{};
+          }
+          accel.closest_hits(std::span<const Ray>(rays.data(), count), std::span<Hit>(hits.data(), count), opts.query,
+                             counted ? std::span<RayStats>(stats.data(), count) : std::span<RayStats>{});
+          for (std::size_t k = 0; k < count; ++k) {
+            values[r0 - i0 + k] = metric_value(opts.metric, rays[k], hits[k], stats[k], opts.c_trav, opts.c_isect);
+            if (hits[k].valid()) ++hit_count;
+          }
+        }
+        return hit_count;
+      },
+      img);
   if (!done) throw BuildCancelled();
-
-  return metric_image_from_hits(rays, hits, stats, opts, ms, figures);
+  if (figures) set_render_time(*figures, ms_since(t0));
+  return img;
 }
 
 MetricImage metric_image_from_hits(std::span<const Ray> rays, std::span<const Hit> hits,
@@ -128,8 +150,10 @@ MetricImage metric_image_from_hits(std::span<const Ray> rays, std::span<const Hi
   const RayStats none;
   const Ray no_ray;
   MetricImage img;
+  HeatmapOptions no_progress = opts;  // values of traced rays: nothing to cancel
+  no_progress.progress = nullptr;
   metric_image_by_blocks(
-      n, opts, trace_ms, figures,
+      n, no_progress, trace_ms, figures,
       [&](std::size_t i0, std::size_t i1, float* values) {
         std::uint64_t hit_count = 0;
         for (std::size_t i = i0; i < i1; ++i) {
@@ -143,7 +167,12 @@ MetricImage metric_image_from_hits(std::span<const Ray> rays, std::span<const Hi
   return img;
 }
 
-void metric_image_by_blocks(std::size_t n, const HeatmapOptions& opts, double trace_ms, HeatmapFigures* figures,
+void set_render_time(HeatmapFigures& figures, double render_ms) {
+  figures.render_ms = render_ms;
+  figures.rays_per_s = render_ms > 0.0 ? static_cast<double>(figures.rays) / (render_ms * 1e-3) : 0.0;
+}
+
+bool metric_image_by_blocks(std::size_t n, const HeatmapOptions& opts, double trace_ms, HeatmapFigures* figures,
                             const MetricBlockFill& fill, MetricImage& into) {
   into.width = opts.width;
   into.height = opts.height;
@@ -156,7 +185,9 @@ void metric_image_by_blocks(std::size_t n, const HeatmapOptions& opts, double tr
     std::uint64_t counted = 0, hits = 0;
   };
   std::vector<Block> blocks((n + kMetricBlock - 1) / kMetricBlock);
-  parallel_for(blocks.size(), opts.threads, 4, [&](std::size_t b0, std::size_t b1, unsigned) {
+  BatchOptions batch{.threads = opts.threads, .chunk = 1};
+  batch.progress = opts.progress;
+  const bool done = for_each_chunk(blocks.size(), batch, [&](std::size_t b0, std::size_t b1) {
     for (std::size_t b = b0; b < b1; ++b) {
       Block& blk = blocks[b];
       const std::size_t i0 = b * kMetricBlock, i1 = std::min(n, i0 + kMetricBlock);
@@ -186,9 +217,9 @@ void metric_image_by_blocks(std::size_t n, const HeatmapOptions& opts, double tr
     figures->hits = hit_count;
     figures->mean = counted ? sum / static_cast<double>(counted) : 0.0;
     figures->max = max;
-    figures->render_ms = trace_ms;
-    figures->rays_per_s = trace_ms > 0.0 ? static_cast<double>(n) / (trace_ms * 1e-3) : 0.0;
+    set_render_time(*figures, trace_ms);
   }
+  return done;
 }
 
 // ---- images --------------------------------------------------------------------

@@ -97,16 +97,26 @@ using MetricBlockFill = std::function<std::uint64_t(std::size_t i0, std::size_t 
 /// Pixels per block of metric_image_by_blocks (the last block may be shorter).
 inline constexpr std::size_t kMetricBlock = 4096;
 
-/// The metric image of `n` traced pixels made in blocks of kMetricBlock on
-/// all threads (opts.threads), each filled by `fill`, into `into` (its
-/// storage reused: the same size allocates nothing), with `figures` (when
-/// given) as metric_image_from_hits computes them: each block's sum,
-/// maximum and counts are combined in block order, so they do not depend on
-/// the threads. opts gives the size and metric; `n` is the pixel count.
-void metric_image_by_blocks(std::size_t n, const HeatmapOptions& opts, double trace_ms, HeatmapFigures* figures,
+/// The metric image of `n` pixels made in blocks of kMetricBlock on
+/// opts.threads threads (dynamic balancing), each filled by `fill`, into
+/// `into` (its storage reused: the same size allocates nothing), with
+/// `figures` (when given): rays, hits, the mean and maximum over finite
+/// values (each block's sum, maximum and counts combined in block order, so
+/// they do not depend on the threads), render_ms `trace_ms`. opts gives the
+/// size and metric; opts.progress, when set, hears the fraction of blocks
+/// done (as for_each_chunk reports it), and false stops the blocks not yet
+/// started: then returns false and the image is incomplete.
+bool metric_image_by_blocks(std::size_t n, const HeatmapOptions& opts, double trace_ms, HeatmapFigures* figures,
                             const MetricBlockFill& fill, MetricImage& into);
 
-/// Traces one primary ray per pixel and returns the metric image.
+/// Sets render_ms and rays_per_s (figures.rays per render_ms) of `figures`.
+void set_render_time(HeatmapFigures& figures, double render_ms);
+
+/// Traces one primary ray per pixel and returns the metric image: block by
+/// block on opts.threads threads, each block's rays made, traced (counted
+/// when the metric needs statistics) and turned into values in turn, without
+/// image-sized arrays of rays, hits or counters. figures->render_ms is the
+/// wall time of that pass. Throws BuildCancelled when opts.progress cancels.
 MetricImage render_metric(const Accelerator& accel, const Camera& camera, const HeatmapOptions& opts,
                           HeatmapFigures* figures = nullptr);
 

@@ -376,6 +376,77 @@ TEST(Batch, ClosestHitsOfASpanEqualClosestHitPerRay) {
   }
 }
 
+TEST(Heatmap, RenderedBlockByBlockEveryPixelIsItsOwnRaysValueOnAnyThreads) {
+  // render_metric traces each block of 4096 pixels 64 rays at a time, making
+  // each ray from its pixel index: 131x67 = 8,777 pixels are two whole blocks
+  // and a partial one, rows not a multiple of 64 wide, a last run of 9 rays.
+  // Every pixel's value is metric_value of its own ray, hit and counters
+  // (Bvh::closest_hit one ray at a time), the figures are those of one pass,
+  // on 1, 2 and 3 threads; a cancel mid-image throws.
+  const Scene scene = [] {
+    Scene s;
+    s.triangles = tiny_scene();
+    for (int k = 0; k < 40; ++k) {
+      const float x = -3.0f + 0.15f * static_cast<float>(k), z = -0.5f * static_cast<float>(k % 5);
+      s.triangles.push_back({{x, -2.5f, z}, {x + 0.4f, -2.5f, z}, {x + 0.2f, 2.5f, z + 0.3f}});
+    }
+    return s;
+  }();
+  const Bvh bvh(scene.triangles);
+  const Camera cam = tiny_camera();
+  const int w = 131, h = 67;
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  for (HeatMetric metric : {HeatMetric::nodes, HeatMetric::cost, HeatMetric::depth, HeatMetric::shaded}) {
+    HeatmapOptions opts{.metric = metric, .width = w, .height = h, .c_trav = 1.25f, .c_isect = 0.75f};
+    std::vector<float> expect(n);
+    std::uint64_t hit_count = 0, counted = 0;
+    double sum = 0.0, max = 0.0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const Ray ray = primary_ray(cam, x, y, w, h);
+        RayStats st;
+        const Hit hit = bvh.closest_hit(ray, opts.query, &st);
+        const float v = metric_value(metric, ray, hit, st, opts.c_trav, opts.c_isect);
+        expect[static_cast<std::size_t>(y) * w + x] = v;
+        hit_count += hit.valid();
+        if (std::isfinite(v)) {
+          sum += v;
+          max = std::max<double>(max, v);
+          ++counted;
+        }
+      }
+    ASSERT_GT(hit_count, n / 10);
+    ASSERT_LT(hit_count, n);
+    double mean_one_thread = 0.0;
+    for (unsigned threads : {1u, 2u, 3u}) {
+      opts.threads = threads;
+      HeatmapFigures fig;
+      const MetricImage img = render_metric(bvh, cam, opts, &fig);
+      ASSERT_EQ(img.values.size(), n);
+      for (std::size_t i = 0; i < n; ++i)
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(img.values[i]), std::bit_cast<std::uint32_t>(expect[i]))
+            << metric_name(metric) << " pixel " << i << " on " << threads << " threads";
+      EXPECT_EQ(fig.rays, n);
+      EXPECT_EQ(fig.hits, hit_count);
+      EXPECT_DOUBLE_EQ(fig.max, max);
+      EXPECT_NEAR(fig.mean, sum / static_cast<double>(counted), 1e-12 * std::max(1.0, max));
+      if (threads == 1) mean_one_thread = fig.mean;
+      EXPECT_EQ(fig.mean, mean_one_thread);  // combined in block order whatever the threads
+      EXPECT_GT(fig.render_ms, 0.0);
+      EXPECT_DOUBLE_EQ(fig.rays_per_s, static_cast<double>(n) / (fig.render_ms * 1e-3));
+    }
+  }
+  int reports = 0;
+  HeatmapOptions cancelled{.width = w, .height = h, .threads = 2};
+  cancelled.progress = [&](double fraction) {
+    EXPECT_GT(fraction, 0.0);
+    EXPECT_LE(fraction, 1.0);
+    return ++reports < 2;
+  };
+  EXPECT_THROW(render_metric(bvh, cam, cancelled), BuildCancelled);
+  EXPECT_GE(reports, 2);
+}
+
 TEST(Heatmap, FiguresOfManyBlocksAreTheOnePassOnesOnAnyThreads) {
   // 30,000 pixels: several of metric_image_from_hits' blocks of 4096, with
   // hits, misses and counters that vary; the image and figures equal a plain

@@ -240,8 +240,9 @@ double gpu_metric_image(const GpuBvhTracer& tracer, const Camera& camera, const 
   const bool reads_hit = shaded || opts.metric == HeatMetric::depth;
   const Ray no_ray;
   const Hit no_hit;
-  return tracer.read_pixels([&](std::span<const GpuPixel> px) {
-    metric_image_by_blocks(
+  bool done = false;
+  const double ms = tracer.read_pixels([&](std::span<const GpuPixel> px) {
+    done = metric_image_by_blocks(
         n, opts, tracer.trace_ms(), figures,
         [&](std::size_t i0, std::size_t i1, float* values) {
           std::uint64_t hit_count = 0;
@@ -260,6 +261,8 @@ double gpu_metric_image(const GpuBvhTracer& tracer, const Camera& camera, const 
         },
         into);
   });
+  if (!done) throw BuildCancelled();
+  return ms;
 }
 
 MetricImage gpu_render_metric(GpuBvhTracer& tracer, const Camera& camera, const HeatmapOptions& opts,

@@ -160,13 +160,14 @@ using GpuBlockVisit =
 /// alone, core's primary_ray of `camera`, block by block on all threads
 /// (metric_image_by_blocks), `visit` (when given) called after each block.
 /// Returns read_pixels' ms. Throws std::invalid_argument when the trace's
-/// size is not opts' size, and as read_pixels.
+/// size is not opts' size, BuildCancelled when opts.progress cancels, and as
+/// read_pixels.
 double gpu_metric_image(const GpuBvhTracer& tracer, const Camera& camera, const HeatmapOptions& opts,
                         HeatmapFigures* figures, MetricImage& into, const GpuBlockVisit& visit = {});
 
 /// render_metric on the GPU: the same MetricImage (and figures; render_ms is
 /// the GPU trace time) as core's render_metric(bvh, camera, opts) gives,
-/// through metric_value. opts.progress is not used. `readback_ms`, when
+/// through metric_value. `readback_ms`, when
 /// given, gets read_pixels' ms.
 MetricImage gpu_render_metric(GpuBvhTracer& tracer, const Camera& camera, const HeatmapOptions& opts,
                               HeatmapFigures* figures = nullptr, double* readback_ms = nullptr);
