@@ -19,7 +19,6 @@
 
 #include "core/query/batch.h"
 #include "core/query/camera.h"
-#include "core/query/ray_sets.h"
 #include "core/util/parallel.h"
 #include "core/util/timing.h"
 

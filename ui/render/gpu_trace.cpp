@@ -8,7 +8,6 @@
 #include <stdexcept>
 
 #include "core/query/camera.h"
-#include "core/query/ray_sets.h"
 #include "core/util/parallel.h"
 #include "core/util/timing.h"
 

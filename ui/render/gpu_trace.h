@@ -6,8 +6,9 @@
 // (OsMesaContext headless, the GUI's window context); every call must come
 // from the thread that context is current on.
 //
-// The per-pixel figures come back as core's RayStats and Hit, so the
-// heatmap's metric values, colour map, legend and PNG writing are core's
+// The per-pixel figures are read in place (read_pixels) and turned into
+// core's RayStats and Hit per pixel (stats_of, hit_of), so the heatmap's
+// metric values, colour map, legend and PNG writing are core's
 // (metric_value, colorize, write_png): only the tracing moves.
 #include <cstdint>
 #include <functional>
