@@ -239,6 +239,7 @@ double gpu_metric_image(const GpuBvhTracer& tracer, const Camera& camera, const 
   const bool reads_hit = shaded || opts.metric == HeatMetric::depth;
   const Ray no_ray;
   const Hit no_hit;
+  const auto w = static_cast<std::size_t>(opts.width);
   bool done = false;
   const double ms = tracer.read_pixels([&](std::span<const GpuPixel> px) {
     done = metric_image_by_blocks(
@@ -247,7 +248,6 @@ double gpu_metric_image(const GpuBvhTracer& tracer, const Camera& camera, const 
           std::uint64_t hit_count = 0;
           for (std::size_t i = i0; i < i1; ++i) {
             const Hit hit = reads_hit ? tracer.hit_of(px[i]) : no_hit;
-            const auto w = static_cast<std::size_t>(opts.width);
             const Ray ray =
                 shaded ? primary_ray(camera, static_cast<int>(i % w), static_cast<int>(i / w), opts.width, opts.height)
                        : no_ray;

@@ -84,7 +84,6 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
   for (const BvhNode& n : nodes_) block_count += bvh_detail::tri4_block_count(n.count);
   leaf_block_.assign(nodes_.size(), 0);
   HugePageVector<std::uint32_t> leaf_order;
-  leaf_order.reserve(nodes_.size() / 2 + 1);
   std::size_t wide_bytes = 0;
   if (opts_.wide_traversal && !nodes_.empty()) {
     const int merge = opts_.wide_merge_blocks >= 0                                        ? opts_.wide_merge_blocks
@@ -102,10 +101,13 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
     }
     stats_.extra["wide_width"] = width;
   } else {
+    // A binary tree of n nodes has (n + 1) / 2 leaves: every entry is written.
+    leaf_order.resize((nodes_.size() + 1) / 2);
     std::uint32_t next_block = 0;
+    std::size_t at = 0;
     for (std::uint32_t i = 0; i < nodes_.size(); ++i)
       if (nodes_[i].count > 0)
-        next_block = bvh_detail::append_leaf_blocks(nodes_, i, next_block, leaf_order, leaf_block_);
+        next_block = bvh_detail::place_leaf_blocks(nodes_, i, next_block, leaf_order[at++], leaf_block_);
   }
   const double wide_ms = ms_since(t0) - topology_ms;
   blocks_.resize(block_count);  // default-initialised: not written here (HugePageAllocator)

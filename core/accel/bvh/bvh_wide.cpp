@@ -311,9 +311,7 @@ void lay_out_leaf_blocks(WideBvhT<W>& wide, std::span<const BvhNode> binary, Hug
       if (is_leaf_slot(w, s)) {
         const std::uint32_t first = next;
         for_each_leaf_under(binary, wide.source[W * w + s], [&](std::uint32_t leaf) {
-          leaf_order[at++] = leaf;
-          leaf_block[leaf] = next;
-          next += tri4_block_count(binary[leaf].count);
+          next = place_leaf_blocks(binary, leaf, next, leaf_order[at++], leaf_block);
         });
         wide.nodes[w].child[s] = first;
         wide.nodes[w].meta[s] = next - first;

@@ -65,14 +65,14 @@ void for_each_leaf_under(std::span<const BvhNode> binary, std::uint32_t node, co
   for_each_leaf_under(binary, binary[node].index + 1, f);
 }
 
-/// One step of laying the triangle blocks out: binary leaf `leaf` goes next
-/// in `leaf_order`, from block `next` on (leaf_block[leaf] = next). Returns
-/// the block after its last. Class Bvh without a wide copy lays its leaves
-/// out with it, in node order (lay_out_leaf_blocks does the same per slot).
-inline std::uint32_t append_leaf_blocks(std::span<const BvhNode> binary, std::uint32_t leaf, std::uint32_t next,
-                                        HugePageVector<std::uint32_t>& leaf_order,
-                                        std::span<std::uint32_t> leaf_block) {
-  leaf_order.push_back(leaf);
+/// One step of laying the triangle blocks out: binary leaf `leaf` takes the
+/// leaf-order entry `order_entry`, its blocks from block `next` on
+/// (leaf_block[leaf] = next). Returns the block after its last. Both
+/// layouts place their leaves with it: class Bvh without a wide copy in node
+/// order, lay_out_leaf_blocks per leaf slot.
+inline std::uint32_t place_leaf_blocks(std::span<const BvhNode> binary, std::uint32_t leaf, std::uint32_t next,
+                                       std::uint32_t& order_entry, std::span<std::uint32_t> leaf_block) {
+  order_entry = leaf;
   leaf_block[leaf] = next;
   return next + tri4_block_count(binary[leaf].count);
 }
