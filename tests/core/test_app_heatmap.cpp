@@ -70,16 +70,27 @@ TEST(AppHeatmap, LevelsRefineToExactlyWhatRenderComputes) {
     EXPECT_EQ(frames[0]->summary.rays, coarse);
     EXPECT_EQ(frames[3]->summary.rays, static_cast<std::uint64_t>(w) * h);
 
-    // Coarse levels: every pixel shows its block's sample.
-    for (const auto& f : frames)
+    // Coarse levels: every pixel shows its block's sample, in the image and
+    // in its figures; a level holds the figures of its lattice points only.
+    const HeatmapFrame& last = *frames[3];
+    for (const auto& f : frames) {
+      const int s = f->stride;
+      ASSERT_EQ(f->lattice_width(), (w + s - 1) / s);
+      ASSERT_EQ(f->pixels.size(), static_cast<std::size_t>(f->lattice_width()) * ((h + s - 1) / s)) << "stride " << s;
       for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
-          const int s = f->stride;
-          ASSERT_TRUE(same_value(f->image.at(x, y), f->image.at(x / s * s, y / s * s)))
+          const int bx = x / s * s, by = y / s * s;
+          ASSERT_TRUE(same_value(f->image.at(x, y), f->image.at(bx, by)))
               << "stride " << s << " pixel " << x << "," << y;
-          ASSERT_TRUE(same_value(f->image.at(x / s * s, y / s * s), frames[3]->image.at(x / s * s, y / s * s)))
+          ASSERT_TRUE(same_value(f->image.at(bx, by), last.image.at(bx, by)))
               << "a sample keeps its exact value at every level";
+          const PixelFigures &p = f->at(x, y), &q = last.at(bx, by);
+          ASSERT_TRUE(same_value(p.value, f->image.at(x, y))) << "stride " << s << " pixel " << x << "," << y;
+          ASSERT_TRUE(same_value(p.value, q.value) && p.nodes == q.nodes && p.prims == q.prims && p.prim == q.prim &&
+                      same_value(p.t, q.t))
+              << "stride " << s << " pixel " << x << "," << y << ": the figures of its block's sample";
         }
+    }
 
     // The last level is core's heatmap, bit for bit.
     HeatmapFigures fig;

@@ -91,60 +91,84 @@ HeatmapSummary summarise_pixels(std::span<const PixelFigures> pixels, double ren
   return a.summary(render_ms);
 }
 
+namespace {
+
+/// Lattice points of spacing s across n pixels: 0, s, 2s, ...
+int lattice_count(int n, int s) {
+  return (n + s - 1) / s;
+}
+
+}  // namespace
+
 bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::function<bool()>& keep_going,
                        const std::function<void(std::shared_ptr<const HeatmapFrame>)>& publish) {
   const HeatmapOptions& o = r.options;
   const int w = o.width, h = o.height;
   if (w <= 0 || h <= 0 || !r.structure || !r.structure->accel) return true;
   const Accelerator& accel = *r.structure->accel;
-  const std::size_t n = static_cast<std::size_t>(w) * h;
-
-  MetricImage image;
-  image.width = w;
-  image.height = h;
-  image.metric = o.metric;
-  image.values.assign(n, std::numeric_limits<float>::quiet_NaN());
-  std::vector<PixelFigures> pixels(n);
   const unsigned threads = resolve_threads(o.threads);
 
   int coarsest = 1;
   while (coarsest * 2 <= std::max(1, r.coarsest)) coarsest *= 2;
 
+  // Each level's frame holds its own lattice's figures only (HeatmapFrame::
+  // pixels), so no level copies or fills image-sized figures: a level takes
+  // the points it shares with the level before from that level's frame
+  // (immutable once published) and traces the rest into its own.
+  std::shared_ptr<const HeatmapFrame> prev;
   PixelTally total;
   double render_ms = 0.0;
   for (int s = coarsest; s >= 1; s /= 2) {
-    // Lattice s: rows y ≡ 0 (mod s). Below the coarsest level, rows that
-    // were already lattice rows of 2s only need their odd multiples of s.
-    std::vector<int> rows;
-    for (int y = 0; y < h; y += s) rows.push_back(y);
+    const int lw = lattice_count(w, s), lh = lattice_count(h, s);
+    auto frame = std::make_shared<HeatmapFrame>();
+    frame->id = id;
+    frame->stride = s;
+    frame->complete = s == 1;
+    frame->request = r;
+    MetricImage& image = frame->image;
+    image.width = w;
+    image.height = h;
+    image.metric = o.metric;
+    std::vector<PixelFigures>& pixels = frame->pixels;
+    pixels.resize(static_cast<std::size_t>(lw) * lh);
+    // The last level writes its values straight into its image.
+    if (s == 1) image.values.resize(static_cast<std::size_t>(w) * h);
+
+    // Lattice s: rows y = 0, s, 2s, ... Below the coarsest level, the rows
+    // of the lattice 2s only need their odd multiples of s; their even ones
+    // come from the frame before.
     std::vector<PixelTally> acc(threads);
     std::atomic<bool> stopped{false};
     const auto t0 = std::chrono::steady_clock::now();
-    parallel_for(rows.size(), threads, 1, [&](std::size_t b, std::size_t e, unsigned ti) {
+    parallel_for(static_cast<std::size_t>(lh), threads, 1, [&](std::size_t b, std::size_t e, unsigned ti) {
       std::vector<Ray> row_rays;
       std::vector<Hit> row_hits;
       std::vector<RayStats> row_stats;
-      for (std::size_t i = b; i < e; ++i) {
+      for (std::size_t ly = b; ly < e; ++ly) {
         if (stopped.load(std::memory_order_relaxed) || !keep_going()) {
           stopped = true;
           return;
         }
-        const int y = rows[i];
-        const bool done_before = s < coarsest && y % (2 * s) == 0;
+        const int y = static_cast<int>(ly) * s;
+        PixelFigures* row = pixels.data() + ly * lw;
+        const bool done_before = prev && ly % 2 == 0;
+        if (done_before) {
+          const PixelFigures* from = prev->pixels.data() + (ly / 2) * prev->lattice_width();
+          for (int lx = 0; lx < lw; lx += 2) row[lx] = from[lx / 2];
+        }
         // The row's pixels in one closest_hits call: a BVH walks them
         // several rays in turns (the counted walk render_metric runs).
-        const int x0 = done_before ? s : 0, dx = done_before ? 2 * s : s;
+        const int lx0 = done_before ? 1 : 0, dlx = done_before ? 2 : 1;
         row_rays.clear();
-        for (int x = x0; x < w; x += dx) row_rays.push_back(primary_ray(r.camera, x, y, w, h));
+        for (int lx = lx0; lx < lw; lx += dlx) row_rays.push_back(primary_ray(r.camera, lx * s, y, w, h));
         row_hits.resize(row_rays.size());
         row_stats.assign(row_rays.size(), RayStats{});
         accel.closest_hits(row_rays, row_hits, o.query, row_stats);
         for (std::size_t k = 0; k < row_rays.size(); ++k) {
-          const int x = x0 + static_cast<int>(k) * dx;
           const Ray& ray = row_rays[k];
           const Hit& hit = row_hits[k];
           const RayStats& stats = row_stats[k];
-          PixelFigures& p = pixels[static_cast<std::size_t>(y) * w + x];
+          PixelFigures& p = row[lx0 + static_cast<int>(k) * dlx];
           p.value = metric_value(o.metric, ray, hit, stats, o.c_trav, o.c_isect);
           p.nodes = stats.nodes_visited;
           p.prims = stats.prim_tests;
@@ -160,48 +184,35 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
               p.shadow_nodes += ss.nodes_visited;
               p.shadow_prims += ss.prim_tests;
             }
-          image.values[static_cast<std::size_t>(y) * w + x] = p.value;
           acc[ti].add(p);
         }
+        if (s == 1)
+          for (int x = 0; x < w; ++x) image.values[static_cast<std::size_t>(y) * w + x] = row[x].value;
       }
     });
     render_ms += ms_since(t0);
     if (stopped) return false;
     for (const PixelTally& a : acc) total.merge(a);
 
-    // Every lattice point fills its s×s block; the finer lattices inside
-    // the block are traced later and overwrite their own pixels then. The
-    // lattice rows' blocks are disjoint: on all threads.
-    if (s > 1)
-      parallel_for(rows.size(), threads, 1, [&](std::size_t b, std::size_t e, unsigned) {
-        for (std::size_t i = b; i < e; ++i) {
-          const int y = rows[i];
-          for (int x = 0; x < w; x += s) {
-            const std::size_t src = static_cast<std::size_t>(y) * w + x;
-            for (int by = y; by < std::min(h, y + s); ++by)
-              for (int bx = x; bx < std::min(w, x + s); ++bx) {
-                const std::size_t dst = static_cast<std::size_t>(by) * w + bx;
-                if (dst == src) continue;
-                pixels[dst] = pixels[src];
-                image.values[dst] = image.values[src];
-              }
-          }
+    // A coarse level's image: every lattice point fills its s×s block (the
+    // finer levels trace the block's other pixels later). Each lattice row
+    // is made once and copied to the block's rows; on all threads.
+    if (s > 1) {
+      image.values.resize(static_cast<std::size_t>(w) * h);
+      parallel_for(static_cast<std::size_t>(lh), threads, 1, [&](std::size_t b, std::size_t e, unsigned) {
+        for (std::size_t ly = b; ly < e; ++ly) {
+          const PixelFigures* row = pixels.data() + ly * lw;
+          const int y = static_cast<int>(ly) * s;
+          float* first = image.values.data() + static_cast<std::size_t>(y) * w;
+          for (int x = 0; x < w; ++x) first[x] = row[x / s].value;
+          for (int by = y + 1; by < std::min(h, y + s); ++by)
+            std::copy(first, first + w, image.values.data() + static_cast<std::size_t>(by) * w);
         }
       });
-
-    auto frame = std::make_shared<HeatmapFrame>();
-    frame->id = id;
-    frame->stride = s;
-    frame->complete = s == 1;
-    if (s == 1) {  // the last level: its arrays are not needed any more (83 MB of figures at 1920x1080)
-      frame->image = std::move(image);
-      frame->pixels = std::move(pixels);
-    } else {
-      frame->image = image;
-      frame->pixels = pixels;
     }
+
     frame->summary = total.summary(render_ms);
-    frame->request = r;
+    prev = frame;
     publish(std::move(frame));
   }
   return true;

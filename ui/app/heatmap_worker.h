@@ -84,14 +84,21 @@ struct PixelTally {
 
 struct HeatmapFrame {
   std::uint64_t id = 0;
-  int stride = 0;                    ///< lattice spacing of this level (1 = every pixel traced)
-  bool complete = false;             ///< stride 1 done
-  MetricImage image;                 ///< W×H, block-filled below stride 1
-  std::vector<PixelFigures> pixels;  ///< W×H, row 0 at the top, block-filled like the image
+  int stride = 1;         ///< lattice spacing of this level (1 = every pixel traced)
+  bool complete = false;  ///< stride 1 done
+  MetricImage image;      ///< W×H, block-filled below stride 1
+  /// The figures of the lattice points (x, y multiples of the stride), row
+  /// 0 at the top: lattice_width() × ceil(H / stride); W×H at stride 1.
+  /// Read a pixel's through at(), which maps it to its block's point.
+  std::vector<PixelFigures> pixels;
   HeatmapSummary summary;
   HeatmapRequest request;  ///< what it shows (structure, camera, size, metric)
 
-  const PixelFigures& at(int x, int y) const { return pixels[static_cast<std::size_t>(y) * image.width + x]; }
+  int lattice_width() const { return (image.width + stride - 1) / stride; }
+  /// The figures pixel (x, y) shows: its own at stride 1, its block's below.
+  const PixelFigures& at(int x, int y) const {
+    return pixels[static_cast<std::size_t>(y / stride) * lattice_width() + x / stride];
+  }
 };
 
 /// Traces request `r` level by level, synchronously, calling `publish`
