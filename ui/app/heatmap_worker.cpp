@@ -129,7 +129,7 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
     image.width = w;
     image.height = h;
     image.metric = o.metric;
-    std::vector<PixelFigures>& pixels = frame->pixels;
+    HugePageVector<PixelFigures>& pixels = frame->pixels;
     pixels.resize(static_cast<std::size_t>(lw) * lh);
     // The last level writes its values straight into its image.
     if (s == 1) image.values.resize(static_cast<std::size_t>(w) * h);

@@ -17,6 +17,7 @@
 
 #include "core/accel/accel.h"
 #include "core/analysis/heatmap.h"
+#include "core/util/huge_page_allocator.h"
 #include "ui/app/build_worker.h"
 #include "ui/app/latest_job_worker.h"
 
@@ -90,7 +91,7 @@ struct HeatmapFrame {
   /// The figures of the lattice points (x, y multiples of the stride), row
   /// 0 at the top: lattice_width() × ceil(H / stride); W×H at stride 1.
   /// Read a pixel's through at(), which maps it to its block's point.
-  std::vector<PixelFigures> pixels;
+  HugePageVector<PixelFigures> pixels;
   HeatmapSummary summary;
   HeatmapRequest request;  ///< what it shows (structure, camera, size, metric)
 
