@@ -220,20 +220,27 @@ template <bool AnyHit, bool Ordered, TriangleTest Test>
           continue;
         } else {
           int slot[kWidth], k = 0;
-          while (mask != 0) {
-            slot[k++] = std::countr_zero(static_cast<unsigned>(mask));
-            mask &= mask - 1;
-          }
           if constexpr (Ordered) {
-            // Insertion sort by entry distance; equal distances keep slot order.
-            for (int i = 1; i < k; ++i) {
-              const int v = slot[i];
-              int j = i;
-              while (j > 0 && te[slot[j - 1]] > te[v]) {
-                slot[j] = slot[j - 1];
-                --j;
-              }
-              slot[j] = v;
+            // Nearest first, without branching on the distances
+            // (bvh_wide.h). Two children, the commonest case: the far one
+            // pushed, on to the near one.
+            const unsigned rest = static_cast<unsigned>(mask & (mask - 1));  // not 0: two or more hit
+            if ((rest & (rest - 1)) == 0) {
+              int near, far;
+              bvh_detail::order_two_hit_slots(mask, te, near, far);
+              const std::uint32_t c = n.child[far], m = n.meta[far];
+              prefetch_slot(wide, bvh, c, m);
+              stack[sp++] = {c, m, te[far]};
+              child = n.child[near];
+              meta = n.meta[near];
+              prefetch_slot(wide, bvh, child, meta);
+              continue;
+            }
+            k = bvh_detail::sort_hit_slots<kWidth>(mask, te, slot);
+          } else {
+            while (mask != 0) {
+              slot[k++] = std::countr_zero(static_cast<unsigned>(mask));
+              mask &= mask - 1;
             }
           }
           // The pushed children are visited later: start fetching them now, so
