@@ -276,18 +276,17 @@ void traverse_packet(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView
       }
       if (k != 0) {
         int order[kWidth];
-        for (int i = 0; i < k; ++i) order[i] = AnyHit ? k - 1 - i : i;  // any hit: last slot first
         if constexpr (Ordered && !AnyHit) {
-          // Insertion sort by the packet's nearest entry; ties keep slot order.
-          for (int i = 1; i < k; ++i) {
-            const int v = order[i];
-            int j = i;
-            while (j > 0 && key[order[j - 1]] > key[v]) {
-              order[j] = order[j - 1];
-              --j;
-            }
-            order[j] = v;
-          }
+          // By the packet's nearest entry, ties in slot order, as the
+          // single-ray walk orders its slots (bvh_wide.h).
+          if (k == 1)
+            order[0] = 0;
+          else if (k == 2)
+            bvh_detail::order_two_hit_slots(0b11, key, order[0], order[1]);
+          else
+            bvh_detail::sort_hit_slots<kWidth>((1 << k) - 1, key, order);
+        } else {
+          for (int i = 0; i < k; ++i) order[i] = AnyHit ? k - 1 - i : i;  // any hit: last slot first
         }
         for (int j = k - 1; j >= 1; --j) {
           const int i = order[j];
