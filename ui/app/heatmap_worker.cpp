@@ -1,9 +1,9 @@
 #include "ui/app/heatmap_worker.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <limits>
 
 #include "core/query/camera.h"
 #include "core/scene/effects.h"
