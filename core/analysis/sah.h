@@ -8,17 +8,21 @@
 //
 // Recomputed from the node array alone, independently of what the builder
 // estimated while splitting, so it also measures refitted trees.
-#include "core/accel/bvh/bvh.h"
-
+#include <cstddef>
 #include <cstdint>
 #include <span>
+
+#include "core/accel/bvh/bvh.h"
 
 namespace accelviz {
 
 /// SAH cost of `nodes` (root at 0). 0 for an empty tree. When the root box
 /// has zero area (all primitives on a point or a line) every ratio is taken
-/// as 1: every ray that hits the root then hits every node.
-double bvh_sah_cost(std::span<const BvhNode> nodes, double cost_traversal, double cost_intersect);
+/// as 1: every ray that hits the root then hits every node. Summed in fixed
+/// chunks of kSahChunk nodes, added in chunk order, on `threads` threads (0:
+/// all): the same value, bit for bit, on any number of threads.
+double bvh_sah_cost(std::span<const BvhNode> nodes, double cost_traversal, double cost_intersect, unsigned threads = 1);
+inline constexpr std::size_t kSahChunk = 16384;
 
 /// Counts and depths of a node array (root depth 0).
 struct TreeShape {

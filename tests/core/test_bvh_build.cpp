@@ -17,6 +17,7 @@
 
 #include "core/accel/bvh/bvh.h"
 #include "core/accel/bvh/bvh_build.h"
+#include "core/analysis/sah.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_bvh_build {
@@ -58,10 +59,14 @@ void expect_valid_tree(const Bvh& bvh, std::span<const Triangle> tris, const Bvh
   std::vector<std::uint32_t> depth(nodes.size(), 0);
   std::vector<int> parents(nodes.size(), 0);
   std::size_t leaves = 0;
+  std::uint64_t depth_sum = 0;
+  std::uint32_t max_depth = 0;
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     const BvhNode& n = nodes[i];
     if (n.count > 0) {
       ++leaves;
+      depth_sum += depth[i];
+      max_depth = std::max(max_depth, depth[i]);
       ASSERT_LE(std::uint64_t{n.index} + n.count, ids.size()) << "leaf " << i;
       if (o.splitter == BvhSplitter::median)
         EXPECT_LE(n.count, static_cast<std::uint32_t>(o.max_leaf_size)) << "leaf " << i;
@@ -95,9 +100,18 @@ void expect_valid_tree(const Bvh& bvh, std::span<const Triangle> tris, const Bvh
   for (std::size_t i = 1; i < nodes.size(); ++i) EXPECT_EQ(parents[i], 1) << "node " << i << " parents";
   for (std::size_t p = 0; p < seen.size(); ++p) EXPECT_EQ(seen[p], 1) << "primitive " << p;
   EXPECT_EQ(nodes.size(), 2 * leaves - 1);
+  // The shape, counted by the builder as it made the leaves, and the SAH
+  // cost, summed on the build threads: the finished array's, exactly.
   const BuildStats& st = bvh.build_stats();
   EXPECT_EQ(st.node_count, nodes.size());
   EXPECT_EQ(st.leaf_count, leaves);
+  EXPECT_EQ(st.max_depth, max_depth);
+  EXPECT_EQ(st.avg_leaf_depth, static_cast<double>(depth_sum) / static_cast<double>(leaves));
+  const TreeShape shape = bvh_tree_shape(nodes);
+  EXPECT_EQ(st.leaf_count, shape.leaf_count);
+  EXPECT_EQ(st.max_depth, shape.max_depth);
+  EXPECT_EQ(st.avg_leaf_depth, shape.avg_leaf_depth);
+  EXPECT_EQ(st.sah_cost, bvh_sah_cost(nodes, o.cost_traversal, o.cost_intersect));
 }
 
 std::vector<BvhOptions> option_sets() {
@@ -456,6 +470,7 @@ TEST(BvhBuild, ThreadCountDoesNotChangeTheNodeArray) {
       EXPECT_EQ(std::memcmp(b.nodes().data(), ref.nodes().data(), ref.nodes().size_bytes()), 0);
       EXPECT_EQ(std::memcmp(b.prim_indices().data(), ref.prim_indices().data(), ref.prim_indices().size_bytes()), 0);
       EXPECT_EQ(b.build_stats().sah_cost, ref.build_stats().sah_cost);
+      expect_valid_tree(b, scene, o);  // the shape and SAH figures too, on these threads
       // The triangle blocks, filled on all build threads, hold the same triangles.
       const std::vector<Triangle> got = b.copy_leaf_triangles(), want = ref.copy_leaf_triangles();
       ASSERT_EQ(got.size(), want.size());
