@@ -90,7 +90,8 @@ struct HeatmapFrame {
   MetricImage image;      ///< W×H, block-filled below stride 1
   /// The figures of the lattice points (x, y multiples of the stride), row
   /// 0 at the top: lattice_width() × ceil(H / stride); W×H at stride 1.
-  /// Read a pixel's through at(), which maps it to its block's point.
+  /// Read a pixel's through at(), which maps it to its block's point. On
+  /// huge pages where the system allows (83 MB at 1920×1080 at stride 1).
   HugePageVector<PixelFigures> pixels;
   HeatmapSummary summary;
   HeatmapRequest request;  ///< what it shows (structure, camera, size, metric)

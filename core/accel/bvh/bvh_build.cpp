@@ -15,7 +15,8 @@
 //     layout (children adjacent, left subtree before right subtree, depth
 //     first) is the same whether or not a subtree was built on another thread,
 //     so the node array does not depend on the thread count.
-//  4. Statistics over the finished array (counts, depths, SAH cost).
+//  4. Statistics: counts and depths tallied as the leaves are made (per
+//     thread, merged at each join), the SAH cost over the finished array.
 #include "core/accel/bvh/bvh_build.h"
 
 #include <algorithm>
