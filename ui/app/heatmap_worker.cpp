@@ -129,10 +129,9 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
     image.width = w;
     image.height = h;
     image.metric = o.metric;
+    image.values.resize(static_cast<std::size_t>(w) * h);
     HugePageVector<PixelFigures>& pixels = frame->pixels;
     pixels.resize(static_cast<std::size_t>(lw) * lh);
-    // The last level writes its values straight into its image.
-    if (s == 1) image.values.resize(static_cast<std::size_t>(w) * h);
 
     // Lattice s: rows y = 0, s, 2s, ... Below the coarsest level, the rows
     // of the lattice 2s only need their odd multiples of s; their even ones
@@ -186,30 +185,18 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
             }
           acc[ti].add(p);
         }
-        if (s == 1)
-          for (int x = 0; x < w; ++x) image.values[static_cast<std::size_t>(y) * w + x] = row[x].value;
+        // The image's rows y .. y + s - 1: every lattice point fills its
+        // s×s block (the finer levels trace the block's other pixels later);
+        // at s = 1 each pixel its own value. The row is made once, then copied.
+        float* first = image.values.data() + static_cast<std::size_t>(y) * w;
+        for (int x = 0; x < w; ++x) first[x] = row[x / s].value;
+        for (int by = y + 1; by < std::min(h, y + s); ++by)
+          std::copy(first, first + w, image.values.data() + static_cast<std::size_t>(by) * w);
       }
     });
     render_ms += ms_since(t0);
     if (stopped) return false;
     for (const PixelTally& a : acc) total.merge(a);
-
-    // A coarse level's image: every lattice point fills its s×s block (the
-    // finer levels trace the block's other pixels later). Each lattice row
-    // is made once and copied to the block's rows; on all threads.
-    if (s > 1) {
-      image.values.resize(static_cast<std::size_t>(w) * h);
-      parallel_for(static_cast<std::size_t>(lh), threads, 1, [&](std::size_t b, std::size_t e, unsigned) {
-        for (std::size_t ly = b; ly < e; ++ly) {
-          const PixelFigures* row = pixels.data() + ly * lw;
-          const int y = static_cast<int>(ly) * s;
-          float* first = image.values.data() + static_cast<std::size_t>(y) * w;
-          for (int x = 0; x < w; ++x) first[x] = row[x / s].value;
-          for (int by = y + 1; by < std::min(h, y + s); ++by)
-            std::copy(first, first + w, image.values.data() + static_cast<std::size_t>(by) * w);
-        }
-      });
-    }
 
     frame->summary = total.summary(render_ms);
     prev = frame;
