@@ -60,7 +60,8 @@ struct HeatmapSummary {
   double mean_instances = 0.0;  ///< instances visited per pixel (two-level; 0 elsewhere)
   std::uint32_t max_instances = 0;
   double mean_value = 0.0, max_value = 0.0;  ///< of the metric, over pixels with a value
-  double render_ms = 0.0;                    ///< tracing time of all levels so far (instrumented)
+  double render_ms = 0.0;  ///< tracing time of all levels so far (instrumented; the CPU worker's includes writing each
+                           ///< level's image rows)
   double rays_per_s = 0.0;
   std::uint64_t shadow_rays = 0;   ///< shadow (any-hit) rays traced (0 when the request has no lights)
   std::uint64_t shadowed = 0;      ///< of them, occluded
