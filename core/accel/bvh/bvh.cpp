@@ -18,6 +18,7 @@
 
 #include "core/accel/bvh/bvh_build.h"
 #include "core/accel/bvh/bvh_slab.h"
+#include "core/accel/bvh/bvh_tri8.h"
 #include "core/accel/bvh/bvh_triangle.h"
 #include "core/accel/bvh/bvh_wide.h"
 #include "core/analysis/epo.h"

@@ -70,6 +70,14 @@ struct LeafRay {
       // slot order are the leaf's triangles in order: the same sequence of
       // tests and acceptances as the scalar loop below.
       for (const bvh_detail::TriBlock4* blk = bvh.blocks + child; blk != end; ++blk) {
+#ifdef ACCELVIZ_BVH_WIDE8_AVX2
+        if constexpr (kWidth == 8)
+          if (end - blk >= 2) {
+            if (test_pair<AnyHit>(blk, tmin, closest, best)) return true;
+            ++blk;  // and the loop's
+            continue;
+          }
+#endif
         const int valid = bvh_detail::tri4_used_lanes(*blk);
         bvh_detail::Tri4Result res;
         bvh_detail::intersect_tri4(*blk, tr4_.v, tmin, res);
@@ -101,6 +109,14 @@ struct LeafRay {
       // accepted against the closest hit so far, as the scalar loop below
       // would (t <= tmax is the scalar test's last check).
       for (const bvh_detail::TriBlock4* blk = bvh.blocks + child; blk != end; ++blk) {
+#ifdef ACCELVIZ_BVH_WIDE8_AVX2
+        if constexpr (kWidth == 8)
+          if (end - blk >= 2) {
+            if (test_pair_mt<AnyHit>(blk, tmin, closest, best)) return true;
+            ++blk;  // and the loop's
+            continue;
+          }
+#endif
         const int valid = bvh_detail::tri4_used_lanes(*blk);
         bvh_detail::Tri4MtResult res;
         bvh_detail::intersect_tri4_mt(*blk, tm4_.v, tmin, res);
@@ -131,6 +147,56 @@ struct LeafRay {
       return false;
     }
   }
+
+#ifdef ACCELVIZ_BVH_WIDE8_AVX2
+  /// The watertight test on blocks blk[0] and blk[1] at once (8-wide walk
+  /// only, bvh_tri8.h): the lanes' figures are the four-lane test's, and
+  /// they are accepted lane by lane in leaf order as test() does.
+  template <bool AnyHit>
+  [[gnu::always_inline]] bool test_pair(const bvh_detail::TriBlock4* blk, float tmin, float& closest, Hit& best) {
+    bvh_detail::Tri8Result res;
+    bvh_detail::intersect_tri8(blk, wr_.v, tmin, res);
+    int lanes = (res.candidate | res.special) & bvh_detail::tri8_used_lanes(blk);
+    while (lanes != 0) {
+      const int l = std::countr_zero(static_cast<unsigned>(lanes));
+      lanes &= lanes - 1;
+      const bvh_detail::TriBlock4& b = blk[l >> 2];
+      float t, u, v;
+      bool hit;
+      if ((res.special >> l) & 1) {
+        Hit h;
+        hit = intersect_watertight(*ray, wr_.v.wr, bvh_detail::tri4_triangle(b, static_cast<std::uint32_t>(l & 3)),
+                                   tmin, closest, h);
+        t = h.t;
+        u = h.u;
+        v = h.v;
+      } else {
+        hit = bvh_detail::watertight_accept_tmax(res.det[l], res.T[l], res.t[l], closest);
+        t = res.t[l];
+        u = res.u[l];
+        v = res.v[l];
+      }
+      if (hit && take_hit<AnyHit>(b, l & 3, t, u, v, closest, best)) return true;
+    }
+    return false;
+  }
+
+  /// The Moller-Trumbore test on blocks blk[0] and blk[1] at once.
+  template <bool AnyHit>
+  [[gnu::always_inline]] bool test_pair_mt(const bvh_detail::TriBlock4* blk, float tmin, float& closest, Hit& best) {
+    bvh_detail::Tri8MtResult res;
+    bvh_detail::intersect_tri8_mt(blk, *ray, tmin, res);
+    int lanes = res.candidate & bvh_detail::tri8_used_lanes(blk);
+    while (lanes != 0) {
+      const int l = std::countr_zero(static_cast<unsigned>(lanes));
+      lanes &= lanes - 1;
+      const float t = res.t[l];
+      if (!(t <= closest)) continue;
+      if (take_hit<AnyHit>(blk[l >> 2], l & 3, t, res.u[l], res.v[l], closest, best)) return true;
+    }
+    return false;
+  }
+#endif
 };
 
 /// Starts fetching what slot (c, m) leads to: a wide node (four cache lines)
