@@ -115,152 +115,244 @@ void refit_tri4_blocks(const TriAt& tri, Blocks& blocks) {
 
 #ifdef ACCELVIZ_BVH_TRI4_SSE2
 
-/// Per-ray constants of the four-lane test.
-struct Tri4Ray {
-  __m128 ox, oy, oz, sx, sy, sz;
-  int kx = 0, ky = 1, kz = 2;
-  Tri4Ray() = default;  ///< unset; assign before use
-  explicit Tri4Ray(const InlineWatertightRay& r)
-      : ox(_mm_set1_ps(r.ox)),
-        oy(_mm_set1_ps(r.oy)),
-        oz(_mm_set1_ps(r.oz)),
-        sx(_mm_set1_ps(r.wr.sx)),
-        sy(_mm_set1_ps(r.wr.sy)),
-        sz(_mm_set1_ps(r.wr.sz)),
-        kx(r.wr.kx),
-        ky(r.wr.ky),
-        kz(r.wr.kz) {}
-};
-
-/// The tmax-independent part of the watertight test on four lanes.
-struct Tri4Result {
-  alignas(16) float T[4], det[4], t[4], u[4], v[4];
-  int candidate = 0;  ///< lanes inside, det != 0, and t >= tmin with t finite (tmax not yet applied)
-  int special = 0;    ///< lanes the scalar function must answer
-};
-
+/// Lanes of x that are finite (the 8-wide box test's ray set-up uses it).
 [[gnu::always_inline]] inline __m128 finite_mask(__m128 x) {
   // x - x is 0 for finite x, NaN for inf/NaN; (0 == 0) true, NaN compares false.
   return _mm_cmpeq_ps(_mm_sub_ps(x, x), _mm_setzero_ps());
 }
 
-[[gnu::always_inline]] inline void intersect_tri4(const TriBlock4& b, const Tri4Ray& r, float tmin, Tri4Result& out) {
-  const __m128 zero = _mm_setzero_ps();
-  const __m128 Ax = _mm_sub_ps(_mm_load_ps(b.v[0 + r.kx]), r.ox), Ay = _mm_sub_ps(_mm_load_ps(b.v[0 + r.ky]), r.oy),
-               Az = _mm_sub_ps(_mm_load_ps(b.v[0 + r.kz]), r.oz);
-  const __m128 Bx = _mm_sub_ps(_mm_load_ps(b.v[3 + r.kx]), r.ox), By = _mm_sub_ps(_mm_load_ps(b.v[3 + r.ky]), r.oy),
-               Bz = _mm_sub_ps(_mm_load_ps(b.v[3 + r.kz]), r.oz);
-  const __m128 Cx = _mm_sub_ps(_mm_load_ps(b.v[6 + r.kx]), r.ox), Cy = _mm_sub_ps(_mm_load_ps(b.v[6 + r.ky]), r.oy),
-               Cz = _mm_sub_ps(_mm_load_ps(b.v[6 + r.kz]), r.oz);
-  const __m128 ax = _mm_sub_ps(Ax, _mm_mul_ps(r.sx, Az)), ay = _mm_sub_ps(Ay, _mm_mul_ps(r.sy, Az));
-  const __m128 bx = _mm_sub_ps(Bx, _mm_mul_ps(r.sx, Bz)), by = _mm_sub_ps(By, _mm_mul_ps(r.sy, Bz));
-  const __m128 cx = _mm_sub_ps(Cx, _mm_mul_ps(r.sx, Cz)), cy = _mm_sub_ps(Cy, _mm_mul_ps(r.sy, Cz));
-  const __m128 U = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
-  const __m128 V = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
-  const __m128 W = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
-  const __m128 det = _mm_add_ps(_mm_add_ps(U, V), W);
-  // Special: a zero edge function, or U + V + W not finite (as triangle.cpp's checks, in its order).
-  __m128 special = _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(U, zero), _mm_cmpeq_ps(V, zero)), _mm_cmpeq_ps(W, zero));
-  special = _mm_or_ps(special, _mm_andnot_ps(finite_mask(det), _mm_castsi128_ps(_mm_set1_epi32(-1))));
-  const __m128 any_neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(U, zero), _mm_cmplt_ps(V, zero)), _mm_cmplt_ps(W, zero));
-  const __m128 any_pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(U, zero), _mm_cmpgt_ps(V, zero)), _mm_cmpgt_ps(W, zero));
-  __m128 ok = _mm_andnot_ps(_mm_and_ps(any_neg, any_pos), _mm_cmpneq_ps(det, zero));
-  // No lane inside and none special: nothing below can make a lane a
-  // candidate or special (both need `ok` or `special`), so stop here.
-  if (_mm_movemask_ps(_mm_or_ps(ok, special)) == 0) {
-    out.special = 0;
-    out.candidate = 0;
-    return;
-  }
-  // |det| < 1e-30: special (only for lanes still in the game, as the scalar order has it).
-  const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF));
-  const __m128 low = _mm_set1_ps(1e-30f);
-  const __m128 tiny_det = _mm_and_ps(ok, _mm_cmplt_ps(_mm_and_ps(det, abs_mask), low));
-  const __m128 az = _mm_mul_ps(r.sz, Az), bz = _mm_mul_ps(r.sz, Bz), cz = _mm_mul_ps(r.sz, Cz);
-  const __m128 T = _mm_add_ps(_mm_add_ps(_mm_mul_ps(U, az), _mm_mul_ps(V, bz)), _mm_mul_ps(W, cz));
-  const __m128 absT = _mm_and_ps(T, abs_mask);
-  const __m128 bad_T = _mm_or_ps(_mm_andnot_ps(finite_mask(T), _mm_castsi128_ps(_mm_set1_epi32(-1))),
-                                 _mm_and_ps(_mm_cmplt_ps(absT, low), _mm_cmpneq_ps(T, zero)));
-  const __m128 special_late = _mm_andnot_ps(tiny_det, _mm_and_ps(ok, bad_T));
-  const __m128 late = _mm_or_ps(tiny_det, special_late);
-  ok = _mm_andnot_ps(late, ok);
-  // tmin side of the scaled compare: det > 0: T >= tmin·det; det < 0: T <= tmin·det.
-  const __m128 tmin_det = _mm_mul_ps(_mm_set1_ps(tmin), det);
-  const __m128 pos = _mm_cmpgt_ps(det, zero);
-  const __m128 tmin_ok =
-      _mm_or_ps(_mm_and_ps(pos, _mm_cmpge_ps(T, tmin_det)), _mm_andnot_ps(pos, _mm_cmple_ps(T, tmin_det)));
-  ok = _mm_and_ps(ok, tmin_ok);
-  const __m128 rcp = _mm_div_ps(_mm_set1_ps(1.0f), det);
-  const __m128 t = _mm_mul_ps(T, rcp);
-  ok = _mm_and_ps(ok, _mm_cmpge_ps(t, _mm_set1_ps(tmin)));
-  _mm_store_ps(out.T, T);
-  _mm_store_ps(out.det, det);
-  _mm_store_ps(out.t, t);
-  _mm_store_ps(out.u, _mm_mul_ps(V, rcp));
-  _mm_store_ps(out.v, _mm_mul_ps(W, rcp));
-  const int sp = _mm_movemask_ps(special);
-  out.special = sp | (_mm_movemask_ps(late) & ~sp);
-  out.candidate = _mm_movemask_ps(ok) & ~sp;
+/// N float lanes and N int32 masks (-1 true, 0 false) as GCC vector
+/// extensions: N = 4 is one SSE register, N = 8 one AVX register (used only
+/// inside AVX2 functions, bvh_tri8.h). The lane tests below are written once
+/// for both widths; their operations are IEEE like the scalar ones.
+template <int N>
+struct Lanes;
+template <>
+struct Lanes<4> {
+  typedef float F __attribute__((vector_size(16)));
+  typedef std::int32_t I __attribute__((vector_size(16)));
+};
+template <>
+struct Lanes<8> {
+  typedef float F __attribute__((vector_size(32)));
+  typedef std::int32_t I __attribute__((vector_size(32)));
+};
+
+/// Row `row` of the N / 4 consecutive blocks b[0..N/4) (lanes 0-3 from
+/// b[0], 4-7 from b[1]), written to `out` (a 256-bit value is not returned
+/// from a function that is not compiled for AVX).
+template <int N>
+[[gnu::always_inline]] inline void lane_row(const TriBlock4* b, int row, typename Lanes<N>::F& out) {
+  static_assert(N == 4 || N == 8);
+  __builtin_memcpy(&out, b[0].v[row], sizeof(b[0].v[row]));
+  if constexpr (N == 8) __builtin_memcpy(reinterpret_cast<char*>(&out) + 16, b[1].v[row], sizeof(b[1].v[row]));
 }
 
-/// Per-ray constants of the four-lane Moller-Trumbore test.
-struct Tri4MtRay {
-  __m128 ox, oy, oz, dx, dy, dz;
-  Tri4MtRay() = default;  ///< unset; assign before use
-  explicit Tri4MtRay(const Ray& r)
-      : ox(_mm_set1_ps(r.origin.x)),
-        oy(_mm_set1_ps(r.origin.y)),
-        oz(_mm_set1_ps(r.origin.z)),
-        dx(_mm_set1_ps(r.direction.x)),
-        dy(_mm_set1_ps(r.direction.y)),
-        dz(_mm_set1_ps(r.direction.z)) {}
+/// Per-ray constants of the N-lane watertight test.
+template <int N>
+struct TriLanesRay {
+  using F = typename Lanes<N>::F;
+  F ox, oy, oz, sx, sy, sz;
+  int kx = 0, ky = 1, kz = 2;
+  TriLanesRay() = default;  ///< unset; assign before use
+  [[gnu::always_inline]] explicit TriLanesRay(const InlineWatertightRay& r)
+      : ox(F{} + r.ox),
+        oy(F{} + r.oy),
+        oz(F{} + r.oz),
+        sx(F{} + r.wr.sx),
+        sy(F{} + r.wr.sy),
+        sz(F{} + r.wr.sz),
+        kx(r.wr.kx),
+        ky(r.wr.ky),
+        kz(r.wr.kz) {}
+};
+using Tri4Ray = TriLanesRay<4>;
+
+/// The tmax-independent part of the watertight test on N lanes.
+template <int N>
+struct TriLanesResult {
+  alignas(4 * N) float T[N], det[N], t[N], u[N], v[N];
+  int candidate = 0;  ///< lanes inside, det != 0, and t >= tmin with t finite (tmax not yet applied)
+  int special = 0;    ///< lanes the scalar function must answer
+};
+using Tri4Result = TriLanesResult<4>;
+
+/// A result's lanes from the stages' masks, as movemask bits (the caller's
+/// width has its own movemask): a special lane is only special; a late
+/// special one (tri_lanes_distance) too; the rest of `ok` are candidates.
+template <int N>
+[[gnu::always_inline]] inline void set_lanes(TriLanesResult<N>& out, int special, int late, int ok) {
+  out.special = special | (late & ~special);
+  out.candidate = ok & ~special;
+}
+
+/// The watertight test's state between its two stages, as lane masks.
+template <int N>
+struct TriLanesWork {
+  typename Lanes<N>::F Az, Bz, Cz, U, V, W, det;
+  typename Lanes<N>::I special, ok, late;
 };
 
-/// The tmax-independent part of the Moller-Trumbore test on four lanes.
-struct Tri4MtResult {
-  alignas(16) float t[4], u[4], v[4];
+/// Stage one of the watertight test on N lanes: the edge functions U, V, W,
+/// det, the lanes inside (`ok`) and the special ones (a zero edge function,
+/// det not finite), as triangle.cpp computes them, in its order.
+template <int N>
+[[gnu::always_inline]] inline void tri_lanes_edges(const TriBlock4* b, const TriLanesRay<N>& r, TriLanesWork<N>& w) {
+  using F = typename Lanes<N>::F;
+  // Vertex rows in the ray's axis order, loaded straight from the blocks
+  // (the axes are per ray: an array of all nine rows indexed by them would
+  // go through the stack), each minus the origin.
+  F Ax, Ay, Bx, By, Cx, Cy;
+  lane_row<N>(b, 0 + r.kx, Ax);
+  lane_row<N>(b, 0 + r.ky, Ay);
+  lane_row<N>(b, 0 + r.kz, w.Az);
+  lane_row<N>(b, 3 + r.kx, Bx);
+  lane_row<N>(b, 3 + r.ky, By);
+  lane_row<N>(b, 3 + r.kz, w.Bz);
+  lane_row<N>(b, 6 + r.kx, Cx);
+  lane_row<N>(b, 6 + r.ky, Cy);
+  lane_row<N>(b, 6 + r.kz, w.Cz);
+  Ax -= r.ox, Ay -= r.oy, w.Az -= r.oz;
+  Bx -= r.ox, By -= r.oy, w.Bz -= r.oz;
+  Cx -= r.ox, Cy -= r.oy, w.Cz -= r.oz;
+  const F ax = Ax - r.sx * w.Az, ay = Ay - r.sy * w.Az;
+  const F bx = Bx - r.sx * w.Bz, by = By - r.sy * w.Bz;
+  const F cx = Cx - r.sx * w.Cz, cy = Cy - r.sy * w.Cz;
+  w.U = cx * by - cy * bx;
+  w.V = ax * cy - ay * cx;
+  w.W = bx * ay - by * ax;
+  w.det = (w.U + w.V) + w.W;
+  // det - det is 0 for a finite det, NaN for inf/NaN (which compares false).
+  w.special = (w.U == 0.0f) | (w.V == 0.0f) | (w.W == 0.0f) | ~((w.det - w.det) == 0.0f);
+  const auto any_neg = (w.U < 0.0f) | (w.V < 0.0f) | (w.W < 0.0f);
+  const auto any_pos = (w.U > 0.0f) | (w.V > 0.0f) | (w.W > 0.0f);
+  w.ok = ~(any_neg & any_pos) & (w.det != 0.0f);
+}
+
+/// Stage two, for a block with a lane inside or special: the distance T,
+/// the late special lanes (tiny det, T not finite or tiny), the tmin side of
+/// the scaled compare, and the figures into `out`.
+template <int N>
+[[gnu::always_inline]] inline void tri_lanes_distance(const TriLanesRay<N>& r, float tmin, TriLanesWork<N>& w,
+                                                      TriLanesResult<N>& out) {
+  using F = typename Lanes<N>::F;
+  using I = typename Lanes<N>::I;
+  const I abs_mask = I{} + 0x7FFFFFFF;
+  const I tiny_det = w.ok & (reinterpret_cast<F>(reinterpret_cast<I>(w.det) & abs_mask) < 1e-30f);
+  const F az = r.sz * w.Az, bz = r.sz * w.Bz, cz = r.sz * w.Cz;
+  const F T = (w.U * az + w.V * bz) + w.W * cz;
+  const F absT = reinterpret_cast<F>(reinterpret_cast<I>(T) & abs_mask);
+  const I bad_T = ~((T - T) == 0.0f) | ((absT < 1e-30f) & (T != 0.0f));
+  const I special_late = ~tiny_det & (w.ok & bad_T);
+  w.late = tiny_det | special_late;
+  w.ok = ~w.late & w.ok;
+  // tmin side of the scaled compare: det > 0: T >= tmin·det; det < 0: T <= tmin·det.
+  const F tmin_det = (F{} + tmin) * w.det;
+  const I pos = w.det > 0.0f;
+  w.ok &= (pos & (T >= tmin_det)) | (~pos & (T <= tmin_det));
+  const F rcp = (F{} + 1.0f) / w.det;
+  const F t = T * rcp;
+  w.ok &= t >= tmin;
+  const F u = w.V * rcp, v = w.W * rcp;
+  __builtin_memcpy(out.T, &T, sizeof T);
+  __builtin_memcpy(out.det, &w.det, sizeof w.det);
+  __builtin_memcpy(out.t, &t, sizeof t);
+  __builtin_memcpy(out.u, &u, sizeof u);
+  __builtin_memcpy(out.v, &v, sizeof v);
+}
+
+/// The two stages' lane masks into `out` (`mask` is the width's movemask).
+template <int N, class Mask>
+[[gnu::always_inline]] inline void tri_lanes_masks(const TriLanesWork<N>& w, const Mask& mask, TriLanesResult<N>& out) {
+  const int sp = mask(w.special);
+  out.special = sp | (mask(w.late) & ~sp);
+  out.candidate = mask(w.ok) & ~sp;
+}
+
+/// Per-ray constants of the N-lane Moller-Trumbore test.
+template <int N>
+struct TriLanesMtRay {
+  using F = typename Lanes<N>::F;
+  F ox, oy, oz, dx, dy, dz;
+  TriLanesMtRay() = default;  ///< unset; assign before use
+  [[gnu::always_inline]] explicit TriLanesMtRay(const Ray& r)
+      : ox(F{} + r.origin.x),
+        oy(F{} + r.origin.y),
+        oz(F{} + r.origin.z),
+        dx(F{} + r.direction.x),
+        dy(F{} + r.direction.y),
+        dz(F{} + r.direction.z) {}
+};
+using Tri4MtRay = TriLanesMtRay<4>;
+
+/// The tmax-independent part of the Moller-Trumbore test on N lanes.
+template <int N>
+struct TriLanesMtResult {
+  alignas(4 * N) float t[N], u[N], v[N];
   int candidate = 0;  ///< lanes with det != 0, u, v inside and t >= tmin (tmax not yet applied)
 };
+using Tri4MtResult = TriLanesMtResult<4>;
 
-/// intersect_moller_trumbore_inline (core/geometry/triangle_inline.h) on the
-/// four lanes of a block: the same operations in the same order (glm::cross,
-/// glm::dot as (x + y) + z, one IEEE division), so each lane's t, u, v and
-/// outcome are bit for bit the scalar test's (the core library never
-/// contracts to FMA). A lane is a hit when it is a candidate and t <= tmax,
-/// the scalar test's last check. NaN compares false in both, so a NaN u or v
-/// passes and a NaN t fails in both.
+/// intersect_moller_trumbore_inline (core/geometry/triangle_inline.h) on N
+/// lanes: the same operations in the same order (glm::cross, glm::dot as
+/// (x + y) + z, one IEEE division), so each lane's t, u, v and outcome are
+/// bit for bit the scalar test's (the core library never contracts to
+/// FMA). The figures go to `out`, the candidate lanes to `ok` (a lane is a
+/// hit when it is a candidate and t <= tmax, the scalar test's last check;
+/// NaN compares false in both, so a NaN u or v passes and a NaN t fails in
+/// both).
+template <int N>
+[[gnu::always_inline]] inline void tri_lanes_mt(const TriBlock4* b, const TriLanesMtRay<N>& r, float tmin,
+                                                TriLanesMtResult<N>& out, typename Lanes<N>::I& ok) {
+  using F = typename Lanes<N>::F;
+  F row[9];
+  for (int k = 0; k < 9; ++k) lane_row<N>(b, k, row[k]);
+  const F v0x = row[0], v0y = row[1], v0z = row[2];
+  const F e1x = row[3] - v0x, e1y = row[4] - v0y, e1z = row[5] - v0z;
+  const F e2x = row[6] - v0x, e2y = row[7] - v0y, e2z = row[8] - v0z;
+  // p = cross(d, e2)
+  const F px = r.dy * e2z - e2y * r.dz;
+  const F py = r.dz * e2x - e2z * r.dx;
+  const F pz = r.dx * e2y - e2x * r.dy;
+  const F det = (e1x * px + e1y * py) + e1z * pz;
+  const F inv = (F{} + 1.0f) / det;
+  const F sx = r.ox - v0x, sy = r.oy - v0y, sz = r.oz - v0z;
+  const F u = ((sx * px + sy * py) + sz * pz) * inv;
+  // q = cross(s, e1)
+  const F qx = sy * e1z - e1y * sz;
+  const F qy = sz * e1x - e1z * sx;
+  const F qz = sx * e1y - e1x * sy;
+  const F v = ((r.dx * qx + r.dy * qy) + r.dz * qz) * inv;
+  const F t = ((e2x * qx + e2y * qy) + e2z * qz) * inv;
+  const auto reject = (((det == 0.0f) | (u < 0.0f)) | (u > 1.0f)) | ((v < 0.0f) | ((u + v) > 1.0f));
+  ok = ~reject & (t >= tmin);
+  __builtin_memcpy(out.t, &t, sizeof t);
+  __builtin_memcpy(out.u, &u, sizeof u);
+  __builtin_memcpy(out.v, &v, sizeof v);
+}
+
+[[gnu::always_inline]] inline int lanes_mask(Lanes<4>::I m) {
+  return _mm_movemask_ps(reinterpret_cast<__m128>(m));
+}
+
+/// The watertight test on the four lanes of block b (tri_lanes_edges, then
+/// tri_lanes_distance unless no lane is inside or special).
+[[gnu::always_inline]] inline void intersect_tri4(const TriBlock4& b, const Tri4Ray& r, float tmin, Tri4Result& out) {
+  TriLanesWork<4> w;
+  tri_lanes_edges<4>(&b, r, w);
+  // No lane inside and none special: nothing below can make a lane a
+  // candidate or special (both need `ok` or `special`), so stop here.
+  if (lanes_mask(w.ok | w.special) == 0) return set_lanes(out, 0, 0, 0);
+  tri_lanes_distance<4>(r, tmin, w, out);
+  set_lanes(out, lanes_mask(w.special), lanes_mask(w.late), lanes_mask(w.ok));
+}
+
+/// The Moller-Trumbore test on the four lanes of block b.
 [[gnu::always_inline]] inline void intersect_tri4_mt(const TriBlock4& b, const Tri4MtRay& r, float tmin,
                                                      Tri4MtResult& out) {
-  const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
-  const __m128 v0x = _mm_load_ps(b.v[0]), v0y = _mm_load_ps(b.v[1]), v0z = _mm_load_ps(b.v[2]);
-  const __m128 e1x = _mm_sub_ps(_mm_load_ps(b.v[3]), v0x), e1y = _mm_sub_ps(_mm_load_ps(b.v[4]), v0y),
-               e1z = _mm_sub_ps(_mm_load_ps(b.v[5]), v0z);
-  const __m128 e2x = _mm_sub_ps(_mm_load_ps(b.v[6]), v0x), e2y = _mm_sub_ps(_mm_load_ps(b.v[7]), v0y),
-               e2z = _mm_sub_ps(_mm_load_ps(b.v[8]), v0z);
-  // p = cross(d, e2)
-  const __m128 px = _mm_sub_ps(_mm_mul_ps(r.dy, e2z), _mm_mul_ps(e2y, r.dz));
-  const __m128 py = _mm_sub_ps(_mm_mul_ps(r.dz, e2x), _mm_mul_ps(e2z, r.dx));
-  const __m128 pz = _mm_sub_ps(_mm_mul_ps(r.dx, e2y), _mm_mul_ps(e2x, r.dy));
-  const __m128 det = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e1x, px), _mm_mul_ps(e1y, py)), _mm_mul_ps(e1z, pz));
-  const __m128 inv = _mm_div_ps(one, det);
-  const __m128 sx = _mm_sub_ps(r.ox, v0x), sy = _mm_sub_ps(r.oy, v0y), sz = _mm_sub_ps(r.oz, v0z);
-  const __m128 u = _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(sx, px), _mm_mul_ps(sy, py)), _mm_mul_ps(sz, pz)), inv);
-  // q = cross(s, e1)
-  const __m128 qx = _mm_sub_ps(_mm_mul_ps(sy, e1z), _mm_mul_ps(e1y, sz));
-  const __m128 qy = _mm_sub_ps(_mm_mul_ps(sz, e1x), _mm_mul_ps(e1z, sx));
-  const __m128 qz = _mm_sub_ps(_mm_mul_ps(sx, e1y), _mm_mul_ps(e1x, sy));
-  const __m128 v =
-      _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(r.dx, qx), _mm_mul_ps(r.dy, qy)), _mm_mul_ps(r.dz, qz)), inv);
-  const __m128 t =
-      _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(e2x, qx), _mm_mul_ps(e2y, qy)), _mm_mul_ps(e2z, qz)), inv);
-  const __m128 reject =
-      _mm_or_ps(_mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(det, zero), _mm_cmplt_ps(u, zero)), _mm_cmpgt_ps(u, one)),
-                _mm_or_ps(_mm_cmplt_ps(v, zero), _mm_cmpgt_ps(_mm_add_ps(u, v), one)));
-  const __m128 ok = _mm_andnot_ps(reject, _mm_cmpge_ps(t, _mm_set1_ps(tmin)));
-  _mm_store_ps(out.t, t);
-  _mm_store_ps(out.u, u);
-  _mm_store_ps(out.v, v);
-  out.candidate = _mm_movemask_ps(ok);
+  Lanes<4>::I ok;
+  tri_lanes_mt<4>(&b, r, tmin, out, ok);
+  out.candidate = lanes_mask(ok);
 }
 
 /// The scalar test's tmax-dependent acceptance of candidate lane l.
