@@ -1,8 +1,10 @@
 #pragma once
 // Four triangles per SIMD test: the leaves of the 4-wide BVH keep their
 // triangles as blocks of four in structure-of-arrays order (Embree's
-// "triangle4" idea), and the watertight test (Woop et al. 2013) runs on the
-// four lanes at once with SSE2.
+// "triangle4" idea), and the watertight test (Woop et al. 2013) and
+// Moller-Trumbore run on the four lanes at once with SSE2. The lane tests
+// are written once for N lanes (GCC vector extensions): N = 4 here, N = 8
+// (two blocks, AVX2) in bvh_tri8.h.
 //
 // Exactness: each lane performs the float operations of
 // core/geometry/triangle.cpp's intersect_watertight in the same order (SSE2
