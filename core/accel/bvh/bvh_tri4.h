@@ -263,14 +263,6 @@ template <int N>
   __builtin_memcpy(out.v, &v, sizeof v);
 }
 
-/// The two stages' lane masks into `out` (`mask` is the width's movemask).
-template <int N, class Mask>
-[[gnu::always_inline]] inline void tri_lanes_masks(const TriLanesWork<N>& w, const Mask& mask, TriLanesResult<N>& out) {
-  const int sp = mask(w.special);
-  out.special = sp | (mask(w.late) & ~sp);
-  out.candidate = mask(w.ok) & ~sp;
-}
-
 /// Per-ray constants of the N-lane Moller-Trumbore test.
 template <int N>
 struct TriLanesMtRay {
