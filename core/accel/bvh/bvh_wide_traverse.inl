@@ -72,36 +72,19 @@ struct LeafRay {
       for (const bvh_detail::TriBlock4* blk = bvh.blocks + child; blk != end; ++blk) {
 #ifdef ACCELVIZ_BVH_WIDE8_AVX2
         if constexpr (kWidth == 8)
-          if (end - blk >= 2) {
-            if (test_pair<AnyHit>(blk, tmin, closest, best)) return true;
+          if (end - blk >= 2) {  // two blocks in one test (bvh_tri8.h)
+            bvh_detail::Tri8Result res;
+            bvh_detail::intersect_tri8(blk, wr_.v, tmin, res);
+            const int lanes = (res.candidate | res.special) & bvh_detail::tri8_used_lanes(blk);
+            if (accept_watertight<AnyHit>(blk, res, lanes, tmin, closest, best)) return true;
             ++blk;  // and the loop's
             continue;
           }
 #endif
-        const int valid = bvh_detail::tri4_used_lanes(*blk);
         bvh_detail::Tri4Result res;
         bvh_detail::intersect_tri4(*blk, tr4_.v, tmin, res);
-        int lanes = (res.candidate | res.special) & valid;
-        while (lanes != 0) {
-          const int l = std::countr_zero(static_cast<unsigned>(lanes));
-          lanes &= lanes - 1;
-          float t, u, v;
-          bool hit;
-          if ((res.special >> l) & 1) {
-            Hit h;
-            hit = intersect_watertight(r, wr_.v.wr, bvh_detail::tri4_triangle(*blk, static_cast<std::uint32_t>(l)),
-                                       tmin, closest, h);
-            t = h.t;
-            u = h.u;
-            v = h.v;
-          } else {
-            hit = bvh_detail::tri4_accept(res, l, closest);
-            t = res.t[l];
-            u = res.u[l];
-            v = res.v[l];
-          }
-          if (hit && take_hit<AnyHit>(*blk, l, t, u, v, closest, best)) return true;
-        }
+        const int lanes = (res.candidate | res.special) & bvh_detail::tri4_used_lanes(*blk);
+        if (accept_watertight<AnyHit>(blk, res, lanes, tmin, closest, best)) return true;
       }
       return false;
     } else if constexpr (Test == TriangleTest::moller_trumbore) {
@@ -111,23 +94,18 @@ struct LeafRay {
       for (const bvh_detail::TriBlock4* blk = bvh.blocks + child; blk != end; ++blk) {
 #ifdef ACCELVIZ_BVH_WIDE8_AVX2
         if constexpr (kWidth == 8)
-          if (end - blk >= 2) {
-            if (test_pair_mt<AnyHit>(blk, tmin, closest, best)) return true;
+          if (end - blk >= 2) {  // two blocks in one test (bvh_tri8.h)
+            bvh_detail::Tri8MtResult res;
+            bvh_detail::intersect_tri8_mt(blk, *ray, tmin, res);
+            if (accept_mt<AnyHit>(blk, res, res.candidate & bvh_detail::tri8_used_lanes(blk), closest, best))
+              return true;
             ++blk;  // and the loop's
             continue;
           }
 #endif
-        const int valid = bvh_detail::tri4_used_lanes(*blk);
         bvh_detail::Tri4MtResult res;
         bvh_detail::intersect_tri4_mt(*blk, tm4_.v, tmin, res);
-        int lanes = res.candidate & valid;
-        while (lanes != 0) {
-          const int l = std::countr_zero(static_cast<unsigned>(lanes));
-          lanes &= lanes - 1;
-          const float t = res.t[l];
-          if (!(t <= closest)) continue;
-          if (take_hit<AnyHit>(*blk, l, t, res.u[l], res.v[l], closest, best)) return true;
-        }
+        if (accept_mt<AnyHit>(blk, res, res.candidate & bvh_detail::tri4_used_lanes(*blk), closest, best)) return true;
       }
       return false;
     } else
@@ -148,19 +126,20 @@ struct LeafRay {
     }
   }
 
-#ifdef ACCELVIZ_BVH_WIDE8_AVX2
-  /// The watertight test on blocks blk[0] and blk[1] at once (8-wide walk
-  /// only, bvh_tri8.h): the lanes' figures are the four-lane test's, and
-  /// they are accepted lane by lane in leaf order as test() does.
-  template <bool AnyHit>
-  [[gnu::always_inline]] bool test_pair(const bvh_detail::TriBlock4* blk, float tmin, float& closest, Hit& best) {
-    bvh_detail::Tri8Result res;
-    bvh_detail::intersect_tri8(blk, wr_.v, tmin, res);
-    int lanes = (res.candidate | res.special) & bvh_detail::tri8_used_lanes(blk);
+#ifdef ACCELVIZ_BVH_TRI4_SSE2
+  /// The lanes `lanes` of an N-lane watertight result over blocks
+  /// blk[0 .. N/4), in lane order (the leaf's order): a special lane
+  /// answered by the scalar test, the others accepted against the closest
+  /// hit so far (the scalar test's last, tmax-dependent step), each hit
+  /// taken as the scalar loop over the leaf would. True: an any hit.
+  template <bool AnyHit, int N>
+  [[gnu::always_inline]] bool accept_watertight(const bvh_detail::TriBlock4* blk,
+                                                const bvh_detail::TriLanesResult<N>& res, int lanes, float tmin,
+                                                float& closest, Hit& best) {
     while (lanes != 0) {
       const int l = std::countr_zero(static_cast<unsigned>(lanes));
       lanes &= lanes - 1;
-      const bvh_detail::TriBlock4& b = blk[l >> 2];
+      const bvh_detail::TriBlock4& b = blk[N == 4 ? 0 : l >> 2];
       float t, u, v;
       bool hit;
       if ((res.special >> l) & 1) {
@@ -181,18 +160,17 @@ struct LeafRay {
     return false;
   }
 
-  /// The Moller-Trumbore test on blocks blk[0] and blk[1] at once.
-  template <bool AnyHit>
-  [[gnu::always_inline]] bool test_pair_mt(const bvh_detail::TriBlock4* blk, float tmin, float& closest, Hit& best) {
-    bvh_detail::Tri8MtResult res;
-    bvh_detail::intersect_tri8_mt(blk, *ray, tmin, res);
-    int lanes = res.candidate & bvh_detail::tri8_used_lanes(blk);
+  /// The lanes `lanes` of an N-lane Moller-Trumbore result, in lane order,
+  /// each a hit when t <= the closest hit so far (the scalar test's last check).
+  template <bool AnyHit, int N>
+  [[gnu::always_inline]] bool accept_mt(const bvh_detail::TriBlock4* blk, const bvh_detail::TriLanesMtResult<N>& res,
+                                        int lanes, float& closest, Hit& best) {
     while (lanes != 0) {
       const int l = std::countr_zero(static_cast<unsigned>(lanes));
       lanes &= lanes - 1;
       const float t = res.t[l];
       if (!(t <= closest)) continue;
-      if (take_hit<AnyHit>(blk[l >> 2], l & 3, t, res.u[l], res.v[l], closest, best)) return true;
+      if (take_hit<AnyHit>(blk[N == 4 ? 0 : l >> 2], l & 3, t, res.u[l], res.v[l], closest, best)) return true;
     }
     return false;
   }
