@@ -42,97 +42,58 @@
 /// for all (docs/performance.md, "Packet queries").
 constexpr int kAloneLanes = 4;
 
-/// One triangle against the packet's lanes at once (ray-parallel), the
-/// single-ray four-lane tests of bvh_tri4.h with the roles swapped: each
-/// lane does its ray's operations of intersect_tri4 (watertight; all lanes
-/// must share the sheared axes kx, ky, kz) or intersect_tri4_mt, in the same
-/// order, so each lane's T, det, t, u, v, candidate and special bits are bit
-/// for bit those the ray's own test gives for this triangle. tmax is applied
-/// afterwards lane by lane, as the single-ray leaf loop does.
+/// One triangle against the packet's lanes at once (ray-parallel): the lane
+/// tests of bvh_tri4.h (watertight_lanes_edges, watertight_lanes_distance,
+/// mt_lanes) with the roles swapped, the triangle's coordinates broadcast
+/// and each lane one ray (the watertight test needs all lanes to share the
+/// sheared axes kx, ky, kz), so each lane's T, det, t, u, v, candidate and
+/// special bits are bit for bit those the ray's own test gives for this
+/// triangle. tmax is applied afterwards lane by lane, as the single-ray leaf
+/// loop does.
 /// Filled at a packet's first leaf (most packets of a scene's primary rays
 /// never reach one: zeroing all of it per packet was 7 % of the any-hit walk
 /// on the kitchen); lanes without a ray hold ray 0's direction and a zero
 /// origin (their results are never read).
 struct PacketTriRays {
-  PacketF ox, oy, oz, sx, sy, sz;  ///< watertight: origin[kx], [ky], [kz] and the shear, per lane
+  bvh_detail::Vec3Lanes<PacketF> o;  ///< watertight: origin[kx], [ky], [kz] per lane
+  PacketF sx, sy, sz;                ///< watertight: the shear per lane
   int kx = 0, ky = 1, kz = 2;
-  PacketF org[3], dir[3];  ///< Moller-Trumbore: origin and direction per lane
+  bvh_detail::Vec3Lanes<PacketF> org, dir;  ///< Moller-Trumbore: origin and direction per lane
 };
-struct PacketTriResult {
-  PacketF T, det, t, u, v;
+struct PacketTriResult : bvh_detail::LaneFigures<PacketF> {
   int candidate = 0, special = 0;
 };
+
+/// Vertex k of lane j of `b`, broadcast (x - 0 keeps every value's bits, -0 included),
+/// with its axes in the order a0, a1, a2.
+[[gnu::always_inline]] inline void packet_vertex(const bvh_detail::TriBlock4& b, int j, int k, int a0, int a1, int a2,
+                                                 bvh_detail::Vec3Lanes<PacketF>& p) {
+  const PacketF zero{};
+  p.x = b.v[3 * k + a0][j] - zero;
+  p.y = b.v[3 * k + a1][j] - zero;
+  p.z = b.v[3 * k + a2][j] - zero;
+}
 
 /// Block lane j of `b` against the packet: intersect_tri4's operations per ray.
 [[gnu::always_inline]] inline void packet_tri_watertight(const bvh_detail::TriBlock4& b, int j, const PacketTriRays& r,
                                                          const PacketF& tmin, PacketTriResult& out) {
-  const PacketF Ax = b.v[0 + r.kx][j] - r.ox, Ay = b.v[0 + r.ky][j] - r.oy, Az = b.v[0 + r.kz][j] - r.oz;
-  const PacketF Bx = b.v[3 + r.kx][j] - r.ox, By = b.v[3 + r.ky][j] - r.oy, Bz = b.v[3 + r.kz][j] - r.oz;
-  const PacketF Cx = b.v[6 + r.kx][j] - r.ox, Cy = b.v[6 + r.ky][j] - r.oy, Cz = b.v[6 + r.kz][j] - r.oz;
-  const PacketF ax = Ax - r.sx * Az, ay = Ay - r.sy * Az;
-  const PacketF bx = Bx - r.sx * Bz, by = By - r.sy * Bz;
-  const PacketF cx = Cx - r.sx * Cz, cy = Cy - r.sy * Cz;
-  const PacketF U = cx * by - cy * bx;
-  const PacketF V = ax * cy - ay * cx;
-  const PacketF W = bx * ay - by * ax;
-  const PacketF det = (U + V) + W;
-  // x - x is 0 for finite x, NaN (compares false) for inf and NaN.
-  const PacketI special = (U == 0.0f) | (V == 0.0f) | (W == 0.0f) | ~((det - det) == 0.0f);
-  const PacketI any_neg = (U < 0.0f) | (V < 0.0f) | (W < 0.0f);
-  const PacketI any_pos = (U > 0.0f) | (V > 0.0f) | (W > 0.0f);
-  PacketI ok = ~(any_neg & any_pos) & (det != 0.0f);
-  if (packet_mask(ok | special) == 0) {
-    out.candidate = out.special = 0;
-    return;
-  }
-  const PacketF low = kWatertightLowRange - PacketF{};
-  const PacketI tiny_det = ok & ((PacketF)((PacketI)det & 0x7FFFFFFF) < low);  // |det| (vector casts: the bits)
-  const PacketF az = r.sz * Az, bz = r.sz * Bz, cz = r.sz * Cz;
-  const PacketF T = (U * az + V * bz) + W * cz;
-  const PacketI bad_T = ~((T - T) == 0.0f) | (((PacketF)((PacketI)T & 0x7FFFFFFF) < low) & (T != 0.0f));
-  const PacketI special_late = ~tiny_det & (ok & bad_T);
-  const PacketI late = tiny_det | special_late;
-  ok = ~late & ok;
-  const PacketF tmin_det = tmin * det;
-  const PacketI pos = det > 0.0f;
-  ok = ok & ((pos & (T >= tmin_det)) | (~pos & (T <= tmin_det)));
-  const PacketF rcp = 1.0f / det;
-  const PacketF t = T * rcp;
-  ok = ok & (t >= tmin);
-  out.T = T;
-  out.det = det;
-  out.t = t;
-  out.u = V * rcp;
-  out.v = W * rcp;
-  const int sp = packet_mask(special);
-  out.special = sp | (packet_mask(late) & ~sp);
-  out.candidate = packet_mask(ok) & ~sp;
+  bvh_detail::Vec3Lanes<PacketF> p[3];
+  for (int k = 0; k < 3; ++k) packet_vertex(b, j, k, r.kx, r.ky, r.kz, p[k]);
+  bvh_detail::WatertightLanes<PacketF> w;
+  bvh_detail::watertight_lanes_edges(p[0], p[1], p[2], r.o, r.sx, r.sy, w);
+  if (packet_mask(w.ok | w.special) == 0) return bvh_detail::set_lanes(out, 0, 0, 0);  // as intersect_tri4
+  bvh_detail::watertight_lanes_distance(r.sz, tmin, w, out);
+  bvh_detail::set_lanes(out, packet_mask(w.special), packet_mask(w.late), packet_mask(w.ok));
 }
 
 /// Block lane j of `b` against the packet: intersect_tri4_mt's operations per ray.
 [[gnu::always_inline]] inline void packet_tri_mt(const bvh_detail::TriBlock4& b, int j, const PacketTriRays& r,
                                                  const PacketF& tmin, PacketTriResult& out) {
-  const float v0x = b.v[0][j], v0y = b.v[1][j], v0z = b.v[2][j];
-  const float e1x = b.v[3][j] - v0x, e1y = b.v[4][j] - v0y, e1z = b.v[5][j] - v0z;
-  const float e2x = b.v[6][j] - v0x, e2y = b.v[7][j] - v0y, e2z = b.v[8][j] - v0z;
-  const PacketF &dx = r.dir[0], &dy = r.dir[1], &dz = r.dir[2];
-  const PacketF px = dy * e2z - e2y * dz;
-  const PacketF py = dz * e2x - e2z * dx;
-  const PacketF pz = dx * e2y - e2x * dy;
-  const PacketF det = (e1x * px + e1y * py) + e1z * pz;
-  const PacketF inv = 1.0f / det;
-  const PacketF sx = r.org[0] - v0x, sy = r.org[1] - v0y, sz = r.org[2] - v0z;
-  const PacketF u = ((sx * px + sy * py) + sz * pz) * inv;
-  const PacketF qx = sy * e1z - e1y * sz;
-  const PacketF qy = sz * e1x - e1z * sx;
-  const PacketF qz = sx * e1y - e1x * sy;
-  const PacketF v = ((dx * qx + dy * qy) + dz * qz) * inv;
-  const PacketF t = ((e2x * qx + e2y * qy) + e2z * qz) * inv;
-  const PacketI reject = (det == 0.0f) | (u < 0.0f) | (u > 1.0f) | (v < 0.0f) | ((u + v) > 1.0f);
-  out.t = t;
-  out.u = u;
-  out.v = v;
-  out.candidate = packet_mask(~reject & (t >= tmin));
+  bvh_detail::Vec3Lanes<PacketF> p[3];
+  for (int k = 0; k < 3; ++k) packet_vertex(b, j, k, 0, 1, 2, p[k]);
+  PacketI ok;
+  bvh_detail::mt_lanes(p[0], p[1], p[2], r.org, r.dir, tmin, out, ok);
+  out.candidate = packet_mask(ok);
   out.special = 0;
 }
 
@@ -327,15 +288,11 @@ void traverse_packet(const bvh_detail::WideBvhT<kWidth>& wide_bvh, const BvhView
             tri.sx = dir[tri.kx] / dz;
             tri.sy = dir[tri.ky] / dz;
             tri.sz = 1.0f / dz;
-            tri.ox = org[tri.kx];
-            tri.oy = org[tri.ky];
-            tri.oz = org[tri.kz];
+            tri.o = {org[tri.kx], org[tri.ky], org[tri.kz]};
           }
         } else {
-          for (int a = 0; a < 3; ++a) {
-            tri.dir[a] = dir[a];
-            tri.org[a] = org[a];
-          }
+          tri.org = {org[0], org[1], org[2]};
+          tri.dir = {dir[0], dir[1], dir[2]};
         }
       }
       if (tri_mode == 1 && std::popcount(static_cast<unsigned>(lanes)) > 1) {

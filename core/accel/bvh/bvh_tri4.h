@@ -3,8 +3,10 @@
 // triangles as blocks of four in structure-of-arrays order (Embree's
 // "triangle4" idea), and the watertight test (Woop et al. 2013) and
 // Moller-Trumbore run on the four lanes at once with SSE2. The lane tests
-// are written once for N lanes (GCC vector extensions): N = 4 here, N = 8
-// (two blocks, AVX2) in bvh_tri8.h.
+// are written once for any width of GCC vector (watertight_lanes_edges,
+// watertight_lanes_distance, mt_lanes): four triangles against one ray here,
+// eight (two blocks, AVX2) in bvh_tri8.h, and one triangle against a packet
+// of eight rays in bvh_packet_traverse.inl.
 //
 // Exactness: each lane performs the float operations of
 // core/geometry/triangle.cpp's intersect_watertight in the same order (SSE2
@@ -115,6 +117,136 @@ void refit_tri4_blocks(const TriAt& tri, Blocks& blocks) {
   return t <= tmax;
 }
 
+/// The lane tests' arithmetic, written once for any GCC float vector F: the
+/// single-ray tests below (one ray against N triangles, the ray's figures
+/// broadcast) and the packet walk's (bvh_packet_traverse.inl: one triangle
+/// against eight rays, the triangle's coordinates broadcast) fill the same
+/// inputs, so each lane performs the scalar test's operations in its order
+/// either way. Inputs and outputs go by reference: a 256-bit vector is not
+/// passed by value in code compiled without AVX.
+template <class F>
+using LaneMask = decltype(F{} < F{});
+
+/// Three vectors: x, y and z of N points (or of one point, broadcast).
+template <class F>
+struct Vec3Lanes {
+  F x, y, z;
+};
+
+/// The watertight test's state between its two stages, as lane masks.
+template <class F>
+struct WatertightLanes {
+  F Az, Bz, Cz, U, V, W, det;
+  LaneMask<F> special, ok, late;
+};
+
+/// Stage one of the watertight test: the edge functions U, V, W, det, the
+/// lanes inside (`ok`) and the special ones (a zero edge function, det not
+/// finite), as triangle.cpp computes them, in its order. A, B, C are the
+/// vertices and o the origin, each in the ray's axis order (kx, ky, kz);
+/// sx, sy the shear.
+template <class F>
+[[gnu::always_inline]] inline void watertight_lanes_edges(const Vec3Lanes<F>& A, const Vec3Lanes<F>& B,
+                                                          const Vec3Lanes<F>& C, const Vec3Lanes<F>& o, const F& sx,
+                                                          const F& sy, WatertightLanes<F>& w) {
+  const F Ax = A.x - o.x, Ay = A.y - o.y;
+  const F Bx = B.x - o.x, By = B.y - o.y;
+  const F Cx = C.x - o.x, Cy = C.y - o.y;
+  w.Az = A.z - o.z, w.Bz = B.z - o.z, w.Cz = C.z - o.z;
+  const F ax = Ax - sx * w.Az, ay = Ay - sy * w.Az;
+  const F bx = Bx - sx * w.Bz, by = By - sy * w.Bz;
+  const F cx = Cx - sx * w.Cz, cy = Cy - sy * w.Cz;
+  w.U = cx * by - cy * bx;
+  w.V = ax * cy - ay * cx;
+  w.W = bx * ay - by * ax;
+  w.det = (w.U + w.V) + w.W;
+  // det - det is 0 for a finite det, NaN for inf/NaN (which compares false).
+  w.special = (w.U == 0.0f) | (w.V == 0.0f) | (w.W == 0.0f) | ~((w.det - w.det) == 0.0f);
+  const LaneMask<F> any_neg = (w.U < 0.0f) | (w.V < 0.0f) | (w.W < 0.0f);
+  const LaneMask<F> any_pos = (w.U > 0.0f) | (w.V > 0.0f) | (w.W > 0.0f);
+  w.ok = ~(any_neg & any_pos) & (w.det != 0.0f);
+}
+
+/// The figures of a triangle test per lane (watertight: all five; Moller-
+/// Trumbore: t, u, v).
+template <class F>
+struct LaneFigures {
+  F T, det, t, u, v;
+};
+
+/// Stage two, for lanes inside or special: the distance T, the late special
+/// lanes (tiny det, T not finite or tiny), the tmin side of the scaled
+/// compare and t >= tmin (in w.ok), and the figures into `out`.
+template <class F>
+[[gnu::always_inline]] inline void watertight_lanes_distance(const F& sz, const F& tmin, WatertightLanes<F>& w,
+                                                             LaneFigures<F>& out) {
+  using I = LaneMask<F>;
+  const I abs_mask = I{} + 0x7FFFFFFF;
+  const I tiny_det = w.ok & (reinterpret_cast<F>(reinterpret_cast<I>(w.det) & abs_mask) < kWatertightLowRange);
+  const F az = sz * w.Az, bz = sz * w.Bz, cz = sz * w.Cz;
+  const F T = (w.U * az + w.V * bz) + w.W * cz;
+  const F absT = reinterpret_cast<F>(reinterpret_cast<I>(T) & abs_mask);
+  const I bad_T = ~((T - T) == 0.0f) | ((absT < kWatertightLowRange) & (T != 0.0f));
+  const I special_late = ~tiny_det & (w.ok & bad_T);
+  w.late = tiny_det | special_late;
+  w.ok = ~w.late & w.ok;
+  // tmin side of the scaled compare: det > 0: T >= tmin·det; det < 0: T <= tmin·det.
+  const F tmin_det = tmin * w.det;
+  const I pos = w.det > 0.0f;
+  w.ok &= (pos & (T >= tmin_det)) | (~pos & (T <= tmin_det));
+  const F rcp = (F{} + 1.0f) / w.det;
+  out.T = T;
+  out.det = w.det;
+  out.t = T * rcp;
+  w.ok &= out.t >= tmin;
+  out.u = w.V * rcp;
+  out.v = w.W * rcp;
+}
+
+/// intersect_moller_trumbore_inline (core/geometry/triangle_inline.h) per
+/// lane: the same operations in the same order (glm::cross, glm::dot as
+/// (x + y) + z, one IEEE division), so each lane's t, u, v and outcome are
+/// bit for bit the scalar test's (the core library never contracts to
+/// FMA). p0, p1, p2 are the vertices, o and d the ray. t, u, v go to `out`,
+/// the candidate lanes to `ok` (a lane is a hit when it is a candidate and
+/// t <= tmax, the scalar test's last check; NaN compares false in both, so a
+/// NaN u or v passes and a NaN t fails in both).
+template <class F>
+[[gnu::always_inline]] inline void mt_lanes(const Vec3Lanes<F>& p0, const Vec3Lanes<F>& p1, const Vec3Lanes<F>& p2,
+                                            const Vec3Lanes<F>& o, const Vec3Lanes<F>& d, const F& tmin,
+                                            LaneFigures<F>& out, LaneMask<F>& ok) {
+  const F e1x = p1.x - p0.x, e1y = p1.y - p0.y, e1z = p1.z - p0.z;
+  const F e2x = p2.x - p0.x, e2y = p2.y - p0.y, e2z = p2.z - p0.z;
+  // p = cross(d, e2)
+  const F px = d.y * e2z - e2y * d.z;
+  const F py = d.z * e2x - e2z * d.x;
+  const F pz = d.x * e2y - e2x * d.y;
+  const F det = (e1x * px + e1y * py) + e1z * pz;
+  const F inv = (F{} + 1.0f) / det;
+  const F sx = o.x - p0.x, sy = o.y - p0.y, sz = o.z - p0.z;
+  const F u = ((sx * px + sy * py) + sz * pz) * inv;
+  // q = cross(s, e1)
+  const F qx = sy * e1z - e1y * sz;
+  const F qy = sz * e1x - e1z * sx;
+  const F qz = sx * e1y - e1x * sy;
+  const F v = ((d.x * qx + d.y * qy) + d.z * qz) * inv;
+  const F t = ((e2x * qx + e2y * qy) + e2z * qz) * inv;
+  const LaneMask<F> reject = (((det == 0.0f) | (u < 0.0f)) | (u > 1.0f)) | ((v < 0.0f) | ((u + v) > 1.0f));
+  ok = ~reject & (t >= tmin);
+  out.t = t;
+  out.u = u;
+  out.v = v;
+}
+
+/// A result's lanes from the stages' masks, as movemask bits (each width has
+/// its own movemask): a special lane is only special; a late special one
+/// (watertight_lanes_distance) too; the rest of `ok` are candidates.
+template <class Result>
+[[gnu::always_inline]] inline void set_lanes(Result& out, int special, int late, int ok) {
+  out.special = special | (late & ~special);
+  out.candidate = ok & ~special;
+}
+
 #ifdef ACCELVIZ_BVH_TRI4_SSE2
 
 /// Lanes of x that are finite (the 8-wide box test's ray set-up uses it).
@@ -154,13 +286,12 @@ template <int N>
 template <int N>
 struct TriLanesRay {
   using F = typename Lanes<N>::F;
-  F ox, oy, oz, sx, sy, sz;
+  Vec3Lanes<F> o;  ///< origin[kx], [ky], [kz]
+  F sx, sy, sz;
   int kx = 0, ky = 1, kz = 2;
   TriLanesRay() = default;  ///< unset; assign before use
   [[gnu::always_inline]] explicit TriLanesRay(const InlineWatertightRay& r)
-      : ox(F{} + r.ox),
-        oy(F{} + r.oy),
-        oz(F{} + r.oz),
+      : o{F{} + r.ox, F{} + r.oy, F{} + r.oz},
         sx(F{} + r.wr.sx),
         sy(F{} + r.wr.sy),
         sz(F{} + r.wr.sz),
@@ -179,103 +310,52 @@ struct TriLanesResult {
 };
 using Tri4Result = TriLanesResult<4>;
 
-/// A result's lanes from the stages' masks, as movemask bits (the caller's
-/// width has its own movemask): a special lane is only special; a late
-/// special one (tri_lanes_distance) too; the rest of `ok` are candidates.
+/// The vertices of the N / 4 blocks b[0..N/4) in the ray's axis order
+/// (kx, ky, kz), loaded straight from the blocks (the axes are per ray: an
+/// array of all nine rows indexed by them would go through the stack).
 template <int N>
-[[gnu::always_inline]] inline void set_lanes(TriLanesResult<N>& out, int special, int late, int ok) {
-  out.special = special | (late & ~special);
-  out.candidate = ok & ~special;
+[[gnu::always_inline]] inline void lane_vertices(const TriBlock4* b, int kx, int ky, int kz,
+                                                 Vec3Lanes<typename Lanes<N>::F> (&p)[3]) {
+  for (int k = 0; k < 3; ++k) {
+    lane_row<N>(b, 3 * k + kx, p[k].x);
+    lane_row<N>(b, 3 * k + ky, p[k].y);
+    lane_row<N>(b, 3 * k + kz, p[k].z);
+  }
 }
 
-/// The watertight test's state between its two stages, as lane masks.
+/// Stage one of the watertight test on the N lanes of b (watertight_lanes_edges).
 template <int N>
-struct TriLanesWork {
-  typename Lanes<N>::F Az, Bz, Cz, U, V, W, det;
-  typename Lanes<N>::I special, ok, late;
-};
-
-/// Stage one of the watertight test on N lanes: the edge functions U, V, W,
-/// det, the lanes inside (`ok`) and the special ones (a zero edge function,
-/// det not finite), as triangle.cpp computes them, in its order.
-template <int N>
-[[gnu::always_inline]] inline void tri_lanes_edges(const TriBlock4* b, const TriLanesRay<N>& r, TriLanesWork<N>& w) {
-  using F = typename Lanes<N>::F;
-  // Vertex rows in the ray's axis order, loaded straight from the blocks
-  // (the axes are per ray: an array of all nine rows indexed by them would
-  // go through the stack), each minus the origin.
-  F Ax, Ay, Bx, By, Cx, Cy;
-  lane_row<N>(b, 0 + r.kx, Ax);
-  lane_row<N>(b, 0 + r.ky, Ay);
-  lane_row<N>(b, 0 + r.kz, w.Az);
-  lane_row<N>(b, 3 + r.kx, Bx);
-  lane_row<N>(b, 3 + r.ky, By);
-  lane_row<N>(b, 3 + r.kz, w.Bz);
-  lane_row<N>(b, 6 + r.kx, Cx);
-  lane_row<N>(b, 6 + r.ky, Cy);
-  lane_row<N>(b, 6 + r.kz, w.Cz);
-  Ax -= r.ox, Ay -= r.oy, w.Az -= r.oz;
-  Bx -= r.ox, By -= r.oy, w.Bz -= r.oz;
-  Cx -= r.ox, Cy -= r.oy, w.Cz -= r.oz;
-  const F ax = Ax - r.sx * w.Az, ay = Ay - r.sy * w.Az;
-  const F bx = Bx - r.sx * w.Bz, by = By - r.sy * w.Bz;
-  const F cx = Cx - r.sx * w.Cz, cy = Cy - r.sy * w.Cz;
-  w.U = cx * by - cy * bx;
-  w.V = ax * cy - ay * cx;
-  w.W = bx * ay - by * ax;
-  w.det = (w.U + w.V) + w.W;
-  // det - det is 0 for a finite det, NaN for inf/NaN (which compares false).
-  w.special = (w.U == 0.0f) | (w.V == 0.0f) | (w.W == 0.0f) | ~((w.det - w.det) == 0.0f);
-  const auto any_neg = (w.U < 0.0f) | (w.V < 0.0f) | (w.W < 0.0f);
-  const auto any_pos = (w.U > 0.0f) | (w.V > 0.0f) | (w.W > 0.0f);
-  w.ok = ~(any_neg & any_pos) & (w.det != 0.0f);
+[[gnu::always_inline]] inline void tri_lanes_edges(const TriBlock4* b, const TriLanesRay<N>& r,
+                                                   WatertightLanes<typename Lanes<N>::F>& w) {
+  Vec3Lanes<typename Lanes<N>::F> p[3];
+  lane_vertices<N>(b, r.kx, r.ky, r.kz, p);
+  watertight_lanes_edges(p[0], p[1], p[2], r.o, r.sx, r.sy, w);
 }
 
-/// Stage two, for a block with a lane inside or special: the distance T,
-/// the late special lanes (tiny det, T not finite or tiny), the tmin side of
-/// the scaled compare, and the figures into `out`.
+/// Stage two on N lanes (watertight_lanes_distance), the figures into `out`.
 template <int N>
-[[gnu::always_inline]] inline void tri_lanes_distance(const TriLanesRay<N>& r, float tmin, TriLanesWork<N>& w,
+[[gnu::always_inline]] inline void tri_lanes_distance(const TriLanesRay<N>& r, float tmin,
+                                                      WatertightLanes<typename Lanes<N>::F>& w,
                                                       TriLanesResult<N>& out) {
   using F = typename Lanes<N>::F;
-  using I = typename Lanes<N>::I;
-  const I abs_mask = I{} + 0x7FFFFFFF;
-  const I tiny_det = w.ok & (reinterpret_cast<F>(reinterpret_cast<I>(w.det) & abs_mask) < 1e-30f);
-  const F az = r.sz * w.Az, bz = r.sz * w.Bz, cz = r.sz * w.Cz;
-  const F T = (w.U * az + w.V * bz) + w.W * cz;
-  const F absT = reinterpret_cast<F>(reinterpret_cast<I>(T) & abs_mask);
-  const I bad_T = ~((T - T) == 0.0f) | ((absT < 1e-30f) & (T != 0.0f));
-  const I special_late = ~tiny_det & (w.ok & bad_T);
-  w.late = tiny_det | special_late;
-  w.ok = ~w.late & w.ok;
-  // tmin side of the scaled compare: det > 0: T >= tmin·det; det < 0: T <= tmin·det.
-  const F tmin_det = (F{} + tmin) * w.det;
-  const I pos = w.det > 0.0f;
-  w.ok &= (pos & (T >= tmin_det)) | (~pos & (T <= tmin_det));
-  const F rcp = (F{} + 1.0f) / w.det;
-  const F t = T * rcp;
-  w.ok &= t >= tmin;
-  const F u = w.V * rcp, v = w.W * rcp;
-  __builtin_memcpy(out.T, &T, sizeof T);
-  __builtin_memcpy(out.det, &w.det, sizeof w.det);
-  __builtin_memcpy(out.t, &t, sizeof t);
-  __builtin_memcpy(out.u, &u, sizeof u);
-  __builtin_memcpy(out.v, &v, sizeof v);
+  LaneFigures<F> f;
+  watertight_lanes_distance(r.sz, F{} + tmin, w, f);
+  __builtin_memcpy(out.T, &f.T, sizeof f.T);
+  __builtin_memcpy(out.det, &f.det, sizeof f.det);
+  __builtin_memcpy(out.t, &f.t, sizeof f.t);
+  __builtin_memcpy(out.u, &f.u, sizeof f.u);
+  __builtin_memcpy(out.v, &f.v, sizeof f.v);
 }
 
 /// Per-ray constants of the N-lane Moller-Trumbore test.
 template <int N>
 struct TriLanesMtRay {
   using F = typename Lanes<N>::F;
-  F ox, oy, oz, dx, dy, dz;
+  Vec3Lanes<F> o, d;
   TriLanesMtRay() = default;  ///< unset; assign before use
   [[gnu::always_inline]] explicit TriLanesMtRay(const Ray& r)
-      : ox(F{} + r.origin.x),
-        oy(F{} + r.origin.y),
-        oz(F{} + r.origin.z),
-        dx(F{} + r.direction.x),
-        dy(F{} + r.direction.y),
-        dz(F{} + r.direction.z) {}
+      : o{F{} + r.origin.x, F{} + r.origin.y, F{} + r.origin.z},
+        d{F{} + r.direction.x, F{} + r.direction.y, F{} + r.direction.z} {}
 };
 using Tri4MtRay = TriLanesMtRay<4>;
 
@@ -287,42 +367,19 @@ struct TriLanesMtResult {
 };
 using Tri4MtResult = TriLanesMtResult<4>;
 
-/// intersect_moller_trumbore_inline (core/geometry/triangle_inline.h) on N
-/// lanes: the same operations in the same order (glm::cross, glm::dot as
-/// (x + y) + z, one IEEE division), so each lane's t, u, v and outcome are
-/// bit for bit the scalar test's (the core library never contracts to
-/// FMA). The figures go to `out`, the candidate lanes to `ok` (a lane is a
-/// hit when it is a candidate and t <= tmax, the scalar test's last check;
-/// NaN compares false in both, so a NaN u or v passes and a NaN t fails in
-/// both).
+/// The Moller-Trumbore test (mt_lanes) on the N lanes of b: the figures to
+/// `out`, the candidate lanes to `ok`.
 template <int N>
 [[gnu::always_inline]] inline void tri_lanes_mt(const TriBlock4* b, const TriLanesMtRay<N>& r, float tmin,
                                                 TriLanesMtResult<N>& out, typename Lanes<N>::I& ok) {
   using F = typename Lanes<N>::F;
-  F row[9];
-  for (int k = 0; k < 9; ++k) lane_row<N>(b, k, row[k]);
-  const F v0x = row[0], v0y = row[1], v0z = row[2];
-  const F e1x = row[3] - v0x, e1y = row[4] - v0y, e1z = row[5] - v0z;
-  const F e2x = row[6] - v0x, e2y = row[7] - v0y, e2z = row[8] - v0z;
-  // p = cross(d, e2)
-  const F px = r.dy * e2z - e2y * r.dz;
-  const F py = r.dz * e2x - e2z * r.dx;
-  const F pz = r.dx * e2y - e2x * r.dy;
-  const F det = (e1x * px + e1y * py) + e1z * pz;
-  const F inv = (F{} + 1.0f) / det;
-  const F sx = r.ox - v0x, sy = r.oy - v0y, sz = r.oz - v0z;
-  const F u = ((sx * px + sy * py) + sz * pz) * inv;
-  // q = cross(s, e1)
-  const F qx = sy * e1z - e1y * sz;
-  const F qy = sz * e1x - e1z * sx;
-  const F qz = sx * e1y - e1x * sy;
-  const F v = ((r.dx * qx + r.dy * qy) + r.dz * qz) * inv;
-  const F t = ((e2x * qx + e2y * qy) + e2z * qz) * inv;
-  const auto reject = (((det == 0.0f) | (u < 0.0f)) | (u > 1.0f)) | ((v < 0.0f) | ((u + v) > 1.0f));
-  ok = ~reject & (t >= tmin);
-  __builtin_memcpy(out.t, &t, sizeof t);
-  __builtin_memcpy(out.u, &u, sizeof u);
-  __builtin_memcpy(out.v, &v, sizeof v);
+  Vec3Lanes<F> p[3];
+  lane_vertices<N>(b, 0, 1, 2, p);
+  LaneFigures<F> f;
+  mt_lanes(p[0], p[1], p[2], r.o, r.d, F{} + tmin, f, ok);
+  __builtin_memcpy(out.t, &f.t, sizeof f.t);
+  __builtin_memcpy(out.u, &f.u, sizeof f.u);
+  __builtin_memcpy(out.v, &f.v, sizeof f.v);
 }
 
 [[gnu::always_inline]] inline int lanes_mask(Lanes<4>::I m) {
@@ -332,7 +389,7 @@ template <int N>
 /// The watertight test on the four lanes of block b (tri_lanes_edges, then
 /// tri_lanes_distance unless no lane is inside or special).
 [[gnu::always_inline]] inline void intersect_tri4(const TriBlock4& b, const Tri4Ray& r, float tmin, Tri4Result& out) {
-  TriLanesWork<4> w;
+  WatertightLanes<Lanes<4>::F> w;
   tri_lanes_edges<4>(&b, r, w);
   // No lane inside and none special: nothing below can make a lane a
   // candidate or special (both need `ok` or `special`), so stop here.

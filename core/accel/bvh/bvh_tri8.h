@@ -39,7 +39,7 @@ using Tri8MtResult = TriLanesMtResult<8>;
 [[gnu::target("avx2"), gnu::always_inline]] inline void intersect_tri8(const TriBlock4* b, const InlineWatertightRay& r,
                                                                        float tmin, Tri8Result& out) {
   const TriLanesRay<8> r8(r);
-  TriLanesWork<8> w;
+  WatertightLanes<Lanes<8>::F> w;
   tri_lanes_edges<8>(b, r8, w);
   if (lanes_mask(w.ok | w.special) == 0) return set_lanes(out, 0, 0, 0);  // as intersect_tri4
   tri_lanes_distance<8>(r8, tmin, w, out);
