@@ -542,10 +542,13 @@ TEST(BvhBuild, ExceptionFromProgressCallbackPropagates) {
 }
 
 TEST(BvhBuild, SimdBinningAgreesWithScalarTwin) {
+  // Ranges of 64 primitives and more take the AVX2 pass where the CPU has
+  // AVX2, shorter ones the SSE2 pass: both must give the scalar twin's bits.
+  const std::size_t sizes[] = {500, 501, 64, 63, 17};
   std::mt19937 rng(30);
   for (int round = 0; round < 50; ++round) {
     const int buckets = 2 + static_cast<int>(rng() % 255);
-    std::vector<bvh_detail::BuildPrim> prims(500 + round % 2);  // even and odd counts
+    std::vector<bvh_detail::BuildPrim> prims(sizes[round % 5]);  // even and odd counts
     for (std::uint32_t i = 0; i < prims.size(); ++i) {
       const glm::vec3 a(uniform(rng), uniform(rng), uniform(rng)), b(uniform(rng), uniform(rng), uniform(rng));
       prims[i] = {(a + b) * 0.5f, i, Aabb{glm::min(a, b), glm::max(a, b)}};
@@ -555,6 +558,9 @@ TEST(BvhBuild, SimdBinningAgreesWithScalarTwin) {
       if (i % 7 == 0) prims[i].bounds.lo.x = (i % 14 == 0) ? 0.0f : -0.0f;
       if (i % 11 == 0) prims[i].bounds.hi.z = (i % 22 == 0) ? -0.0f : 0.0f;
       if (i % 7 == 0 || i % 11 == 0) prims[i].bounds.lo = glm::min(prims[i].bounds.lo, prims[i].bounds.hi);
+      // NaN bounds in every other round (the passes keep min/max's operand order, so NaN too).
+      if (round % 2 == 1 && i % 23 == 5) prims[i].bounds.hi.y = std::numeric_limits<float>::quiet_NaN();
+      if (round % 2 == 1 && i % 29 == 3) prims[i].bounds.lo.z = -std::numeric_limits<float>::quiet_NaN();
     }
     const glm::vec3 origin(0.0f);
     const float k[3] = {static_cast<float>(buckets), static_cast<float>(buckets) * 0.9f, static_cast<float>(buckets)};
@@ -639,9 +645,12 @@ TEST(BvhBuild, ParallelSplitEqualsTheSerialSplitElementForElement) {
       bvh_detail::clear_bins(many, 32);
       bvh_detail::bin_primitives(prims, centroids.lo, k, 32, one);
       bvh_detail::bin_primitives_parallel(prims, centroids.lo, k, 32, many, helpers + 1);
-      for (int a = 0; a < 3; ++a) {  // the 32 buckets in use
-        EXPECT_EQ(std::memcmp(one.lo[a], many.lo[a], 32 * sizeof(one.lo[a][0])), 0);
-        EXPECT_EQ(std::memcmp(one.hi[a], many.hi[a], 32 * sizeof(one.hi[a][0])), 0);
+      for (int a = 0; a < 3; ++a) {   // the 32 buckets in use
+        for (int b = 0; b < 32; ++b)  // x, y, z (lane 3 is unused and unspecified)
+          for (int l = 0; l < 3; ++l) {
+            EXPECT_EQ(std::bit_cast<std::uint32_t>(one.lo[a][b][l]), std::bit_cast<std::uint32_t>(many.lo[a][b][l]));
+            EXPECT_EQ(std::bit_cast<std::uint32_t>(one.hi[a][b][l]), std::bit_cast<std::uint32_t>(many.hi[a][b][l]));
+          }
         EXPECT_EQ(std::memcmp(one.count[a], many.count[a], 32 * sizeof(one.count[a][0])), 0);
       }
     }

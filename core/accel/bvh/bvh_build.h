@@ -119,7 +119,7 @@ std::uint32_t morton_code(const glm::vec3& centroid, const MortonFrame& frame);
 /// prims[i]'s after the sort).
 HugePageVector<std::uint32_t> lbvh_sort(std::span<BuildPrim> prims, const MortonFrame& frame, unsigned threads);
 
-/// Bucket contents of one binned SAH pass: bounds (lanes 0..2 used; 16-byte
+/// Bucket contents of one binned SAH pass: bounds (lanes 0..2 used, lane 3 unspecified; 16-byte
 /// rows so that the SIMD pass can load and store them whole) and counts, per
 /// axis and bucket.
 inline constexpr int kMaxBuckets = 256;

@@ -17,6 +17,13 @@
 #if defined(__SSE2__) && !defined(ACCELVIZ_NO_SIMD)
 #include <emmintrin.h>
 #endif
+// The binning pass has an AVX2 form (one 256-bit read-modify-write per axis)
+// compiled with GCC's target attribute into the plain x86-64 binary and taken
+// when the CPU has AVX2.
+#if defined(__SSE2__) && !defined(ACCELVIZ_NO_SIMD) && defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#include <immintrin.h>
+#define ACCELVIZ_BIN_AVX2 1
+#endif
 
 namespace accelviz::bvh_detail {
 
@@ -58,8 +65,76 @@ void bin_primitives_scalar(std::span<const BuildPrim> prims, const glm::vec3& or
 }
 
 #if defined(__SSE2__) && !defined(ACCELVIZ_NO_SIMD)
+namespace {
+
+#ifdef ACCELVIZ_BIN_AVX2
+/// Ranges of at least this many primitives take the AVX2 pass: below, its
+/// set-up (clearing and copying back the buckets) outweighs the saving.
+constexpr std::size_t kAvx2BinMin = 64;
+
+/// bin_primitives with AVX2, for ranges of kAvx2BinMin to 2^30 primitives.
+/// Each bucket is one 32-byte row: lo.xyz, the count (as integer bits) and
+/// -hi.xyz, so one min and one integer add update the whole bucket (a
+/// primitive's row is (lo.xyz, +inf, -hi.xyz, +inf)): min(acc, x) keeps
+/// minps' operand order, and min(-acc, -x) = -max(acc, x) with maxps'
+/// operand order (a tie or a NaN gives x's bits back once negated), so the
+/// bins come out bit for bit as the SSE2 pass leaves them. The count's bits
+/// stay below +inf's (n < 2^30), so the min leaves them as they are.
+[[gnu::target("avx2")]] void bin_primitives_avx2(std::span<const BuildPrim> prims, const glm::vec3& origin,
+                                                 const float k[3], int buckets, Bins& bins) {
+  alignas(32) float rows[3][kMaxBuckets][8];
+  const __m256 empty =
+      _mm256_setr_ps(kInfinity, kInfinity, kInfinity, 0.0f, kInfinity, kInfinity, kInfinity, kInfinity);
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < buckets; ++b) _mm256_store_ps(rows[a][b], empty);
+  const __m128 o = _mm_setr_ps(origin.x, origin.y, origin.z, 0.0f);
+  const __m128 kv = _mm_setr_ps(k[0], k[1], k[2], 0.0f);
+  const __m128 top = _mm_set1_ps(static_cast<float>(buckets - 1));
+  const __m256 negate_hi = _mm256_setr_ps(0.0f, 0.0f, 0.0f, 0.0f, -0.0f, -0.0f, -0.0f, 0.0f);
+  const __m256 inf = _mm256_set1_ps(kInfinity);
+  const __m256i one = _mm256_setr_epi32(0, 0, 0, 1, 0, 0, 0, 0);
+  alignas(16) int idx[4];
+  for (const BuildPrim& p : prims) {
+    const __m128 x = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(&p.centroid.x), o), kv);
+    _mm_store_si128(reinterpret_cast<__m128i*>(idx),
+                    _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(x, _mm_setzero_ps()), top)));
+    const __m128 lo = _mm_loadu_ps(&p.bounds.lo.x);
+    const __m128 hz = _mm_loadu_ps(&p.bounds.lo.z);
+    const __m128 hi = _mm_shuffle_ps(hz, hz, _MM_SHUFFLE(0, 3, 2, 1));
+    // (lo.xyz, +inf, -hi.xyz, +inf): lanes 3 and 7 from `inf` (blend mask 0x88).
+    const __m256 row =
+        _mm256_blend_ps(_mm256_xor_ps(_mm256_insertf128_ps(_mm256_castps128_ps256(lo), hi, 1), negate_hi), inf, 0x88);
+    for (int a = 0; a < 3; ++a) {
+      float* r = rows[a][idx[a]];
+      const __m256 m = _mm256_min_ps(_mm256_load_ps(r), row);
+      _mm256_store_ps(r, _mm256_castsi256_ps(_mm256_add_epi32(_mm256_castps_si256(m), one)));
+    }
+  }
+  // Back into `bins` (which may already hold primitives: a slice merges
+  // with bin_primitives' operand order).
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < buckets; ++b) {
+      const __m256 r = _mm256_load_ps(rows[a][b]);
+      const __m128 row_lo = _mm256_castps256_ps128(r);
+      const __m128 lo = _mm_blend_ps(row_lo, _mm_set1_ps(kInfinity), 0x8);  // lane 3 (unused) stays as cleared
+      const __m128 hi = _mm_xor_ps(_mm256_extractf128_ps(r, 1), _mm_set1_ps(-0.0f));
+      _mm_store_ps(bins.lo[a][b], _mm_min_ps(_mm_load_ps(bins.lo[a][b]), lo));
+      _mm_store_ps(bins.hi[a][b], _mm_max_ps(_mm_load_ps(bins.hi[a][b]), hi));
+      bins.count[a][b] += static_cast<std::uint32_t>(_mm_extract_epi32(_mm_castps_si128(row_lo), 3));
+    }
+}
+
+const bool kCpuHasAvx2 = __builtin_cpu_supports("avx2") != 0;
+#endif
+
+}  // namespace
+
 void bin_primitives(std::span<const BuildPrim> prims, const glm::vec3& origin, const float k[3], int buckets,
                     Bins& bins) {
+#ifdef ACCELVIZ_BIN_AVX2
+  if (kCpuHasAvx2 && prims.size() >= kAvx2BinMin && prims.size() < (std::size_t{1} << 30))
+    return bin_primitives_avx2(prims, origin, k, buckets, bins);
+#endif
   // The three bucket indices in one go: (c - origin)·k, clamped to
   // [0, B-1] by max/min (a NaN or negative lane gives 0, as bucket_of), then
   // truncated. Lane 3 reads the id and is ignored.
