@@ -110,8 +110,9 @@ constexpr std::size_t kAvx2BinMin = 64;
       _mm256_store_ps(r, _mm256_castsi256_ps(_mm256_add_epi32(_mm256_castps_si256(m), one)));
     }
   }
-  // Back into `bins` (which may already hold primitives: a slice merges
-  // with bin_primitives' operand order).
+  // Back into `bins` with bin_primitives' operand order (its callers clear
+  // it first; into bins that already hold primitives this gives the SSE2
+  // pass's bits for bounds without NaN).
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < buckets; ++b) {
       const __m256 r = _mm256_load_ps(rows[a][b]);
@@ -124,7 +125,11 @@ constexpr std::size_t kAvx2BinMin = 64;
     }
 }
 
-const bool kCpuHasAvx2 = __builtin_cpu_supports("avx2") != 0;
+// (set during static initialisation, hence the explicit __builtin_cpu_init)
+const bool kCpuHasAvx2 = [] {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") != 0;
+}();
 #endif
 
 }  // namespace
