@@ -67,6 +67,27 @@ void bin_primitives_scalar(std::span<const BuildPrim> prims, const glm::vec3& or
 #if defined(__SSE2__) && !defined(ACCELVIZ_NO_SIMD)
 namespace {
 
+/// The binning passes' set-up per range and per primitive: the three bucket
+/// indices in one go, (c - origin)·k clamped to [0, B-1] by max/min (a NaN
+/// or negative lane gives 0, as bucket_of), then truncated (lane 3 reads the
+/// id and is ignored); the box as lo.xyz (+ hi.x) and hi.xyz rotated out of
+/// (lo.z, hi.x, hi.y, hi.z): both loads stay inside the 40-byte record.
+struct BinSetup {
+  __m128 o, kv, top;
+  [[gnu::always_inline]] BinSetup(const glm::vec3& origin, const float k[3], int buckets)
+      : o(_mm_setr_ps(origin.x, origin.y, origin.z, 0.0f)),
+        kv(_mm_setr_ps(k[0], k[1], k[2], 0.0f)),
+        top(_mm_set1_ps(static_cast<float>(buckets - 1))) {}
+  [[gnu::always_inline]] void prim(const BuildPrim& p, int* idx, __m128& lo, __m128& hi) const {
+    const __m128 x = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(&p.centroid.x), o), kv);
+    _mm_store_si128(reinterpret_cast<__m128i*>(idx),
+                    _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(x, _mm_setzero_ps()), top)));
+    lo = _mm_loadu_ps(&p.bounds.lo.x);
+    const __m128 hz = _mm_loadu_ps(&p.bounds.lo.z);
+    hi = _mm_shuffle_ps(hz, hz, _MM_SHUFFLE(0, 3, 2, 1));
+  }
+};
+
 #ifdef ACCELVIZ_BIN_AVX2
 /// Ranges of at least this many primitives take the AVX2 pass: below, its
 /// set-up (clearing and copying back the buckets) outweighs the saving.
@@ -87,20 +108,14 @@ constexpr std::size_t kAvx2BinMin = 64;
       _mm256_setr_ps(kInfinity, kInfinity, kInfinity, 0.0f, kInfinity, kInfinity, kInfinity, kInfinity);
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < buckets; ++b) _mm256_store_ps(rows[a][b], empty);
-  const __m128 o = _mm_setr_ps(origin.x, origin.y, origin.z, 0.0f);
-  const __m128 kv = _mm_setr_ps(k[0], k[1], k[2], 0.0f);
-  const __m128 top = _mm_set1_ps(static_cast<float>(buckets - 1));
+  const BinSetup setup(origin, k, buckets);
   const __m256 negate_hi = _mm256_setr_ps(0.0f, 0.0f, 0.0f, 0.0f, -0.0f, -0.0f, -0.0f, 0.0f);
   const __m256 inf = _mm256_set1_ps(kInfinity);
   const __m256i one = _mm256_setr_epi32(0, 0, 0, 1, 0, 0, 0, 0);
   alignas(16) int idx[4];
   for (const BuildPrim& p : prims) {
-    const __m128 x = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(&p.centroid.x), o), kv);
-    _mm_store_si128(reinterpret_cast<__m128i*>(idx),
-                    _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(x, _mm_setzero_ps()), top)));
-    const __m128 lo = _mm_loadu_ps(&p.bounds.lo.x);
-    const __m128 hz = _mm_loadu_ps(&p.bounds.lo.z);
-    const __m128 hi = _mm_shuffle_ps(hz, hz, _MM_SHUFFLE(0, 3, 2, 1));
+    __m128 lo, hi;
+    setup.prim(p, idx, lo, hi);
     // (lo.xyz, +inf, -hi.xyz, +inf): lanes 3 and 7 from `inf` (blend mask 0x88).
     const __m256 row =
         _mm256_blend_ps(_mm256_xor_ps(_mm256_insertf128_ps(_mm256_castps128_ps256(lo), hi, 1), negate_hi), inf, 0x88);
@@ -140,22 +155,11 @@ void bin_primitives(std::span<const BuildPrim> prims, const glm::vec3& origin, c
   if (kCpuHasAvx2 && prims.size() >= kAvx2BinMin && prims.size() < (std::size_t{1} << 30))
     return bin_primitives_avx2(prims, origin, k, buckets, bins);
 #endif
-  // The three bucket indices in one go: (c - origin)·k, clamped to
-  // [0, B-1] by max/min (a NaN or negative lane gives 0, as bucket_of), then
-  // truncated. Lane 3 reads the id and is ignored.
-  const __m128 o = _mm_setr_ps(origin.x, origin.y, origin.z, 0.0f);
-  const __m128 kv = _mm_setr_ps(k[0], k[1], k[2], 0.0f);
-  const __m128 top = _mm_set1_ps(static_cast<float>(buckets - 1));
+  const BinSetup setup(origin, k, buckets);
   alignas(16) int idx[4];
   for (const BuildPrim& p : prims) {
-    const __m128 x = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(&p.centroid.x), o), kv);
-    _mm_store_si128(reinterpret_cast<__m128i*>(idx),
-                    _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(x, _mm_setzero_ps()), top)));
-    // lo.xyz (+ hi.x), and hi.xyz rotated out of (lo.z, hi.x, hi.y, hi.z):
-    // both loads stay inside the 40-byte record.
-    const __m128 lo = _mm_loadu_ps(&p.bounds.lo.x);
-    const __m128 hz = _mm_loadu_ps(&p.bounds.lo.z);
-    const __m128 hi = _mm_shuffle_ps(hz, hz, _MM_SHUFFLE(0, 3, 2, 1));
+    __m128 lo, hi;
+    setup.prim(p, idx, lo, hi);
     for (int a = 0; a < 3; ++a) {
       float* bl = bins.lo[a][idx[a]];
       float* bh = bins.hi[a][idx[a]];
