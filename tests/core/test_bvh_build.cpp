@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <mutex>
 #include <random>
 #include <stdexcept>
@@ -655,6 +656,77 @@ TEST(BvhBuild, ParallelSplitEqualsTheSerialSplitElementForElement) {
       }
     }
   }
+}
+
+TEST(BvhBuild, PartitionAtPlaneSplitsEveryRecordOnceAndBoundsEachSide) {
+  // The binned SAH's partition (blocks of 64 without branches, the rest
+  // two-ended): on every size around the block sizes, every axis and left
+  // shares from none to all, the records before the returned cut are the ones
+  // left of the plane, each record is moved whole (a permutation), and the
+  // two sides' centroid bounds are those of their records (NaN lanes
+  // ignored). Centroids include -0 and +0, ties on the plane and NaN.
+  std::mt19937 rng(97);
+  const std::size_t sizes[] = {1, 2, 63, 127, 128, 129, 255, 256, 257, 1000, 4099};
+  for (const std::size_t n : sizes)
+    for (int axis = 0; axis < 3; ++axis)
+      for (const float share : {0.0f, 0.03f, 0.5f, 0.97f, 1.0f}) {
+        SCOPED_TRACE("n " + std::to_string(n) + " axis " + std::to_string(axis) + " share " + std::to_string(share));
+        std::vector<bvh_detail::BuildPrim> prims(n);
+        for (std::uint32_t i = 0; i < n; ++i) {
+          glm::vec3 c(uniform(rng), uniform(rng), uniform(rng));
+          const std::uint32_t pick = rng() % 16;
+          if (pick == 0) c[axis] = 0.5f;  // on the plane (k = 16, plane 7: (c - 0)·16 = 8)
+          if (pick == 1) c[(axis + 1) % 3] = -0.0f;
+          if (pick == 2) c[(axis + 2) % 3] = 0.0f;
+          if (pick == 3 && i % 7 == 0) c[(axis + 1) % 3] = std::numeric_limits<float>::quiet_NaN();
+          // Move a `share` of the records left of the plane at x = 0.5.
+          c[axis] = uniform(rng) < share ? 0.5f * c[axis] : (pick == 0 ? 0.5f : 0.5f + 0.5f * c[axis]);
+          if (pick == 4 && i % 5 == 0) c[axis] = std::numeric_limits<float>::quiet_NaN();  // goes left
+          prims[i] = {c, i, Aabb{c, c}};
+        }
+        const float lo = 0.0f, k = 16.0f;
+        const int plane = 7;
+        const auto goes_left = [&](const bvh_detail::BuildPrim& p) {
+          return bvh_detail::left_of_plane(p.centroid[axis], lo, k, plane);
+        };
+        std::vector<bvh_detail::BuildPrim> got = prims;
+        Aabb left_c, right_c;
+        const std::size_t mid = bvh_detail::partition_at_plane(got, axis, lo, k, plane, left_c, right_c);
+        ASSERT_LE(mid, n);
+        EXPECT_EQ(mid, static_cast<std::size_t>(std::count_if(prims.begin(), prims.end(), goes_left)));
+        // Each record once, unchanged.
+        std::vector<bool> seen(n, false);
+        for (const bvh_detail::BuildPrim& p : got) {
+          ASSERT_LT(p.id, n);
+          ASSERT_FALSE(seen[p.id]);
+          seen[p.id] = true;
+          EXPECT_EQ(std::memcmp(&p, &prims[p.id], sizeof(p)), 0);
+        }
+        // Bounds of each side, NaN lanes ignored.
+        for (int side = 0; side < 2; ++side) {
+          glm::vec3 want_lo(std::numeric_limits<float>::infinity()), want_hi(-std::numeric_limits<float>::infinity());
+          const std::size_t b = side == 0 ? 0 : mid, e = side == 0 ? mid : n;
+          for (std::size_t i = b; i < e; ++i) {
+            EXPECT_EQ(goes_left(got[i]), side == 0) << "record " << i;
+            for (int l = 0; l < 3; ++l) {
+              const float v = got[i].centroid[l];
+              if (std::isnan(v)) continue;
+              want_lo[l] = std::min(want_lo[l], v);
+              want_hi[l] = std::max(want_hi[l], v);
+            }
+          }
+          const Aabb& have = side == 0 ? left_c : right_c;
+          for (int l = 0; l < 3; ++l) {
+            EXPECT_EQ(have.lo[l], want_lo[l]) << "side " << side << " lane " << l;
+            EXPECT_EQ(have.hi[l], want_hi[l]) << "side " << side << " lane " << l;
+          }
+        }
+        // Already partitioned: nothing moves.
+        std::vector<bvh_detail::BuildPrim> again = got;
+        Aabb l2, r2;
+        EXPECT_EQ(bvh_detail::partition_at_plane(again, axis, lo, k, plane, l2, r2), mid);
+        EXPECT_EQ(std::memcmp(again.data(), got.data(), n * sizeof(got[0])), 0);
+      }
 }
 
 // ---- Quality ordering between splitters ----

@@ -147,6 +147,18 @@ inline bool left_of_plane(float c, float lo, float k, int plane) {
   return !((c - lo) * k >= static_cast<float>(plane + 1));
 }
 
+/// The binned SAH's partition (split_binned_sah's last step): moves the
+/// records left of the plane (left_of_plane(centroid[axis], lo, k, plane))
+/// before the others and returns their count; each side's centroid bounds
+/// come back in left_centroids and right_centroids (the same values as
+/// Aabb::extend over the side; a zero's sign may differ). With SSE2 every
+/// record is classified without a branch: blocks of 64 at both ends, their
+/// misplaced records swapped in pairs (Edelkamp and Weiss's block
+/// partition), and the last 127 or fewer through two buffers; builds
+/// without SIMD take the two-ended (Hoare) loop.
+std::size_t partition_at_plane(std::span<BuildPrim> prims, int axis, float lo, float k, int plane, Aabb& left_centroids,
+                               Aabb& right_centroids);
+
 /// Buckets the binned SAH uses on a node of n primitives: with
 /// `small_node_buckets` (BvhOptions, default), B on large nodes and
 /// min(B, 4 + n/20) on smaller ones (Embree's rule in its binned builders): a

@@ -8,8 +8,10 @@
 // boundaries of each axis with two sweeps over the buckets. Cost per node:
 // O(n + B), no sorting.
 #include <array>
+#include <cstring>
 #include <limits>
 #include <memory>
+#include <type_traits>
 #include <utility>
 
 #include "core/accel/bvh/bvh_build.h"
@@ -470,7 +472,128 @@ bool search_impl(int nb, std::span<const BuildPrim> prims, const Aabb& centroid_
   return true;
 }
 
+#if defined(__SSE2__) && !defined(ACCELVIZ_NO_SIMD)
+/// Records per block of the block partition (offsets fit a byte).
+constexpr unsigned kPartitionBlock = 64;
+
+/// The plane test of left_of_plane on all four lanes of a record's centroid
+/// (the same operations, so the same answer on lane Axis), and the record's
+/// centroid added to its side's bounds without a branch: the other side
+/// gets the centroid with all bits set, a NaN, which minps and maxps pass
+/// over (they return their second operand, the bounds so far). Returns 1
+/// for a record that goes right.
+template <int Axis>
+[[gnu::always_inline]] inline unsigned classify(const BuildPrim& p, __m128 lo, __m128 k, __m128 plane,
+                                                CentroidBounds& left, CentroidBounds& right) {
+  const __m128 c = _mm_loadu_ps(&p.centroid.x);
+  const __m128 x = _mm_mul_ps(_mm_sub_ps(c, lo), k);
+  const __m128 ge = _mm_cmpge_ps(x, plane);    // goes right: (c - lo)·k >= plane + 1
+  const __m128 nge = _mm_cmpnge_ps(x, plane);  // goes left (NaN too, as left_of_plane)
+  constexpr int kLane = _MM_SHUFFLE(Axis, Axis, Axis, Axis);
+  const __m128 to_right = _mm_shuffle_ps(ge, ge, kLane), to_left = _mm_shuffle_ps(nge, nge, kLane);
+  const __m128 cl = _mm_or_ps(c, to_right), cr = _mm_or_ps(c, to_left);  // NaN on the other side
+  left.lo = _mm_min_ps(cl, left.lo);
+  left.hi = _mm_max_ps(cl, left.hi);
+  right.lo = _mm_min_ps(cr, right.lo);
+  right.hi = _mm_max_ps(cr, right.hi);
+  return static_cast<unsigned>(_mm_movemask_ps(ge) >> Axis) & 1u;
+}
+
+/// Edelkamp and Weiss's block partition ("BlockQuicksort", 2016): a block
+/// of 64 records at each end is classified without branches, listing the
+/// offsets of its misplaced records, and the listed pairs are swapped; a
+/// block whose list is used up is done. What is left (under two blocks,
+/// some of it classified already: those centroids are added to their side's
+/// bounds again, which min and max do not mind) goes through two buffers.
+/// The two-ended loop branches on every record, and mispredicts about half
+/// the time on a node whose records are not sorted.
+template <int Axis>
+std::size_t partition_blocks(std::span<BuildPrim> prims, float lo_a, float k_a, int plane, CentroidBounds& left,
+                             CentroidBounds& right) {
+  const __m128 lo = _mm_set1_ps(lo_a), k = _mm_set1_ps(k_a), p = _mm_set1_ps(static_cast<float>(plane + 1));
+  std::uint8_t off_l[kPartitionBlock], off_r[kPartitionBlock];
+  unsigned num_l = 0, num_r = 0, start_l = 0, start_r = 0;
+  std::size_t first = 0, last = prims.size();  // [first, last): not yet in place
+  while (last - first >= 2 * kPartitionBlock) {
+    if (num_l == 0) {  // the left block's records that go right
+      start_l = 0;
+      for (unsigned i = 0; i < kPartitionBlock; ++i) {
+        off_l[num_l] = static_cast<std::uint8_t>(i);
+        num_l += classify<Axis>(prims[first + i], lo, k, p, left, right);
+      }
+    }
+    if (num_r == 0) {  // the right block's records that go left
+      start_r = 0;
+      for (unsigned i = 0; i < kPartitionBlock; ++i) {
+        off_r[num_r] = static_cast<std::uint8_t>(i);
+        num_r += 1u - classify<Axis>(prims[last - 1 - i], lo, k, p, left, right);
+      }
+    }
+    const unsigned num = std::min(num_l, num_r);
+    for (unsigned j = 0; j < num; ++j)
+      std::swap(prims[first + off_l[start_l + j]], prims[last - 1 - off_r[start_r + j]]);
+    num_l -= num;
+    num_r -= num;
+    start_l += num;
+    start_r += num;
+    if (num_l == 0) first += kPartitionBlock;
+    if (num_r == 0) last -= kPartitionBlock;
+  }
+  // The rest, under two blocks: each record copied to both of two buffers,
+  // each buffer's cursor moved on for its own side's records, and the
+  // buffers copied back (a stable partition: records in place stay put).
+  // (Raw bytes: BuildPrim's Aabb would initialise every element.)
+  static_assert(std::is_trivially_copyable_v<BuildPrim>);
+  constexpr std::size_t kRest = 2 * kPartitionBlock - 1, kSize = sizeof(BuildPrim);
+  alignas(BuildPrim) unsigned char to_left[kRest * kSize], to_right[kRest * kSize];
+  std::size_t nl = 0, nr = 0;
+  for (std::size_t i = first; i < last; ++i) {
+    const unsigned goes_right = classify<Axis>(prims[i], lo, k, p, left, right);
+    std::memcpy(to_left + nl * kSize, &prims[i], kSize);
+    std::memcpy(to_right + nr * kSize, &prims[i], kSize);
+    nl += 1u - goes_right;
+    nr += goes_right;
+  }
+  std::memcpy(prims.data() + first, to_left, nl * kSize);
+  std::memcpy(prims.data() + first + nl, to_right, nr * kSize);
+  return first + nl;
+}
+#else
+/// The two-ended (Hoare) partition of prims[first, last): returns where the
+/// right side starts. Every record it passes is added to its side's bounds.
+template <class GoesLeft>
+std::size_t partition_two_ended(std::span<BuildPrim> prims, std::size_t first, std::size_t last,
+                                const GoesLeft& goes_left, CentroidBounds& left, CentroidBounds& right) {
+  std::size_t i = first, j = last;
+  for (;;) {
+    while (i < j && goes_left(prims[i])) left.extend(prims[i++]);
+    while (i < j && !goes_left(prims[j - 1])) right.extend(prims[--j]);
+    if (i >= j) return i;
+    std::swap(prims[i], prims[j - 1]);
+    left.extend(prims[i++]);
+    right.extend(prims[--j]);
+  }
+}
+#endif
+
 }  // namespace
+
+std::size_t partition_at_plane(std::span<BuildPrim> prims, int axis, float lo, float k, int plane, Aabb& left_centroids,
+                               Aabb& right_centroids) {
+  CentroidBounds left, right;
+  std::size_t mid;
+#if defined(__SSE2__) && !defined(ACCELVIZ_NO_SIMD)
+  mid = axis == 0   ? partition_blocks<0>(prims, lo, k, plane, left, right)
+        : axis == 1 ? partition_blocks<1>(prims, lo, k, plane, left, right)
+                    : partition_blocks<2>(prims, lo, k, plane, left, right);
+#else
+  const auto goes_left = [&](const BuildPrim& r) { return left_of_plane(r.centroid[axis], lo, k, plane); };
+  mid = partition_two_ended(prims, 0, prims.size(), goes_left, left, right);
+#endif
+  left_centroids = left.get();
+  right_centroids = right.get();
+  return mid;
+}
 
 bool binned_sah_search(int buckets, std::span<const BuildPrim> prims, const Aabb& centroid_bounds, Bins& bins,
                        BinnedSahSearch& out, CandidateCosts* costs, unsigned threads) {
@@ -514,31 +637,11 @@ SplitOutcome split_binned_sah(const SplitParams& params, std::span<BuildPrim> pr
   for (int b = 0; b < nb; ++b) child_bounds[b <= best_bucket ? 0 : 1].extend(bucket_box(bins, best_axis, b));
 #endif
 
-  // 5. In-place two-ended partition (Hoare), gathering the children's
-  //    centroid bounds on the way; each primitive is classified once
-  //    (left_of_plane: bucket_of(c) <= best_bucket without its branches).
-  const int a = best_axis;
-  const float lo_a = lo[a], k_a = k[a];
-  const auto goes_left = [&](const BuildPrim& p) { return left_of_plane(p.centroid[a], lo_a, k_a, best_bucket); };
-  //    Serial even when threads are lent: a parallel version (each thread
-  //    listing its slice's misplaced records, then swapping the k-th pairs)
-  //    measured 5.6-11.1 ms on the dragon's root against 3.1-7.0 ms for this
-  //    loop (2 vCPUs; the fresh index array's page faults and a second pass).
-  CentroidBounds cb_left, cb_right;
-  std::size_t i = 0, j = n;
-  for (;;) {
-    while (i < j && goes_left(prims[i])) cb_left.extend(prims[i++]);
-    while (i < j && !goes_left(prims[j - 1])) cb_right.extend(prims[--j]);
-    if (i >= j) break;
-    std::swap(prims[i], prims[j - 1]);
-    cb_left.extend(prims[i++]);
-    cb_right.extend(prims[--j]);
-  }
-  out.mid = i;
+  // 5. The partition, gathering the children's centroid bounds on the way.
+  out.mid = partition_at_plane(prims, best_axis, lo[best_axis], k[best_axis], best_bucket, out.centroid_bounds[0],
+                               out.centroid_bounds[1]);
   out.bounds[0] = child_bounds[0];
   out.bounds[1] = child_bounds[1];
-  out.centroid_bounds[0] = cb_left.get();
-  out.centroid_bounds[1] = cb_right.get();
   return SplitOutcome::split;
 }
 
