@@ -1,11 +1,17 @@
 #pragma once
 // A tiny parallel-for over an index range: dynamic chunks handed out through
 // an atomic counter, so uneven work (rays that hit dense regions) balances.
+// The extra threads are pooled ones (thread_pool.h), parked between calls.
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
+#include <exception>
+#include <memory>
+#include <optional>
 #include <thread>
 #include <vector>
+
+#include "core/util/thread_pool.h"
 
 namespace accelviz {
 
@@ -14,6 +20,39 @@ inline unsigned resolve_threads(unsigned requested) {
   if (requested > 0) return requested;
   const unsigned hw = std::thread::hardware_concurrency();
   return hw > 0 ? hw : 1;
+}
+
+/// Runs fn(0) here and fn(1) .. fn(threads - 1) on pooled threads
+/// (thread_pool.h), and returns when all have ended; rethrows the first
+/// exception (in thread order) after all have ended.
+template <typename Fn>
+void fork_join(unsigned threads, Fn& fn) {
+  if (threads <= 1) {
+    fn(0u);
+    return;
+  }
+  struct Part {
+    Fn* fn;
+    unsigned index;
+    void operator()() const { (*fn)(index); }
+  };
+  std::vector<Part> parts;
+  parts.reserve(threads - 1);
+  for (unsigned t = 1; t < threads; ++t) parts.push_back({&fn, t});
+  const std::unique_ptr<std::optional<PooledTask>[]> tasks(new std::optional<PooledTask>[threads - 1]);
+  for (unsigned t = 1; t < threads; ++t) tasks[t - 1].emplace(parts[t - 1]);
+  std::exception_ptr error;
+  try {
+    fn(0u);
+  } catch (...) {
+    error = std::current_exception();
+  }
+  for (unsigned t = 1; t < threads; ++t) try {
+      tasks[t - 1]->join();
+    } catch (...) {
+      if (!error) error = std::current_exception();
+    }
+  if (error) std::rethrow_exception(error);
 }
 
 /// Calls fn(begin, end, thread_index) over [0, n) in chunks of `chunk`.
@@ -35,11 +74,7 @@ void parallel_for(std::size_t n, unsigned threads, std::size_t chunk, Fn&& fn) {
       fn(b, std::min(n, b + chunk), ti);
     }
   };
-  std::vector<std::thread> pool;
-  pool.reserve(threads - 1);
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker, t);
-  worker(0);
-  for (auto& th : pool) th.join();
+  fork_join(threads, worker);
 }
 
 }  // namespace accelviz

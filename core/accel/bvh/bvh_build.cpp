@@ -27,7 +27,6 @@
 #include <mutex>
 #include <stdexcept>
 #include <string>
-#include <thread>
 
 #include "core/analysis/sah.h"
 #include "core/util/parallel.h"
@@ -194,7 +193,7 @@ class Builder {
       HugePageVector<BvhNode> right_nodes;
       LeafTally right_tally;
       std::exception_ptr right_error;
-      std::thread worker([&] {
+      const auto build_right = [&] {
         try {
           SplitScratch own_scratch;
           right_nodes.reserve(2 * (right.end - right.begin));
@@ -205,7 +204,8 @@ class Builder {
           cancelled_.store(true);
         }
         release_thread();
-      });
+      };
+      PooledTask worker(build_right);  // a parked thread (core/util/thread_pool.h)
       try {
         build(left, out, first_child, scratch, tally);
       } catch (...) {

@@ -23,7 +23,6 @@
 #include <bit>
 #include <cassert>
 #include <cmath>
-#include <thread>
 
 #include "core/accel/bvh/bvh_build.h"
 #include "core/util/parallel.h"
@@ -83,16 +82,7 @@ HugePageVector<std::uint32_t> lbvh_sort(std::span<BuildPrim> prims, const Morton
   const auto chunk = [&](unsigned t) {
     return std::pair<std::size_t, std::size_t>{n * t / threads, n * (t + 1) / threads};
   };
-  const auto for_chunks = [&](auto&& fn) {
-    if (threads == 1) {
-      fn(0u);
-      return;
-    }
-    std::vector<std::thread> pool;
-    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(fn, t);
-    fn(0u);
-    for (std::thread& th : pool) th.join();
-  };
+  const auto for_chunks = [&](auto&& fn) { fork_join(threads, fn); };
   for_chunks([&](unsigned t) {
     const auto [b, e] = chunk(t);
     for (std::size_t i = b; i < e; ++i) {
