@@ -2,6 +2,7 @@
 #include "core/util/thread_pool.h"
 
 #include <atomic>
+#include <memory>
 #include <thread>
 #include <vector>
 
@@ -43,10 +44,11 @@ class ThreadPool {
       }
     }
     if (w == nullptr) {
-      w = new PoolWorker;
-      w->task = &t;
+      auto fresh = std::make_unique<PoolWorker>();  // freed if the thread cannot start
+      fresh->task = &t;
+      std::thread([this, fw = fresh.get()] { loop(fw); }).detach();
+      fresh.release();  // the thread's now
       started_.fetch_add(1, std::memory_order_relaxed);
-      std::thread([this, w] { loop(w); }).detach();
       return;
     }
     {
