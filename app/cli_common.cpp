@@ -74,6 +74,12 @@ void StructureCli::add_to(CLI::App* app) {
                 "Embree robust mode (RTC_SCENE_FLAG_ROBUST: no optimisations that lose watertightness), the "
                 "counterpart of our watertight triangle test")
       ->group("Structure");
+  app->add_option("--embree-isa", embree_isa,
+                  "Embree's kernels: auto (its own choice, the widest the CPU has), sse2, sse4.2, avx, avx2 (our "
+                  "fast path's), avx512")
+      ->check(CLI::IsMember({"auto", "sse2", "sse4.2", "avx", "avx2", "avx512"}))
+      ->capture_default_str()
+      ->group("Structure");
 }
 
 StructureOptions StructureCli::to_options(unsigned threads, bool compute_epo) const {
@@ -93,6 +99,7 @@ StructureOptions StructureCli::to_options(unsigned threads, bool compute_epo) co
   o.bvh.wide_width = wide;
   o.embree.quality = parse_embree_quality(embree_quality).value_or(EmbreeQuality::medium);
   o.embree.robust = embree_robust;
+  o.embree.isa = parse_embree_isa(embree_isa).value_or(EmbreeIsa::automatic);
   return o;
 }
 

@@ -72,6 +72,7 @@ struct StructureCli {
   float cisect = BvhOptions{}.cost_intersect;
   std::string embree_quality = "medium";
   bool embree_robust = false;
+  std::string embree_isa = "auto";
 
   void add_to(CLI::App* app);
   /// Options for the factory; `threads` is the build thread count.

@@ -326,7 +326,10 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   j["warmup"] = o.warmup;
   j["size"] = {size.width, size.height};
   j["triangle_test"] = o.triangle_test;
-  if (kHaveEmbree) j["embree_robust"] = so.embree.robust;
+  if (kHaveEmbree) {
+    j["embree_robust"] = so.embree.robust;
+    j["embree_isa"] = std::string(embree_isa_name(so.embree.isa));
+  }
   j["ray_sets"] = nlohmann::json::object();
   for (const RaySet& set : sets) {
     j["ray_sets"][set.name] = {{"rays", set.rays.size()}};
@@ -392,9 +395,13 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
 
   // ---- text ----
   const std::string warm = o.warmup > 0 ? " after " + std::to_string(o.warmup) + " untimed" : "";
-  std::printf("scene %s: %zu triangles; %u threads; medians of %d runs%s; %s triangle test%s\n", o.scene.c_str(),
+  const std::string embree_isa = so.embree.isa == EmbreeIsa::automatic
+                                     ? std::string()
+                                     : ", its " + std::string(embree_isa_name(so.embree.isa)) + " kernels";
+  std::printf("scene %s: %zu triangles; %u threads; medians of %d runs%s; %s triangle test%s%s\n", o.scene.c_str(),
               scene.triangles.size(), all, o.repeat, warm.c_str(), o.triangle_test.c_str(),
-              kHaveEmbree ? (so.embree.robust ? "; Embree robust" : "; Embree default (not robust)") : "");
+              kHaveEmbree ? (so.embree.robust ? "; Embree robust" : "; Embree default (not robust)") : "",
+              kHaveEmbree ? embree_isa.c_str() : "");
   for (const RaySet& set : sets)
     std::printf("  %-8s %zu rays%s\n", set.name.c_str(), set.rays.size(),
                 set.name == "shadow" && synthetic_light ? " (to a synthetic light: the scene has none)" : "");

@@ -4,9 +4,12 @@ namespace accelviz {
 
 std::string_view embree_quality_name(EmbreeQuality q) {
   switch (q) {
-    case EmbreeQuality::low: return "low";
-    case EmbreeQuality::medium: return "medium";
-    case EmbreeQuality::high: return "high";
+    case EmbreeQuality::low:
+      return "low";
+    case EmbreeQuality::medium:
+      return "medium";
+    case EmbreeQuality::high:
+      return "high";
   }
   return "medium";
 }
@@ -17,12 +20,34 @@ std::optional<EmbreeQuality> parse_embree_quality(std::string_view name) {
   return std::nullopt;
 }
 
+std::string_view embree_isa_name(EmbreeIsa isa) {
+  switch (isa) {
+    case EmbreeIsa::automatic:
+      return "auto";
+    case EmbreeIsa::sse2:
+      return "sse2";
+    case EmbreeIsa::sse42:
+      return "sse4.2";
+    case EmbreeIsa::avx:
+      return "avx";
+    case EmbreeIsa::avx2:
+      return "avx2";
+    case EmbreeIsa::avx512:
+      return "avx512";
+  }
+  return "auto";
+}
+
+std::optional<EmbreeIsa> parse_embree_isa(std::string_view name) {
+  for (EmbreeIsa isa :
+       {EmbreeIsa::automatic, EmbreeIsa::sse2, EmbreeIsa::sse42, EmbreeIsa::avx, EmbreeIsa::avx2, EmbreeIsa::avx512})
+    if (embree_isa_name(isa) == name) return isa;
+  return std::nullopt;
+}
+
 }  // namespace accelviz
 
 #ifdef ACCELVIZ_HAVE_EMBREE
-
-#include "core/analysis/sah.h"
-#include "core/util/timing.h"
 
 #include <embree3/rtcore.h>
 
@@ -35,6 +60,9 @@ std::optional<EmbreeQuality> parse_embree_quality(std::string_view name) {
 #include <string>
 #include <vector>
 
+#include "core/analysis/sah.h"
+#include "core/util/timing.h"
+
 namespace accelviz {
 
 namespace {
@@ -45,10 +73,13 @@ using Clock = std::chrono::steady_clock;
 /// memory monitor that tracks what Embree holds. Released on destruction.
 class Device {
  public:
-  explicit Device(unsigned threads) {
-    const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : std::string();
+  Device(unsigned threads, EmbreeIsa isa) {
+    // Embree's device config: comma-separated "key=value" items.
+    std::string config = threads > 0 ? "threads=" + std::to_string(threads) : std::string();
+    if (isa != EmbreeIsa::automatic) config += (config.empty() ? "isa=" : ",isa=") + std::string(embree_isa_name(isa));
     device_ = rtcNewDevice(config.empty() ? nullptr : config.c_str());
-    if (!device_) throw std::runtime_error("embree: cannot create a device (" + error_name(rtcGetDeviceError(nullptr)) + ")");
+    if (!device_)
+      throw std::runtime_error("embree: cannot create a device (" + error_name(rtcGetDeviceError(nullptr)) + ")");
     rtcSetDeviceErrorFunction(device_, &Device::on_error, this);
     rtcSetDeviceMemoryMonitorFunction(device_, &Device::on_memory, this);
   }
@@ -75,13 +106,20 @@ class Device {
  private:
   static std::string error_name(RTCError code) {
     switch (code) {
-      case RTC_ERROR_NONE: return "no error";
-      case RTC_ERROR_INVALID_ARGUMENT: return "invalid argument";
-      case RTC_ERROR_INVALID_OPERATION: return "invalid operation";
-      case RTC_ERROR_OUT_OF_MEMORY: return "out of memory";
-      case RTC_ERROR_UNSUPPORTED_CPU: return "unsupported CPU";
-      case RTC_ERROR_CANCELLED: return "cancelled";
-      default: return "unknown error";
+      case RTC_ERROR_NONE:
+        return "no error";
+      case RTC_ERROR_INVALID_ARGUMENT:
+        return "invalid argument";
+      case RTC_ERROR_INVALID_OPERATION:
+        return "invalid operation";
+      case RTC_ERROR_OUT_OF_MEMORY:
+        return "out of memory";
+      case RTC_ERROR_UNSUPPORTED_CPU:
+        return "unsupported CPU";
+      case RTC_ERROR_CANCELLED:
+        return "cancelled";
+      default:
+        return "unknown error";
     }
   }
   static void on_error(void* user, RTCError code, const char* str) {
@@ -102,9 +140,12 @@ class Device {
 
 RTCBuildQuality to_rtc(EmbreeQuality q) {
   switch (q) {
-    case EmbreeQuality::low: return RTC_BUILD_QUALITY_LOW;
-    case EmbreeQuality::medium: return RTC_BUILD_QUALITY_MEDIUM;
-    case EmbreeQuality::high: return RTC_BUILD_QUALITY_HIGH;
+    case EmbreeQuality::low:
+      return RTC_BUILD_QUALITY_LOW;
+    case EmbreeQuality::medium:
+      return RTC_BUILD_QUALITY_MEDIUM;
+    case EmbreeQuality::high:
+      return RTC_BUILD_QUALITY_HIGH;
   }
   return RTC_BUILD_QUALITY_MEDIUM;
 }
@@ -114,7 +155,7 @@ RTCBuildQuality to_rtc(EmbreeQuality q) {
 // ---- the accelerator ---------------------------------------------------------------
 
 struct EmbreeAccelerator::Impl {
-  explicit Impl(unsigned threads) : device(threads) {}
+  Impl(unsigned threads, EmbreeIsa isa) : device(threads, isa) {}
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
   }
@@ -123,12 +164,12 @@ struct EmbreeAccelerator::Impl {
   RTCScene scene = nullptr;
   // Embree reads vertex buffers with 16-byte loads: one spare float3 at the
   // end keeps the last vertex's load inside our allocation.
-  std::vector<float> vertices;        ///< 3 per triangle corner, plus one padding vertex
-  std::vector<std::uint32_t> indices; ///< 0, 1, 2, ...: triangle i uses corners 3i..3i+2
+  std::vector<float> vertices;         ///< 3 per triangle corner, plus one padding vertex
+  std::vector<std::uint32_t> indices;  ///< 0, 1, 2, ...: triangle i uses corners 3i..3i+2
 };
 
 EmbreeAccelerator::EmbreeAccelerator(std::span<const Triangle> triangles, const EmbreeOptions& opts)
-    : impl_(std::make_unique<Impl>(opts.threads)) {
+    : impl_(std::make_unique<Impl>(opts.threads, opts.isa)) {
   const auto t0 = Clock::now();
   const std::size_t n = triangles.size();
   impl_->vertices.resize(9 * n + 3, 0.0f);
@@ -316,9 +357,9 @@ namespace {
 /// with the RTCBVH). `leaf` distinguishes the two kinds behind a void*.
 struct BuildNode {
   bool leaf = false;
-  std::uint32_t count = 0;        ///< leaf: primitives
+  std::uint32_t count = 0;  ///< leaf: primitives
   BuildNode* children[2] = {nullptr, nullptr};
-  Aabb bounds[2];                 ///< inner: the children's boxes
+  Aabb bounds[2];  ///< inner: the children's boxes
 };
 
 void* create_node(RTCThreadLocalAllocator alloc, unsigned int child_count, void*) {
@@ -356,7 +397,7 @@ EmbreeBvhFigures embree_binary_bvh_sah(std::span<const Triangle> triangles, floa
   if (min_leaf < 1 || max_leaf < min_leaf || max_leaf > RTC_BUILD_MAX_PRIMITIVES_PER_LEAF)
     throw std::invalid_argument("embree_binary_bvh_sah: need 1 <= min_leaf <= max_leaf <= " +
                                 std::to_string(RTC_BUILD_MAX_PRIMITIVES_PER_LEAF));
-  Device dev(threads);
+  Device dev(threads, EmbreeIsa::automatic);  // its generic builder; the SAH does not depend on the ISA
   RTCBVH bvh = rtcNewBVH(dev.get());
   dev.check("rtcNewBVH");
   struct BvhReleaser {

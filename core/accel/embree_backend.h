@@ -5,13 +5,13 @@
 //
 // Built only with ACCELVIZ_HAVE_EMBREE (CMake option ACCELVIZ_WITH_EMBREE and
 // Debian's libembree-dev); no Embree header leaks out of this file pair.
-#include "core/accel/accel.h"
-
 #include <cstdint>
 #include <memory>
 #include <optional>
 #include <span>
 #include <string_view>
+
+#include "core/accel/accel.h"
 
 namespace accelviz {
 
@@ -29,10 +29,22 @@ enum class EmbreeQuality { low, medium, high };
 std::string_view embree_quality_name(EmbreeQuality q);
 std::optional<EmbreeQuality> parse_embree_quality(std::string_view name);
 
+/// The instruction set whose kernels Embree may use ("isa=" in its device
+/// config): automatic = Embree's own choice (the widest the CPU has, e.g.
+/// AVX-512, where our fast path stops at AVX2); the others pin it, so its
+/// figures can be quoted beside ours on the same ISA. A CPU without the ISA
+/// makes the device fail ("unsupported CPU").
+enum class EmbreeIsa { automatic, sse2, sse42, avx, avx2, avx512 };
+
+/// "auto", "sse2", "sse4.2", "avx", "avx2", "avx512".
+std::string_view embree_isa_name(EmbreeIsa isa);
+std::optional<EmbreeIsa> parse_embree_isa(std::string_view name);
+
 struct EmbreeOptions {
   EmbreeQuality quality = EmbreeQuality::medium;  ///< scene and geometry build quality
-  bool robust = false;     ///< RTC_SCENE_FLAG_ROBUST: avoid optimisations that lose watertightness (slower)
-  unsigned threads = 0;    ///< Embree's build threads ("threads=N" device config); 0: Embree's default (all)
+  bool robust = false;   ///< RTC_SCENE_FLAG_ROBUST: avoid optimisations that lose watertightness (slower)
+  unsigned threads = 0;  ///< Embree's build threads ("threads=N" device config); 0: Embree's default (all)
+  EmbreeIsa isa = EmbreeIsa::automatic;  ///< the kernels Embree may use ("isa=" device config)
 };
 
 #ifdef ACCELVIZ_HAVE_EMBREE
@@ -79,8 +91,8 @@ class EmbreeAccelerator final : public Accelerator {
 /// measured with our SAH formula (core/analysis/sah.h), so that our BVH's
 /// SAH cost can be quoted against Embree's under identical rules.
 struct EmbreeBvhFigures {
-  double sah_cost = 0.0;   ///< Σ_inner C_trav·A/A_root + Σ_leaf C_isect·N·A/A_root
-  double build_ms = 0.0;   ///< primitive bounds + rtcBuildBVH
+  double sah_cost = 0.0;  ///< Σ_inner C_trav·A/A_root + Σ_leaf C_isect·N·A/A_root
+  double build_ms = 0.0;  ///< primitive bounds + rtcBuildBVH
   std::uint64_t node_count = 0;
   std::uint64_t leaf_count = 0;
   std::uint32_t max_depth = 0;

@@ -82,4 +82,24 @@ print("embree robust ok")'
   "$accelviz" -q bench 'builtin:soup?size=2000' --structure embree --embree-robust --rays primary --size 8x8 \
     --repeat 1 >"$tmp/robust.txt"
   grep -q "Embree robust" "$tmp/robust.txt" || { echo "FAIL: text output does not say Embree robust"; exit 1; }
+  # --embree-isa: Embree pinned to one instruction set (SSE2: every x86-64 CPU has it), said so in the
+  # JSON and the text (tests/core/test_embree.cpp checks its hits).
+  "$accelviz" -q bench 'builtin:soup?size=2000' --structure bvh,embree --embree-isa sse2 --rays primary \
+    --size 8x8 --repeat 1 --json | python3 -c '
+import json, sys
+j = json.load(sys.stdin)
+assert j["embree_isa"] == "sse2", j.get("embree_isa")
+assert j["ratios_vs_embree"]["bvh"]["primary"]["closest_mrays_1t"] > 0
+print("embree isa ok")'
+  "$accelviz" -q bench 'builtin:soup?size=2000' --structure embree --embree-isa sse2 --rays primary --size 8x8 \
+    --repeat 1 >"$tmp/isa.txt"
+  grep -q "its sse2 kernels" "$tmp/isa.txt" || { echo "FAIL: text output does not name the ISA"; exit 1; }
+  "$accelviz" -q bench 'builtin:soup?size=2000' --structure embree --rays primary --size 8x8 --repeat 1 --json |
+    python3 -c 'import json, sys; assert json.load(sys.stdin)["embree_isa"] == "auto"'
+  if "$accelviz" -q bench 'builtin:soup?size=2000' --structure embree --embree-isa avx3 --rays primary \
+    --size 8x8 --repeat 1 2>"$tmp/isa_err.txt"; then
+    echo "FAIL: --embree-isa avx3 accepted"; exit 1
+  fi
+  [ "$(wc -l <"$tmp/isa_err.txt")" -le 2 ] && grep -q "embree-isa" "$tmp/isa_err.txt" ||
+    { echo "FAIL: --embree-isa avx3: $(cat "$tmp/isa_err.txt")"; exit 1; }
 fi

@@ -287,6 +287,44 @@ TEST(Embree, QualityAndRobustOptionsGiveTheSameHits) {
   }
 }
 
+TEST(Embree, PinnedIsaGivesTheSameHitsAsItsOwnChoice) {
+  // isa=sse2 (every x86-64 CPU has it) and, where the CPU has them, avx2 and
+  // avx512: the same hits as Embree's own choice of kernels (t may differ in
+  // its last bits: the wider kernels contract to FMA).
+  const std::vector<Triangle> tris = random_soup(500, 7);
+  const std::vector<Ray> rays = random_rays(2000, 8);
+  const EmbreeAccelerator own(tris);
+  std::vector<EmbreeIsa> isas = {EmbreeIsa::sse2};
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+  if (__builtin_cpu_supports("avx2")) isas.push_back(EmbreeIsa::avx2);
+  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl")) isas.push_back(EmbreeIsa::avx512);
+#endif
+  for (EmbreeIsa isa : isas) {
+    SCOPED_TRACE(std::string(embree_isa_name(isa)));
+    const EmbreeAccelerator pinned(tris, EmbreeOptions{.threads = 1, .isa = isa});
+    int hits = 0;
+    for (const Ray& r : rays) {
+      const Hit a = own.closest_hit(r, {}), b = pinned.closest_hit(r, {});
+      ASSERT_EQ(a.valid(), b.valid());
+      EXPECT_EQ(own.any_hit(r, {}), pinned.any_hit(r, {}));
+      if (!a.valid()) continue;
+      ++hits;
+      EXPECT_EQ(a.prim, b.prim);
+      EXPECT_TRUE(same_t(a.t, b.t));
+    }
+    EXPECT_GT(hits, 100);
+  }
+}
+
+TEST(Embree, IsaNamesRoundTrip) {
+  for (EmbreeIsa isa :
+       {EmbreeIsa::automatic, EmbreeIsa::sse2, EmbreeIsa::sse42, EmbreeIsa::avx, EmbreeIsa::avx2, EmbreeIsa::avx512})
+    EXPECT_EQ(parse_embree_isa(embree_isa_name(isa)), isa);
+  EXPECT_EQ(embree_isa_name(EmbreeIsa::automatic), "auto");
+  EXPECT_FALSE(parse_embree_isa("avx3").has_value());
+  EXPECT_FALSE(parse_embree_isa("").has_value());
+}
+
 TEST(Embree, BinaryBvhSahOfOneTriangleIsOneIntersection) {
   const std::vector<Triangle> one = {{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}};
   const EmbreeBvhFigures fig = embree_binary_bvh_sah(one, 1.0f, 2.5f, 1);
