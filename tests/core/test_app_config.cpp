@@ -43,6 +43,7 @@ const std::map<std::string, std::string> kOtherValues = {
     {"voxel-level", "5"},
     {"embree-quality", "high"},
     {"embree-robust", "on"},
+    {"embree-isa", "sse2"},
     {"triangle-test", "fast"},
     {"ordered", "off"},
     {"back-to-front", "on"},

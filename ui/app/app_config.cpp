@@ -242,6 +242,16 @@ const std::vector<Entry>& entries() {
         [](AppConfig& c) -> EmbreeQuality& { return c.structure.options.embree.quality; }));
     t.push_back(bool_option("embree-robust", "Embree: robust mode (no optimisations that lose watertightness)",
                             [](AppConfig& c) -> bool& { return c.structure.options.embree.robust; }));
+    t.push_back(
+        enum_option<EmbreeIsa>("embree-isa", "auto|sse2|sse4.2|avx|avx2|avx512",
+                               "Embree: the kernels it may use (auto: the widest the CPU has; avx2: our fast path's)",
+                               {{"auto", EmbreeIsa::automatic},
+                                {"sse2", EmbreeIsa::sse2},
+                                {"sse4.2", EmbreeIsa::sse42},
+                                {"avx", EmbreeIsa::avx},
+                                {"avx2", EmbreeIsa::avx2},
+                                {"avx512", EmbreeIsa::avx512}},
+                               [](AppConfig& c) -> EmbreeIsa& { return c.structure.options.embree.isa; }));
     // Query choices.
     t.push_back(enum_option<TriangleTest>(
         "triangle-test", "watertight|fast", "ray-triangle test: Woop 2013 watertight or Moller-Trumbore",
@@ -398,7 +408,7 @@ std::vector<std::string_view> structure_option_keys(std::string_view name) {
   if (name == "grid") return {"grid-res", "grid-lambda", "grid-exact", "grid-mailboxing"};
   if (name == "octree") return {"octree-depth", "octree-leaf", "octree-mailboxing", "octree-cost-termination"};
   if (name == "voxels") return {"voxel-level"};
-  if (name == "embree") return {"embree-quality", "embree-robust"};
+  if (name == "embree") return {"embree-quality", "embree-robust", "embree-isa"};
   return {};
 }
 

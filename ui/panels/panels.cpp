@@ -1,19 +1,19 @@
 #include "ui/panels/panels.h"
 
-#include "core/accel/factory.h"
-#include "core/scene/load.h"
-#include "ui/app/shortcuts.h"
-
 #include <imgui.h>
 #include <imgui_stdlib.h>
 
 #include <algorithm>
 #include <cinttypes>
-#include <cstdarg>
 #include <cmath>
+#include <cstdarg>
 #include <cstdio>
 #include <string>
 #include <thread>
+
+#include "core/accel/factory.h"
+#include "core/scene/load.h"
+#include "ui/app/shortcuts.h"
 
 namespace accelviz::panels {
 namespace {
@@ -226,6 +226,12 @@ bool structure_panel(StructureChoice& choice, const BuildProgress& progress, boo
       changed = true;
     }
     changed |= checkbox("Robust", o.embree.robust, nullptr);
+    int isa = static_cast<int>(o.embree.isa);  // EmbreeIsa's order
+    if (combo("Kernels", isa,
+              {"auto (widest the CPU has)", "SSE2", "SSE4.2", "AVX", "AVX2 (our fast path's)", "AVX-512"})) {
+      o.embree.isa = static_cast<EmbreeIsa>(isa);
+      changed = true;
+    }
   } else {
     ImGui::TextDisabled("no build options");
   }
