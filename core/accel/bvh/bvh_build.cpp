@@ -93,9 +93,12 @@ void split_object_median(std::span<BuildPrim> prims, const Aabb& centroid_bounds
 
 namespace {
 
-/// Subtrees at least this large may go to another thread; below it a thread
-/// start costs more than it saves.
-constexpr std::size_t kParallelMinPrims = 4096;
+/// Subtrees at least this large may go to another thread; below it a fork
+/// costs more than it saves. 1024 since the forks use pooled threads: two-
+/// thread builds of the bunny took 0.81-0.98 of the time they took with
+/// 4096 (eight alternated rounds; docs/performance.md, "Pooled threads"),
+/// whose tails had subtrees left that no idle thread could take.
+constexpr std::size_t kParallelMinPrims = 1024;
 
 struct NodeWork {
   std::uint32_t begin, end;
