@@ -69,14 +69,51 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+}  // namespace
+
+bool embree_cpu_has(EmbreeIsa isa) {
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+  __builtin_cpu_init();
+  switch (isa) {
+    case EmbreeIsa::automatic:
+      return true;
+    case EmbreeIsa::sse2:
+      return __builtin_cpu_supports("sse2");
+    case EmbreeIsa::sse42:
+      return __builtin_cpu_supports("sse4.2");
+    case EmbreeIsa::avx:
+      return __builtin_cpu_supports("avx");
+    case EmbreeIsa::avx2:
+      return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") &&
+             __builtin_cpu_supports("bmi2") && __builtin_cpu_supports("lzcnt");
+    case EmbreeIsa::avx512:
+      return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512cd") &&
+             __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") &&
+             __builtin_cpu_supports("avx512vl");
+  }
+  return false;
+#else
+  return isa == EmbreeIsa::automatic;  // not an x86 CPU: only Embree's own choice
+#endif
+}
+
+namespace {
+
 /// A device with an error callback that keeps the first message, and a
 /// memory monitor that tracks what Embree holds. Released on destruction.
 class Device {
  public:
   Device(unsigned threads, EmbreeIsa isa) {
-    // Embree's device config: comma-separated "key=value" items.
+    // Embree's device config: comma-separated "key=value" items. "max_isa"
+    // caps Embree's kernels (and its builder's) at the ISA, within what the
+    // CPU has; "isa" would enable the ISA whatever the CPU has (an illegal
+    // instruction later), so a CPU without it is refused here first.
+    if (!embree_cpu_has(isa))
+      throw std::runtime_error("embree: kernels '" + std::string(embree_isa_name(isa)) +
+                               "' requested, but this CPU lacks that instruction set");
     std::string config = threads > 0 ? "threads=" + std::to_string(threads) : std::string();
-    if (isa != EmbreeIsa::automatic) config += (config.empty() ? "isa=" : ",isa=") + std::string(embree_isa_name(isa));
+    if (isa != EmbreeIsa::automatic)
+      config += (config.empty() ? "max_isa=" : ",max_isa=") + std::string(embree_isa_name(isa));
     device_ = rtcNewDevice(config.empty() ? nullptr : config.c_str());
     if (!device_)
       throw std::runtime_error("embree: cannot create a device (" + error_name(rtcGetDeviceError(nullptr)) + ")");

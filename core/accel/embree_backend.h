@@ -29,11 +29,11 @@ enum class EmbreeQuality { low, medium, high };
 std::string_view embree_quality_name(EmbreeQuality q);
 std::optional<EmbreeQuality> parse_embree_quality(std::string_view name);
 
-/// The instruction set whose kernels Embree may use ("isa=" in its device
-/// config): automatic = Embree's own choice (the widest the CPU has, e.g.
-/// AVX-512, where our fast path stops at AVX2); the others pin it, so its
-/// figures can be quoted beside ours on the same ISA. A CPU without the ISA
-/// makes the device fail ("unsupported CPU").
+/// The instruction set whose kernels Embree may use ("max_isa=" in its
+/// device config): automatic = Embree's own choice (the widest the CPU has,
+/// e.g. AVX-512, where our fast path stops at AVX2); the others pin it, so
+/// its figures can be quoted beside ours on the same ISA. On a CPU without
+/// the ISA the accelerator's constructor throws a one-line error.
 enum class EmbreeIsa { automatic, sse2, sse42, avx, avx2, avx512 };
 
 /// "auto", "sse2", "sse4.2", "avx", "avx2", "avx512".
@@ -44,10 +44,15 @@ struct EmbreeOptions {
   EmbreeQuality quality = EmbreeQuality::medium;  ///< scene and geometry build quality
   bool robust = false;   ///< RTC_SCENE_FLAG_ROBUST: avoid optimisations that lose watertightness (slower)
   unsigned threads = 0;  ///< Embree's build threads ("threads=N" device config); 0: Embree's default (all)
-  EmbreeIsa isa = EmbreeIsa::automatic;  ///< the kernels Embree may use ("isa=" device config)
+  EmbreeIsa isa = EmbreeIsa::automatic;  ///< the kernels Embree may use ("max_isa=" device config)
 };
 
 #ifdef ACCELVIZ_HAVE_EMBREE
+
+/// Whether this CPU has what Embree's kernels for `isa` use (its AVX2
+/// kernels also use FMA, BMI1/2 and LZCNT; its AVX-512 ones AVX-512 F, CD,
+/// DQ, BW and VL). Always true for automatic.
+bool embree_cpu_has(EmbreeIsa isa);
 
 /// One Embree scene holding one triangle geometry with every triangle in
 /// scene order, so Embree's primID is our primitive id. Embree keeps no

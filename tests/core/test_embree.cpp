@@ -316,6 +316,27 @@ TEST(Embree, PinnedIsaGivesTheSameHitsAsItsOwnChoice) {
   }
 }
 
+TEST(Embree, IsaTheCpuLacksIsRefusedWithOneLine) {
+  // Every ISA either builds (the CPU has it) or is refused before Embree
+  // could run an instruction the CPU lacks, with a one-line message.
+  const std::vector<Triangle> tris = random_soup(50, 9);
+  for (EmbreeIsa isa : {EmbreeIsa::sse2, EmbreeIsa::sse42, EmbreeIsa::avx, EmbreeIsa::avx2, EmbreeIsa::avx512}) {
+    SCOPED_TRACE(std::string(embree_isa_name(isa)));
+    if (embree_cpu_has(isa)) {
+      EXPECT_NO_THROW(EmbreeAccelerator(tris, EmbreeOptions{.threads = 1, .isa = isa}));
+    } else {
+      try {
+        const EmbreeAccelerator refused(tris, EmbreeOptions{.threads = 1, .isa = isa});
+        ADD_FAILURE() << "built on a CPU without the ISA";
+      } catch (const std::runtime_error& e) {
+        const std::string msg = e.what();
+        EXPECT_NE(msg.find("lacks that instruction set"), std::string::npos) << msg;
+        EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+      }
+    }
+  }
+}
+
 TEST(Embree, IsaNamesRoundTrip) {
   for (EmbreeIsa isa :
        {EmbreeIsa::automatic, EmbreeIsa::sse2, EmbreeIsa::sse42, EmbreeIsa::avx, EmbreeIsa::avx2, EmbreeIsa::avx512})
