@@ -505,8 +505,8 @@ template <int Axis>
 /// block whose list is used up is done. What is left (under two blocks,
 /// some of it classified already: those centroids are added to their side's
 /// bounds again, which min and max do not mind) goes through two buffers.
-/// The two-ended loop branches on every record, and mispredicts about half
-/// the time on a node whose records are not sorted.
+/// The two-ended loop branches on every record's side, which on a node
+/// whose records are not sorted by side no predictor can learn.
 template <int Axis>
 std::size_t partition_blocks(std::span<BuildPrim> prims, float lo_a, float k_a, int plane, CentroidBounds& left,
                              CentroidBounds& right) {
