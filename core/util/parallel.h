@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #include "core/util/thread_pool.h"
@@ -24,15 +25,17 @@ inline unsigned resolve_threads(unsigned requested) {
 
 /// Runs fn(0) here and fn(1) .. fn(threads - 1) on pooled threads
 /// (thread_pool.h), and returns when all have ended; rethrows the first
-/// exception (in thread order) after all have ended.
+/// exception (in thread order) after all have ended. (fn, a temporary
+/// included, lives until then: the pooled parts refer to it.)
 template <typename Fn>
-void fork_join(unsigned threads, Fn& fn) {
+void fork_join(unsigned threads, Fn&& fn) {
   if (threads <= 1) {
     fn(0u);
     return;
   }
+  using F = std::remove_reference_t<Fn>;
   struct Part {
-    Fn* fn;
+    F* fn;
     unsigned index;
     void operator()() const { (*fn)(index); }
   };

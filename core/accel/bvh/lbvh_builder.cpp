@@ -82,8 +82,7 @@ HugePageVector<std::uint32_t> lbvh_sort(std::span<BuildPrim> prims, const Morton
   const auto chunk = [&](unsigned t) {
     return std::pair<std::size_t, std::size_t>{n * t / threads, n * (t + 1) / threads};
   };
-  const auto for_chunks = [&](auto&& fn) { fork_join(threads, fn); };
-  for_chunks([&](unsigned t) {
+  fork_join(threads, [&](unsigned t) {
     const auto [b, e] = chunk(t);
     for (std::size_t i = b; i < e; ++i) {
       keys[i] = morton_code(prims[i].centroid, frame);
@@ -95,7 +94,7 @@ HugePageVector<std::uint32_t> lbvh_sort(std::span<BuildPrim> prims, const Morton
   std::vector<std::array<std::size_t, 256>> hist(threads);
   for (int pass = 0; pass < 4; ++pass) {
     const int shift = 8 * pass;
-    for_chunks([&](unsigned t) {
+    fork_join(threads, [&](unsigned t) {
       const auto [b, e] = chunk(t);
       hist[t].fill(0);
       for (std::size_t i = b; i < e; ++i) ++hist[t][(keys[i] >> shift) & 0xFFu];
@@ -109,7 +108,7 @@ HugePageVector<std::uint32_t> lbvh_sort(std::span<BuildPrim> prims, const Morton
         hist[t][d] = sum;
         sum += c;
       }
-    for_chunks([&](unsigned t) {
+    fork_join(threads, [&](unsigned t) {
       const auto [b, e] = chunk(t);
       auto& h = hist[t];
       for (std::size_t i = b; i < e; ++i) {
@@ -122,7 +121,7 @@ HugePageVector<std::uint32_t> lbvh_sort(std::span<BuildPrim> prims, const Morton
     order.swap(order_tmp);
   }
   HugePageVector<BuildPrim> sorted(n);
-  for_chunks([&](unsigned t) {
+  fork_join(threads, [&](unsigned t) {
     const auto [b, e] = chunk(t);
     for (std::size_t i = b; i < e; ++i) {
       // A gather at random: each record's fetch is started kGatherAhead records ahead.
