@@ -34,16 +34,21 @@ void fork_join(unsigned threads, Fn&& fn) {
     return;
   }
   using F = std::remove_reference_t<Fn>;
+  // Part t's call and its task side by side, in one allocation per fork
+  // (the task refers to the call, so the call must not move).
   struct Part {
     F* fn;
     unsigned index;
+    std::optional<PooledTask> task;
     void operator()() const { (*fn)(index); }
   };
-  std::vector<Part> parts;
-  parts.reserve(threads - 1);
-  for (unsigned t = 1; t < threads; ++t) parts.push_back({&fn, t});
-  const std::unique_ptr<std::optional<PooledTask>[]> tasks(new std::optional<PooledTask>[threads - 1]);
-  for (unsigned t = 1; t < threads; ++t) tasks[t - 1].emplace(parts[t - 1]);
+  const std::unique_ptr<Part[]> parts(new Part[threads - 1]);
+  for (unsigned t = 1; t < threads; ++t) {
+    Part& part = parts[t - 1];
+    part.fn = &fn;
+    part.index = t;
+    part.task.emplace(part);
+  }
   std::exception_ptr error;
   try {
     fn(0u);
@@ -51,7 +56,7 @@ void fork_join(unsigned threads, Fn&& fn) {
     error = std::current_exception();
   }
   for (unsigned t = 1; t < threads; ++t) try {
-      tasks[t - 1]->join();
+      parts[t - 1].task->join();
     } catch (...) {
       if (!error) error = std::current_exception();
     }
