@@ -514,20 +514,26 @@ std::size_t partition_blocks(std::span<BuildPrim> prims, float lo_a, float k_a, 
   std::uint8_t off_l[kPartitionBlock], off_r[kPartitionBlock];
   unsigned num_l = 0, num_r = 0, start_l = 0, start_r = 0;
   std::size_t first = 0, last = prims.size();  // [first, last): not yet in place
-  while (last - first >= 2 * kPartitionBlock) {
-    if (num_l == 0) {  // the left block's records that go right
-      start_l = 0;
-      for (unsigned i = 0; i < kPartitionBlock; ++i) {
-        off_l[num_l] = static_cast<std::uint8_t>(i);
-        num_l += classify<Axis>(prims[first + i], lo, k, p, left, right);
-      }
+  // Lists the offsets of a block's misplaced records: the left block's
+  // (prims[first + i]) that go right, or the right block's (prims[last - 1 - i])
+  // that go left. Returns how many.
+  const auto list_block = [&]<bool RightBlock>(std::uint8_t* off) {
+    unsigned num = 0;
+    for (unsigned i = 0; i < kPartitionBlock; ++i) {
+      off[num] = static_cast<std::uint8_t>(i);
+      const unsigned goes_right = classify<Axis>(prims[RightBlock ? last - 1 - i : first + i], lo, k, p, left, right);
+      num += RightBlock ? 1u - goes_right : goes_right;
     }
-    if (num_r == 0) {  // the right block's records that go left
+    return num;
+  };
+  while (last - first >= 2 * kPartitionBlock) {
+    if (num_l == 0) {
+      start_l = 0;
+      num_l = list_block.template operator()<false>(off_l);
+    }
+    if (num_r == 0) {
       start_r = 0;
-      for (unsigned i = 0; i < kPartitionBlock; ++i) {
-        off_r[num_r] = static_cast<std::uint8_t>(i);
-        num_r += 1u - classify<Axis>(prims[last - 1 - i], lo, k, p, left, right);
-      }
+      num_r = list_block.template operator()<true>(off_r);
     }
     const unsigned num = std::min(num_l, num_r);
     for (unsigned j = 0; j < num; ++j)
