@@ -77,7 +77,11 @@ void StructureCli::add_to(CLI::App* app) {
   app->add_option("--embree-isa", embree_isa,
                   "Embree's kernels: auto (its own choice, the widest the CPU has), sse2, sse4.2, avx, avx2 (our "
                   "fast path's), avx512")
-      ->check(CLI::IsMember({"auto", "sse2", "sse4.2", "avx", "avx2", "avx512"}))
+      ->check(CLI::IsMember([] {
+        std::vector<std::string> names;  // embree_isa_name's
+        for (EmbreeIsa isa : kEmbreeIsas) names.emplace_back(embree_isa_name(isa));
+        return names;
+      }()))
       ->capture_default_str()
       ->group("Structure");
 }

@@ -39,8 +39,7 @@ std::string_view embree_isa_name(EmbreeIsa isa) {
 }
 
 std::optional<EmbreeIsa> parse_embree_isa(std::string_view name) {
-  for (EmbreeIsa isa :
-       {EmbreeIsa::automatic, EmbreeIsa::sse2, EmbreeIsa::sse42, EmbreeIsa::avx, EmbreeIsa::avx2, EmbreeIsa::avx512})
+  for (EmbreeIsa isa : kEmbreeIsas)
     if (embree_isa_name(isa) == name) return isa;
   return std::nullopt;
 }

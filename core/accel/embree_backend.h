@@ -36,6 +36,10 @@ std::optional<EmbreeQuality> parse_embree_quality(std::string_view name);
 /// the ISA the accelerator's constructor throws a one-line error.
 enum class EmbreeIsa { automatic, sse2, sse42, avx, avx2, avx512 };
 
+/// Every EmbreeIsa, in the enum's order (the CLI's and the settings' choices).
+inline constexpr EmbreeIsa kEmbreeIsas[] = {EmbreeIsa::automatic, EmbreeIsa::sse2, EmbreeIsa::sse42,
+                                            EmbreeIsa::avx,       EmbreeIsa::avx2, EmbreeIsa::avx512};
+
 /// "auto", "sse2", "sse4.2", "avx", "avx2", "avx512".
 std::string_view embree_isa_name(EmbreeIsa isa);
 std::optional<EmbreeIsa> parse_embree_isa(std::string_view name);

@@ -242,16 +242,12 @@ const std::vector<Entry>& entries() {
         [](AppConfig& c) -> EmbreeQuality& { return c.structure.options.embree.quality; }));
     t.push_back(bool_option("embree-robust", "Embree: robust mode (no optimisations that lose watertightness)",
                             [](AppConfig& c) -> bool& { return c.structure.options.embree.robust; }));
-    t.push_back(
-        enum_option<EmbreeIsa>("embree-isa", "auto|sse2|sse4.2|avx|avx2|avx512",
-                               "Embree: the kernels it may use (auto: the widest the CPU has; avx2: our fast path's)",
-                               {{"auto", EmbreeIsa::automatic},
-                                {"sse2", EmbreeIsa::sse2},
-                                {"sse4.2", EmbreeIsa::sse42},
-                                {"avx", EmbreeIsa::avx},
-                                {"avx2", EmbreeIsa::avx2},
-                                {"avx512", EmbreeIsa::avx512}},
-                               [](AppConfig& c) -> EmbreeIsa& { return c.structure.options.embree.isa; }));
+    std::vector<std::pair<std::string_view, EmbreeIsa>> isa_names;  // embree_isa_name's
+    for (EmbreeIsa isa : kEmbreeIsas) isa_names.emplace_back(embree_isa_name(isa), isa);
+    t.push_back(enum_option<EmbreeIsa>(
+        "embree-isa", "auto|sse2|sse4.2|avx|avx2|avx512",
+        "Embree: the kernels it may use (auto: the widest the CPU has; avx2: our fast path's)", std::move(isa_names),
+        [](AppConfig& c) -> EmbreeIsa& { return c.structure.options.embree.isa; }));
     // Query choices.
     t.push_back(enum_option<TriangleTest>(
         "triangle-test", "watertight|fast", "ray-triangle test: Woop 2013 watertight or Moller-Trumbore",
