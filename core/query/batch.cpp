@@ -46,7 +46,14 @@ bool for_each_chunk(std::size_t n, const BatchOptions& batch,
     per_chunk(begin, end);
     const std::size_t so_far = done.fetch_add(end - begin, std::memory_order_relaxed) + (end - begin);
     if (batch.progress) {
-      std::unique_lock lock(progress_mutex, std::try_to_lock);
+      // A report may be skipped while another is under way, but not the
+      // last one (1.0): it waits, so the caller always hears the end and
+      // can still cancel there however the workers were scheduled.
+      std::unique_lock lock(progress_mutex, std::defer_lock);
+      if (so_far == n)
+        lock.lock();
+      else
+        lock.try_lock();
       if (lock.owns_lock() && !batch.progress(static_cast<double>(so_far) / static_cast<double>(n)))
         cancelled.store(true, std::memory_order_relaxed);
     }

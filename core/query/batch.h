@@ -2,18 +2,18 @@
 // Tracing a span of rays over all threads. One virtual call per ray, none per
 // node; with an empty `stats` span the structures run their counter-free fast
 // path, so a timed batch measures the product, not the instrumentation.
-#include "core/accel/accel.h"
-
 #include <cstdint>
 #include <functional>
 #include <span>
 
+#include "core/accel/accel.h"
+
 namespace accelviz {
 
 struct BatchOptions {
-  unsigned threads = 0;         ///< worker threads (0: all hardware threads)
-  std::size_t chunk = 256;      ///< rays handed to a worker at a time (dynamic balancing)
-  ProgressCallback progress;    ///< optional; called from worker threads, one call at a time; false cancels
+  unsigned threads = 0;       ///< worker threads (0: all hardware threads)
+  std::size_t chunk = 256;    ///< rays handed to a worker at a time (dynamic balancing)
+  ProgressCallback progress;  ///< optional; called from worker threads, one call at a time; false cancels
 };
 
 /// Runs per_chunk(begin, end) over [0, n) in chunks of batch.chunk on
@@ -21,8 +21,9 @@ struct BatchOptions {
 /// trace_any run on. Progress is reported after each chunk by whichever worker
 /// finished it (the calling thread may get no chunk at all when the others
 /// are quicker), one call at a time: a worker that finds the callback busy
-/// skips its report rather than wait. A cancel stops every worker at its next
-/// chunk; returns false then.
+/// skips its report rather than wait, except the last report (1.0), which
+/// waits. A cancel stops every worker at its next chunk; returns false then
+/// (a cancel at the last report too).
 bool for_each_chunk(std::size_t n, const BatchOptions& batch,
                     const std::function<void(std::size_t begin, std::size_t end)>& per_chunk);
 
@@ -30,8 +31,8 @@ bool for_each_chunk(std::size_t n, const BatchOptions& batch,
 /// non-empty it must have the same size and receives each ray's counters
 /// (reset first). Returns false when the progress callback cancelled: rays not
 /// yet traced are then left untouched. Throws std::invalid_argument on a size mismatch.
-bool trace_closest(const Accelerator& accel, std::span<const Ray> rays, std::span<Hit> hits,
-                   const QueryOptions& query, const BatchOptions& batch, std::span<RayStats> stats = {});
+bool trace_closest(const Accelerator& accel, std::span<const Ray> rays, std::span<Hit> hits, const QueryOptions& query,
+                   const BatchOptions& batch, std::span<RayStats> stats = {});
 
 /// Any hit of every ray: occluded[i] = 1 when something lies in [tmin, tmax].
 bool trace_any(const Accelerator& accel, std::span<const Ray> rays, std::span<std::uint8_t> occluded,

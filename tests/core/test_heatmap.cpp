@@ -2,9 +2,13 @@
 #include <unistd.h>
 
 #include <bit>
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <mutex>
+#include <thread>
+#include <vector>
 
 #include "core/accel/brute_force.h"
 #include "core/accel/bvh/bvh.h"
@@ -324,6 +328,31 @@ TEST(Batch, ProgressCanCancel) {
   ho.height = 32;
   ho.progress = [](double) { return false; };
   EXPECT_THROW(render_metric(accel, tiny_camera(), ho), BuildCancelled);
+}
+
+TEST(Batch, TheLastReportIsNeverSkipped) {
+  // The first report is slow: the other worker finishes every other chunk
+  // meanwhile and finds the callback busy. Its intermediate reports may be
+  // skipped, its last (1.0) must wait and come, so a caller always hears the
+  // end (the heatmap's cancel test relied on it on a loaded machine).
+  for (int round = 0; round < 3; ++round) {
+    std::mutex m;
+    std::vector<double> seen;
+    BatchOptions batch{.threads = 2, .chunk = 1};
+    batch.progress = [&](double fraction) {
+      bool first;
+      {
+        std::lock_guard lock(m);
+        first = seen.empty();
+        seen.push_back(fraction);
+      }
+      if (first) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      return true;
+    };
+    EXPECT_TRUE(for_each_chunk(8, batch, [](std::size_t, std::size_t) {}));
+    ASSERT_FALSE(seen.empty());
+    EXPECT_EQ(seen.back(), 1.0) << "round " << round;
+  }
 }
 
 TEST(Batch, SizeMismatchThrows) {
