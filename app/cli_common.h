@@ -103,9 +103,6 @@ std::string absolute_path(const std::string& path);
 /// One-line JSON on stdout.
 void print_json_line(const nlohmann::json& j);
 
-/// Median of the values (mean of the two middle ones for an even count); 0 if empty.
-double median(std::vector<double> v);
-
 // ---- progress and timing -----------------------------------------------------------
 
 /// Progress on stderr: on a terminal, one line updated in place; otherwise

@@ -205,10 +205,6 @@ int main(int argc, char** argv) {
       gui_readback.push_back(gui.last_readback_ms());
       shown = std::move(frame);
     }
-    const auto median = [](std::vector<double> v) {
-      std::sort(v.begin(), v.end());
-      return v[v.size() / 2];
-    };
 
     const nlohmann::json out = {
         {"scene", spec},

@@ -6,15 +6,16 @@
 // hardware prefetcher honest without making the loop memory-bound.
 #include "core/analysis/calibrate.h"
 
-#include "core/geometry/triangle.h"
-#include "core/math/aabb.h"
-#include "core/math/ray.h"
-#include "core/util/random.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <vector>
+
+#include "core/geometry/triangle.h"
+#include "core/math/aabb.h"
+#include "core/math/ray.h"
+#include "core/util/random.h"
+#include "core/util/timing.h"
 
 namespace accelviz {
 
@@ -27,12 +28,6 @@ struct Rng {
   double next() { return g.uniform_double(); }
   glm::vec3 point() { return {float(next()), float(next()), float(next())}; }
 };
-
-double median_of(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 /// Median ns per call of `test(ray_index, item_index)` -> (hit, t).
 template <typename Test>
@@ -55,7 +50,7 @@ double time_tests(const CalibrateOptions& o, double& hit_fraction, Test&& test) 
     ns.push_back(s * 1e9 / static_cast<double>(std::max<std::size_t>(1, o.tests)));
     hit_fraction = static_cast<double>(hits) / static_cast<double>(std::max<std::size_t>(1, o.tests));
   }
-  return median_of(ns);
+  return median(ns);
 }
 
 }  // namespace

@@ -1,13 +1,8 @@
 // Sweep expansion, measurement and the Pareto front (see sweep.h).
 #include "core/analysis/sweep.h"
 
-#include "core/query/batch.h"
-#include "core/util/parallel.h"
-#include "core/util/random.h"
-
 #include <algorithm>
 #include <array>
-#include <tuple>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -15,17 +10,16 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
+
+#include "core/query/batch.h"
+#include "core/util/parallel.h"
+#include "core/util/random.h"
+#include "core/util/timing.h"
 
 namespace accelviz {
 
 namespace {
-
-double median_of(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 [[noreturn]] void bad_value(const std::string& name, const std::string& value, const std::string& why) {
   throw std::invalid_argument("sweep parameter " + name + ": bad value '" + value + "' (" + why + ")");
@@ -60,7 +54,6 @@ std::string joined(const std::vector<std::string>& v) {
   for (const std::string& x : v) s += (s.empty() ? "" : ", ") + x;
   return s;
 }
-
 
 }  // namespace
 
@@ -109,9 +102,12 @@ void apply_sweep_setting(std::string_view structure, const SweepSetting& setting
       throw std::invalid_argument("unknown sweep parameter '" + name + "' for " + std::string(structure) +
                                   " (valid: " + joined(valid) + ")");
     if (name == "triangle") {
-      if (v == "watertight") q.triangle_test = TriangleTest::watertight;
-      else if (v == "fast") q.triangle_test = TriangleTest::moller_trumbore;
-      else bad_value(name, v, "expected watertight or fast");
+      if (v == "watertight")
+        q.triangle_test = TriangleTest::watertight;
+      else if (v == "fast")
+        q.triangle_test = TriangleTest::moller_trumbore;
+      else
+        bad_value(name, v, "expected watertight or fast");
     } else if (structure == "bvh") {
       if (name == "buckets") {
         if (v == "exact") {
@@ -121,11 +117,16 @@ void apply_sweep_setting(std::string_view structure, const SweepSetting& setting
           o.bvh.splitter = BvhSplitter::binned_sah;
         }
       } else if (name == "splitter") {
-        if (v == "median") o.bvh.splitter = BvhSplitter::median;
-        else if (v == "binned") o.bvh.splitter = BvhSplitter::binned_sah;
-        else if (v == "exact") o.bvh.splitter = BvhSplitter::exact_sah;
-        else if (v == "lbvh") o.bvh.splitter = BvhSplitter::lbvh;
-        else bad_value(name, v, "expected median, binned, exact or lbvh");
+        if (v == "median")
+          o.bvh.splitter = BvhSplitter::median;
+        else if (v == "binned")
+          o.bvh.splitter = BvhSplitter::binned_sah;
+        else if (v == "exact")
+          o.bvh.splitter = BvhSplitter::exact_sah;
+        else if (v == "lbvh")
+          o.bvh.splitter = BvhSplitter::lbvh;
+        else
+          bad_value(name, v, "expected median, binned, exact or lbvh");
       } else if (name == "leaf") {
         o.bvh.max_leaf_size = parse_int(name, v, 1, 255);
         o.bvh.leaf_size_cap = std::max(o.bvh.leaf_size_cap, o.bvh.max_leaf_size);
@@ -135,11 +136,16 @@ void apply_sweep_setting(std::string_view structure, const SweepSetting& setting
         o.bvh.cost_intersect = parse_positive(name, v);
       }
     } else if (structure == "kdtree") {
-      if (name == "depth") o.kdtree.max_depth = parse_int(name, v, 0, 64);
-      else if (name == "ctrav") o.kdtree.cost_traversal = parse_positive(name, v);
-      else if (name == "cisect") o.kdtree.cost_intersect = parse_positive(name, v);
-      else if (name == "leaf") o.kdtree.max_leaf_size = parse_int(name, v, 1, 1 << 20);
-      else if (name == "mailbox") o.kdtree.mailboxing = parse_on_off(name, v);
+      if (name == "depth")
+        o.kdtree.max_depth = parse_int(name, v, 0, 64);
+      else if (name == "ctrav")
+        o.kdtree.cost_traversal = parse_positive(name, v);
+      else if (name == "cisect")
+        o.kdtree.cost_intersect = parse_positive(name, v);
+      else if (name == "leaf")
+        o.kdtree.max_leaf_size = parse_int(name, v, 1, 1 << 20);
+      else if (name == "mailbox")
+        o.kdtree.mailboxing = parse_on_off(name, v);
     } else if (structure == "grid") {
       if (name == "lambda") {
         o.grid.lambda = parse_positive(name, v);
@@ -157,8 +163,10 @@ void apply_sweep_setting(std::string_view structure, const SweepSetting& setting
         o.grid.resolution = r;
       }
     } else if (structure == "octree") {
-      if (name == "depth") o.octree.max_depth = parse_int(name, v, 0, 16);
-      else if (name == "leaf") o.octree.max_leaf_size = parse_int(name, v, 1, 1 << 20);
+      if (name == "depth")
+        o.octree.max_depth = parse_int(name, v, 0, 16);
+      else if (name == "leaf")
+        o.octree.max_leaf_size = parse_int(name, v, 1, 1 << 20);
     } else if (structure == "voxels") {
       if (name == "level") o.voxels.level = parse_int(name, v, 0, 10);
     }
@@ -298,8 +306,8 @@ std::vector<std::array<std::uint32_t, 3>> shared_edge_neighbours(std::span<const
 }
 
 std::uint64_t count_ray_double_hits(std::span<const Triangle> triangles,
-                                    std::span<const std::array<std::uint32_t, 3>> neighbours,
-                                    std::span<const Ray> rays, std::span<const Hit> hits, TriangleTest test) {
+                                    std::span<const std::array<std::uint32_t, 3>> neighbours, std::span<const Ray> rays,
+                                    std::span<const Hit> hits, TriangleTest test) {
   std::uint64_t n = 0;
   for (std::size_t i = 0; i < rays.size() && i < hits.size(); ++i) {
     const Hit& h = hits[i];
@@ -346,7 +354,7 @@ SweepResult measure_sweep_setting(std::span<const Triangle> triangles, std::span
     accel = build_accelerator(config.structure, triangles, so, build_progress);
     r.build_ms_runs.push_back(accel->build_stats().build_ms);
   }
-  r.build_ms = median_of(r.build_ms_runs);
+  r.build_ms = median(r.build_ms_runs);
   const BuildStats& bs = accel->build_stats();
   r.memory_bytes = bs.memory_bytes;
   r.nodes = bs.node_count;
@@ -364,7 +372,7 @@ SweepResult measure_sweep_setting(std::span<const Triangle> triangles, std::span
       const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       r.rays_per_s_runs.push_back(s > 0 ? static_cast<double>(rays.size()) / s : 0.0);
     }
-    r.rays_per_s = median_of(r.rays_per_s_runs);
+    r.rays_per_s = median(r.rays_per_s_runs);
     // Counting pass, outside the timings.
     check();
     std::vector<RayStats> stats(rays.size());

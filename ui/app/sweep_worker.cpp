@@ -11,6 +11,7 @@
 #include "core/query/batch.h"
 #include "core/query/ray_sets.h"
 #include "core/util/parallel.h"
+#include "core/util/timing.h"
 
 namespace accelviz {
 
@@ -127,13 +128,6 @@ std::vector<SweepSeries> sweep_series(std::span<const SweepResult> results, std:
 
 namespace {
 
-double median_of(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 CalibratedTree measure_tree(std::span<const Triangle> triangles, std::span<const Ray> rays, float ctrav, float cisect,
                             double judge_cisect, const QueryOptions& q, unsigned threads, int repeat,
                             const std::function<bool()>& keep_going) {
@@ -161,7 +155,7 @@ CalibratedTree measure_tree(std::span<const Triangle> triangles, std::span<const
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     rps.push_back(s > 0 ? static_cast<double>(rays.size()) / s : 0.0);
   }
-  t.rays_per_s = median_of(rps);
+  t.rays_per_s = median(rps);
   if (!rays.empty()) {
     std::vector<RayStats> stats(rays.size());
     trace_closest(bvh, rays, hits, q, n_threads, stats);
