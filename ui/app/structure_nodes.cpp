@@ -24,6 +24,40 @@ struct Pending {
   std::uint32_t parent;
 };
 
+/// Binary node i's children (first, first + 1) get i as their parent and its
+/// depth + 1. Children come after their parent, so one forward sweep over a
+/// BVH's array sets every depth; ids out of order or range are skipped.
+void link_children(std::vector<StructureNode>& out, std::uint32_t i, std::uint32_t first, std::size_t count) {
+  for (std::uint32_t c : {first, first + 1})
+    if (c > i && c < count) {
+      out[c].parent = i;
+      out[c].depth = out[i].depth + 1;
+    }
+}
+
+/// Fills `out` (`count` nodes) for a tree whose node boxes follow from the
+/// root's (K-D tree, octree): from node 0 with box `root`, each node's box,
+/// depth and parent set, then expand(p, node, push) sets its leaf figures or
+/// calls push(child, child_box) for its children. Children must have larger
+/// ids than their parent (so a corrupt array cannot loop); out-of-range ids
+/// are skipped.
+template <class Expand>
+void fill_from_root(std::vector<StructureNode>& out, std::size_t count, const Aabb& root, const Expand& expand) {
+  out.resize(count);
+  std::vector<Pending> stack;
+  if (count > 0) stack.push_back({0, root, 0, kNone});
+  while (!stack.empty()) {
+    const Pending p = stack.back();
+    stack.pop_back();
+    if (p.id >= count) continue;
+    StructureNode& n = out[p.id];
+    n.bounds = p.box;
+    n.depth = p.depth;
+    n.parent = p.parent;
+    expand(p, n, [&](std::uint32_t child, const Aabb& box) { stack.push_back({child, box, p.depth + 1, p.id}); });
+  }
+}
+
 }  // namespace
 
 StructureNodes StructureNodes::of(const Accelerator& accel) {
@@ -38,12 +72,7 @@ StructureNodes StructureNodes::of(const Accelerator& accel) {
       n.bounds = nodes[i].bounds;
       n.leaf = nodes[i].is_leaf();
       n.prims = n.leaf ? nodes[i].count : 0;
-      if (!n.leaf)
-        for (std::uint32_t c : {nodes[i].index, nodes[i].index + 1})
-          if (c > i && c < nodes.size()) {
-            t.nodes_[c].parent = i;
-            t.nodes_[c].depth = n.depth + 1;
-          }
+      if (!n.leaf) link_children(t.nodes_, i, nodes[i].index, nodes.size());
     }
     t.finish(bvh->options().cost_traversal, bvh->options().cost_intersect);
   } else if (const auto* tlas = dynamic_cast<const Tlas*>(&accel)) {
@@ -59,11 +88,7 @@ StructureNodes StructureNodes::of(const Accelerator& accel) {
       StructureNode& n = t.nodes_[i];
       n.bounds = nodes[i].bounds;
       if (!nodes[i].is_leaf()) {
-        for (std::uint32_t c : {nodes[i].index, nodes[i].index + 1})
-          if (c > i && c < nodes.size()) {
-            t.nodes_[c].parent = i;
-            t.nodes_[c].depth = n.depth + 1;
-          }
+        link_children(t.nodes_, i, nodes[i].index, nodes.size());
         continue;
       }
       for (std::uint32_t k = nodes[i].index; k < nodes[i].index + nodes[i].count && k < order.size(); ++k) {
@@ -82,54 +107,34 @@ StructureNodes StructureNodes::of(const Accelerator& accel) {
   } else if (const auto* kd = dynamic_cast<const KdTree*>(&accel)) {
     t.kind_ = "kdtree";
     const auto nodes = kd->nodes();
-    t.nodes_.resize(nodes.size());
-    std::vector<Pending> stack;
-    if (!nodes.empty()) stack.push_back({0, kd->bounds(), 0, kNone});
-    while (!stack.empty()) {
-      const Pending p = stack.back();
-      stack.pop_back();
-      if (p.id >= nodes.size()) continue;
-      StructureNode& n = t.nodes_[p.id];
-      n.bounds = p.box;
-      n.depth = p.depth;
-      n.parent = p.parent;
+    fill_from_root(t.nodes_, nodes.size(), kd->bounds(), [&](const Pending& p, StructureNode& n, const auto& push) {
       const KdNode& k = nodes[p.id];
       n.leaf = k.is_leaf();
       if (n.leaf) {
         n.prims = k.prim_count();
-        continue;
+        return;
       }
       Aabb below = p.box, above = p.box;
       below.hi[k.axis()] = k.split();
       above.lo[k.axis()] = k.split();
-      if (k.above_child() > p.id) stack.push_back({k.above_child(), above, p.depth + 1, p.id});
-      stack.push_back({p.id + 1, below, p.depth + 1, p.id});
-    }
+      if (k.above_child() > p.id) push(k.above_child(), above);
+      push(p.id + 1, below);
+    });
     t.finish(kd->options().cost_traversal, kd->options().cost_intersect);
   } else if (const auto* oct = dynamic_cast<const Octree*>(&accel)) {
     t.kind_ = "octree";
     const auto nodes = oct->nodes();
-    t.nodes_.resize(nodes.size());
-    std::vector<Pending> stack;
-    if (!nodes.empty()) stack.push_back({0, oct->root_box(), 0, kNone});
-    while (!stack.empty()) {
-      const Pending p = stack.back();
-      stack.pop_back();
-      if (p.id >= nodes.size()) continue;
-      StructureNode& n = t.nodes_[p.id];
-      n.bounds = p.box;
-      n.depth = p.depth;
-      n.parent = p.parent;
+    fill_from_root(t.nodes_, nodes.size(), oct->root_box(), [&](const Pending& p, StructureNode& n, const auto& push) {
       n.leaf = nodes[p.id].is_leaf();
       if (n.leaf) {
         n.prims = nodes[p.id].count;
-        continue;
+        return;
       }
       for (int o = 7; o >= 0; --o) {
         const std::uint32_t c = nodes[p.id].index + static_cast<std::uint32_t>(o);
-        if (c > p.id) stack.push_back({c, Octree::child_box(p.box, o), p.depth + 1, p.id});
+        if (c > p.id) push(c, Octree::child_box(p.box, o));
       }
-    }
+    });
     t.finish(1.0f, 1.0f);  // the octree's SAH figure uses unit costs too
   } else if (const auto* vox = dynamic_cast<const Voxels*>(&accel)) {
     t.kind_ = "voxels";
