@@ -23,8 +23,7 @@ void GpuHeatmap::start(const HeatmapRequest& r, std::uint64_t id) {
   if (!tracer_) tracer_ = std::make_unique<GpuBvhTracer>();
   if (uploaded_ != r.structure) {
     // Spare frames let go of the structure they showed (it may be freed now).
-    for (std::shared_ptr<HeatmapFrame>& f : frames_)
-      if (f && f.use_count() == 1) f->request = HeatmapRequest{};
+    frames_.release_requests();
     uploaded_.reset();
     tracer_->upload(*bvh);
     uploaded_ = r.structure;
@@ -72,20 +71,10 @@ std::shared_ptr<const HeatmapFrame> GpuHeatmap::step(double budget_ms) {
   }
 }
 
-std::shared_ptr<HeatmapFrame> GpuHeatmap::spare_frame() {
-  // A frame no one else holds any more (AppState drops the one it shows when
-  // the next arrives) is written over: same size, no allocation.
-  for (std::shared_ptr<HeatmapFrame>& f : frames_)
-    if (f && f.use_count() == 1) return f;
-  for (std::shared_ptr<HeatmapFrame>& f : frames_)
-    if (!f) return f = std::make_shared<HeatmapFrame>();
-  return std::make_shared<HeatmapFrame>();  // both still held elsewhere
-}
-
 std::shared_ptr<const HeatmapFrame> GpuHeatmap::finish() {
   running_ = false;
   const auto t0 = std::chrono::steady_clock::now();
-  std::shared_ptr<HeatmapFrame> frame = spare_frame();
+  std::shared_ptr<HeatmapFrame> frame = frames_.take(1);  // one shown while the other is written
   const std::size_t n = static_cast<std::size_t>(request_.options.width) * request_.options.height;
   frame->pixels.resize(n);
   HeatmapFigures fig;

@@ -37,13 +37,12 @@ class GpuHeatmap final : public GpuHeatmapJob {
 
  private:
   std::shared_ptr<const HeatmapFrame> finish();
-  std::shared_ptr<HeatmapFrame> spare_frame();
 
   std::unique_ptr<GpuBvhTracer> tracer_;
-  /// The last two frames made: one is shown while the other is written
-  /// (1920x1080 is 83 MB of pixel figures; a fresh one costs more to
-  /// allocate and first touch than the GPU takes to trace it).
-  std::shared_ptr<HeatmapFrame> frames_[2];
+  /// The frames made, written over once no one holds them (1920x1080 is
+  /// 83 MB of pixel figures; a fresh one costs more to allocate and first
+  /// touch than the GPU takes to trace it).
+  HeatmapFramePool frames_;
   double last_finish_ms_ = 0.0, last_readback_ms_ = 0.0;
   std::shared_ptr<const BuiltStructure> uploaded_;  ///< held: a freed structure's address may come back
   HeatmapRequest request_;

@@ -32,8 +32,8 @@ bool SceneView::sync(const AppState& app) {
     colored_ = colored;
     changed = true;
   }
-  if (app.heatmap() && app.heatmap().get() != heatmap_frame_) {
-    heatmap_frame_ = app.heatmap().get();
+  if (app.heatmap() && app.heatmap() != heatmap_frame_) {
+    heatmap_frame_ = app.heatmap();
     renderer_.set_heatmap(app.heatmap()->image);
     has_heatmap_ = true;
     changed = true;

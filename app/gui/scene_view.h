@@ -3,6 +3,7 @@
 // colour map, ray path) in step with the AppState and maps the user's view
 // settings onto a RenderView. Needs the window's GL context current.
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include "ui/app/app_state.h"
@@ -55,8 +56,11 @@ class SceneView {
   void upload_ray(const AppState& app);
 
   Renderer renderer_;
-  const void* scene_ = nullptr;          ///< identity of the uploaded scene
-  const void* heatmap_frame_ = nullptr;  ///< identity of the uploaded heatmap level
+  const void* scene_ = nullptr;  ///< identity of the uploaded scene
+  /// The uploaded heatmap level, held: the heatmap workers write over frames
+  /// that no one holds (HeatmapFramePool, GpuHeatmap), so a level let go
+  /// could come back at the same address with another picture.
+  std::shared_ptr<const HeatmapFrame> heatmap_frame_;
   BoxInsight box_insight_;
   std::string box_key_;
   const void* region_uploaded_ = nullptr;

@@ -47,6 +47,32 @@ bool same_value(float a, float b) {
   return (std::isnan(a) && std::isnan(b)) || a == b;
 }
 
+/// Two frames show the same: their levels, images and every figure of every
+/// lattice point.
+void expect_same_frame(const HeatmapFrame& a, const HeatmapFrame& b) {
+  EXPECT_EQ(a.id, b.id);
+  EXPECT_EQ(a.stride, b.stride);
+  EXPECT_EQ(a.complete, b.complete);
+  EXPECT_EQ(a.summary.rays, b.summary.rays);
+  EXPECT_EQ(a.summary.hits, b.summary.hits);
+  EXPECT_EQ(a.summary.max_nodes, b.summary.max_nodes);
+  EXPECT_EQ(a.image.width, b.image.width);
+  EXPECT_EQ(a.image.height, b.image.height);
+  EXPECT_EQ(a.image.metric, b.image.metric);
+  ASSERT_EQ(a.image.values.size(), b.image.values.size());
+  for (std::size_t i = 0; i < a.image.values.size(); ++i)
+    ASSERT_TRUE(same_value(a.image.values[i], b.image.values[i])) << "image value " << i << ", stride " << a.stride;
+  ASSERT_EQ(a.pixels.size(), b.pixels.size());
+  for (std::size_t i = 0; i < a.pixels.size(); ++i) {
+    const PixelFigures &p = a.pixels[i], &q = b.pixels[i];
+    ASSERT_TRUE(same_value(p.value, q.value) && p.nodes == q.nodes && p.prims == q.prims &&
+                p.instances == q.instances && p.prim == q.prim && same_value(p.t, q.t) &&
+                p.shadow_rays == q.shadow_rays && p.shadow_nodes == q.shadow_nodes &&
+                p.shadow_prims == q.shadow_prims && p.shadowed == q.shadowed)
+        << "pixel " << i << ", stride " << a.stride;
+  }
+}
+
 }  // namespace
 
 TEST(AppHeatmap, LevelsRefineToExactlyWhatRenderComputes) {
@@ -101,6 +127,65 @@ TEST(AppHeatmap, LevelsRefineToExactlyWhatRenderComputes) {
     EXPECT_NEAR(frames[3]->summary.mean_value, fig.mean, 1e-9 * std::max(1.0, fig.mean));
     EXPECT_DOUBLE_EQ(frames[3]->summary.max_value, fig.max);
   }
+}
+
+TEST(AppHeatmap, PooledFramesAreWrittenWhollyAndOnlyWhenNoOneHoldsThem) {
+  const auto built = teapot_bvh();
+  const int w = 53, h = 37;
+  HeatmapRequest first = request_for(built, w, h, HeatMetric::nodes);
+  first.shadow_lights.push_back(Light{});  // the shadow figures too
+  first.shadow_lights.back().position = {0.0f, 100.0f, 0.0f};
+  // Another camera, metric and no lights: every figure of a reused frame's
+  // stale content differs somewhere from what the second job writes.
+  HeatmapRequest second = request_for(built, w, h, HeatMetric::depth);
+  second.camera.position += 0.3f * second.camera.up;
+
+  HeatmapFramePool pool;
+  std::vector<std::shared_ptr<const HeatmapFrame>> a;
+  ASSERT_TRUE(trace_progressive(
+      first, 1, [] { return true; }, [&](auto f) { a.push_back(f); }, &pool));
+  ASSERT_EQ(a.size(), 4u);
+  EXPECT_EQ(pool.size(), 4u) << "one frame per spacing";
+  const HeatmapFrame* first_job[4] = {a[0].get(), a[1].get(), a[2].get(), a[3].get()};
+
+  // The shown frame (the last level) is held: the next job must not write
+  // over it; the coarser ones are let go and written over.
+  const std::shared_ptr<const HeatmapFrame> shown = a[3];
+  a.clear();
+  std::vector<std::shared_ptr<const HeatmapFrame>> b, want;
+  ASSERT_TRUE(trace_progressive(
+      second, 2, [] { return true; }, [&](auto f) { b.push_back(f); }, &pool));
+  ASSERT_TRUE(trace_progressive(
+      second, 2, [] { return true; }, [&](auto f) { want.push_back(f); }));
+  ASSERT_EQ(b.size(), 4u);
+  ASSERT_EQ(want.size(), 4u);
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(b[k].get(), first_job[k]) << "level " << k << " reuses its frame";
+  EXPECT_NE(b[3].get(), first_job[3]) << "a held frame is never written over";
+  EXPECT_EQ(shown->id, 1u);
+  EXPECT_EQ(shown->request.options.metric, HeatMetric::nodes);
+  EXPECT_EQ(pool.size(), 5u) << "a second frame of spacing 1, kept";
+  for (int k = 0; k < 4; ++k) {
+    SCOPED_TRACE("level " + std::to_string(k));
+    expect_same_frame(*b[k], *want[k]);  // nothing stale left in a reused frame
+    EXPECT_EQ(b[k]->request.options.metric, HeatMetric::depth);
+  }
+  // The second job's frames held too: a third job makes new ones, kept up to
+  // two per spacing; its spacing-1 frame is not kept (the first two are).
+  std::vector<std::shared_ptr<const HeatmapFrame>> c;
+  ASSERT_TRUE(trace_progressive(
+      first, 3, [] { return true; }, [&](auto f) { c.push_back(f); }, &pool));
+  ASSERT_EQ(c.size(), 4u);
+  EXPECT_NE(c[3].get(), shown.get());
+  EXPECT_NE(c[3].get(), b[3].get());
+  EXPECT_EQ(pool.size(), 8u);
+  EXPECT_EQ(c[3].use_count(), 1) << "not kept by the pool";
+  EXPECT_EQ(c[0].use_count(), 2) << "kept by the pool";
+  // A frame no one holds lets go of its request, and so of the structure.
+  const HeatmapFrame* idle = c[0].get();
+  c.clear();
+  b.clear();
+  pool.take(16);  // any take looks at every kept frame
+  EXPECT_EQ(idle->request.structure, nullptr);
 }
 
 TEST(AppHeatmap, PixelFiguresMatchASingleRay) {

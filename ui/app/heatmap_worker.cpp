@@ -100,8 +100,43 @@ int lattice_count(int n, int s) {
 
 }  // namespace
 
+namespace {
+
+/// No one but the pool holds `f`. use_count() reads the count without
+/// ordering: the fence orders what this thread then writes to the frame after
+/// the last holder's reads of it (its release of the count, which the load read).
+bool idle(const std::shared_ptr<HeatmapFrame>& f) {
+  if (f.use_count() != 1) return false;
+  std::atomic_thread_fence(std::memory_order_acquire);
+  return true;
+}
+
+}  // namespace
+
+void HeatmapFramePool::release_requests() {
+  for (std::shared_ptr<HeatmapFrame>& f : frames_)
+    if (idle(f)) f->request = HeatmapRequest{};
+}
+
+std::shared_ptr<HeatmapFrame> HeatmapFramePool::take(int stride) {
+  release_requests();
+  std::shared_ptr<HeatmapFrame> found;
+  int same_stride = 0;
+  for (std::shared_ptr<HeatmapFrame>& f : frames_) {
+    if (f->stride != stride) continue;
+    ++same_stride;
+    if (!found && idle(f)) found = f;
+  }
+  if (found) return found;
+  auto f = std::make_shared<HeatmapFrame>();
+  f->stride = stride;
+  if (same_stride < 2) frames_.push_back(f);
+  return f;
+}
+
 bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::function<bool()>& keep_going,
-                       const std::function<void(std::shared_ptr<const HeatmapFrame>)>& publish) {
+                       const std::function<void(std::shared_ptr<const HeatmapFrame>)>& publish,
+                       HeatmapFramePool* pool) {
   const HeatmapOptions& o = r.options;
   const int w = o.width, h = o.height;
   if (w <= 0 || h <= 0 || !r.structure || !r.structure->accel) return true;
@@ -120,7 +155,7 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
   double render_ms = 0.0;
   for (int s = coarsest; s >= 1; s /= 2) {
     const int lw = lattice_count(w, s), lh = lattice_count(h, s);
-    auto frame = std::make_shared<HeatmapFrame>();
+    std::shared_ptr<HeatmapFrame> frame = pool ? pool->take(s) : std::make_shared<HeatmapFrame>();
     frame->id = id;
     frame->stride = s;
     frame->complete = s == 1;
@@ -206,9 +241,9 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
 }
 
 HeatmapWorker::HeatmapWorker()
-    : worker_([](const HeatmapRequest& r, std::uint64_t id, const std::function<bool()>& keep_going,
-                 const std::function<void(std::shared_ptr<const HeatmapFrame>)>& publish) {
-        trace_progressive(r, id, keep_going, publish);
+    : worker_([this](const HeatmapRequest& r, std::uint64_t id, const std::function<bool()>& keep_going,
+                     const std::function<void(std::shared_ptr<const HeatmapFrame>)>& publish) {
+        trace_progressive(r, id, keep_going, publish, &pool_);
       }) {}
 
 }  // namespace accelviz

@@ -104,13 +104,36 @@ struct HeatmapFrame {
   }
 };
 
+/// Frames that no one holds any more, written over by later levels of the
+/// same lattice spacing: their pixel and image arrays already have the size
+/// (no allocation, no fill, no fresh pages; each level writes every element).
+/// At most two per spacing are kept: one shown while the other is written.
+/// The CPU worker's levels and GpuHeatmap's frames come from one. Used by one
+/// thread at a time.
+class HeatmapFramePool {
+ public:
+  /// A frame for lattice spacing `stride`: an idle kept one, else a new one
+  /// (kept when fewer than two of that spacing are). Its fields are stale:
+  /// the caller sets every one. Calls release_requests() first.
+  std::shared_ptr<HeatmapFrame> take(int stride);
+  /// Idle frames let go of their requests (and so of the structures they
+  /// name, which may then be freed).
+  void release_requests();
+  std::size_t size() const { return frames_.size(); }
+
+ private:
+  std::vector<std::shared_ptr<HeatmapFrame>> frames_;
+};
+
 /// Traces request `r` level by level, synchronously, calling `publish`
 /// after each level (on the calling thread); stops early (returning false)
 /// when `keep_going` returns false. `keep_going` is asked once per image
 /// row, from all tracing threads at once, so it must be thread-safe. The
-/// worker's engine, exposed for tests.
+/// worker's engine, exposed for tests. With a `pool`, the levels' frames
+/// come from it (the worker's jobs reuse the frames of the jobs before).
 bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::function<bool()>& keep_going,
-                       const std::function<void(std::shared_ptr<const HeatmapFrame>)>& publish);
+                       const std::function<void(std::shared_ptr<const HeatmapFrame>)>& publish,
+                       HeatmapFramePool* pool = nullptr);
 
 /// The summary of fully traced pixels (every pixel counted once), as the
 /// worker computes it for its frames; used by the GPU path too.
@@ -133,6 +156,7 @@ class HeatmapWorker {
   std::uint64_t latest_request() const { return worker_.latest_request(); }
 
  private:
+  HeatmapFramePool pool_;  ///< the worker thread's only
   /// A superseded job's levels are never shown (the default store rule).
   LatestJobWorker<HeatmapRequest, std::shared_ptr<const HeatmapFrame>> worker_;
 };
