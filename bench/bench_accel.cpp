@@ -17,6 +17,13 @@
 // TraceClosestPackets8 and TraceAnyPackets8: the same rays in packets of
 // eight (Embree: rtcIntersect8, rtcOccluded8).
 //
+// HeatmapJob/POOL/W/H (built with the GUI's GL-free library): one job of
+// the GUI's CPU heatmap (trace_progressive: levels of spacing 8, 4, 2, 1)
+// on our BVH, two threads, nodes metric, the last level held as the GUI
+// holds the one it shows; POOL 1: the levels' frames from a HeatmapFramePool
+// (what the worker does), 0: new frames. Counter setup_ms: the job's time
+// outside its tracing (the levels' set-up).
+//
 // ACCELVIZ_BENCH_PAIRING: which of our triangle tests meets which Embree
 // mode (the pairs of `accelviz bench`): unset or `default`, our watertight
 // test against Embree's default mode; `robust`, watertight against Embree's
@@ -41,6 +48,10 @@
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
 #include "core/scene/load.h"
+#include "core/util/timing.h"
+#ifdef ACCELVIZ_GBENCH_HEATMAP
+#include "ui/app/heatmap_worker.h"
+#endif
 
 namespace {
 
@@ -164,6 +175,44 @@ void trace(benchmark::State& state, const std::string& name, bool any, bool pack
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * rays.size()));  // rays/s
 }
 
+#ifdef ACCELVIZ_GBENCH_HEATMAP
+/// One job of the GUI's CPU heatmap; range(0) = pool (0 or 1), range(1) x
+/// range(2) = image size.
+void heatmap_job(benchmark::State& state) {
+  static const auto built = [] {
+    auto b = std::make_shared<BuiltStructure>();
+    b->accel = make("bvh", 0);
+    return std::shared_ptr<const BuiltStructure>(b);
+  }();
+  HeatmapRequest r;
+  r.structure = built;
+  r.options.width = static_cast<int>(state.range(1));
+  r.options.height = static_cast<int>(state.range(2));
+  r.options.threads = 2;
+  r.camera = frame_bounds(fixture().scene.bounds(), static_cast<float>(r.options.width) / r.options.height);
+  HeatmapFramePool pool;
+  std::shared_ptr<const HeatmapFrame> shown;
+  std::uint64_t id = 0;
+  // One job; returns its time outside the tracing.
+  const auto job = [&] {
+    const auto t0 = std::chrono::steady_clock::now();
+    double trace_ms = 0.0;
+    trace_progressive(
+        r, ++id, [] { return true; },
+        [&](std::shared_ptr<const HeatmapFrame> f) {
+          trace_ms = f->summary.render_ms;
+          shown = std::move(f);
+        },
+        state.range(0) != 0 ? &pool : nullptr);
+    return ms_since(t0) - trace_ms;
+  };
+  job();  // untimed: the pool's first frames (the GUI's first job at a size)
+  double setup_ms = 0.0;
+  for (auto _ : state) setup_ms += job();
+  state.counters["setup_ms"] = setup_ms / static_cast<double>(state.iterations());
+}
+#endif
+
 void register_all() {
   std::vector<std::string> names = {"bvh", "lbvh"};
   if (kHaveEmbree) names.push_back("embree");
@@ -187,6 +236,14 @@ void register_all() {
           ->UseRealTime();
     }
   }
+#ifdef ACCELVIZ_GBENCH_HEATMAP
+  benchmark::RegisterBenchmark("HeatmapJob", heatmap_job)
+      ->ArgsProduct({{0, 1}, {1280}, {720}})
+      ->Args({0, 1920, 1080})
+      ->Args({1, 1920, 1080})
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime();
+#endif
 }
 
 }  // namespace
