@@ -12,33 +12,40 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+# Each phase's start time (UTC) and the seconds since the script began, so a
+# slow CI run shows where its time went.
+t_start=$(date +%s)
+phase() { echo "== $(date -u +%H:%M:%S) (+$(($(date +%s) - t_start)) s) $*"; }
+
+phase "install dependencies"
 ./scripts/install-deps.sh
 
 jobs="$(nproc)"
-echo "== release build"
+phase "release build"
 cmake --preset release >/dev/null
 cmake --build --preset release -j "$jobs"
-echo "== release tests"
+phase "release tests"
 ctest --preset release -j "$jobs"
 
 if [ "${ACCELVIZ_SKIP_FUZZ:-0}" != "1" ]; then
   # libFuzzer on the glTF/GLB, OBJ and ray-file readers (clang, ASan+UBSan),
   # ACCELVIZ_FUZZ_SECONDS (default 45) per target, side by side.
-  echo "== fuzz (tests/fuzz/run.sh)"
+  phase "fuzz (tests/fuzz/run.sh)"
   ./tests/fuzz/run.sh
 fi
 
 if [ "${ACCELVIZ_SKIP_NOSIMD:-0}" != "1" ]; then
-  echo "== no-renderer build on the scalar code paths (preset nosimd): core and CLI tests"
+  phase "no-renderer build on the scalar code paths (preset nosimd): core and CLI tests"
   cmake --preset nosimd >/dev/null
   cmake --build --preset nosimd -j "$jobs"
   ctest --preset nosimd -j "$jobs"
 fi
 
 if [ "${ACCELVIZ_SKIP_SANITIZERS:-0}" != "1" ]; then
-  echo "== asan+ubsan build"
+  phase "asan+ubsan build"
   cmake --preset asan >/dev/null
   cmake --build --preset asan -j "$jobs"
-  echo "== asan+ubsan tests"
+  phase "asan+ubsan tests"
   ctest --preset asan -j "$jobs"
 fi
+phase "done"
