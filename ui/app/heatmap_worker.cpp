@@ -98,10 +98,6 @@ int lattice_count(int n, int s) {
   return (n + s - 1) / s;
 }
 
-}  // namespace
-
-namespace {
-
 /// No one but the pool holds `f`. use_count() reads the count without
 /// ordering: the fence orders what this thread then writes to the frame after
 /// the last holder's reads of it (its release of the count, which the load read).

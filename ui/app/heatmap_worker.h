@@ -117,7 +117,9 @@ class HeatmapFramePool {
   /// the caller sets every one. Calls release_requests() first.
   std::shared_ptr<HeatmapFrame> take(int stride);
   /// Idle frames let go of their requests (and so of the structures they
-  /// name, which may then be freed).
+  /// name, which may then be freed). Until then a frame let go after the
+  /// last take keeps its job's structure alive (the worker's latest frame
+  /// does so for the last job in any case).
   void release_requests();
   std::size_t size() const { return frames_.size(); }
 
