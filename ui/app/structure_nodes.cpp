@@ -38,9 +38,9 @@ void link_children(std::vector<StructureNode>& out, std::uint32_t i, std::uint32
 /// Fills `out` (`count` nodes) for a tree whose node boxes follow from the
 /// root's (K-D tree, octree): from node 0 with box `root`, each node's box,
 /// depth and parent set, then expand(p, node, push) sets its leaf figures or
-/// calls push(child, child_box) for its children. Children must have larger
-/// ids than their parent (so a corrupt array cannot loop); out-of-range ids
-/// are skipped.
+/// calls push(child, child_box) for its children. A child whose id is not
+/// larger than its parent's is not pushed (so a corrupt array cannot loop),
+/// nor is one out of range.
 template <class Expand>
 void fill_from_root(std::vector<StructureNode>& out, std::size_t count, const Aabb& root, const Expand& expand) {
   out.resize(count);
@@ -49,12 +49,13 @@ void fill_from_root(std::vector<StructureNode>& out, std::size_t count, const Aa
   while (!stack.empty()) {
     const Pending p = stack.back();
     stack.pop_back();
-    if (p.id >= count) continue;
     StructureNode& n = out[p.id];
     n.bounds = p.box;
     n.depth = p.depth;
     n.parent = p.parent;
-    expand(p, n, [&](std::uint32_t child, const Aabb& box) { stack.push_back({child, box, p.depth + 1, p.id}); });
+    expand(p, n, [&](std::uint32_t child, const Aabb& box) {
+      if (child > p.id && child < count) stack.push_back({child, box, p.depth + 1, p.id});
+    });
   }
 }
 
@@ -117,7 +118,7 @@ StructureNodes StructureNodes::of(const Accelerator& accel) {
       Aabb below = p.box, above = p.box;
       below.hi[k.axis()] = k.split();
       above.lo[k.axis()] = k.split();
-      if (k.above_child() > p.id) push(k.above_child(), above);
+      push(k.above_child(), above);
       push(p.id + 1, below);
     });
     t.finish(kd->options().cost_traversal, kd->options().cost_intersect);
@@ -131,8 +132,7 @@ StructureNodes StructureNodes::of(const Accelerator& accel) {
         return;
       }
       for (int o = 7; o >= 0; --o) {
-        const std::uint32_t c = nodes[p.id].index + static_cast<std::uint32_t>(o);
-        if (c > p.id) push(c, Octree::child_box(p.box, o));
+        push(nodes[p.id].index + static_cast<std::uint32_t>(o), Octree::child_box(p.box, o));
       }
     });
     t.finish(1.0f, 1.0f);  // the octree's SAH figure uses unit costs too
