@@ -655,7 +655,60 @@ TEST(BvhBuild, ParallelSplitEqualsTheSerialSplitElementForElement) {
         EXPECT_EQ(std::memcmp(one.count[a], many.count[a], 32 * sizeof(one.count[a][0])), 0);
       }
     }
+    // Out of place (SplitScratch::move_to), on one thread and with lent
+    // ones: the same cut and boxes; the records in `move_to`, each side in
+    // its order in the node (so the same on any thread count); the node's
+    // own range untouched; the centroid bounds the same bits on any count.
+    std::vector<bool> goes_left(n, false);
+    for (std::size_t i = 0; i < want_r.mid; ++i) goes_left[want[i].id] = true;
+    std::vector<bvh_detail::BuildPrim> stable;
+    for (const bool side : {true, false})
+      for (const bvh_detail::BuildPrim& p : prims)
+        if (goes_left[p.id] == side) stable.push_back(p);
+    bvh_detail::SplitResult first;
+    for (unsigned helpers : {0u, 1u, 2u, 3u, 6u}) {
+      SCOPED_TRACE("out of place, helpers " + std::to_string(helpers));
+      std::vector<bvh_detail::BuildPrim> got = prims, to(n);
+      bvh_detail::SplitScratch scratch;
+      scratch.helpers = helpers;
+      scratch.move_to = to;
+      bvh_detail::SplitResult r;
+      ASSERT_EQ(bvh_detail::split_binned_sah(params, got, bounds, centroids, scratch, r),
+                bvh_detail::SplitOutcome::split);
+      EXPECT_TRUE(r.moved);
+      EXPECT_EQ(r.mid, want_r.mid);
+      EXPECT_EQ(std::memcmp(got.data(), prims.data(), n * sizeof(got[0])), 0);
+      EXPECT_EQ(std::memcmp(to.data(), stable.data(), n * sizeof(to[0])), 0);
+      if (helpers == 0) first = r;
+      for (int side = 0; side < 2; ++side) {
+        EXPECT_EQ(std::memcmp(&r.bounds[side], &want_r.bounds[side], sizeof(Aabb)), 0);
+        EXPECT_TRUE(r.centroid_bounds[side].lo == want_r.centroid_bounds[side].lo);
+        EXPECT_TRUE(r.centroid_bounds[side].hi == want_r.centroid_bounds[side].hi);
+        EXPECT_EQ(std::memcmp(&r.centroid_bounds[side], &first.centroid_bounds[side], sizeof(Aabb)), 0);
+      }
+    }
   }
+}
+
+/// Records for the partition tests, cut at x = 0.5 on `axis` (lo 0, k 16,
+/// plane 7: (c - 0)·16 = 8): a `share` of them left of it; centroids
+/// include -0 and +0, ties on the plane and NaN (on `axis`: goes left).
+constexpr float kPlaneTestLo = 0.0f, kPlaneTestK = 16.0f;
+constexpr int kPlaneTestPlane = 7;
+std::vector<bvh_detail::BuildPrim> plane_test_records(std::mt19937& rng, std::size_t n, int axis, float share) {
+  std::vector<bvh_detail::BuildPrim> prims(n);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    glm::vec3 c(uniform(rng), uniform(rng), uniform(rng));
+    const std::uint32_t pick = rng() % 16;
+    if (pick == 0) c[axis] = 0.5f;  // on the plane
+    if (pick == 1) c[(axis + 1) % 3] = -0.0f;
+    if (pick == 2) c[(axis + 2) % 3] = 0.0f;
+    if (pick == 3 && i % 7 == 0) c[(axis + 1) % 3] = std::numeric_limits<float>::quiet_NaN();
+    c[axis] = uniform(rng) < share ? 0.5f * c[axis] : (pick == 0 ? 0.5f : 0.5f + 0.5f * c[axis]);
+    if (pick == 4 && i % 5 == 0) c[axis] = std::numeric_limits<float>::quiet_NaN();  // goes left
+    prims[i] = {c, i, Aabb{c, c}};
+  }
+  return prims;
 }
 
 TEST(BvhBuild, PartitionAtPlaneSplitsEveryRecordOnceAndBoundsEachSide) {
@@ -671,21 +724,9 @@ TEST(BvhBuild, PartitionAtPlaneSplitsEveryRecordOnceAndBoundsEachSide) {
     for (int axis = 0; axis < 3; ++axis)
       for (const float share : {0.0f, 0.03f, 0.5f, 0.97f, 1.0f}) {
         SCOPED_TRACE("n " + std::to_string(n) + " axis " + std::to_string(axis) + " share " + std::to_string(share));
-        std::vector<bvh_detail::BuildPrim> prims(n);
-        for (std::uint32_t i = 0; i < n; ++i) {
-          glm::vec3 c(uniform(rng), uniform(rng), uniform(rng));
-          const std::uint32_t pick = rng() % 16;
-          if (pick == 0) c[axis] = 0.5f;  // on the plane (k = 16, plane 7: (c - 0)·16 = 8)
-          if (pick == 1) c[(axis + 1) % 3] = -0.0f;
-          if (pick == 2) c[(axis + 2) % 3] = 0.0f;
-          if (pick == 3 && i % 7 == 0) c[(axis + 1) % 3] = std::numeric_limits<float>::quiet_NaN();
-          // Move a `share` of the records left of the plane at x = 0.5.
-          c[axis] = uniform(rng) < share ? 0.5f * c[axis] : (pick == 0 ? 0.5f : 0.5f + 0.5f * c[axis]);
-          if (pick == 4 && i % 5 == 0) c[axis] = std::numeric_limits<float>::quiet_NaN();  // goes left
-          prims[i] = {c, i, Aabb{c, c}};
-        }
-        const float lo = 0.0f, k = 16.0f;
-        const int plane = 7;
+        const std::vector<bvh_detail::BuildPrim> prims = plane_test_records(rng, n, axis, share);
+        const float lo = kPlaneTestLo, k = kPlaneTestK;
+        const int plane = kPlaneTestPlane;
         const auto goes_left = [&](const bvh_detail::BuildPrim& p) {
           return bvh_detail::left_of_plane(p.centroid[axis], lo, k, plane);
         };
@@ -726,6 +767,75 @@ TEST(BvhBuild, PartitionAtPlaneSplitsEveryRecordOnceAndBoundsEachSide) {
         Aabb l2, r2;
         EXPECT_EQ(bvh_detail::partition_at_plane(again, axis, lo, k, plane, l2, r2), mid);
         EXPECT_EQ(std::memcmp(again.data(), got.data(), n * sizeof(got[0])), 0);
+      }
+}
+
+TEST(BvhBuild, PartitionToIsTheStablePartitionOnAnyNumberOfSlices) {
+  // partition_to (the out-of-place partition): on sizes around the slice
+  // cuts, every axis, left shares from none to all and 1 to 7 slices (on
+  // as many threads), `dst` holds the left records then the right ones,
+  // each side in its order in `src`, and each side's centroid bounds are
+  // its records' (NaN lanes ignored), the same bits on any slicing. A left
+  // count that is not the slice's own throws, and writes nothing outside
+  // `dst`.
+  std::mt19937 rng(5);
+  const auto goes_left = [](const bvh_detail::BuildPrim& p, int axis) {
+    return bvh_detail::left_of_plane(p.centroid[axis], kPlaneTestLo, kPlaneTestK, kPlaneTestPlane);
+  };
+  for (const std::size_t n : {std::size_t{1}, std::size_t{2}, std::size_t{7}, std::size_t{100}, std::size_t{4099}})
+    for (int axis = 0; axis < 3; ++axis)
+      for (const float share : {0.0f, 0.5f, 0.97f, 1.0f}) {
+        const std::vector<bvh_detail::BuildPrim> src = plane_test_records(rng, n, axis, share);
+        std::vector<bvh_detail::BuildPrim> want;
+        for (const bool side : {true, false})
+          for (const bvh_detail::BuildPrim& p : src)
+            if (goes_left(p, axis) == side) want.push_back(p);
+        const auto want_mid = static_cast<std::size_t>(
+            std::count_if(src.begin(), src.end(), [&](const auto& p) { return goes_left(p, axis); }));
+        Aabb first[2];
+        for (const std::size_t slices : {1, 2, 3, 7}) {
+          if (slices > n) continue;
+          SCOPED_TRACE("n " + std::to_string(n) + " axis " + std::to_string(axis) + " share " + std::to_string(share) +
+                       " slices " + std::to_string(slices));
+          std::vector<std::size_t> left(slices);
+          for (std::size_t t = 0; t < slices; ++t)
+            left[t] =
+                static_cast<std::size_t>(std::count_if(src.begin() + static_cast<std::ptrdiff_t>(n * t / slices),
+                                                       src.begin() + static_cast<std::ptrdiff_t>(n * (t + 1) / slices),
+                                                       [&](const auto& p) { return goes_left(p, axis); }));
+          std::vector<bvh_detail::BuildPrim> dst(n);
+          Aabb lc, rc;
+          ASSERT_EQ(bvh_detail::partition_to(src, dst, axis, kPlaneTestLo, kPlaneTestK, kPlaneTestPlane, left, lc, rc),
+                    want_mid);
+          EXPECT_EQ(std::memcmp(dst.data(), want.data(), n * sizeof(dst[0])), 0);
+          for (int side = 0; side < 2; ++side) {
+            glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-std::numeric_limits<float>::infinity());
+            for (std::size_t i = side == 0 ? 0 : want_mid; i < (side == 0 ? want_mid : n); ++i)
+              for (int l = 0; l < 3; ++l)
+                if (!std::isnan(want[i].centroid[l])) {
+                  lo[l] = std::min(lo[l], want[i].centroid[l]);
+                  hi[l] = std::max(hi[l], want[i].centroid[l]);
+                }
+            const Aabb& have = side == 0 ? lc : rc;
+            EXPECT_TRUE(have.lo == lo && have.hi == hi) << "side " << side;
+            if (slices == 1) first[side] = have;
+            EXPECT_EQ(std::memcmp(&have, &first[side], sizeof(Aabb)), 0) << "side " << side;
+          }
+          // A count off by one (one slice's record counted in its neighbour):
+          // a logic_error, and the records around `dst` stay as they were.
+          if (slices > 1 && left[0] > 0 && left[1] < n * 2 / slices - n / slices) {
+            std::vector<std::size_t> wrong = left;
+            --wrong[0];
+            ++wrong[1];
+            std::vector<bvh_detail::BuildPrim> guarded(n + 2, bvh_detail::BuildPrim{glm::vec3(9.0f), 77, Aabb{}});
+            const std::vector<bvh_detail::BuildPrim> before = guarded;
+            EXPECT_THROW(bvh_detail::partition_to(src, std::span(guarded).subspan(1, n), axis, kPlaneTestLo,
+                                                  kPlaneTestK, kPlaneTestPlane, wrong, lc, rc),
+                         std::logic_error);
+            EXPECT_EQ(std::memcmp(&guarded[0], &before[0], sizeof(guarded[0])), 0);
+            EXPECT_EQ(std::memcmp(&guarded[n + 1], &before[n + 1], sizeof(guarded[0])), 0);
+          }
+        }
       }
 }
 

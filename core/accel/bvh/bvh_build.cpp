@@ -6,7 +6,11 @@
 //     and calls build_bvh_records).
 //  2. Recurse from the root: a node becomes a leaf when it is small enough
 //     (max_leaf_size) or when the splitter's SAH says so; otherwise the
-//     splitter partitions its range in place and both children recurse.
+//     splitter partitions its range and both children recurse. The binned
+//     SAH partitions its nodes of kOutOfPlaceMinPrims records or more into a
+//     second array of records, stable, on the threads lent to the split, and
+//     their children from there back into the first; the others, and the
+//     other splitters, partition in place.
 //     Splitters that cannot separate the primitives (all centroids equal) and
 //     nodes about to exceed the depth budget fall back to an object median
 //     split, so every build terminates with bounded leaves and depth.
@@ -23,6 +27,7 @@
 #include <atomic>
 #include <bit>
 #include <chrono>
+#include <cstring>
 #include <exception>
 #include <mutex>
 #include <stdexcept>
@@ -104,6 +109,7 @@ struct NodeWork {
   std::uint32_t begin, end;
   Aabb bounds, centroid_bounds;
   std::uint32_t depth;
+  bool moved = false;  ///< the records are in the builder's second array (its split moved them)
 };
 
 /// The tree's shape, counted as its leaves are made (integers: the same sums
@@ -128,11 +134,33 @@ inline std::uint32_t ceil_log2(std::size_t n) {
   return n <= 1 ? 0u : static_cast<std::uint32_t>(std::bit_width(n - 1));
 }
 
+/// Storage for n build records, left unwritten (a vector would initialise
+/// each): BuildPrim is an aggregate of trivially copyable members, so a
+/// record copied in with memcpy is a record.
+class RawRecords {
+ public:
+  explicit RawRecords(std::size_t n) : n_(n), p_(n > 0 ? HugePageAllocator<BuildPrim>().allocate(n) : nullptr) {}
+  ~RawRecords() {
+    if (p_) HugePageAllocator<BuildPrim>().deallocate(p_, n_);
+  }
+  RawRecords(const RawRecords&) = delete;
+  RawRecords& operator=(const RawRecords&) = delete;
+  std::span<BuildPrim> span() const { return {p_, n_}; }
+
+ private:
+  std::size_t n_;
+  BuildPrim* p_;
+};
+
 class Builder {
  public:
-  Builder(const SplitParams& params, Splitter split, std::span<BuildPrim> prims, unsigned threads,
-          const ProgressCallback& progress)
-      : params_(params), split_(split), prims_(prims), max_threads_(threads), progress_(progress) {
+  /// `moved`: empty, or an array as long as `prims` into which the binned
+  /// SAH partitions nodes of kOutOfPlaceMinPrims records or more
+  /// (SplitScratch::move_to), and out of which it partitions their children
+  /// back.
+  Builder(const SplitParams& params, Splitter split, std::span<BuildPrim> prims, std::span<BuildPrim> moved,
+          unsigned threads, const ProgressCallback& progress)
+      : params_(params), split_(split), prims_(prims), moved_(moved), max_threads_(threads), progress_(progress) {
     report_step_ = std::max<std::uint64_t>(1, prims.size() / 128);
   }
 
@@ -142,16 +170,27 @@ class Builder {
              LeafTally& tally) {
     if (cancelled_.load(std::memory_order_relaxed)) return;
     const std::size_t n = w.end - w.begin;
+    // The records are in prims_, or in moved_ when the parent's split moved
+    // them there; a leaf and the in-place splits take them back first.
+    bool moved = w.moved;
+    std::span<BuildPrim> range = (moved ? moved_ : prims_).subspan(w.begin, n);
+    const auto in_place = [&] {
+      if (!moved) return;
+      std::memcpy(prims_.data() + w.begin, range.data(), n * sizeof(BuildPrim));
+      range = prims_.subspan(w.begin, n);
+      moved = false;
+    };
     if (n <= static_cast<std::size_t>(params_.max_leaf_size)) {
+      in_place();
       make_leaf(w, out, slot, tally);
       return;
     }
-    std::span<BuildPrim> range = prims_.subspan(w.begin, n);
     SplitResult s;
     // The object median needs the node's centroid bounds, which a
     // bounds_after splitter's children do not carry: computed here, for the
     // (rare) nodes that fall back to it.
     const auto median_split = [&] {
+      in_place();
       Aabb centroids = w.centroid_bounds;
       if (split_.bounds_after) {
         Aabb unused;
@@ -167,13 +206,25 @@ class Builder {
       median_split();
     } else {
       const ThreadLoan loan(*this, scratch, n);
+      // Out of place: every node this large (on any number of threads, so
+      // the tree is the same on all; partition_to on the lent threads), and
+      // every node whose records are in moved_ (back to prims_).
+      const bool move_out = moved || (!moved_.empty() && n >= kOutOfPlaceMinPrims);
+      scratch.move_to = move_out ? (moved ? prims_ : moved_).subspan(w.begin, n) : std::span<BuildPrim>{};
       const SplitOutcome r = split_.split(params_, range, w.bounds, w.centroid_bounds, scratch, s);
+      scratch.move_to = {};
+      if (r == SplitOutcome::split && s.moved) {
+        moved = !moved;
+        range = (moved ? moved_ : prims_).subspan(w.begin, n);
+      }
       if (r == SplitOutcome::leaf) {
+        in_place();
         make_leaf(w, out, slot, tally);
         return;
       }
       if (r == SplitOutcome::unsplittable) {
         if (n <= static_cast<std::size_t>(params_.leaf_size_cap)) {
+          in_place();
           make_leaf(w, out, slot, tally);
           return;
         }
@@ -184,8 +235,8 @@ class Builder {
     if (s.mid == 0 || s.mid >= n) median_split();
 
     const std::uint32_t mid = w.begin + static_cast<std::uint32_t>(s.mid);
-    const NodeWork left{w.begin, mid, s.bounds[0], s.centroid_bounds[0], w.depth + 1};
-    const NodeWork right{mid, w.end, s.bounds[1], s.centroid_bounds[1], w.depth + 1};
+    const NodeWork left{w.begin, mid, s.bounds[0], s.centroid_bounds[0], w.depth + 1, moved};
+    const NodeWork right{mid, w.end, s.bounds[1], s.centroid_bounds[1], w.depth + 1, moved};
     const auto first_child = static_cast<std::uint32_t>(out.size());
     out.resize(out.size() + 2);
     out[slot] = BvhNode{w.bounds, first_child, 0};
@@ -312,6 +363,7 @@ class Builder {
   const SplitParams params_;
   const Splitter split_;
   std::span<BuildPrim> prims_;
+  std::span<BuildPrim> moved_;
   const unsigned max_threads_;
   const ProgressCallback& progress_;
   std::atomic<unsigned> active_threads_{1};
@@ -373,7 +425,11 @@ BvhTopology build_bvh_records(std::span<BuildPrim> prims, const Aabb& root_bound
                            : opts.splitter == BvhSplitter::exact_sah ? Splitter{split_exact_sah}
                            : opts.splitter == BvhSplitter::lbvh      ? Splitter{split_lbvh, false, true}
                                                                      : Splitter{split_median};
-    Builder builder(params, split, prims, resolve_threads(opts.threads), progress);
+    // The binned SAH's second array of records (see Builder), unwritten:
+    // raw storage (a vector would initialise every record), reused from
+    // build to build like the other build arrays (HugePageAllocator).
+    const RawRecords moved(opts.splitter == BvhSplitter::binned_sah && n >= kOutOfPlaceMinPrims ? n : 0);
+    Builder builder(params, split, prims, moved.span(), resolve_threads(opts.threads), progress);
     // At most 2n - 1 nodes: reserving them all spares the regrowth copies.
     // No shrink_to_fit after: pages never written are never touched (not
     // resident), and trimming would copy the whole array (18.5 MB and 4.5k

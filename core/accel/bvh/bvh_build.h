@@ -64,14 +64,26 @@ struct SplitResult {
   std::size_t mid = 0;      ///< primitives in the left child
   Aabb bounds[2];           ///< children's geometric bounds
   Aabb centroid_bounds[2];  ///< children's centroid bounds
+  /// The records went to SplitScratch::move_to (left ones first, each side
+  /// in its old order); the node's own range is left as it was.
+  bool moved = false;
 };
 
 /// Nodes of at least this many primitives may be split on several threads:
 /// the builder lends its idle threads to them (SplitScratch::helpers), one per
 /// kParallelSplitGrain primitives at most. Only the binned SAH uses them, to
-/// bin (bin_primitives_parallel); its partition stays serial.
+/// bin (bin_primitives_parallel) and to partition (partition_to).
 inline constexpr std::size_t kParallelSplitMinPrims = 32768;
 inline constexpr std::size_t kParallelSplitGrain = 16384;
+/// The binned SAH's builder partitions every node of at least this many
+/// primitives out of place (SplitScratch::move_to: partition_to, which can
+/// run on lent threads), whatever the thread count, so that the tree does
+/// not depend on how many threads a split had; and the children of such a
+/// node out of place again, back into the build's records. Measured on the
+/// 2-vCPU VM (docs/performance.md, "The partition out of place"): builds on
+/// one and two threads at 256 took 0-4 % less time than at 32768 and 1-14 %
+/// less than with every partition in place.
+inline constexpr std::size_t kOutOfPlaceMinPrims = 256;
 
 /// Per-thread buffers reused from node to node, so that the recursion does not allocate.
 struct SplitScratch {
@@ -79,6 +91,15 @@ struct SplitScratch {
   /// Threads this split may use besides the calling one (set by the builder
   /// for the duration of one split; 0: split on the calling thread alone).
   unsigned helpers = 0;
+  /// Set (as long as the node's range) for a binned split that is to write
+  /// its records here, partitioned and stable (partition_to), instead of
+  /// partitioning them in place; empty: in place. Set by the builder for one
+  /// split; splitters other than the binned SAH ignore it.
+  std::span<BuildPrim> move_to;
+  /// The binning's bucket counts per thread's slice (bin_primitives_parallel),
+  /// and each slice's count left of the chosen plane, for partition_to.
+  std::vector<std::uint32_t> slice_counts;
+  std::vector<std::size_t> slice_left;
 };
 
 /// Signature shared by the splitters. `prims` is the node's range,
@@ -147,7 +168,8 @@ inline bool left_of_plane(float c, float lo, float k, int plane) {
   return !((c - lo) * k >= static_cast<float>(plane + 1));
 }
 
-/// The binned SAH's partition (split_binned_sah's last step): moves the
+/// The binned SAH's partition in place (split_binned_sah's last step when
+/// SplitScratch::move_to is empty): moves the
 /// records left of the plane (left_of_plane(centroid[axis], lo, k, plane))
 /// before the others and returns their count; each side's centroid bounds
 /// come back in left_centroids and right_centroids (the same values as
@@ -186,8 +208,11 @@ void bin_primitives_scalar(std::span<const BuildPrim> prims, const glm::vec3& or
 /// own Bins, and the slices merge in order with bin_primitives' min/max
 /// operand order, so `bins` comes out bit for bit as bin_primitives leaves it
 /// (for bounds without NaN). `bins` must be cleared for `buckets`.
+/// With `slice_counts`, also writes each slice's bucket counts there:
+/// threads·3·kMaxBuckets values, slice t's count of bucket b on axis a at
+/// (t·3 + a)·kMaxBuckets + b (slice t is prims[n·t/threads, n·(t+1)/threads)).
 void bin_primitives_parallel(std::span<const BuildPrim> prims, const glm::vec3& origin, const float k[3], int buckets,
-                             Bins& bins, unsigned threads);
+                             Bins& bins, unsigned threads, std::uint32_t* slice_counts = nullptr);
 
 /// Box of bucket b on `axis` (empty when the bucket is).
 Aabb bucket_box(const Bins& bins, int axis, int b);
@@ -211,8 +236,24 @@ using CandidateCosts = float[3][kMaxBuckets];
 /// false (bins untouched) when no axis is usable (all centroids on one
 /// point). With `costs`, also records every candidate's cost. With
 /// threads > 1 the binning runs on that many threads (the same bins).
+/// With `slice_counts`, the binning's counts per slice go there (resized;
+/// see bin_primitives_parallel).
 bool binned_sah_search(int buckets, std::span<const BuildPrim> prims, const Aabb& centroid_bounds, Bins& bins,
-                       BinnedSahSearch& out, CandidateCosts* costs = nullptr, unsigned threads = 1);
+                       BinnedSahSearch& out, CandidateCosts* costs = nullptr, unsigned threads = 1,
+                       std::vector<std::uint32_t>* slice_counts = nullptr);
+
+/// partition_at_plane out of place and stable: writes the records of `src`
+/// left of the plane to dst[0, mid) and the others to dst[mid, n), each side
+/// in its order in `src`, and returns mid. `slice_left` holds, for each of
+/// its S slices of `src` (slice t is src[n·t/S, n·(t+1)/S)), how many of the
+/// slice's records are left of the plane, as the binning counted them; the
+/// slices are written on S threads (parallel_for). The result, and each
+/// side's centroid bounds (merged slice by slice in order, so the bits of one
+/// pass), do not depend on S. Throws std::logic_error when a slice's count
+/// is not its own (no write leaves `dst` then, but its contents are undefined).
+std::size_t partition_to(std::span<const BuildPrim> src, std::span<BuildPrim> dst, int axis, float lo, float k,
+                         int plane, std::span<const std::size_t> slice_left, Aabb& left_centroids,
+                         Aabb& right_centroids);
 
 /// Object median split: orders the range by centroid on the axis of largest
 /// centroid extent (ties by primitive id, so the result is unique) and cuts

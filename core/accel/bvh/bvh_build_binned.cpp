@@ -11,8 +11,10 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <stdexcept>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 #include "core/accel/bvh/bvh_build.h"
 
@@ -210,9 +212,17 @@ inline std::size_t slice_begin(std::size_t n, std::size_t t, std::size_t parts) 
 }  // namespace
 
 void bin_primitives_parallel(std::span<const BuildPrim> prims, const glm::vec3& origin, const float k[3], int buckets,
-                             Bins& bins, unsigned threads) {
+                             Bins& bins, unsigned threads, std::uint32_t* slice_counts) {
+  // Slice t's counts (the buckets in use; the others are never read).
+  const auto keep_counts = [&](unsigned t, const Bins& b) {
+    if (slice_counts)
+      for (int a = 0; a < 3; ++a)
+        std::memcpy(slice_counts + (static_cast<std::size_t>(t) * 3 + a) * kMaxBuckets, b.count[a],
+                    static_cast<std::size_t>(buckets) * sizeof(std::uint32_t));
+  };
   if (threads <= 1) {
-    bin_primitives(prims, origin, k, buckets, bins);
+    bin_primitives(prims, origin, k, buckets, bins);  // `bins` held nothing before (cleared)
+    keep_counts(0, bins);
     return;
   }
   const std::size_t n = prims.size();
@@ -222,6 +232,7 @@ void bin_primitives_parallel(std::span<const BuildPrim> prims, const glm::vec3& 
       clear_bins(part[t], buckets);
       const std::size_t b = slice_begin(n, t, threads), e = slice_begin(n, t + 1, threads);
       bin_primitives(prims.subspan(b, e - b), origin, k, buckets, part[t]);
+      keep_counts(static_cast<unsigned>(t), part[t]);
     }
   });
   for (unsigned t = 0; t < threads; ++t) merge_bins(bins, part[t], buckets);
@@ -399,6 +410,12 @@ struct CentroidBounds {
     lo = _mm_min_ps(c, lo);  // glm::min(lo, c)
     hi = _mm_max_ps(c, hi);  // glm::max(hi, c)
   }
+  /// Then the centroids that `later` has seen, as if extend had gone on
+  /// over them (min(x, acc): a tie keeps what was seen first).
+  void merge(const CentroidBounds& later) {
+    lo = _mm_min_ps(later.lo, lo);
+    hi = _mm_max_ps(later.hi, hi);
+  }
   Aabb get() const {
     alignas(16) float l[4], h[4];
     _mm_store_ps(l, lo);
@@ -410,13 +427,14 @@ struct CentroidBounds {
 struct CentroidBounds {
   Aabb box;
   void extend(const BuildPrim& p) { box.extend(p.centroid); }
+  void merge(const CentroidBounds& later) { box.extend(later.box); }
   Aabb get() const { return box; }
 };
 #endif
 
 template <bool Record>
 bool search_impl(int nb, std::span<const BuildPrim> prims, const Aabb& centroid_bounds, Bins& bins, BinnedSahSearch& s,
-                 CandidateCosts* costs, unsigned threads) {
+                 CandidateCosts* costs, unsigned threads, std::vector<std::uint32_t>* slice_counts) {
   const std::size_t n = prims.size();
   s = BinnedSahSearch{};
 
@@ -435,7 +453,9 @@ bool search_impl(int nb, std::span<const BuildPrim> prims, const Aabb& centroid_
 
   // 2. Binning: one pass, all three axes. (Only the B buckets in use are cleared.)
   clear_bins(bins, nb);
-  bin_primitives_parallel(prims, centroid_bounds.lo, s.k, nb, bins, threads);
+  if (slice_counts) slice_counts->resize(static_cast<std::size_t>(std::max(threads, 1u)) * 3 * kMaxBuckets);
+  bin_primitives_parallel(prims, centroid_bounds.lo, s.k, nb, bins, threads,
+                          slice_counts ? slice_counts->data() : nullptr);
 #if defined(__SSE2__) && !defined(ACCELVIZ_NO_SIMD)
   if constexpr (!Record) {
     if (n < (std::size_t{1} << 30)) {
@@ -601,10 +621,112 @@ std::size_t partition_at_plane(std::span<BuildPrim> prims, int axis, float lo, f
   return mid;
 }
 
+namespace {
+
+/// One slice of partition_to: each record, in order, copied to its side's
+/// next place in `dst` (from `next_left` and `next_right` on; both moved
+/// on), and its centroid added to its side's bounds. The place is clamped
+/// to dst's last record, so counts that are not the slice's own cannot
+/// write outside `dst` (partition_to then throws).
+template <int Axis>
+void scatter_slice(std::span<const BuildPrim> src, std::span<BuildPrim> dst, std::size_t& next_left,
+                   std::size_t& next_right, float lo_a, float k_a, int plane, CentroidBounds& left_out,
+                   CentroidBounds& right_out) {
+  const std::size_t last = dst.size() - 1;
+  std::size_t l = next_left, r = next_right;
+  // Local bounds, stored once at the end: the record copies may alias
+  // anything, so bounds behind a reference would be stored after every
+  // record, and the slices' bounds share cache lines.
+  CentroidBounds left, right;
+#if defined(__SSE2__) && !defined(ACCELVIZ_NO_SIMD)
+  const __m128 lo = _mm_set1_ps(lo_a), k = _mm_set1_ps(k_a), p = _mm_set1_ps(static_cast<float>(plane + 1));
+  for (const BuildPrim& rec : src) {
+    // The place without a branch (on records in no spatial order a branch
+    // on the side is mispredicted half the time: the 1M soup's one-thread
+    // build took 8% longer with the conditional form, which GCC compiled
+    // to a jump).
+    const std::size_t goes_right = classify<Axis>(rec, lo, k, p, left, right);
+    const std::size_t at = l ^ ((l ^ r) & (0 - goes_right));
+    std::memcpy(&dst[std::min(at, last)], &rec, sizeof(BuildPrim));
+    l += 1 - goes_right;
+    r += goes_right;
+  }
+#else
+  for (const BuildPrim& rec : src) {
+    const bool goes_left = left_of_plane(rec.centroid[Axis], lo_a, k_a, plane);
+    (goes_left ? left : right).extend(rec);
+    const std::size_t at = goes_left ? l++ : r++;
+    std::memcpy(&dst[at < last ? at : last], &rec, sizeof(BuildPrim));
+  }
+#endif
+  next_left = l;
+  next_right = r;
+  left_out = left;
+  right_out = right;
+}
+
+}  // namespace
+
+std::size_t partition_to(std::span<const BuildPrim> src, std::span<BuildPrim> dst, int axis, float lo, float k,
+                         int plane, std::span<const std::size_t> slice_left, Aabb& left_centroids,
+                         Aabb& right_centroids) {
+  const std::size_t n = src.size(), slices = slice_left.size();
+  if (dst.size() != n || slices == 0 || slices > n || axis < 0 || axis > 2)
+    throw std::logic_error("partition_to: bad arguments");
+  // Per slice: where its left and right records start (the left ones of
+  // all slices in slice order, then the right ones), where they ended, and
+  // their bounds; one cache line each. On the stack for a few slices (most
+  // calls have one: a node is partitioned out of place on any thread count).
+  struct alignas(64) SliceWork {
+    std::size_t left_at, right_at, left_end, right_end;
+    CentroidBounds left, right;
+  };
+  constexpr std::size_t kOnStack = 4;
+  SliceWork on_stack[kOnStack];
+  std::unique_ptr<SliceWork[]> on_heap;
+  if (slices > kOnStack) on_heap.reset(new SliceWork[slices]);
+  SliceWork* work = on_heap ? on_heap.get() : on_stack;
+  std::size_t mid = 0;
+  for (std::size_t t = 0; t < slices; ++t) {
+    if (slice_left[t] > slice_begin(n, t + 1, slices) - slice_begin(n, t, slices))
+      throw std::logic_error("partition_to: a slice's left count exceeds its size");
+    work[t].left_at = mid;
+    mid += slice_left[t];
+  }
+  for (std::size_t t = 0, r = mid; t < slices; ++t) {
+    work[t].right_at = r;
+    r += slice_begin(n, t + 1, slices) - slice_begin(n, t, slices) - slice_left[t];
+  }
+  parallel_for(slices, static_cast<unsigned>(slices), 1, [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t t = begin; t < end; ++t) {
+      SliceWork& w = work[t];
+      const std::size_t b = slice_begin(n, t, slices), e = slice_begin(n, t + 1, slices);
+      const std::span<const BuildPrim> part = src.subspan(b, e - b);
+      w.left_end = w.left_at;
+      w.right_end = w.right_at;
+      if (axis == 0) scatter_slice<0>(part, dst, w.left_end, w.right_end, lo, k, plane, w.left, w.right);
+      if (axis == 1) scatter_slice<1>(part, dst, w.left_end, w.right_end, lo, k, plane, w.left, w.right);
+      if (axis == 2) scatter_slice<2>(part, dst, w.left_end, w.right_end, lo, k, plane, w.left, w.right);
+    }
+  });
+  for (std::size_t t = 0; t < slices; ++t)
+    if (work[t].left_end != work[t].left_at + slice_left[t] ||
+        work[t].right_end != (t + 1 < slices ? work[t + 1].right_at : n))
+      throw std::logic_error("partition_to: a slice's left count is not the one its records give");
+  for (std::size_t t = 1; t < slices; ++t) {
+    work[0].left.merge(work[t].left);
+    work[0].right.merge(work[t].right);
+  }
+  left_centroids = work[0].left.get();
+  right_centroids = work[0].right.get();
+  return mid;
+}
+
 bool binned_sah_search(int buckets, std::span<const BuildPrim> prims, const Aabb& centroid_bounds, Bins& bins,
-                       BinnedSahSearch& out, CandidateCosts* costs, unsigned threads) {
-  return costs ? search_impl<true>(buckets, prims, centroid_bounds, bins, out, costs, threads)
-               : search_impl<false>(buckets, prims, centroid_bounds, bins, out, nullptr, threads);
+                       BinnedSahSearch& out, CandidateCosts* costs, unsigned threads,
+                       std::vector<std::uint32_t>* slice_counts) {
+  return costs ? search_impl<true>(buckets, prims, centroid_bounds, bins, out, costs, threads, slice_counts)
+               : search_impl<false>(buckets, prims, centroid_bounds, bins, out, nullptr, threads, slice_counts);
 }
 
 SplitOutcome split_binned_sah(const SplitParams& params, std::span<BuildPrim> prims, const Aabb& bounds,
@@ -617,7 +739,12 @@ SplitOutcome split_binned_sah(const SplitParams& params, std::span<BuildPrim> pr
   //      explainer in core/analysis/insight). Bins is left uninitialised.
   Bins bins;
   BinnedSahSearch search;
-  if (!binned_sah_search(nb, prims, centroid_bounds, bins, search, nullptr, threads)) return SplitOutcome::unsplittable;
+  const bool move = !scratch.move_to.empty();
+  if (move && scratch.move_to.size() != n) throw std::logic_error("split_binned_sah: move_to is not the node's size");
+  out.moved = false;
+  if (!binned_sah_search(nb, prims, centroid_bounds, bins, search, nullptr, threads,
+                         move ? &scratch.slice_counts : nullptr))
+    return SplitOutcome::unsplittable;
   const float best_cost = search.best_cost;
   const int best_axis = search.best_axis, best_bucket = search.best_bucket;
   const glm::vec3 lo = centroid_bounds.lo;
@@ -643,14 +770,30 @@ SplitOutcome split_binned_sah(const SplitParams& params, std::span<BuildPrim> pr
   for (int b = 0; b < nb; ++b) child_bounds[b <= best_bucket ? 0 : 1].extend(bucket_box(bins, best_axis, b));
 #endif
 
-  // 5. The partition, gathering the children's centroid bounds on the way.
-  //    Serial even when threads are lent: a parallel version (each thread
-  //    listing its slice's misplaced records, then swapping the k-th pairs)
-  //    measured 5.6-11.1 ms on the dragon's root against 3.1-7.0 ms for the
-  //    two-ended loop then in use (2 vCPUs; the fresh index array's page
-  //    faults and a second pass).
-  out.mid = partition_at_plane(prims, best_axis, lo[best_axis], k[best_axis], best_bucket, out.centroid_bounds[0],
-                               out.centroid_bounds[1]);
+  // 5. The partition, gathering the children's centroid bounds on the way:
+  //    into scratch.move_to when the builder asks for it, on the lent
+  //    threads, each its slice of the binning with the left counts the
+  //    binning found there; else in place, on this thread. (An in-place
+  //    parallel version, each thread listing its slice's misplaced records
+  //    and then the k-th pairs swapped, measured 5.6-11.1 ms on the
+  //    dragon's root against 3.1-7.0 ms serial on 2 vCPUs: a second pass.)
+  if (move) {
+    const std::size_t slices = scratch.slice_counts.size() / (3 * kMaxBuckets);
+    std::vector<std::size_t>& slice_left = scratch.slice_left;
+    slice_left.resize(slices);
+    for (std::size_t t = 0; t < slices; ++t) {
+      const std::uint32_t* c = &scratch.slice_counts[(t * 3 + static_cast<std::size_t>(best_axis)) * kMaxBuckets];
+      std::size_t sum = 0;
+      for (int b = 0; b <= best_bucket; ++b) sum += c[b];
+      slice_left[t] = sum;
+    }
+    out.mid = partition_to(prims, scratch.move_to, best_axis, lo[best_axis], k[best_axis], best_bucket, slice_left,
+                           out.centroid_bounds[0], out.centroid_bounds[1]);
+    out.moved = true;
+  } else {
+    out.mid = partition_at_plane(prims, best_axis, lo[best_axis], k[best_axis], best_bucket, out.centroid_bounds[0],
+                                 out.centroid_bounds[1]);
+  }
   out.bounds[0] = child_bounds[0];
   out.bounds[1] = child_bounds[1];
   return SplitOutcome::split;
