@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <deque>
 #include <functional>
 #include <limits>
 #include <optional>
@@ -100,10 +101,20 @@ Entry bool_option(std::string_view key, std::string_view help, std::function<boo
           }};
 }
 
-// An option with a fixed set of names.
+// An option with a fixed set of names; what it accepts ("a|b|c", for the
+// help texts and the error) is those names, so the two cannot drift apart.
 template <typename T>
-Entry enum_option(std::string_view key, std::string_view values, std::string_view help,
-                  std::vector<std::pair<std::string_view, T>> names, std::function<T&(AppConfig&)> field) {
+Entry enum_option(std::string_view key, std::string_view help, std::vector<std::pair<std::string_view, T>> names,
+                  std::function<T&(AppConfig&)> field) {
+  // OptionInfo holds views: the joined names live as long as the table
+  // (built once, by entries()' static initialisation).
+  static std::deque<std::string> joined;
+  std::string j;
+  for (const auto& [n, t] : names) {
+    if (!j.empty()) j += '|';
+    j += n;
+  }
+  const std::string_view values = joined.emplace_back(std::move(j));
   return {{key, values, help},
           [field, names](const AppConfig& c) {
             const T v = field(const_cast<AppConfig&>(c));
@@ -135,13 +146,13 @@ const std::vector<Entry>& entries() {
                    return {};
                  }});
     // BVH (BvhOptions, core/accel/bvh/bvh.h).
-    t.push_back(enum_option<BvhSplitter>(
-        "splitter", "binned|exact|median|lbvh", "BVH split: binned SAH (Wald 2007), exact SAH sweep, median, LBVH",
-        {{"binned", BvhSplitter::binned_sah},
-         {"exact", BvhSplitter::exact_sah},
-         {"median", BvhSplitter::median},
-         {"lbvh", BvhSplitter::lbvh}},
-        [](AppConfig& c) -> BvhSplitter& { return c.structure.options.bvh.splitter; }));
+    t.push_back(
+        enum_option<BvhSplitter>("splitter", "BVH split: binned SAH (Wald 2007), exact SAH sweep, median, LBVH",
+                                 {{"binned", BvhSplitter::binned_sah},
+                                  {"exact", BvhSplitter::exact_sah},
+                                  {"median", BvhSplitter::median},
+                                  {"lbvh", BvhSplitter::lbvh}},
+                                 [](AppConfig& c) -> BvhSplitter& { return c.structure.options.bvh.splitter; }));
     t.push_back(int_option("buckets", "2..256", "BVH binned SAH buckets", 2, 256,
                            [](AppConfig& c) -> int& { return c.structure.options.bvh.buckets; }));
     // Raising the cap along with the leaf size keeps the pair valid, as the
@@ -237,7 +248,7 @@ const std::vector<Entry>& entries() {
                            [](AppConfig& c) -> int& { return c.structure.options.voxels.level; }));
     // Embree (EmbreeOptions).
     t.push_back(enum_option<EmbreeQuality>(
-        "embree-quality", "low|medium|high", "Embree build quality",
+        "embree-quality", "Embree build quality",
         {{"low", EmbreeQuality::low}, {"medium", EmbreeQuality::medium}, {"high", EmbreeQuality::high}},
         [](AppConfig& c) -> EmbreeQuality& { return c.structure.options.embree.quality; }));
     t.push_back(bool_option("embree-robust", "Embree: robust mode (no optimisations that lose watertightness)",
@@ -245,14 +256,13 @@ const std::vector<Entry>& entries() {
     std::vector<std::pair<std::string_view, EmbreeIsa>> isa_names;  // embree_isa_name's
     for (EmbreeIsa isa : kEmbreeIsas) isa_names.emplace_back(embree_isa_name(isa), isa);
     t.push_back(enum_option<EmbreeIsa>(
-        "embree-isa", "auto|sse2|sse4.2|avx|avx2|avx512",
-        "Embree: the kernels it may use (auto: the widest the CPU has; avx2: our fast path's)", std::move(isa_names),
-        [](AppConfig& c) -> EmbreeIsa& { return c.structure.options.embree.isa; }));
+        "embree-isa", "Embree: the kernels it may use (auto: the widest the CPU has; avx2: our fast path's)",
+        std::move(isa_names), [](AppConfig& c) -> EmbreeIsa& { return c.structure.options.embree.isa; }));
     // Query choices.
-    t.push_back(enum_option<TriangleTest>(
-        "triangle-test", "watertight|fast", "ray-triangle test: Woop 2013 watertight or Moller-Trumbore",
-        {{"watertight", TriangleTest::watertight}, {"fast", TriangleTest::moller_trumbore}},
-        [](AppConfig& c) -> TriangleTest& { return c.structure.query.triangle_test; }));
+    t.push_back(
+        enum_option<TriangleTest>("triangle-test", "ray-triangle test: Woop 2013 watertight or Moller-Trumbore",
+                                  {{"watertight", TriangleTest::watertight}, {"fast", TriangleTest::moller_trumbore}},
+                                  [](AppConfig& c) -> TriangleTest& { return c.structure.query.triangle_test; }));
     t.push_back(bool_option("ordered", "front-to-back child order (off: fixed order)",
                             [](AppConfig& c) -> bool& { return c.structure.query.ordered; }));
     t.push_back(bool_option("back-to-front", "BVH, ordered: the farther child first (the worst order; same hit)",
@@ -264,8 +274,7 @@ const std::vector<Entry>& entries() {
     t.push_back(
         bool_option("wireframe", "triangle edges", [](AppConfig& c) -> bool& { return c.view.show_wireframe; }));
     t.push_back(bool_option("boxes", "node boxes", [](AppConfig& c) -> bool& { return c.view.show_boxes; }));
-    t.push_back(enum_option<BoxMode>("box-mode", "depth|range|leaves|subtree",
-                                     "which node boxes: one depth, a depth range, leaves, a subtree",
+    t.push_back(enum_option<BoxMode>("box-mode", "which node boxes: one depth, a depth range, leaves, a subtree",
                                      {{"depth", BoxMode::depth},
                                       {"range", BoxMode::depth_range},
                                       {"leaves", BoxMode::leaves},
@@ -277,12 +286,12 @@ const std::vector<Entry>& entries() {
                            [](AppConfig& c) -> int& { return c.view.box_depth_last; }));
     t.push_back(int_option("box-node", "0..2^31", "subtree: the selected node", 0, std::numeric_limits<int>::max(),
                            [](AppConfig& c) -> int& { return c.view.box_node; }));
-    t.push_back(enum_option<BoxColorBy>("box-color", "depth|sah", "box colours: by depth or by share of the SAH cost",
+    t.push_back(enum_option<BoxColorBy>("box-color", "box colours: by depth or by share of the SAH cost",
                                         {{"depth", BoxColorBy::depth}, {"sah", BoxColorBy::sah_share}},
                                         [](AppConfig& c) -> BoxColorBy& { return c.view.box_color; }));
     t.push_back(bool_option("boxes-through-mesh", "boxes are not hidden by the mesh",
                             [](AppConfig& c) -> bool& { return c.view.boxes_through_mesh; }));
-    t.push_back(enum_option<BoxLevel>("box-level", "tlas|blas",
+    t.push_back(enum_option<BoxLevel>("box-level",
                                       "two-level: top-level node boxes, or every instance's BLAS boxes in world space",
                                       {{"tlas", BoxLevel::tlas}, {"blas", BoxLevel::blas}},
                                       [](AppConfig& c) -> BoxLevel& { return c.view.box_level; }));
@@ -292,10 +301,10 @@ const std::vector<Entry>& entries() {
     t.push_back(bool_option("instance-colors", "two-level: each instance in its own colour (hashed from its id)",
                             [](AppConfig& c) -> bool& { return c.view.instance_colors; }));
     t.push_back(enum_option<HeatmapDisplay>(
-        "heatmap", "off|full|blend", "per-pixel metric: off, replacing the mesh, or blended over it",
+        "heatmap", "per-pixel metric: off, replacing the mesh, or blended over it",
         {{"off", HeatmapDisplay::off}, {"full", HeatmapDisplay::full_screen}, {"blend", HeatmapDisplay::blend}},
         [](AppConfig& c) -> HeatmapDisplay& { return c.view.heatmap; }));
-    t.push_back(enum_option<HeatMetric>("metric", "nodes|prims|cost|shaded|depth|instances", "heatmap metric",
+    t.push_back(enum_option<HeatMetric>("metric", "heatmap metric",
                                         {{"nodes", HeatMetric::nodes},
                                          {"prims", HeatMetric::prims},
                                          {"cost", HeatMetric::cost},
@@ -310,7 +319,7 @@ const std::vector<Entry>& entries() {
                              "GPU heatmap: ms of tracing per frame, in row bands (0: one 8-row band a frame)", 0, 1000,
                              false, [](AppConfig& c) -> float& { return c.view.heatmap_gpu_ms; }));
     t.push_back(enum_option<ColorMap>(
-        "colormap", "viridis|inferno|turbo", "heatmap colour map",
+        "colormap", "heatmap colour map",
         {{"viridis", ColorMap::viridis}, {"inferno", ColorMap::inferno}, {"turbo", ColorMap::turbo}},
         [](AppConfig& c) -> ColorMap& { return c.view.colormap; }));
     t.push_back(float_option("opacity", "0..1", "blend: heatmap opacity", 0, 1, false,
