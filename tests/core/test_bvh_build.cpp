@@ -360,6 +360,49 @@ TEST(BvhBuild, AllCentroidsEqualFallsBackToObjectMedian) {
   }
 }
 
+TEST(BvhBuild, NodesPartitionedOutOfPlaceComeBackForLeaves) {
+  // The binned SAH partitions nodes of kOutOfPlaceMinPrims records or more
+  // into its second array, and their children back. A child whose records
+  // are in the second array and that ends as a leaf (by size, by the SAH, or
+  // unsplittable under the cap) must take its records back first, and one
+  // that falls back to a median split (unsplittable above the cap) must
+  // split them where they are. Each scene is a soup of 300 triangles with
+  // a cluster far off, which the root's split (out of place) cuts off into
+  // a child of that kind: 3 triangles (a leaf by size), 8 distinct ones
+  // with nearly the same box (a leaf by the SAH), 10 identical ones (unsplittable, under the
+  // leaf cap of 16) and 40 identical ones (unsplittable, median splits).
+  struct Cluster {
+    int count;
+    bool identical;
+  };
+  for (const Cluster cluster : {Cluster{3, true}, Cluster{8, false}, Cluster{10, true}, Cluster{40, true}}) {
+    SCOPED_TRACE("cluster of " + std::to_string(cluster.count));
+    // The cluster first, so that the partition moves it (in place, stale
+    // records would be its own).
+    std::vector<Triangle> tris;
+    for (int i = 0; i < cluster.count; ++i) {
+      // Distinct ones: shifted a little, so that their boxes nearly coincide
+      // and no split pays.
+      const glm::vec3 p(1000.0f + (cluster.identical ? 0.0f : 1e-4f * static_cast<float>(i)), 0.0f, 0.0f);
+      tris.push_back({p, p + glm::vec3(1, 0, 0), p + glm::vec3(0, 1, 0)});
+    }
+    const std::vector<Triangle> soup = random_soup(300, 78, 0.01f);
+    tris.insert(tris.end(), soup.begin(), soup.end());
+    ASSERT_GE(tris.size(), bvh_detail::kOutOfPlaceMinPrims);
+    BvhOptions o;
+    o.compute_epo = false;
+    const Bvh bvh(tris, o);
+    expect_valid_tree(bvh, tris, o);
+    // The root's children: the cluster's subtree holds exactly its triangles.
+    const BvhNode& root = bvh.nodes()[0];
+    ASSERT_EQ(root.count, 0u);
+    std::size_t far = 0;
+    for (std::uint32_t c = root.index; c < root.index + 2; ++c)
+      if (bvh.nodes()[c].bounds.lo.x >= 999.0f) ++far;
+    EXPECT_EQ(far, 1u) << "the root's split did not cut the cluster off";
+  }
+}
+
 TEST(BvhBuild, ZeroExtentOnTheLargestAxisStillSplits) {
   // A flat scene (every vertex at z = 0.5) and a scene whose centroids lie on
   // one line (only x varies): the splitter must not pick an axis it cannot bin.

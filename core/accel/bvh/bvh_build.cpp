@@ -171,7 +171,8 @@ class Builder {
     if (cancelled_.load(std::memory_order_relaxed)) return;
     const std::size_t n = w.end - w.begin;
     // The records are in prims_, or in moved_ when the parent's split moved
-    // them there; a leaf and the in-place splits take them back first.
+    // them there: a leaf takes them back first; a split of such a node
+    // partitions them back (a median split, where they are).
     bool moved = w.moved;
     std::span<BuildPrim> range = (moved ? moved_ : prims_).subspan(w.begin, n);
     const auto in_place = [&] {
@@ -190,7 +191,6 @@ class Builder {
     // bounds_after splitter's children do not carry: computed here, for the
     // (rare) nodes that fall back to it.
     const auto median_split = [&] {
-      in_place();
       Aabb centroids = w.centroid_bounds;
       if (split_.bounds_after) {
         Aabb unused;
