@@ -7,6 +7,7 @@
 // once (counts and bounds), and the SAH is evaluated only at the B-1 bucket
 // boundaries of each axis with two sweeps over the buckets. Cost per node:
 // O(n + B), no sorting.
+#include <algorithm>
 #include <array>
 #include <cstring>
 #include <limits>
@@ -656,7 +657,7 @@ void scatter_slice(std::span<const BuildPrim> src, std::span<BuildPrim> dst, std
     const bool goes_left = left_of_plane(rec.centroid[Axis], lo_a, k_a, plane);
     (goes_left ? left : right).extend(rec);
     const std::size_t at = goes_left ? l++ : r++;
-    std::memcpy(&dst[at < last ? at : last], &rec, sizeof(BuildPrim));
+    std::memcpy(&dst[std::min(at, last)], &rec, sizeof(BuildPrim));
   }
 #endif
   next_left = l;
