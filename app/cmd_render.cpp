@@ -178,6 +178,7 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
 }
 
 int run_render(const RenderOptions& o, const GlobalOptions& global) {
+  if (const std::string problem = png_name_problem(o.out); !problem.empty()) throw UsageError(problem);
   if (o.gl && o.device != "gpu") throw UsageError("--gl needs --device gpu");
   if (o.device == "gpu") {
 #ifndef ACCELVIZ_HAVE_UI

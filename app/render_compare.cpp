@@ -99,7 +99,7 @@ CompareSide parse_compare_spec(const std::string& spec, const CompareSide& a) {
 ComparePaths compare_paths(const std::string& out) {
   const std::filesystem::path p(out);
   const std::filesystem::path dir = p.parent_path();
-  const std::string stem = p.stem().string(), ext = p.has_extension() ? p.extension().string() : ".png";
+  const std::string stem = p.stem().string(), ext = p.extension().string();  // .png (run_render checked)
   const auto make = [&](const char* suffix) { return (dir / (stem + suffix + ext)).string(); };
   return {make("-a"), make("-b"), make("-diff")};
 }

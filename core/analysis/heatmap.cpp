@@ -510,12 +510,20 @@ void write_to_file(void* context, void* data, int size) {
 
 }  // namespace
 
+std::string png_name_problem(const std::string& path) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  const bool png =
+      ext.size() == 4 && ext[0] == '.' && (ext[1] | 0x20) == 'p' && (ext[2] | 0x20) == 'n' && (ext[3] | 0x20) == 'g';
+  return png ? std::string() : path + ": a PNG file's name must end in .png";
+}
+
 void write_png(const std::string& path, const RgbImage& img, bool overwrite) {
+  if (const std::string problem = png_name_problem(path); !problem.empty()) throw std::runtime_error(problem);
   if (img.width <= 0 || img.height <= 0) throw std::runtime_error(path + ": cannot write an empty image");
   // "x": the existence check and the creation are one step (no overwrite race).
   std::unique_ptr<std::FILE, FileCloser> f(std::fopen(path.c_str(), overwrite ? "wb" : "wbx"));
   if (!f) {
-    if (errno == EEXIST) throw std::runtime_error(path + ": exists (use --force to overwrite)");
+    if (errno == EEXIST) throw FileExistsError(path + ": exists (use --force to overwrite)");
     throw std::runtime_error(path + ": cannot create: " + std::strerror(errno));
   }
   WriteContext ctx{f.get(), true};

@@ -8,6 +8,7 @@
 #include <glm/glm.hpp>
 #include <optional>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -168,9 +169,24 @@ void draw_text(RgbImage& img, int x, int y, std::string_view text, glm::u8vec3 c
 /// A legend number: "0", "12", "0.25", "1.5k", "2.3M", "1e-05".
 std::string format_tick(double v);
 
-/// Writes a PNG (stb_image_write). Refuses, with "<file>: exists (use --force
-/// to overwrite)", when the file exists and `overwrite` is false; other failures
-/// are "<file>: <reason>". Throws std::runtime_error.
+/// "" when `path` names a PNG file (its name ends in .png, in any case), else
+/// "<path>: a PNG file's name must end in .png". write_png refuses other
+/// names (a heatmap saved as "heat.jpg" would be a PNG under a JPEG's name);
+/// the CLI and the GUI's scripts check the name before any long work.
+std::string png_name_problem(const std::string& path);
+
+/// write_png's refusal of an existing file: callers that speak of it their
+/// own way (the GUI: "exists (not overwritten)") catch this type.
+class FileExistsError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Writes a PNG (stb_image_write). Refuses, with FileExistsError "<file>:
+/// exists (use --force to overwrite)", when the file exists and `overwrite`
+/// is false (the existence check and the creation are one step); a name not
+/// ending in .png is png_name_problem's message; other failures are "<file>:
+/// <reason>". Throws std::runtime_error.
 void write_png(const std::string& path, const RgbImage& img, bool overwrite = false);
 
 /// Reads any image stb_image understands as 8-bit RGB. Throws std::runtime_error "<file>: <reason>".

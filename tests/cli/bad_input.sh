@@ -59,6 +59,14 @@ expect 2 "required" -- trace 'builtin:soup?size=10' --out "$tmp/z.hits"
 expect 2 "nosuchcommand" -- nosuchcommand
 expect 2 "--repeat" -- bench 'builtin:soup?size=10' --repeat 0
 
+# A PNG under another format's name (or none): refused before any work, nothing written.
+expect 2 "$tmp/heat.jpg: a PNG file's name must end in .png" -- render 'builtin:soup?size=10' --out "$tmp/heat.jpg"
+expect 2 "$tmp/heat: a PNG file's name must end in .png" -- render 'builtin:soup?size=10' --out "$tmp/heat" \
+  --compare 'buckets=4'
+for f in heat.jpg heat heat-a heat-b heat-diff; do
+  [ ! -e "$tmp/$f" ] || { echo "FAIL: render wrote $tmp/$f under a name that is not .png"; fail=1; }
+done
+
 # Missing output directory.
 expect 1 "$tmp/no/dir/a.png" -- render 'builtin:soup?size=10' --out "$tmp/no/dir/a.png"
 

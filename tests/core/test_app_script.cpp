@@ -108,6 +108,9 @@ TEST(AppScript, ErrorsNameFileAndLine) {
            Case{"camera gltf:x\n", "s.txt:1: camera: expected gltf:N"},
            Case{"wait now\n", "s.txt:1: wait: takes no argument"},
            Case{"quit please\n", "s.txt:1: quit: takes no argument"},
+           Case{"screenshot out/figure.jpg\n",
+                "s.txt:1: screenshot: out/figure.jpg: a PNG file's name must end in .png"},
+           Case{"screenshot out/figure\n", "s.txt:1: screenshot: out/figure: a PNG file's name must end in .png"},
        }) {
     const std::string e = parse_error(c.text);
     EXPECT_EQ(e.rfind(c.expected, 0), 0u) << "script: " << c.text << "\ngot: " << e;
@@ -115,6 +118,7 @@ TEST(AppScript, ErrorsNameFileAndLine) {
   // Later lines are not checked against earlier ones' configuration only
   // when they come first: the cap is fine before the leaf grows.
   EXPECT_EQ(parse_error("set leaf-cap 32\nset leaf 8\n"), "(no error)");
+  EXPECT_EQ(parse_error("screenshot out/Figure 1.PNG\n"), "(no error)");
 }
 
 TEST(AppScript, InsightRegionAndABCommands) {

@@ -184,6 +184,30 @@ TEST(Heatmap, LegendPlacements) {
   EXPECT_EQ(colorize(img, co).height, 48);  // no legend for the shaded picture
 }
 
+TEST(Heatmap, WritePngTakesOnlyPngNames) {
+  const RgbImage img(4, 4, {10, 20, 30});
+  for (const char* name : {"heat.jpg", "heat", "heat.png.txt", "heat.pn"}) {
+    const std::string path = temp_png(name);
+    fs::remove(path);
+    EXPECT_EQ(png_name_problem(path), path + ": a PNG file's name must end in .png");
+    try {
+      write_png(path, img);
+      ADD_FAILURE() << "wrote " << path;
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()), path + ": a PNG file's name must end in .png");
+    }
+    EXPECT_FALSE(fs::exists(path)) << path;
+  }
+  for (const char* name : {"upper.PNG", "mixed.Png", "two.dots.png"}) {
+    const std::string path = temp_png(name);
+    fs::remove(path);
+    EXPECT_EQ(png_name_problem(path), "");
+    write_png(path, img);
+    EXPECT_EQ(read_png(path).width, 4) << path;
+    fs::remove(path);
+  }
+}
+
 TEST(Heatmap, WritePngRefusesToOverwrite) {
   const std::string path = temp_png("exists.png");
   fs::remove(path);
@@ -192,7 +216,7 @@ TEST(Heatmap, WritePngRefusesToOverwrite) {
   try {
     write_png(path, RgbImage(2, 2));
     ADD_FAILURE() << "overwrote";
-  } catch (const std::runtime_error& e) {
+  } catch (const FileExistsError& e) {  // its own type: the GUI words it its own way
     EXPECT_EQ(std::string(e.what()), path + ": exists (use --force to overwrite)");
   }
   EXPECT_EQ(read_png(path).width, 4);

@@ -110,6 +110,13 @@ TEST_F(Screenshot, ReportsUnwritablePaths) {
   EXPECT_FALSE(r);
   EXPECT_EQ(r.error.rfind("/nonexistent-dir/accelviz/frame.png: ", 0), 0u) << r.error;
   EXPECT_FALSE(write_screenshot_png("/tmp/never.png", Rgba8Image{}));
+  // Through core's writer: a name that is not .png is refused, nothing written.
+  TempDir dir("screenshot");
+  const auto jpg = dir.path() / "frame.jpg";
+  const SaveResult named = write_screenshot_png(jpg, frame);
+  EXPECT_FALSE(named);
+  EXPECT_EQ(named.error, jpg.string() + ": a PNG file's name must end in .png");
+  EXPECT_FALSE(std::filesystem::exists(jpg));
 }
 
 TEST(ScreenshotPath, NextFreeNameNeverCollides) {

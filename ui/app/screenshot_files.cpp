@@ -67,10 +67,13 @@ SavedScreenshot write_pair(const ScreenshotPaths& paths, const RgbImage& frame, 
     }
   try {
     write_png(paths.png.string(), add_caption(frame, screenshot_caption(info.config)), /*overwrite=*/false);
-  } catch (const std::exception& e) {
+  } catch (const FileExistsError&) {
     // core's message for an existing file speaks of --force; say it the GUI's way.
-    *name_taken = fs::exists(paths.png, ec);
-    r.error = *name_taken ? paths.png.string() + ": exists (not overwritten)" : std::string(e.what());
+    *name_taken = true;
+    r.error = paths.png.string() + ": exists (not overwritten)";
+    return r;
+  } catch (const std::exception& e) {
+    r.error = e.what();
     return r;
   }
   const std::string error = write_text_exclusive(paths.json, screenshot_sidecar(info, paths.png).dump(2) + "\n");

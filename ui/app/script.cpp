@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/accel/factory.h"
+#include "core/analysis/heatmap.h"
 #include "ui/app/app_config.h"
 #include "ui/app/dynamics.h"
 #include "ui/app/flatten_worker.h"
@@ -160,6 +161,8 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
         // The rest of the line, so paths may hold spaces.
         need_rest(c.kind == ScriptCommand::Kind::open ? "a scene (file or builtin:NAME)" : "a file path");
         c.arg = std::string(rest);
+        if (c.kind == ScriptCommand::Kind::screenshot)
+          if (const std::string problem = png_name_problem(c.arg); !problem.empty()) fail("screenshot: " + problem);
         break;
       case ScriptCommand::Kind::structure: {
         need_rest("a structure name");
