@@ -332,6 +332,7 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
   }
   vi.boxes_drawn = view_->boxes_drawn();
   vi.boxes_truncated = view_->boxes_truncated();
+  vi.boxes_matched = view_->boxes_matched();
   const glm::vec2 range = view_->heatmap_range(app_);
   vi.range_min = range.x;
   vi.range_max = range.y;
@@ -474,7 +475,9 @@ SavedScreenshot Gui::write_frame(const std::optional<std::filesystem::path>& exp
   view_->draw(app_, w, h);
   const RgbImage frame = to_rgb(view_->renderer().read_pixels());
   const glm::vec2 range = view_->heatmap_range(app_);
-  const ScreenshotInfo info = app_.screenshot_info(range.x, range.y);
+  ScreenshotInfo info = app_.screenshot_info(range.x, range.y);
+  info.boxes_drawn = view_->boxes_drawn();
+  info.boxes_matched = view_->boxes_matched();
   if (explicit_path) return save_screenshot_as(*explicit_path, frame, info);
   const std::filesystem::path dir = app_.settings().screenshot_dir.empty()
                                         ? default_screenshot_dir()
@@ -620,6 +623,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       doc["frames"] = frames_drawn_;
       view_->sync(app_);  // the overlay as the settings stand now
       doc["boxes"] = {{"drawn", view_->boxes_drawn()},
+                      {"matched", view_->boxes_matched()},
                       {"truncated", view_->boxes_truncated()},
                       {"instance_colors", view_->instance_colored()}};
       fail_if(write_file_atomic(c.arg, doc.dump(2) + "\n"));

@@ -85,6 +85,7 @@ void SceneView::upload_boxes(const AppState& app) {
   if (key == box_key_) return;
   box_key_ = key;
   boxes_drawn_ = 0;
+  boxes_matched_ = 0;
   boxes_truncated_ = false;
   if (!built || built->nodes.empty()) {
     renderer_.set_boxes({});
@@ -97,6 +98,7 @@ void SceneView::upload_boxes(const AppState& app) {
   sel.node = static_cast<std::uint32_t>(v.box_node);
   StructureNodes::Selection s;
   if (region) {  // the nodes the region's rays entered, instead of the view's selection
+    s.matched = region->nodes.size();
     for (const std::uint32_t id : region->nodes) {
       if (s.boxes.size() >= kMaxBoxes) {
         s.truncated = true;
@@ -113,6 +115,7 @@ void SceneView::upload_boxes(const AppState& app) {
     s = built->nodes.select(sel, kMaxBoxes);
   }
   boxes_drawn_ = s.boxes.size();
+  boxes_matched_ = std::max<std::uint64_t>(s.matched, s.boxes.size());
   boxes_truncated_ = s.truncated;
 
   std::vector<ColoredBox> boxes;

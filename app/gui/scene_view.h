@@ -47,6 +47,8 @@ class SceneView {
   /// The mesh is drawn in per-instance colours (instance-colors on, a tlas shown).
   bool instance_colored() const { return colored_; }
   bool boxes_truncated() const { return boxes_truncated_; }
+  /// Boxes the selection names (more than drawn when the list was cut at kMaxBoxes).
+  std::uint64_t boxes_matched() const { return boxes_matched_; }
 
   /// Most boxes drawn at once (llvmpipe draws ~1e5 instanced boxes per frame comfortably).
   static constexpr std::size_t kMaxBoxes = 200000;
@@ -68,7 +70,7 @@ class SceneView {
   int colormap_ = -1;
   bool colored_ = false;  ///< per-instance triangle colours uploaded
   bool has_heatmap_ = false;
-  std::uint64_t boxes_drawn_ = 0;
+  std::uint64_t boxes_drawn_ = 0, boxes_matched_ = 0;
   bool boxes_truncated_ = false;
 };
 

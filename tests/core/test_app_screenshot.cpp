@@ -135,6 +135,32 @@ TEST(AppScreenshot, CaptionStripUnderTheFrame) {
   EXPECT_EQ(add_caption(frame, "BVH").pixels, add_caption(frame, "bvh").pixels);
 }
 
+TEST(AppScreenshot, LongCaptionsWrapInsteadOfBeingCut) {
+  using V = std::vector<std::string>;
+  EXPECT_EQ(wrap_caption("bvh (buckets=8), watertight", 40, 4), V{"bvh (buckets=8), watertight"});
+  EXPECT_EQ(wrap_caption("bvh (buckets=8), watertight, heatmap nodes", 20, 4),
+            (V{"bvh (buckets=8),", "watertight, heatmap", "nodes"}));
+  EXPECT_EQ(wrap_caption("abcdefghij", 4, 4), (V{"abcd", "efgh", "ij"})) << "no space: broken mid-word";
+  EXPECT_EQ(wrap_caption("aa bb cc dd ee ff", 5, 2), (V{"aa bb", "cc .."})) << "the last line says it goes on";
+  EXPECT_TRUE(wrap_caption("", 10, 4).empty());
+
+  // On the picture: one strip line per caption line, every line drawn.
+  const RgbImage frame = test_frame(200, 40);
+  const std::string caption = "bvh (splitter=binned, buckets=32, leaf=4, leaf-cap=16), watertight, heatmap nodes";
+  const RgbImage one = add_caption(frame, "bvh");
+  const RgbImage wrapped = add_caption(frame, caption);
+  const int lines = static_cast<int>(wrap_caption(caption, (200 - 8) / 6, kCaptionMaxLines).size());
+  ASSERT_GE(lines, 2);
+  ASSERT_LE(lines, kCaptionMaxLines);
+  EXPECT_EQ(wrapped.height - one.height, (lines - 1) * 10);
+  for (int line = 0; line < lines; ++line) {
+    int bright = 0;
+    for (int y = 40 + 4 + line * 10; y < 40 + 4 + line * 10 + 7; ++y)
+      for (int x = 0; x < 200; ++x) bright += wrapped.at(x, y).x > 150;
+    EXPECT_GT(bright, 20) << "line " << line;
+  }
+}
+
 TEST(AppScreenshot, SideCarSaysHowToReproduceThePicture) {
   const ScreenshotInfo info = test_info();
   const nlohmann::json j = screenshot_sidecar(info, "/x/accelviz-1.png");
@@ -155,6 +181,7 @@ TEST(AppScreenshot, SideCarSaysHowToReproduceThePicture) {
   EXPECT_EQ(j["options"].size(), option_table().size());
   EXPECT_EQ(j["ray_pixel"][0], 32);
   EXPECT_EQ(j["caption"], screenshot_caption(info.config));
+  EXPECT_EQ(j["boxes"]["drawn"], 0);
 
   const std::string cmd = j["reproduce"]["render_heatmap"];
   for (const char* part :
@@ -173,6 +200,26 @@ TEST(AppScreenshot, SideCarSaysHowToReproduceThePicture) {
   EXPECT_NE(std::find(script.begin(), script.end(), "click 32 24"), script.end());
   EXPECT_EQ(script.back(), "quit");
   EXPECT_TRUE(j["reproduce"]["notes"].empty());
+}
+
+TEST(AppScreenshot, AThinnedBoxOverlayIsSaidOnThePictureAndInTheSideCar) {
+  ScreenshotInfo info = test_info();
+  info.boxes_drawn = 200000;
+  info.boxes_matched = 288291;
+  EXPECT_EQ(screenshot_caption(info), screenshot_caption(info.config) + ", boxes 200000 of 288291");
+  const nlohmann::json j = screenshot_sidecar(info, "shot.png");
+  EXPECT_EQ(j["caption"], screenshot_caption(info));
+  EXPECT_EQ(j["boxes"]["drawn"], 200000);
+  EXPECT_EQ(j["boxes"]["matched"], 288291);
+  const auto& notes = j["reproduce"]["notes"];
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_EQ(notes[0],
+            "raster: the window drew 200000 of the 288291 boxes, spread evenly over the selection; the command line "
+            "draws all");
+  // All drawn: nothing added.
+  info.boxes_drawn = info.boxes_matched = 5000;
+  EXPECT_EQ(screenshot_caption(info), screenshot_caption(info.config));
+  EXPECT_TRUE(screenshot_sidecar(info, "shot.png")["reproduce"]["notes"].empty());
 }
 
 TEST(AppScreenshot, SideCarNotesWhatTheCommandLineCannotSay) {

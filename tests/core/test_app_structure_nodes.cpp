@@ -93,10 +93,22 @@ TEST(AppStructureNodes, SelectionsPickWhatTheySay) {
   const auto some = t.select({BoxMode::subtree, 0, 0, 5}, 1u << 30);
   for (const NodeBox& b : some.boxes) EXPECT_TRUE(inside(*t.box(5), b.bounds, 0.0f));
 
-  const auto cut = t.select({BoxMode::leaves, 0, 0, 0}, 10);
-  EXPECT_EQ(cut.boxes.size(), 10u);
-  EXPECT_TRUE(cut.truncated);
-  EXPECT_GT(cut.matched, 10u);
+  // A cut list: `limit` boxes spread evenly over the whole selection (box
+  // floor(k * matched / limit) of the uncut list), not its first ones.
+  const auto leaves = t.select({BoxMode::leaves, 0, 0, 0}, 1u << 30);
+  EXPECT_FALSE(leaves.truncated);
+  for (const std::size_t limit : {std::size_t{1}, std::size_t{10}, leaves.boxes.size() - 1}) {
+    SCOPED_TRACE(limit);
+    const auto cut = t.select({BoxMode::leaves, 0, 0, 0}, limit);
+    ASSERT_EQ(cut.boxes.size(), limit);
+    EXPECT_TRUE(cut.truncated);
+    EXPECT_EQ(cut.matched, leaves.boxes.size());
+    for (std::size_t k = 0; k < limit; ++k)
+      ASSERT_EQ(cut.boxes[k].id, leaves.boxes[k * leaves.boxes.size() / limit].id) << k;
+  }
+  const auto exact = t.select({BoxMode::leaves, 0, 0, 0}, leaves.boxes.size());
+  EXPECT_FALSE(exact.truncated);
+  EXPECT_EQ(exact.boxes.size(), leaves.boxes.size());
 }
 
 TEST(AppStructureNodes, GridCellsAreTheGridsOwn) {

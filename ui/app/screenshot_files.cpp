@@ -66,7 +66,7 @@ SavedScreenshot write_pair(const ScreenshotPaths& paths, const RgbImage& frame, 
       return r;
     }
   try {
-    write_png(paths.png.string(), add_caption(frame, screenshot_caption(info.config)), /*overwrite=*/false);
+    write_png(paths.png.string(), add_caption(frame, screenshot_caption(info)), /*overwrite=*/false);
   } catch (const FileExistsError&) {
     // core's message for an existing file speaks of --force; say it the GUI's way.
     *name_taken = true;
@@ -114,19 +114,45 @@ ScreenshotPaths unique_screenshot_paths(const fs::path& dir, const std::string& 
   }
 }
 
+std::vector<std::string> wrap_caption(const std::string& text, int max_chars, int max_lines) {
+  std::vector<std::string> lines;
+  if (max_chars <= 0 || max_lines <= 0) return lines;
+  std::size_t at = 0;
+  while (at < text.size()) {
+    if (static_cast<int>(lines.size()) == max_lines - 1 && text.size() - at > static_cast<std::size_t>(max_chars)) {
+      lines.push_back(text.substr(at, static_cast<std::size_t>(std::max(0, max_chars - 2))) + "..");
+      break;
+    }
+    std::size_t len = std::min(text.size() - at, static_cast<std::size_t>(max_chars));
+    if (at + len < text.size()) {
+      // Break after the last ", " or " " that fits (its space ends the line), else mid-word.
+      const std::size_t space = text.rfind(' ', at + len);
+      if (space != std::string::npos && space > at) len = space - at + 1;
+    }
+    std::string line = text.substr(at, len);
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    lines.push_back(line);
+    at += len;
+  }
+  return lines;
+}
+
 RgbImage add_caption(const RgbImage& frame, const std::string& caption) {
   const int scale = frame.width >= 1000 ? 2 : 1;
   const int pad = 4 * scale;
-  const int strip = pad + 7 * scale + pad;
-  RgbImage out(frame.width, frame.height + strip, glm::u8vec3(28, 30, 34));
-  std::copy(frame.pixels.begin(), frame.pixels.end(), out.pixels.begin());
   // The legend font has lower-case letters only (and M); everything else
   // it lacks draws as a blank, so lower-case the caption first.
   std::string text;
   for (char c : caption) text += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   const int max_chars = std::max(0, (frame.width - 2 * pad) / (6 * scale));
-  if (static_cast<int>(text.size()) > max_chars) text = text.substr(0, std::max(0, max_chars - 2)) + "..";
-  draw_text(out, pad, frame.height + pad, text, glm::u8vec3(225, 228, 232), scale);
+  const std::vector<std::string> lines = wrap_caption(text, max_chars, kCaptionMaxLines);
+  const int line_height = 10 * scale;  // 7 rows of glyph, 3 of spacing
+  const int strip = pad + std::max<int>(1, static_cast<int>(lines.size())) * line_height - 3 * scale + pad;
+  RgbImage out(frame.width, frame.height + strip, glm::u8vec3(28, 30, 34));
+  std::copy(frame.pixels.begin(), frame.pixels.end(), out.pixels.begin());
+  for (std::size_t i = 0; i < lines.size(); ++i)
+    draw_text(out, pad, frame.height + pad + static_cast<int>(i) * line_height, lines[i], glm::u8vec3(225, 228, 232),
+              scale);
   return out;
 }
 
@@ -182,6 +208,10 @@ std::string render_command(const ScreenshotInfo& info, bool raster, const std::s
       }
       if (notes && v.box_color != BoxColorBy::depth)
         notes->push_back("raster: boxes are coloured by depth on the command line");
+      if (notes && info.boxes_drawn < info.boxes_matched)
+        notes->push_back("raster: the window drew " + std::to_string(info.boxes_drawn) + " of the " +
+                         std::to_string(info.boxes_matched) +
+                         " boxes, spread evenly over the selection; the command line draws all");
     }
     if (v.show_wireframe) cmd += " --wireframe";
     if (v.heatmap == HeatmapDisplay::blend) cmd += " --blend " + format_number(v.opacity);
@@ -190,6 +220,13 @@ std::string render_command(const ScreenshotInfo& info, bool raster, const std::s
       cmd += " --ray-pixel " + std::to_string(info.ray_pixel->first) + "," + std::to_string(info.ray_pixel->second);
   }
   return cmd + " --out " + shell_quote(out);
+}
+
+std::string screenshot_caption(const ScreenshotInfo& info) {
+  std::string s = screenshot_caption(info.config);
+  if (info.boxes_drawn < info.boxes_matched)
+    s += ", boxes " + std::to_string(info.boxes_drawn) + " of " + std::to_string(info.boxes_matched);
+  return s;
 }
 
 nlohmann::json screenshot_sidecar(const ScreenshotInfo& info, const fs::path& png) {
@@ -221,7 +258,8 @@ nlohmann::json screenshot_sidecar(const ScreenshotInfo& info, const fs::path& pn
 
   return {
       {"png", fs::absolute(png).string()},
-      {"caption", screenshot_caption(c)},
+      {"caption", screenshot_caption(info)},
+      {"boxes", {{"drawn", info.boxes_drawn}, {"matched", info.boxes_matched}}},
       {"scene", info.scene},
       {"triangles", info.triangles},
       {"size", {{"width", info.width}, {"height", info.height}}},

@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace accelviz {
 
@@ -43,10 +44,28 @@ struct ScreenshotInfo {
   float scale_min = 0.0f;  ///< the heatmap range actually drawn
   float scale_max = 1.0f;
   std::optional<std::pair<int, int>> ray_pixel;  ///< the inspected pixel, when a ray is shown
+  /// The node-box overlay as drawn: boxes drawn and boxes the selection
+  /// names (more when the window cut the list and thinned it; 0 and 0
+  /// without boxes).
+  std::uint64_t boxes_drawn = 0, boxes_matched = 0;
 };
 
-/// The frame with a caption strip below it: screenshot_caption(config),
-/// lower-cased, in the 5×7 font of core's legends (truncated to the width).
+/// screenshot_caption(info.config), and ", boxes N of M" when the overlay
+/// showed only N of the M boxes its selection names: the caption on the
+/// picture and in its side-car.
+std::string screenshot_caption(const ScreenshotInfo& info);
+
+/// At most this many caption lines under a screenshot.
+inline constexpr int kCaptionMaxLines = 4;
+
+/// `text` in lines of at most `max_chars`, each broken after its last space
+/// that fits (mid-word only when none does), at most `max_lines` of them:
+/// the last one cut with ".." when the text goes on.
+std::vector<std::string> wrap_caption(const std::string& text, int max_chars, int max_lines);
+
+/// The frame with a caption strip below it: screenshot_caption(info),
+/// lower-cased, in the 5×7 font of core's legends, wrapped to the width in
+/// up to kCaptionMaxLines lines (wrap_caption).
 RgbImage add_caption(const RgbImage& frame, const std::string& caption);
 
 /// The side-car object (documented in docs/gui.md): scene, camera, size,

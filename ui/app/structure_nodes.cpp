@@ -262,39 +262,32 @@ std::vector<std::uint32_t> StructureNodes::children(std::uint32_t id) const {
   return {children_.begin() + child_start_[id], children_.begin() + child_start_[id + 1]};
 }
 
-StructureNodes::Selection StructureNodes::select(const NodeSelection& sel, std::size_t limit) const {
-  Selection out;
-  auto add = [&](const NodeBox& b) {
-    ++out.matched;
-    if (out.boxes.size() < limit)
-      out.boxes.push_back(b);
-    else
-      out.truncated = true;
-  };
+template <class F>
+void StructureNodes::for_each_selected(const NodeSelection& sel, F&& add) const {
   if (grid_) {
     const auto& g = *grid_;
     if (sel.mode == BoxMode::depth && sel.depth == 0) {
       add({g.bounds, 0, 0, false, 1.0f});
-      return out;
+      return;
     }
     if (sel.mode == BoxMode::subtree) {
       if (const auto b = box(sel.node)) add({*b, sel.node, 1, true, 0.0f});
-      return out;
+      return;
     }
     if (sel.mode == BoxMode::depth_range && sel.depth == 0) add({g.bounds, 0, 0, false, 1.0f});
-    if (sel.mode == BoxMode::depth && sel.depth > 1) return out;
+    if (sel.mode == BoxMode::depth && sel.depth > 1) return;
     double total = 0.0;
     for (std::uint32_t c : g.counts) total += c;
     for (std::uint32_t c = 0; c < g.counts.size(); ++c)
       if (g.counts[c] > 0) add({*box(c), c, 1, true, total > 0.0 ? static_cast<float>(g.counts[c] / total) : 0.0f});
-    return out;
+    return;
   }
   auto to_box = [&](std::uint32_t i) {
     const StructureNode& n = nodes_[i];
     return NodeBox{n.bounds, i, n.depth, n.leaf, n.sah_share, n.instance};
   };
   if (sel.mode == BoxMode::subtree) {
-    if (sel.node >= nodes_.size()) return out;
+    if (sel.node >= nodes_.size()) return;
     std::vector<std::uint32_t> stack{sel.node};
     while (!stack.empty()) {
       const std::uint32_t i = stack.back();
@@ -303,7 +296,7 @@ StructureNodes::Selection StructureNodes::select(const NodeSelection& sel, std::
       const auto kids = children(i);
       for (auto it = kids.rbegin(); it != kids.rend(); ++it) stack.push_back(*it);
     }
-    return out;
+    return;
   }
   // Depth-first order from the roots, so boxes come parent before child
   // whatever the id layout (the voxel octree stores its root last).
@@ -336,6 +329,28 @@ StructureNodes::Selection StructureNodes::select(const NodeSelection& sel, std::
     const auto kids = children(i);
     for (auto it = kids.rbegin(); it != kids.rend(); ++it) stack.push_back(*it);
   }
+}
+
+StructureNodes::Selection StructureNodes::select(const NodeSelection& sel, std::size_t limit) const {
+  Selection out;
+  for_each_selected(sel, [&](const NodeBox&) { ++out.matched; });
+  if (out.matched <= limit) {
+    out.boxes.reserve(out.matched);
+    for_each_selected(sel, [&](const NodeBox& b) { out.boxes.push_back(b); });
+    return out;
+  }
+  // More than `limit`: `limit` boxes spread evenly over the selection's
+  // order (box floor(k * matched / limit) for k = 0, 1, ...), so that a cut
+  // list thins the whole structure out instead of showing its first boxes
+  // only (on the dragon's leaves: one half of the mesh covered, the other bare).
+  out.truncated = true;
+  out.boxes.reserve(limit);
+  std::uint64_t index = 0;
+  for_each_selected(sel, [&](const NodeBox& b) {
+    const auto k = static_cast<unsigned __int128>(out.boxes.size());
+    if (out.boxes.size() < limit && index == k * out.matched / limit) out.boxes.push_back(b);
+    ++index;
+  });
   return out;
 }
 

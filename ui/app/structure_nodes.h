@@ -68,9 +68,11 @@ class StructureNodes {
     bool truncated = false;      ///< more matched than `limit`
     std::uint64_t matched = 0;   ///< how many matched
   };
-  /// The nodes `sel` names, at most `limit` of them. A grid's cells are
-  /// depth 1 under its bounding box (depth 0); every mode but depth 0 shows
-  /// its non-empty cells (subtree: the one cell).
+  /// The nodes `sel` names, at most `limit` of them: when more match, `limit`
+  /// of them spread evenly over the selection's order (parents still before
+  /// their children), so the overlay thins the whole structure out. A grid's
+  /// cells are depth 1 under its bounding box (depth 0); every mode but depth
+  /// 0 shows its non-empty cells (subtree: the one cell).
   Selection select(const NodeSelection& sel, std::size_t limit) const;
 
   /// The children of a tree node, in id order.
@@ -78,6 +80,9 @@ class StructureNodes {
 
  private:
   void finish(float c_trav, float c_isect);
+  /// Calls add(box) for every node `sel` names, parents before children.
+  template <class F>
+  void for_each_selected(const NodeSelection& sel, F&& add) const;
 
   std::string kind_;
   std::vector<StructureNode> nodes_;

@@ -386,8 +386,12 @@ bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout
     changed = true;
   }
   changed |= checkbox("Through mesh", v.boxes_through_mesh, "boxes are not hidden by the mesh");
-  if (!info.node_kind.empty())
-    ImGui::TextDisabled("%" PRIu64 " boxes drawn%s", info.boxes_drawn, info.boxes_truncated ? " (list cut)" : "");
+  if (!info.node_kind.empty()) {
+    if (info.boxes_truncated)
+      ImGui::TextDisabled("%" PRIu64 " of %" PRIu64 " boxes drawn (list cut)", info.boxes_drawn, info.boxes_matched);
+    else
+      ImGui::TextDisabled("%" PRIu64 " boxes drawn", info.boxes_drawn);
+  }
 
   section("Heatmap");
   int display = static_cast<int>(v.heatmap);

@@ -64,13 +64,14 @@ struct ViewInfo {
   std::uint64_t node_count = 0;
   std::uint64_t boxes_drawn = 0;
   bool boxes_truncated = false;
-  std::uint32_t blas_max_depth = 0;           ///< tlas: the deepest BLAS node (the blas level's depth range)
-  std::uint64_t instances = 0;                ///< tlas: instances (the blas level's instance choice)
-  float range_min = 0.0f, range_max = 1.0f;   ///< the heatmap range in use
-  bool heatmap_on_gpu = false;                ///< the heatmap shown was traced on the GPU
-  std::string gpu_note;                       ///< why "Trace on: GPU" fell back to the CPU ("" when it did not)
-  int gpu_rows_done = -1;                     ///< the GPU trace in progress: rows done (-1: none running)
-  int gpu_rows = 0;                           ///< and rows in all
+  std::uint64_t boxes_matched = 0;           ///< boxes the selection names (more than drawn when cut)
+  std::uint32_t blas_max_depth = 0;          ///< tlas: the deepest BLAS node (the blas level's depth range)
+  std::uint64_t instances = 0;               ///< tlas: instances (the blas level's instance choice)
+  float range_min = 0.0f, range_max = 1.0f;  ///< the heatmap range in use
+  bool heatmap_on_gpu = false;               ///< the heatmap shown was traced on the GPU
+  std::string gpu_note;                      ///< why "Trace on: GPU" fell back to the CPU ("" when it did not)
+  int gpu_rows_done = -1;                    ///< the GPU trace in progress: rows done (-1: none running)
+  int gpu_rows = 0;                          ///< and rows in all
 };
 /// Every renderer layer: mesh, wireframe, node boxes (selection, colouring),
 /// heatmap (display, metric, colour map, scale, opacity, legend), ray path,
@@ -114,8 +115,8 @@ bool progress_cancel_row(double fraction, const char* overlay, float bar_width, 
 
 // ---- Cost of accuracy (accuracy_panel.cpp) -----------------------------------------------
 struct AccuracyPanelState {
-  std::string params;      ///< "buckets=2,4,exact leaf=1,4" (the structure's default when it changes)
-  std::string params_for;  ///< structure `params` was made for
+  std::string params;             ///< "buckets=2,4,exact leaf=1,4" (the structure's default when it changes)
+  std::string params_for;         ///< structure `params` was made for
   int width = 160, height = 120;  ///< primary rays of the current view
   int repeat = 1;
   double ray_budget = 1e6;
@@ -166,10 +167,10 @@ void dynamics_panel(DynamicsPlayer& player, const DynamicsSnapshot* snap, bool b
 
 // ---- Flatten what-if (flatten_panel.cpp) ----------------------------------------------
 struct FlattenPanelState {
-  std::string ids;                      ///< the selection as typed ("0,2,5-9", "all")
-  std::vector<std::uint32_t> selected;  ///< parsed, sorted, distinct
-  std::string error;                    ///< the text's parse error
-  int width = 160, height = 120;        ///< primary rays of the current view traced for the prediction
+  std::string ids;                              ///< the selection as typed ("0,2,5-9", "all")
+  std::vector<std::uint32_t> selected;          ///< parsed, sorted, distinct
+  std::string error;                            ///< the text's parse error
+  int width = 160, height = 120;                ///< primary rays of the current view traced for the prediction
   const LoadedScene* scene_identity = nullptr;  ///< the scene the selection is of (results of others are hidden)
   bool collapsed_at_start = true;
 };
@@ -185,7 +186,6 @@ void set_flatten_selection(FlattenPanelState& state, std::vector<std::uint32_t> 
 /// triangle tests, instances per ray, trace ms, memory, SAH, build ms) and
 /// Commit, enabled once the shown prediction is of the current selection.
 FlattenAction flatten_panel(FlattenPanelState& state, const Scene* scene, const FlattenResult* result, bool busy,
-                            double fraction, std::optional<std::uint32_t> clicked_instance,
-                            const PanelLayout& layout);
+                            double fraction, std::optional<std::uint32_t> clicked_instance, const PanelLayout& layout);
 
 }  // namespace accelviz::panels
