@@ -581,7 +581,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       return Status::again;
     }
     case K::wait:
-      return app_.settled() ? Status::done : Status::again;
+      return app_.settled() && insight_.caught_up(app_) ? Status::done : Status::again;
     case K::click:
       fail_if(app_.cast_ray(c.x, c.y));
       return Status::done;

@@ -170,6 +170,28 @@ const SplitExplanation* InsightViews::explanation(const AppState& app, std::stri
   return explanation_ ? &*explanation_ : nullptr;
 }
 
+void InsightViews::select(AppState& app, std::uint32_t id) {
+  const ViewSettings& v = app.config().view;
+  if (!selection_of_) {
+    mode_before_selection_ = v.box_mode;
+    boxes_before_selection_ = v.show_boxes;
+  }
+  select_node(app, id);
+  selection_of_ = app.current().get();
+  selected_id_ = id;
+}
+
+void InsightViews::drop_stale_selection(AppState& app) {
+  if (!selection_of_ || app.current().get() == selection_of_) return;
+  ViewSettings& v = app.config().view;
+  // Only while the view still shows that selection (not after the user chose another).
+  if (v.box_mode == BoxMode::subtree && v.box_node == static_cast<int>(selected_id_)) {
+    v.box_mode = mode_before_selection_;
+    v.show_boxes = boxes_before_selection_;
+  }
+  selection_of_ = nullptr;
+}
+
 void InsightViews::draw(AppState& app, const panels::PanelLayout& layout) {
   // A/B.
   const auto ab_result = ab_job_.result();
@@ -186,17 +208,19 @@ void InsightViews::draw(AppState& app, const panels::PanelLayout& layout) {
   }
 
   // A click in the 3D view: the leaf its hit lies in becomes the selection
-  // (its path opens in the tree, which scrolls to it).
+  // (its path opens in the tree, which scrolls to it). The ray is cast again
+  // when another structure is shown, so a click's selection follows it.
   if (app.inspection_version() != inspection_seen_) {
     inspection_seen_ = app.inspection_version();
     const auto& insp = app.inspection();
     if (insight_state_.click_selects_leaf && insp && app.current())
       if (const auto leaf = hit_leaf(insp->trace, insp->hit, app.current()->nodes)) {
-        select_node(app, *leaf);
+        select(app, *leaf);
         insight_state_.region.reset();
         scroll_tree_ = true;
       }
   }
+  drop_stale_selection(app);
 
   // Predicted vs measured, hot nodes.
   const auto insight = shown_insight(app);
@@ -210,7 +234,7 @@ void InsightViews::draw(AppState& app, const panels::PanelLayout& layout) {
                                                          insight_job_.error(), selected_node(app), layout);
   if (ia.refresh && app.current()) request_insight(app);
   if (ia.select) {
-    select_node(app, *ia.select);
+    select(app, *ia.select);
     insight_state_.region.reset();
   }
   if (shown) draw_labels(app, *shown, layout);
@@ -224,7 +248,7 @@ void InsightViews::draw(AppState& app, const panels::PanelLayout& layout) {
   if (const auto pick =
           panels::tree_panel(app.current() ? &app.current()->nodes : nullptr, shown ? &shown->visits : nullptr,
                              selected_node(app), scroll_tree_, layout, app.config().view.colormap)) {
-    select_node(app, *pick);
+    select(app, *pick);
     insight_state_.region.reset();
   }
 

@@ -29,8 +29,17 @@ class InsightViews {
   void select_view_region(AppState& app, int ax, int ay, int bx, int by);
   /// A job is running (keep frames coming).
   bool busy();
+  /// The latest ray inspection's consequences (a click selects the leaf its
+  /// hit lies in) are applied: the script's `wait` waits for it too.
+  bool caught_up(const AppState& app) const { return inspection_seen_ == app.inspection_version(); }
 
  private:
+  /// Selects node `id` of the structure shown (the Boxes view's subtree mode),
+  /// remembering the box mode it replaces.
+  void select(AppState& app, std::uint32_t id);
+  /// A node selected in another structure than the one now shown names
+  /// nothing there: the box mode before it comes back.
+  void drop_stale_selection(AppState& app);
   void request_insight(AppState& app);
   /// The measured insight when it belongs to the structure shown.
   std::shared_ptr<const ViewInsight> shown_insight(const AppState& app);
@@ -49,6 +58,12 @@ class InsightViews {
   PixelRect region_rect_for_;
   std::optional<PixelRect> pending_view_region_;  ///< select-region before a measurement: applied once measured
   std::uint64_t inspection_seen_ = 0;
+  /// The structure (build) the selected node belongs to (null: no selection
+  /// made here), the node, and the box view it replaced.
+  const BuiltStructure* selection_of_ = nullptr;
+  std::uint32_t selected_id_ = 0;
+  BoxMode mode_before_selection_ = BoxMode::depth;
+  bool boxes_before_selection_ = true;
   bool scroll_tree_ = false;
   AsyncJob<nlohmann::json> ab_dump_job_;
   bool script_ab_requested_ = false;

@@ -135,6 +135,41 @@ TEST(AppHotNodes, AClickedHitNamesItsLeafAndPath) {
   EXPECT_FALSE(hit_leaf(VisitTrace{}, insp.hit, built.nodes));
 }
 
+// A grid has cells, not nodes: the cell a click selects is the one the walk
+// ended in, which holds the hit point (the hit's triangle may have been
+// tested in an earlier cell it overlaps).
+TEST(AppHotNodes, AClickedHitInAGridNamesTheCellHoldingIt) {
+  const auto& f = fixture();
+  auto loaded = std::make_shared<LoadedScene>();
+  loaded->scene = f.scene;
+  BuiltStructure built;
+  built.scene = loaded;
+  built.accel = build_accelerator("grid", loaded->scene.triangles, StructureOptions{});
+  built.nodes = StructureNodes::of(*built.accel);
+  ASSERT_EQ(built.nodes.kind(), "grid");
+  int hits = 0;
+  for (int y = 8; y < 48; y += 8)
+    for (int x = 8; x < 64; x += 8) {
+      const RayInspection insp = inspect_pixel(built, f.camera, x, y, 64, 48, QueryOptions{});
+      if (!insp.hit.valid()) {
+        EXPECT_FALSE(hit_leaf(insp.trace, insp.hit, built.nodes));
+        continue;
+      }
+      ++hits;
+      const auto cell = hit_leaf(insp.trace, insp.hit, built.nodes);
+      ASSERT_TRUE(cell) << x << "," << y;
+      const auto box = built.nodes.box(*cell);
+      ASSERT_TRUE(box);
+      const glm::vec3 p = insp.ray.origin + insp.hit.t * insp.ray.direction;
+      const float tol = 1e-4f * glm::length(box->extent()) + 1e-5f;
+      for (int a = 0; a < 3; ++a) {
+        EXPECT_GE(p[a], box->lo[a] - tol) << x << "," << y;
+        EXPECT_LE(p[a], box->hi[a] + tol) << x << "," << y;
+      }
+    }
+  EXPECT_GT(hits, 5);
+}
+
 TEST(AppHotNodes, ViewRectanglesMapOntoTheRecord) {
   const PixelRect all = view_rect_to_record(0, 0, 640, 480, 640, 480, 128, 96);
   EXPECT_EQ(all.x0, 0);

@@ -626,6 +626,33 @@ TEST_F(GuiScript, InsightRegionSelectionAndClickSelectsTheHitLeaf) {
   EXPECT_TRUE(entered) << c["selected"];
 }
 
+// A click's leaf selection is applied before the script's `wait` returns,
+// follows the ray into the next structure shown (a grid: the cell the walk
+// ended in, which holds the hit), and is dropped where the structure has
+// nothing to select (brute force): the box view from before the click comes
+// back instead of a node id that names something else there.
+TEST_F(GuiScript, AClicksSelectionFollowsTheStructureShown) {
+  const RunResult r = run(std::string("open ") + kTeapot + "\nsize 320 240\ncamera " + kCamera +
+                          "\nset box-mode leaves\nwait\nclick 160 120\nwait\nscreenshot " + path("bvh.png").string() +
+                          "\nstructure grid\nwait\nscreenshot " + path("grid.png").string() + "\ndump-ray " +
+                          path("grid-ray.json").string() + "\nstructure brute\nwait\nscreenshot " +
+                          path("brute.png").string() + "\nquit\n");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json bvh = read_json(path("bvh.json"))["options"];
+  const nlohmann::json grid = read_json(path("grid.json"))["options"];
+  const nlohmann::json brute = read_json(path("brute.json"))["options"];
+  EXPECT_EQ(bvh["box-mode"], "subtree") << "the click's selection is in the picture taken after `wait`";
+  EXPECT_EQ(grid["box-mode"], "subtree");
+  const nlohmann::json ray = read_json(path("grid-ray.json"));
+  ASSERT_FALSE(ray["hit"].is_null());
+  std::string last_cell;
+  for (const auto& st : ray["steps"])
+    if (st["kind"] == "entered") last_cell = std::to_string(st["id"].get<std::uint64_t>());
+  EXPECT_EQ(grid["box-node"], last_cell) << "the grid's selection is the cell its walk ended in";
+  EXPECT_NE(grid["box-node"], bvh["box-node"]);
+  EXPECT_EQ(brute["box-mode"], "leaves") << "nothing to select: the box view before the click";
+}
+
 // A/B from a script: A pinned with leaf size 1, B with leaf size 16 on the
 // same view: B tests more primitives and enters fewer nodes. Then x-ray on
 // (the heatmap's traversal toggle): the heatmap and B count more primitive

@@ -97,6 +97,10 @@ std::optional<std::uint32_t> hit_leaf(const VisitTrace& trace, const Hit& hit, c
     if (s.kind == VisitStep::Kind::prim_hit && s.id == hit.prim && last_entered) found = last_entered;
   }
   if (!found) return std::nullopt;
+  if (nodes.kind() == "grid") {  // cells have boxes but no node entries
+    if (!nodes.box(*last_entered)) return std::nullopt;
+    return last_entered;
+  }
   const StructureNode* n = nodes.node(*found);
   if (!n || !n->leaf) return std::nullopt;
   return found;

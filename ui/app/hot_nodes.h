@@ -49,8 +49,11 @@ std::vector<NodeLabel> node_labels(const StructureNodes& nodes, std::span<const 
 std::optional<glm::vec2> project_to_pixel(const Camera& cam, const glm::vec3& p, int width, int height);
 
 /// The leaf the traced ray's closest hit was found in: the last node entered
-/// before the last prim_hit step of `hit.prim`. Empty on a miss, when the
-/// trace has no such step, or when that node is not a leaf of `nodes`.
+/// before the last prim_hit step of `hit.prim`; for a grid, the last cell the
+/// walk entered (a 3D-DDA ends in the cell that holds its closest hit, while
+/// the hit's triangle may have been tested in an earlier cell it overlaps).
+/// Empty on a miss, when the trace has no prim_hit step of `hit.prim`, or when
+/// that node is not a leaf (a cell) of `nodes`.
 std::optional<std::uint32_t> hit_leaf(const VisitTrace& trace, const Hit& hit, const StructureNodes& nodes);
 
 /// The nodes from the root down to `node` (inclusive); empty for an unknown id.
