@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <string>
+#include <string_view>
 
 #include "core/query/camera.h"
 
@@ -12,7 +13,10 @@ namespace accelviz {
 namespace {
 
 std::string count(std::size_t n, const char* what) {
-  return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
+  if (n == 1) return "1 " + std::string(what);
+  const std::string_view w(what);
+  const bool es = w.ends_with("sh") || w.ends_with("ch") || w.ends_with('s') || w.ends_with('x');
+  return std::to_string(n) + " " + std::string(w) + (es ? "es" : "s");
 }
 
 void apply_force(Effect& e, bool force) {

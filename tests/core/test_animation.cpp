@@ -251,6 +251,9 @@ TEST(Effects, InstancedSceneBuildsEachUniqueMeshOnce) {
   EXPECT_EQ(tlas.blas_count(), s.meshes.size());  // tree and ground, once each
   EXPECT_GT(tlas.instances().size(), 100u);
   EXPECT_LT(tlas.memory_two_level(), tlas.memory_flattened_estimate());
+  EXPECT_EQ(fx.two_level.reason.rfind("1 mesh instanced more than once (", 0), 0u) << fx.two_level.reason;
+  const SceneEffects island = decide_effects(make_builtin("island?size=1"));
+  EXPECT_EQ(island.two_level.reason.find("8 meshes instanced more than once ("), 0u) << island.two_level.reason;
   // Textures are never on and cannot be forced.
   EffectForces f;
   f.textures = true;
