@@ -327,7 +327,7 @@ class GltfConverter {
     warn_ignored_extensions();
     check_world_triangle_count();
     scene_.flatten();
-    if (scene_.triangles.empty()) fail("scene contains no triangles");
+    if (scene_.triangles.empty()) fail(no_triangles_message(scene_.report));
     cap_warnings();
   }
 

@@ -324,7 +324,7 @@ Scene load_obj(const std::string& path) {
   }
 
   scene.flatten();
-  if (scene.triangles.empty()) fail(path, "scene contains no triangles");
+  if (scene.triangles.empty()) fail(path, no_triangles_message(scene.report));
   cap_warnings(scene.report);
   return scene;
 }

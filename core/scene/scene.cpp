@@ -2,9 +2,23 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 namespace accelviz {
+
+std::string no_triangles_message(const LoadReport& report) {
+  std::string why;
+  const auto add = [&why](const std::string& part) { why += (why.empty() ? " (" : "; ") + part; };
+  if (report.dropped_nonfinite > 0)
+    add(std::to_string(report.dropped_nonfinite) + (report.dropped_nonfinite == 1
+                                                        ? " triangle dropped: a NaN or infinite vertex"
+                                                        : " triangles dropped: NaN or infinite vertices"));
+  if (report.skipped_primitives > 0)
+    add(std::to_string(report.skipped_primitives) + " point/line primitive" +
+        (report.skipped_primitives == 1 ? "" : "s") + " skipped");
+  return "scene contains no triangles" + (why.empty() ? std::string() : why + ")");
+}
 
 std::vector<glm::vec3> morphed_positions(const Mesh& mesh, const std::vector<float>& weights) {
   if (mesh.morph_deltas.empty()) return mesh.positions;

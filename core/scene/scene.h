@@ -123,6 +123,11 @@ struct LoadReport {
   std::vector<std::string> warnings;     ///< one line each
 };
 
+/// The loaders' error for a scene left without triangles: "scene contains no
+/// triangles", followed by what the loader removed on the way when it removed
+/// something, e.g. " (1 triangle dropped: a NaN or infinite vertex)".
+std::string no_triangles_message(const LoadReport& report);
+
 struct Scene {
   std::string source;  ///< file path or built-in spec it came from
   std::vector<Mesh> meshes;

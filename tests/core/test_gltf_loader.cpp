@@ -779,7 +779,7 @@ TEST_F(GltfLoader, EmptySceneIsAnError) {
   const int pos = points.positions({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
   points.mesh({points.primitive(pos, -1, 0)});
   points.node({{"mesh", 0}});
-  expect_error(write_gltf(points, "points.gltf"), "scene contains no triangles");
+  expect_error(write_gltf(points, "points.gltf"), "scene contains no triangles (1 point/line primitive skipped)");
 }
 
 TEST_F(GltfLoader, DeeplyNestedJsonIsRejectedNotCrashing) {

@@ -212,7 +212,10 @@ TEST_F(ObjLoader, MalformedFaceLine) {
 TEST_F(ObjLoader, EmptySceneIsAnError) {
   expect_error(write(""), "scene contains no triangles");
   expect_error(write("v 0 0 0\nv 1 0 0\nl 1 2\n", "lines.obj"), "scene contains no triangles");
-  expect_error(write("v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "allnan.obj"), "scene contains no triangles");
+  expect_error(write("v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "allnan.obj"),
+               "scene contains no triangles (1 triangle dropped: a NaN or infinite vertex)");
+  expect_error(write("v 1e39 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\n", "overflow.obj"),
+               "scene contains no triangles (2 triangles dropped: NaN or infinite vertices)");
 }
 
 }  // namespace
