@@ -104,14 +104,20 @@ TEST(AppHotNodes, ProjectionInvertsPrimaryRays) {
   EXPECT_FALSE(project_to_pixel(f.camera, f.camera.position - f.camera.forward, 64, 48));
 }
 
-TEST(AppHotNodes, AClickedHitNamesItsLeafAndPath) {
-  const auto& f = fixture();
+/// `name` built over the fixture's scene, with its node table, as the app shows it.
+BuiltStructure built_over_fixture(const char* name) {
   auto loaded = std::make_shared<LoadedScene>();
-  loaded->scene = f.scene;
+  loaded->scene = fixture().scene;
   BuiltStructure built;
   built.scene = loaded;
-  built.accel = build_accelerator("bvh", loaded->scene.triangles, StructureOptions{});
+  built.accel = build_accelerator(name, loaded->scene.triangles, StructureOptions{});
   built.nodes = StructureNodes::of(*built.accel);
+  return built;
+}
+
+TEST(AppHotNodes, AClickedHitNamesItsLeafAndPath) {
+  const auto& f = fixture();
+  const BuiltStructure built = built_over_fixture("bvh");
   const RayInspection insp = inspect_pixel(built, f.camera, 32, 24, 64, 48, QueryOptions{});
   ASSERT_TRUE(insp.hit.valid()) << "the middle pixel hits the teapot";
   const auto leaf = hit_leaf(insp.trace, insp.hit, built.nodes);
@@ -140,12 +146,7 @@ TEST(AppHotNodes, AClickedHitNamesItsLeafAndPath) {
 // tested in an earlier cell it overlaps).
 TEST(AppHotNodes, AClickedHitInAGridNamesTheCellHoldingIt) {
   const auto& f = fixture();
-  auto loaded = std::make_shared<LoadedScene>();
-  loaded->scene = f.scene;
-  BuiltStructure built;
-  built.scene = loaded;
-  built.accel = build_accelerator("grid", loaded->scene.triangles, StructureOptions{});
-  built.nodes = StructureNodes::of(*built.accel);
+  const BuiltStructure built = built_over_fixture("grid");
   ASSERT_EQ(built.nodes.kind(), "grid");
   int hits = 0;
   for (int y = 8; y < 48; y += 8)
