@@ -7,6 +7,7 @@
 #include "core/analysis/chart.h"
 #include "core/analysis/sweep.h"
 #include "core/query/camera.h"
+#include "core/util/huge_page_allocator.h"
 #include "core/util/parallel.h"
 
 #include <cmath>
@@ -31,6 +32,7 @@ struct SweepCliOptions {
   std::string rays = "primary";
   std::string size = "640x480";
   int repeat = 3;
+  int warmup = 1;
   unsigned threads = 0;
   double ray_budget = 1e6;
   std::string camera;
@@ -221,6 +223,7 @@ nlohmann::json result_json(const SweepResult& r, double budget) {
 }
 
 int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
+  use_fixed_malloc_thresholds();  // the settings' builds compare fairly from the first on
   // ---- everything that can be a usage error, before any long work ----
   if (o.params.empty()) throw UsageError("sweep: give at least one --param NAME=V1,V2,...");
   if (!(o.ray_budget > 0) || !std::isfinite(o.ray_budget)) throw UsageError("--ray-budget must be positive");
@@ -264,6 +267,7 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
   config.base.bvh.threads = o.threads;
   config.base.threads = o.threads;
   config.repeat = o.repeat;
+  config.warmup = o.warmup;
   config.threads = o.threads;
   config.ray_budget = o.ray_budget;
   std::vector<SweepResult> results;
@@ -299,6 +303,7 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
   j["rays"] = {{"kind", o.rays}, {"count", rays.size()}, {"size", {size.width, size.height}}, {"seed", o.seed}};
   if (kind == RayKind::shadow) j["rays"]["synthetic_light"] = synthetic_light;
   j["repeat"] = o.repeat;
+  j["warmup"] = o.warmup;
   j["ray_budget"] = o.ray_budget;
   j["params"] = nlohmann::json::object();
   for (const SweepParam& p : params) j["params"][p.name] = p.values;
@@ -378,6 +383,9 @@ Command add_sweep_command(CLI::App& parent, const GlobalOptions& global) {
   sub->add_option("--size", o->size, "Primary rays: one per pixel of a WxH image")->check(size_validator())->capture_default_str();
   sub->add_option("--repeat,-n", o->repeat, "Builds and timed passes per setting (medians)")
       ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  sub->add_option("--warmup", o->warmup, "Untimed builds and passes per setting before the timed ones")
+      ->check(CLI::Range(0, 100))
       ->capture_default_str();
   sub->add_option("--threads,-j", o->threads, "Build and trace threads (0: all hardware threads)")->capture_default_str();
   sub->add_option("--ray-budget", o->ray_budget, "Rays N of total time = build + N / (rays/s)")->capture_default_str();

@@ -10,6 +10,7 @@
 #include "app/gui/scene_view.h"
 #include "core/accel/tlas/tlas.h"
 #include "core/scene/load.h"
+#include "core/util/huge_page_allocator.h"
 #include "ui/app/app_state.h"
 #include "ui/app/dynamics.h"
 #include "ui/app/flatten_worker.h"
@@ -879,6 +880,7 @@ bool settings_disabled_by_environment() {
 }
 
 int run_gui(const GuiOptions& options) {
+  use_fixed_malloc_thresholds();  // rebuilds reuse mapped pages; the Accuracy panel's sweeps compare fairly
   GuiOptions o = options;
   if (o.script || settings_disabled_by_environment()) o.use_settings = false;
 

@@ -340,6 +340,7 @@ SweepResult measure_sweep_setting(std::span<const Triangle> triangles, std::span
   so.bvh.threads = config.threads;
   r.triangle_test = q.triangle_test == TriangleTest::watertight ? "watertight" : "fast";
   const int repeat = std::max(1, config.repeat);
+  const int warmup = std::max(0, config.warmup);
   const unsigned threads = resolve_threads(config.threads);
 
   const auto check = [&] {
@@ -348,8 +349,17 @@ SweepResult measure_sweep_setting(std::span<const Triangle> triangles, std::span
   ProgressCallback build_progress;
   if (config.keep_going) build_progress = [&](double) { return config.keep_going(); };
   std::unique_ptr<Accelerator> accel;
-  for (int k = 0; k < repeat; ++k) {
+  std::vector<Hit> hits(rays.size());
+  // Warm-up rounds: a build and a trace pass each, untimed.
+  for (int k = 0; k < warmup; ++k) {
     accel.reset();  // never two copies in memory
+    check();
+    accel = build_accelerator(config.structure, triangles, so, build_progress);
+    check();
+    if (!rays.empty()) trace_closest(*accel, rays, hits, q, threads);
+  }
+  for (int k = 0; k < repeat; ++k) {
+    accel.reset();
     check();
     accel = build_accelerator(config.structure, triangles, so, build_progress);
     r.build_ms_runs.push_back(accel->build_stats().build_ms);
@@ -363,7 +373,6 @@ SweepResult measure_sweep_setting(std::span<const Triangle> triangles, std::span
   r.sah_cost = bs.sah_cost;
   if (const auto it = bs.extra.find("epo"); it != bs.extra.end()) r.epo = it->second;
 
-  std::vector<Hit> hits(rays.size());
   if (!rays.empty()) {
     for (int k = 0; k < repeat; ++k) {
       check();

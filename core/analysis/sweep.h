@@ -98,6 +98,10 @@ struct SweepConfig {
   StructureOptions base;      ///< options before each setting is applied
   QueryOptions query;         ///< before each setting is applied
   int repeat = 3;             ///< builds and timed passes per setting (medians)
+  /// Untimed rounds per setting (a build and a trace pass each) before the
+  /// timed ones: the first build and pass of a setting touch memory the next
+  /// ones reuse.
+  int warmup = 1;
   unsigned threads = 0;       ///< build and trace threads (0: all hardware threads)
   double ray_budget = 1e6;    ///< N of total(N)
   /// Asked during builds and between timed passes (any thread); false

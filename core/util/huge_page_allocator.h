@@ -38,6 +38,9 @@
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 namespace accelviz {
 
@@ -143,6 +146,21 @@ inline void release_kept_regions() {
 }
 
 }  // namespace huge_page_detail
+
+/// Fixes glibc's malloc thresholds for this process: allocations below 64 MiB
+/// come from the heap and freed heap memory is kept up to 256 MiB, so that
+/// repeated builds reuse mapped pages. By default glibc maps every allocation
+/// of 128 KiB or more afresh (page faults on each build) until a larger block
+/// is freed and it raises its threshold: a `sweep`'s first setting then built
+/// in about twice the time of the same setting later in the process
+/// (docs/accuracy-vs-time.md). Called where builds are compared within a
+/// process (the `sweep` command, the app's window); does nothing without glibc.
+inline void use_fixed_malloc_thresholds() {
+#if defined(__GLIBC__)
+  mallopt(M_MMAP_THRESHOLD, 64 << 20);
+  mallopt(M_TRIM_THRESHOLD, 256 << 20);
+#endif
+}
 
 template <class T>
 struct HugePageAllocator {

@@ -34,6 +34,7 @@ j = json.load(open(os.path.join(out, "sweep.json")))
 for k in ("cpu_model", "hardware_threads", "threads_used", "date", "command_line"):
     assert k in j["machine"], k
 assert j["machine"]["threads_used"] == 1
+assert j["warmup"] == 1 and j["repeat"] == 1, (j["warmup"], j["repeat"])
 assert "sweep" in j["machine"]["command_line"]
 assert len(j["results"]) == 6 and len(j["pareto_front"]) >= 1
 assert {b["rays"] for b in j["best_for_budget"]} >= {1e6, 1e9}, j["best_for_budget"]

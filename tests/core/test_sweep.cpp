@@ -303,6 +303,35 @@ TEST_P(SweepSah, EveryRequestedSettingHasSaneFiguresAndSahImprovesWithEffort) {
 INSTANTIATE_TEST_SUITE_P(SmallScenes, SweepSah,
                          ::testing::Values("builtin:soup?size=3000", "builtin:teapot?size=3000"));
 
+// Warm-up rounds run (more work is asked about) but never enter the figures.
+TEST(Sweep, WarmupRoundsRunUntimed) {
+  const Scene scene = load_scene("builtin:teapot?size=800");
+  const std::vector<Ray> rays = small_primary(scene, 24, 18);
+  const std::vector<SweepParam> params{{"buckets", {"8"}}};
+  const std::vector<SweepSetting> settings = expand_sweep("bvh", params);
+  std::size_t asked = 0;
+  SweepConfig cfg;
+  cfg.repeat = 3;
+  cfg.threads = 1;
+  cfg.keep_going = [&asked] {
+    ++asked;
+    return true;
+  };
+  std::size_t asked_by[3] = {};
+  for (int warmup : {0, 2}) {
+    cfg.warmup = warmup;
+    asked = 0;
+    const std::vector<SweepResult> res = run_sweep(scene.triangles, rays, {}, cfg, settings);
+    ASSERT_EQ(res.size(), 1u);
+    EXPECT_EQ(res[0].build_ms_runs.size(), 3u) << "warm-up " << warmup;
+    EXPECT_EQ(res[0].rays_per_s_runs.size(), 3u) << "warm-up " << warmup;
+    asked_by[warmup] = asked;
+  }
+  // Two more builds and two more passes, each asked about at least once.
+  EXPECT_GE(asked_by[2], asked_by[0] + 4);
+  EXPECT_EQ(SweepConfig{}.warmup, 1);
+}
+
 TEST(Sweep, OtherStructuresSweepTheirOwnParameters) {
   const Scene scene = load_scene("builtin:soup?size=2000");
   const std::vector<Ray> rays = small_primary(scene, 24, 18);
