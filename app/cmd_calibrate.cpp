@@ -9,6 +9,7 @@
 #include "core/query/batch.h"
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
+#include "core/util/huge_page_allocator.h"
 #include "core/util/parallel.h"
 
 #include <cstdio>
@@ -69,6 +70,7 @@ nlohmann::json figures_json(const BvhFigures& f, double ctrav, double cisect) {
 }
 
 int run_calibrate(const CalibrateCliOptions& o, const GlobalOptions& global) {
+  use_fixed_malloc_thresholds();  // the two trees' builds compare fairly
   const ImageSize size = parse_size(o.size);
   const QueryOptions q{parse_triangle_test(o.triangle_test), true};
   Progress progress(global.quiet);

@@ -72,7 +72,8 @@ struct CalibrationReport {
   CalibratedTree with_default, with_calibrated;
 };
 
-/// Builds both trees over `triangles` and traces `rays` (medians of `repeat`).
+/// Builds both trees over `triangles` and traces `rays`: after one untimed build and
+/// pass each, medians of `repeat` builds and passes.
 CalibrationReport compare_calibrated_bvh(std::span<const Triangle> triangles, std::span<const Ray> rays,
                                          const Calibration& c, const QueryOptions& query, unsigned threads, int repeat,
                                          const std::function<bool()>& keep_going = {});
