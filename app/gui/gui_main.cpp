@@ -20,6 +20,7 @@
 #include "ui/gl/glfw_context.h"
 #include "ui/imgui/imgui_context.h"
 #include "ui/panels/panels.h"
+#include "ui/render/screenshot.h"
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
@@ -62,13 +63,6 @@ std::vector<KeyPress>* g_keys = nullptr;
 void on_key(GLFWwindow* /*window*/, int key, int /*scancode*/, int action, int mods) {
   if (g_keys && (action == GLFW_PRESS || action == GLFW_REPEAT))
     g_keys->push_back({key, mods | (action == GLFW_REPEAT ? 0x10000 : 0)});
-}
-
-RgbImage to_rgb(const Rgba8Image& frame) {
-  RgbImage out(frame.width, frame.height);
-  for (std::size_t i = 0, n = static_cast<std::size_t>(frame.width) * frame.height; i < n; ++i)
-    for (int c = 0; c < 3; ++c) out.pixels[3 * i + c] = frame.pixels[4 * i + c];
-  return out;
 }
 
 class Gui final : public ScriptHost {

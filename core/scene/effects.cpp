@@ -4,20 +4,13 @@
 #include <algorithm>
 #include <cstdio>
 #include <string>
-#include <string_view>
 
 #include "core/query/camera.h"
+#include "core/util/one_line.h"
 
 namespace accelviz {
 
 namespace {
-
-std::string count(std::size_t n, const char* what) {
-  if (n == 1) return "1 " + std::string(what);
-  const std::string_view w(what);
-  const bool es = w.ends_with("sh") || w.ends_with("ch") || w.ends_with('s') || w.ends_with('x');
-  return std::to_string(n) + " " + std::string(w) + (es ? "es" : "s");
-}
 
 void apply_force(Effect& e, bool force) {
   if (!force || e.on) return;
@@ -38,7 +31,7 @@ SceneEffects decide_effects(const Scene& scene, const EffectForces& forces) {
   fx.shadow_rays.on = shadow_rays_wanted(scene, {});
   fx.shadow_rays.reason = scene.lights.empty()
                               ? "no lights: nothing casts a shadow"
-                              : count(scene.lights.size(), "light") + ": one any-hit ray per light per hit";
+                              : count_of(scene.lights.size(), "light") + ": one any-hit ray per light per hit";
 
   fx.per_frame_updates.name = "per-frame-updates";
   std::size_t channels = 0;
@@ -48,10 +41,10 @@ SceneEffects decide_effects(const Scene& scene, const EffectForces& forces) {
   fx.per_frame_updates.on = scene_animates(scene);
   if (fx.per_frame_updates.on) {
     std::string what;
-    if (channels > 0) what = count(channels, "animation channel") + " (rigid: instance transforms + TLAS)";
+    if (channels > 0) what = count_of(channels, "animation channel") + " (rigid: instance transforms + TLAS)";
     const std::size_t deforming = deforming_meshes(scene).size();
     if (deforming > 0)
-      what += (what.empty() ? "" : ", ") + count(deforming, "deforming mesh") + " (BLAS refit or rebuild)";
+      what += (what.empty() ? "" : ", ") + count_of(deforming, "deforming mesh") + " (BLAS refit or rebuild)";
     fx.per_frame_updates.reason = what;
   } else {
     fx.per_frame_updates.reason = "nothing animates: the structure is built once";
@@ -67,8 +60,8 @@ SceneEffects decide_effects(const Scene& scene, const EffectForces& forces) {
   if (scene.triangles.empty() && !scene.instances.empty())
     fx.two_level.reason = "instanced and too large to flatten: only the two-level structure holds it";
   else if (fx.two_level.on)
-    fx.two_level.reason = count(shared, "mesh") + " instanced more than once (" +
-                          count(scene.instances.size(), "instance") + "): one BLAS per unique mesh";
+    fx.two_level.reason = count_of(shared, "mesh") + " instanced more than once (" +
+                          count_of(scene.instances.size(), "instance") + "): one BLAS per unique mesh";
   else
     fx.two_level.reason = "no mesh is instanced twice: a single flattened BVH";
 

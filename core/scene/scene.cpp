@@ -5,18 +5,17 @@
 #include <string>
 #include <vector>
 
+#include "core/util/one_line.h"
+
 namespace accelviz {
 
 std::string no_triangles_message(const LoadReport& report) {
   std::string why;
   const auto add = [&why](const std::string& part) { why += (why.empty() ? " (" : "; ") + part; };
   if (report.dropped_nonfinite > 0)
-    add(std::to_string(report.dropped_nonfinite) + (report.dropped_nonfinite == 1
-                                                        ? " triangle dropped: a NaN or infinite vertex"
-                                                        : " triangles dropped: NaN or infinite vertices"));
-  if (report.skipped_primitives > 0)
-    add(std::to_string(report.skipped_primitives) + " point/line primitive" +
-        (report.skipped_primitives == 1 ? "" : "s") + " skipped");
+    add(count_of(report.dropped_nonfinite, "triangle") +
+        " dropped: " + (report.dropped_nonfinite == 1 ? "a NaN or infinite vertex" : "NaN or infinite vertices"));
+  if (report.skipped_primitives > 0) add(count_of(report.skipped_primitives, "point/line primitive") + " skipped");
   return "scene contains no triangles" + (why.empty() ? std::string() : why + ")");
 }
 

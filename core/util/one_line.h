@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace accelviz {
@@ -30,6 +31,15 @@ inline std::string first_line(const std::string& text) {
     start = end + 1;
   }
   return "unknown error";
+}
+
+/// "1 mesh", "8 meshes", "2 instances": `n` and the English plural of `word`
+/// when n != 1 (-es after -s, -x, -ch, -sh).
+inline std::string count_of(std::size_t n, std::string_view word) {
+  std::string out = std::to_string(n) + " " + std::string(word);
+  if (n == 1) return out;
+  const bool es = word.ends_with("sh") || word.ends_with("ch") || word.ends_with('s') || word.ends_with('x');
+  return out + (es ? "es" : "s");
 }
 
 /// `text` with every newline made a space (nothing is dropped).

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "core/accel/tlas/flatten_json.h"
+#include "core/util/one_line.h"
 #include "core/util/timing.h"
 
 namespace accelviz {
@@ -75,7 +76,7 @@ std::vector<std::uint32_t> parse_instance_ids(std::string_view text, std::size_t
     }
     if (r.hi >= count)
       throw std::invalid_argument("instances: '" + r.text + "' is out of range (the scene has " +
-                                  std::to_string(count) + " instance" + (count == 1 ? "" : "s") + ")");
+                                  count_of(count, "instance") + ")");
     for (std::uint64_t i = r.lo; i <= r.hi; ++i) ids.push_back(static_cast<std::uint32_t>(i));
   }
   std::sort(ids.begin(), ids.end());
@@ -100,7 +101,7 @@ std::string format_instance_ids(const std::vector<std::uint32_t>& ids) {
 }
 
 std::string flattened_spec(const std::string& spec, std::size_t merged) {
-  return spec + " [flattened " + std::to_string(merged) + " instance" + (merged == 1 ? "" : "s") + "]";
+  return spec + " [flattened " + count_of(merged, "instance") + "]";
 }
 
 nlohmann::json flatten_result_json(const FlattenResult& r, const std::string& spec) {

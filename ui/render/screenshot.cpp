@@ -3,24 +3,21 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "core/analysis/heatmap.h"
-
 namespace accelviz {
+
+RgbImage to_rgb(const Rgba8Image& frame) {
+  RgbImage out(frame.width, frame.height);
+  for (std::size_t i = 0, n = static_cast<std::size_t>(frame.width) * frame.height; i < n; ++i)
+    for (int c = 0; c < 3; ++c) out.pixels[3 * i + c] = frame.pixels[4 * i + c];
+  return out;
+}
 
 SaveResult write_screenshot_png(const std::filesystem::path& path, const Rgba8Image& image, bool overwrite) {
   const std::string name = path.string();
   if (image.empty() || image.pixels.size() != static_cast<std::size_t>(image.width) * image.height * 4) {
     return {false, name + ": nothing to write (empty image)"};
   }
-  RgbImage rgb;
-  rgb.width = image.width;
-  rgb.height = image.height;
-  rgb.pixels.resize(static_cast<std::size_t>(image.width) * image.height * 3);
-  for (std::size_t i = 0, n = rgb.pixels.size() / 3; i < n; ++i) {
-    rgb.pixels[i * 3 + 0] = image.pixels[i * 4 + 0];
-    rgb.pixels[i * 3 + 1] = image.pixels[i * 4 + 1];
-    rgb.pixels[i * 3 + 2] = image.pixels[i * 4 + 2];
-  }
+  const RgbImage rgb = to_rgb(image);
   // core's writer (the one every PNG of the project goes through); its
   // refusal of an existing file is said this function's way.
   try {

@@ -1,6 +1,7 @@
 #pragma once
 // Screenshots: what the renderer drew (legend included), read back from its
 // framebuffer and written as PNG.
+#include "core/analysis/heatmap.h"
 #include "ui/render/image.h"
 
 #include <filesystem>
@@ -13,6 +14,9 @@ struct [[nodiscard]] SaveResult {
   std::string error;  ///< one line, "<file>: <problem>", when !ok
   explicit operator bool() const { return ok; }
 };
+
+/// The frame without its alpha channel (the frame is opaque).
+RgbImage to_rgb(const Rgba8Image& frame);
 
 /// Writes `image` as an 8-bit RGB PNG (the frame is opaque; alpha is
 /// dropped). Never replaces an existing file unless `overwrite`: the file is
