@@ -338,6 +338,7 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
     vi.gpu_rows_done = gpu_trace->rows_done;
     vi.gpu_rows = gpu_trace->rows;
   }
+  vi.box_node_note = insight_.box_node_note(app_);
   panels::view_panel(app_.config().view, vi, layout, &app_.config().structure.query);
 
   const auto& insp = app_.inspection();
@@ -473,6 +474,7 @@ SavedScreenshot Gui::write_frame(const std::optional<std::filesystem::path>& exp
   ScreenshotInfo info = app_.screenshot_info(range.x, range.y);
   info.boxes_drawn = view_->boxes_drawn();
   info.boxes_matched = view_->boxes_matched();
+  if (app_.config().view.show_boxes) info.box_node_note = insight_.box_node_note(app_);
   if (explicit_path) return save_screenshot_as(*explicit_path, frame, info);
   const std::filesystem::path dir = app_.settings().screenshot_dir.empty()
                                         ? default_screenshot_dir()
@@ -620,7 +622,8 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       doc["boxes"] = {{"drawn", view_->boxes_drawn()},
                       {"matched", view_->boxes_matched()},
                       {"truncated", view_->boxes_truncated()},
-                      {"instance_colors", view_->instance_colored()}};
+                      {"instance_colors", view_->instance_colored()},
+                      {"node_note", insight_.box_node_note(app_)}};
       fail_if(write_file_atomic(c.arg, doc.dump(2) + "\n"));
       return Status::done;
     }

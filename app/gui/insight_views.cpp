@@ -179,6 +179,34 @@ void InsightViews::select(AppState& app, std::uint32_t id) {
   select_node(app, id);
   selection_of_ = app.current().get();
   selected_id_ = id;
+  // Set in this build even when the id is the one already there.
+  box_node_seen_ = -1;
+  track_box_node(app);
+}
+
+void InsightViews::track_box_node(const AppState& app) {
+  const int id = app.config().view.box_node;
+  const std::shared_ptr<const BuiltStructure>& rest = app.rest();
+  // An id from the settings or the command line belongs to the first build shown.
+  if (id == box_node_seen_ || !rest) return;
+  box_node_seen_ = id;
+  box_node_set_in_ = rest;
+  box_node_set_in_name_ = describe_structure(rest->choice);
+}
+
+std::string InsightViews::box_node_note(const AppState& app) const {
+  const ViewSettings& v = app.config().view;
+  const BuiltStructure* shown = app.current().get();
+  if (v.box_mode != BoxMode::subtree || !shown) return "";
+  std::string note;
+  if (shown->nodes.kind() == "tlas" && v.box_level == BoxLevel::blas)
+    note = "BLAS node " + std::to_string(v.box_node) + " of each instance shown";
+  else
+    note = shown->nodes.describe(static_cast<std::uint32_t>(v.box_node));
+  // (An expired build is an earlier one too.)
+  if (box_node_seen_ == v.box_node && box_node_set_in_.lock() != app.rest())
+    note += "; the id was set in an earlier build (" + box_node_set_in_name_ + "): node ids are per build";
+  return note;
 }
 
 void InsightViews::drop_stale_selection(AppState& app) {
@@ -221,6 +249,7 @@ void InsightViews::draw(AppState& app, const panels::PanelLayout& layout) {
       }
   }
   drop_stale_selection(app);
+  track_box_node(app);
 
   // Predicted vs measured, hot nodes.
   const auto insight = shown_insight(app);

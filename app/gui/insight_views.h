@@ -32,6 +32,11 @@ class InsightViews {
   /// The latest ray inspection's consequences (a click selects the leaf its
   /// hit lies in) are applied: the script's `wait` waits for it too.
   bool caught_up(const AppState& app) const { return inspection_seen_ == app.inspection_version(); }
+  /// The subtree mode's node id in words: what it names in the structure
+  /// shown (StructureNodes::describe) and, when it was set (typed, or
+  /// selected) while another build was shown, which one: node ids are per
+  /// build. "" outside subtree mode.
+  std::string box_node_note(const AppState& app) const;
 
  private:
   /// Selects node `id` of the structure shown (the Boxes view's subtree mode),
@@ -40,6 +45,8 @@ class InsightViews {
   /// A node selected in another structure than the one now shown names
   /// nothing there: the box mode before it comes back.
   void drop_stale_selection(AppState& app);
+  /// Notes the build shown (at rest) when the subtree node id changes.
+  void track_box_node(const AppState& app);
   void request_insight(AppState& app);
   /// The measured insight when it belongs to the structure shown.
   std::shared_ptr<const ViewInsight> shown_insight(const AppState& app);
@@ -65,6 +72,11 @@ class InsightViews {
   BoxMode mode_before_selection_ = BoxMode::depth;
   bool boxes_before_selection_ = true;
   bool scroll_tree_ = false;
+  /// The build (at rest) shown when the subtree node id got its value, its
+  /// description, and that value (-1: none seen yet).
+  std::weak_ptr<const BuiltStructure> box_node_set_in_;
+  std::string box_node_set_in_name_;
+  int box_node_seen_ = -1;
   AsyncJob<nlohmann::json> ab_dump_job_;
   bool script_ab_requested_ = false;
   panels::ExplainerState explainer_;

@@ -132,6 +132,36 @@ TEST(AppStructureNodes, GridCellsAreTheGridsOwn) {
             static_cast<std::uint64_t>(grid.build_stats().node_count - grid.build_stats().extra.at("empty_cells")));
 }
 
+// The View panel's line for a node id: what the id names in the structure
+// shown (inner node, leaf, grid cell), and an id past the end said as such.
+TEST(AppStructureNodes, DescribeSaysWhatAnIdNamesHere) {
+  const auto accel = build_accelerator("bvh", teapot().triangles, StructureOptions{});
+  const StructureNodes t = StructureNodes::of(*accel);
+  EXPECT_EQ(t.describe(0),
+            "node 0: depth 0, 2 children, " + std::to_string(teapot().triangles.size()) + " primitives below")
+      << "a BVH references each triangle once";
+  std::uint32_t leaf = 0;
+  while (!t.node(leaf)->leaf) ++leaf;
+  const StructureNode& l = *t.node(leaf);
+  EXPECT_EQ(t.describe(leaf), "node " + std::to_string(leaf) + ": a leaf at depth " + std::to_string(l.depth) + ", " +
+                                  std::to_string(l.prims) + (l.prims == 1 ? " primitive" : " primitives"));
+  const auto n = static_cast<std::uint32_t>(t.size());
+  EXPECT_EQ(t.describe(n), "no node " + std::to_string(n) + ": this bvh has nodes 0-" + std::to_string(n - 1));
+
+  const auto g = build_accelerator("grid", teapot().triangles, StructureOptions{});
+  const auto& grid = dynamic_cast<const Grid&>(*g);
+  const StructureNodes cells = StructureNodes::of(*g);
+  const auto r = grid.resolution();
+  const std::uint32_t id = static_cast<std::uint32_t>(1 + r[0] * (2 + r[1] * 1));
+  const std::uint32_t held = grid.cell_start()[id + 1] - grid.cell_start()[id];
+  EXPECT_EQ(cells.describe(id), "cell " + std::to_string(id) + " (x 1, y 2, z 1): " + std::to_string(held) +
+                                    (held == 1 ? " primitive" : " primitives"));
+  EXPECT_EQ(cells.describe(static_cast<std::uint32_t>(cells.size())).rfind("no cell ", 0), 0u);
+
+  const auto brute = build_accelerator("brute", teapot().triangles, StructureOptions{});
+  EXPECT_EQ(StructureNodes::of(*brute).describe(3), "no node 3: this structure has no nodes to show");
+}
+
 TEST(AppStructureNodes, EnteredNodesContainTheRaySegmentTheyReport) {
   const Scene& s = teapot();
   const Camera cam = camera_from_spec("", s, 1.0f);

@@ -226,6 +226,7 @@ std::string screenshot_caption(const ScreenshotInfo& info) {
   std::string s = screenshot_caption(info.config);
   if (info.boxes_drawn < info.boxes_matched)
     s += ", boxes " + std::to_string(info.boxes_drawn) + " of " + std::to_string(info.boxes_matched);
+  if (!info.box_node_note.empty()) s += ", boxes of " + info.box_node_note;
   return s;
 }
 
@@ -259,7 +260,7 @@ nlohmann::json screenshot_sidecar(const ScreenshotInfo& info, const fs::path& pn
   return {
       {"png", fs::absolute(png).string()},
       {"caption", screenshot_caption(info)},
-      {"boxes", {{"drawn", info.boxes_drawn}, {"matched", info.boxes_matched}}},
+      {"boxes", {{"drawn", info.boxes_drawn}, {"matched", info.boxes_matched}, {"node_note", info.box_node_note}}},
       {"scene", info.scene},
       {"triangles", info.triangles},
       {"size", {{"width", info.width}, {"height", info.height}}},

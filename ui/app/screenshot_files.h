@@ -48,11 +48,15 @@ struct ScreenshotInfo {
   /// names (more when the window cut the list and thinned it; 0 and 0
   /// without boxes).
   std::uint64_t boxes_drawn = 0, boxes_matched = 0;
+  /// Boxes of a selected subtree: what its node id names and, when it was
+  /// set in an earlier build, that build ("" otherwise).
+  std::string box_node_note;
 };
 
-/// screenshot_caption(info.config), and ", boxes N of M" when the overlay
-/// showed only N of the M boxes its selection names: the caption on the
-/// picture and in its side-car.
+/// screenshot_caption(info.config), ", boxes N of M" when the overlay
+/// showed only N of the M boxes its selection names, and the subtree's node
+/// note when boxes of a subtree are shown: the caption on the picture and in
+/// its side-car.
 std::string screenshot_caption(const ScreenshotInfo& info);
 
 /// At most this many caption lines under a screenshot.

@@ -9,6 +9,7 @@
 #include "core/accel/octree/octree.h"
 #include "core/accel/tlas/tlas.h"
 #include "core/accel/voxels/voxels.h"
+#include "core/util/one_line.h"
 
 namespace accelviz {
 namespace {
@@ -255,6 +256,40 @@ std::optional<Aabb> StructureNodes::box(std::uint32_t id) const {
   }
   if (id >= nodes_.size()) return std::nullopt;
   return nodes_[id].bounds;
+}
+
+std::string StructureNodes::describe(std::uint32_t id) const {
+  const std::string word = grid_ ? "cell" : "node";
+  const std::uint64_t n = size();
+  if (id >= n) {
+    if (n == 0)
+      return "no " + word + " " + std::to_string(id) + ": " + (kind_.empty() ? "this structure" : kind_) +
+             " has no nodes to show";
+    return "no " + word + " " + std::to_string(id) + ": this " + kind_ + " has " + word + "s 0-" +
+           std::to_string(n - 1);
+  }
+  const std::string name = word + " " + std::to_string(id);
+  if (grid_) {
+    const auto& g = *grid_;
+    const std::uint32_t rx = static_cast<std::uint32_t>(g.res[0]), ry = static_cast<std::uint32_t>(g.res[1]);
+    return name + " (x " + std::to_string(id % rx) + ", y " + std::to_string((id / rx) % ry) + ", z " +
+           std::to_string(id / (rx * ry)) + "): " + count_of(g.counts[id], "primitive");
+  }
+  const StructureNode& node = nodes_[id];
+  if (node.leaf)
+    return name + ": a leaf at depth " + std::to_string(node.depth) + ", " + count_of(node.prims, "primitive");
+  // Primitives referenced by the leaves below (a primitive in two leaves counts twice).
+  std::uint64_t below = 0;
+  std::vector<std::uint32_t> stack{id};
+  while (!stack.empty()) {
+    const std::uint32_t i = stack.back();
+    stack.pop_back();
+    if (nodes_[i].leaf) below += nodes_[i].prims;
+    for (std::uint32_t c : children(i)) stack.push_back(c);
+  }
+  const std::size_t kids = children(id).size();
+  return name + ": depth " + std::to_string(node.depth) + ", " + std::to_string(kids) +
+         (kids == 1 ? " child, " : " children, ") + count_of(below, "primitive") + " below";
 }
 
 std::vector<std::uint32_t> StructureNodes::children(std::uint32_t id) const {

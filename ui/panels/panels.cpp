@@ -377,6 +377,11 @@ bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout
         changed = true;
       }
       ImGui::TextDisabled("F frames it; the Ray panel's node ids work here");
+      if (!info.box_node_note.empty()) {
+        ImGui::PushTextWrapPos(0.0f);
+        ImGui::TextDisabled("%s", info.box_node_note.c_str());
+        ImGui::PopTextWrapPos();
+      }
       break;
     }
   }

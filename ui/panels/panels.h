@@ -72,6 +72,7 @@ struct ViewInfo {
   std::string gpu_note;                      ///< why "Trace on: GPU" fell back to the CPU ("" when it did not)
   int gpu_rows_done = -1;                    ///< the GPU trace in progress: rows done (-1: none running)
   int gpu_rows = 0;                          ///< and rows in all
+  std::string box_node_note;                 ///< subtree mode: what the node id names here (and where it was set)
 };
 /// Every renderer layer: mesh, wireframe, node boxes (selection, colouring),
 /// heatmap (display, metric, colour map, scale, opacity, legend), ray path,
