@@ -2,18 +2,16 @@
 // ray-box test and of both ray-triangle tests, the SAH constants they imply
 // (C_trav = 1), and with --scene what the calibrated constants change in the
 // BVH (SAH cost under the calibrated constants, measured rays/s on primary rays).
-#include "app/cli_common.h"
+#include <cstdio>
+#include <iostream>
 
+#include "app/cli_common.h"
 #include "core/analysis/calibrate.h"
-#include "core/analysis/sah.h"
-#include "core/query/batch.h"
+#include "core/analysis/sweep.h"
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
 #include "core/util/huge_page_allocator.h"
 #include "core/util/parallel.h"
-
-#include <cstdio>
-#include <iostream>
 
 namespace accelviz::cli {
 
@@ -28,44 +26,14 @@ struct CalibrateCliOptions {
   std::string triangle_test = "watertight";
 };
 
-struct BvhFigures {
-  double build_ms = 0, sah_own = 0, sah_calibrated = 0, rays_per_s = 0, nodes_per_ray = 0, prims_per_ray = 0;
-};
-
-BvhFigures measure_bvh(const Scene& scene, const std::vector<Ray>& rays, const BvhOptions& opts, double ctrav,
-                       double cisect, const QueryOptions& q, unsigned threads, int repeat) {
-  BvhFigures f;
-  const Bvh bvh(scene.triangles, opts);
-  f.build_ms = bvh.build_stats().build_ms;
-  f.sah_own = bvh.build_stats().sah_cost;
-  f.sah_calibrated = bvh_sah_cost(bvh.nodes(), ctrav, cisect);  // both trees judged by the same constants
-  std::vector<Hit> hits(rays.size());
-  std::vector<double> rps;
-  for (int r = 0; r < repeat; ++r) {
-    const auto t0 = Clock::now();
-    trace_closest(bvh, rays, hits, q, threads);
-    const double ms = ms_since(t0);
-    rps.push_back(ms > 0 ? static_cast<double>(rays.size()) / (ms * 1e-3) : 0.0);
-  }
-  f.rays_per_s = median(rps);
-  std::vector<RayStats> stats(rays.size());
-  trace_closest(bvh, rays, hits, q, threads, stats);
-  for (const RayStats& s : stats) {
-    f.nodes_per_ray += s.nodes_visited;
-    f.prims_per_ray += s.prim_tests;
-  }
-  if (!rays.empty()) {
-    f.nodes_per_ray /= static_cast<double>(rays.size());
-    f.prims_per_ray /= static_cast<double>(rays.size());
-  }
-  return f;
-}
-
-nlohmann::json figures_json(const BvhFigures& f, double ctrav, double cisect) {
-  return {{"c_trav", ctrav},           {"c_isect", cisect},
-          {"build_ms", f.build_ms},    {"sah_cost_own_constants", f.sah_own},
+nlohmann::json figures_json(const CalibratedTree& f) {
+  return {{"c_trav", f.c_trav},
+          {"c_isect", f.c_isect},
+          {"build_ms", f.build_ms},
+          {"sah_cost_own_constants", f.sah_own},
           {"sah_cost_calibrated_constants", f.sah_calibrated},
-          {"rays_per_s", f.rays_per_s}, {"nodes_per_ray", f.nodes_per_ray},
+          {"rays_per_s", f.rays_per_s},
+          {"nodes_per_ray", f.nodes_per_ray},
           {"prims_per_ray", f.prims_per_ray}};
 }
 
@@ -79,8 +47,6 @@ int run_calibrate(const CalibrateCliOptions& o, const GlobalOptions& global) {
   copts.repeat = o.repeat;
   const Calibration c = calibrate(copts);
   progress.end();
-  const double cisect = q.triangle_test == TriangleTest::watertight ? c.c_isect_watertight() : c.c_isect_fast();
-
   nlohmann::json j = {{"ns_box_test", c.ns_box},
                       {"ns_triangle_watertight", c.ns_triangle_watertight},
                       {"ns_triangle_fast", c.ns_triangle_fast},
@@ -90,31 +56,22 @@ int run_calibrate(const CalibrateCliOptions& o, const GlobalOptions& global) {
                       {"c_isect_watertight", c.c_isect_watertight()},
                       {"c_isect_fast", c.c_isect_fast()},
                       {"repeat", o.repeat}};
-  BvhFigures def, cal;
-  BvhOptions dopts, copts_bvh;
+  CalibrationReport report;
   if (!o.scene.empty()) {
     progress.begin("loading " + o.scene);
     const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
     progress.end(std::to_string(scene.triangles.size()) + " triangles");
     const std::vector<Ray> rays = primary_rays(camera_for("", scene, size), size.width, size.height);
-    const unsigned threads = resolve_threads(o.threads);
-    dopts.threads = copts_bvh.threads = o.threads;
-    dopts.compute_epo = copts_bvh.compute_epo = false;
-    copts_bvh.cost_traversal = 1.0f;
-    copts_bvh.cost_intersect = static_cast<float>(cisect);
-    progress.begin("BVH with the default constants");
-    def = measure_bvh(scene, rays, dopts, 1.0, cisect, q, threads, o.repeat);
-    progress.end();
-    progress.begin("BVH with the calibrated constants");
-    cal = measure_bvh(scene, rays, copts_bvh, 1.0, cisect, q, threads, o.repeat);
+    progress.begin("BVH with the default and the calibrated constants");
+    report = compare_calibrated_bvh(scene.triangles, rays, c, q, o.threads, o.repeat);
     progress.end();
     j["scene"] = {{"name", o.scene},
                   {"triangles", scene.triangles.size()},
                   {"rays", rays.size()},
-                  {"threads", threads},
+                  {"threads", resolve_threads(o.threads)},
                   {"triangle_test", o.triangle_test},
-                  {"default", figures_json(def, dopts.cost_traversal, dopts.cost_intersect)},
-                  {"calibrated", figures_json(cal, 1.0, cisect)}};
+                  {"default", figures_json(report.with_default)},
+                  {"calibrated", figures_json(report.with_calibrated)}};
   }
   if (o.json) {
     std::cout << j.dump(2) << std::endl;
@@ -130,10 +87,11 @@ int run_calibrate(const CalibrateCliOptions& o, const GlobalOptions& global) {
                 static_cast<std::size_t>(size.width) * size.height, o.triangle_test.c_str());
     std::printf("  %-28s %10s %14s %10s %10s %10s\n", "constants", "build ms", "SAH (calib.)", "Mrays/s", "nodes/ray",
                 "prims/ray");
+    const CalibratedTree &def = report.with_default, &cal = report.with_calibrated;
     std::printf("  %-28s %10.1f %14.3f %10.2f %10.2f %10.2f\n", "default (1, 1)", def.build_ms, def.sah_calibrated,
                 def.rays_per_s / 1e6, def.nodes_per_ray, def.prims_per_ray);
     char label[64];
-    std::snprintf(label, sizeof label, "calibrated (1, %.3f)", cisect);
+    std::snprintf(label, sizeof label, "calibrated (1, %.3f)", report.c_isect);
     std::printf("  %-28s %10.1f %14.3f %10.2f %10.2f %10.2f\n", label, cal.build_ms, cal.sah_calibrated,
                 cal.rays_per_s / 1e6, cal.nodes_per_ray, cal.prims_per_ray);
   }

@@ -12,6 +12,8 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "core/accel/bvh/bvh.h"
+#include "core/analysis/sah.h"
 #include "core/query/batch.h"
 #include "core/util/parallel.h"
 #include "core/util/random.h"
@@ -328,6 +330,101 @@ std::uint64_t count_ray_double_hits(std::span<const Triangle> triangles,
 
 // ---- measuring ---------------------------------------------------------------------
 
+TimedStructure time_structure(
+    const std::function<std::unique_ptr<Accelerator>(const ProgressCallback& progress)>& build,
+    std::span<const Ray> rays, const QueryOptions& query, unsigned threads, int warmup, int repeat,
+    const std::function<bool()>& keep_going) {
+  const auto check = [&] {
+    if (keep_going && !keep_going()) throw BuildCancelled();
+  };
+  ProgressCallback progress;
+  if (keep_going) progress = [&](double) { return keep_going(); };
+  const unsigned n_threads = resolve_threads(threads);
+  TimedStructure t;
+  t.hits.resize(rays.size());
+  for (int k = 0; k < std::max(0, warmup); ++k) {
+    t.accel.reset();  // never two copies in memory
+    check();
+    t.accel = build(progress);
+    check();
+    if (!rays.empty()) trace_closest(*t.accel, rays, t.hits, query, n_threads);
+  }
+  for (int k = 0; k < std::max(1, repeat); ++k) {
+    t.accel.reset();
+    check();
+    t.accel = build(progress);
+    t.build_ms_runs.push_back(t.accel->build_stats().build_ms);
+  }
+  if (rays.empty()) return t;
+  for (int k = 0; k < std::max(1, repeat); ++k) {
+    check();
+    const auto t0 = std::chrono::steady_clock::now();
+    trace_closest(*t.accel, rays, t.hits, query, n_threads);
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    t.rays_per_s_runs.push_back(s > 0 ? static_cast<double>(rays.size()) / s : 0.0);
+  }
+  check();
+  std::vector<RayStats> stats(rays.size());
+  trace_closest(*t.accel, rays, t.hits, query, n_threads, stats);
+  double nodes = 0, prims = 0, hit_count = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    nodes += stats[i].nodes_visited;
+    prims += stats[i].prim_tests;
+    hit_count += t.hits[i].valid();
+  }
+  const double n = static_cast<double>(rays.size());
+  t.nodes_per_ray = nodes / n;
+  t.prims_per_ray = prims / n;
+  t.hit_fraction = hit_count / n;
+  return t;
+}
+
+namespace {
+
+CalibratedTree measure_tree(std::span<const Triangle> triangles, std::span<const Ray> rays, float ctrav, float cisect,
+                            double judge_cisect, const QueryOptions& q, unsigned threads, int repeat,
+                            const std::function<bool()>& keep_going) {
+  BvhOptions o;
+  o.cost_traversal = ctrav;
+  o.cost_intersect = cisect;
+  o.compute_epo = false;
+  o.threads = threads;
+  // One untimed round first: the tree measured first must not pay for the
+  // memory its builds touch first (the default tree, built first, read twice
+  // the calibrated one's build time on the same teapot).
+  const TimedStructure timed =
+      time_structure([&](const ProgressCallback& progress) { return std::make_unique<Bvh>(triangles, o, progress); },
+                     rays, q, threads, /*warmup=*/1, repeat, keep_going);
+  const Bvh& bvh = dynamic_cast<const Bvh&>(*timed.accel);
+  CalibratedTree t;
+  t.c_trav = ctrav;
+  t.c_isect = cisect;
+  t.build_ms = median(timed.build_ms_runs);
+  t.nodes = bvh.build_stats().node_count;
+  t.sah_own = bvh.build_stats().sah_cost;
+  t.sah_calibrated = bvh_sah_cost(bvh.nodes(), 1.0, judge_cisect);
+  t.rays_per_s = median(timed.rays_per_s_runs);
+  t.nodes_per_ray = timed.nodes_per_ray;
+  t.prims_per_ray = timed.prims_per_ray;
+  return t;
+}
+
+}  // namespace
+
+CalibrationReport compare_calibrated_bvh(std::span<const Triangle> triangles, std::span<const Ray> rays,
+                                         const Calibration& c, const QueryOptions& query, unsigned threads, int repeat,
+                                         const std::function<bool()>& keep_going) {
+  CalibrationReport r;
+  r.machine = c;
+  r.c_isect = query.triangle_test == TriangleTest::watertight ? c.c_isect_watertight() : c.c_isect_fast();
+  if (!(r.c_isect > 0) || !std::isfinite(r.c_isect))
+    throw std::runtime_error("calibration gave no usable C_isect (box test time 0?)");
+  r.with_default = measure_tree(triangles, rays, 1.0f, 1.0f, r.c_isect, query, threads, repeat, keep_going);
+  r.with_calibrated =
+      measure_tree(triangles, rays, 1.0f, static_cast<float>(r.c_isect), r.c_isect, query, threads, repeat, keep_going);
+  return r;
+}
+
 SweepResult measure_sweep_setting(std::span<const Triangle> triangles, std::span<const Ray> rays,
                                   std::span<const EdgeProbe> probes, const SweepConfig& config,
                                   const SweepSetting& setting) {
@@ -339,33 +436,12 @@ SweepResult measure_sweep_setting(std::span<const Triangle> triangles, std::span
   so.threads = config.threads;
   so.bvh.threads = config.threads;
   r.triangle_test = q.triangle_test == TriangleTest::watertight ? "watertight" : "fast";
-  const int repeat = std::max(1, config.repeat);
-  const int warmup = std::max(0, config.warmup);
-  const unsigned threads = resolve_threads(config.threads);
-
-  const auto check = [&] {
-    if (config.keep_going && !config.keep_going()) throw BuildCancelled();
-  };
-  ProgressCallback build_progress;
-  if (config.keep_going) build_progress = [&](double) { return config.keep_going(); };
-  std::unique_ptr<Accelerator> accel;
-  std::vector<Hit> hits(rays.size());
-  // Warm-up rounds: a build and a trace pass each, untimed.
-  for (int k = 0; k < warmup; ++k) {
-    accel.reset();  // never two copies in memory
-    check();
-    accel = build_accelerator(config.structure, triangles, so, build_progress);
-    check();
-    if (!rays.empty()) trace_closest(*accel, rays, hits, q, threads);
-  }
-  for (int k = 0; k < repeat; ++k) {
-    accel.reset();
-    check();
-    accel = build_accelerator(config.structure, triangles, so, build_progress);
-    r.build_ms_runs.push_back(accel->build_stats().build_ms);
-  }
+  TimedStructure t = time_structure(
+      [&](const ProgressCallback& progress) { return build_accelerator(config.structure, triangles, so, progress); },
+      rays, q, config.threads, config.warmup, config.repeat, config.keep_going);
+  r.build_ms_runs = std::move(t.build_ms_runs);
   r.build_ms = median(r.build_ms_runs);
-  const BuildStats& bs = accel->build_stats();
+  const BuildStats& bs = t.accel->build_stats();
   r.memory_bytes = bs.memory_bytes;
   r.nodes = bs.node_count;
   r.leaves = bs.leaf_count;
@@ -374,31 +450,14 @@ SweepResult measure_sweep_setting(std::span<const Triangle> triangles, std::span
   if (const auto it = bs.extra.find("epo"); it != bs.extra.end()) r.epo = it->second;
 
   if (!rays.empty()) {
-    for (int k = 0; k < repeat; ++k) {
-      check();
-      const auto t0 = std::chrono::steady_clock::now();
-      trace_closest(*accel, rays, hits, q, threads);
-      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      r.rays_per_s_runs.push_back(s > 0 ? static_cast<double>(rays.size()) / s : 0.0);
-    }
+    r.rays_per_s_runs = std::move(t.rays_per_s_runs);
     r.rays_per_s = median(r.rays_per_s_runs);
-    // Counting pass, outside the timings.
-    check();
-    std::vector<RayStats> stats(rays.size());
-    trace_closest(*accel, rays, hits, q, threads, stats);
-    double nodes = 0, prims = 0, hit_count = 0;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-      nodes += stats[i].nodes_visited;
-      prims += stats[i].prim_tests;
-      hit_count += hits[i].valid();
-    }
-    const double n = static_cast<double>(rays.size());
-    r.nodes_per_ray = nodes / n;
-    r.prims_per_ray = prims / n;
-    r.hit_fraction = hit_count / n;
+    r.nodes_per_ray = t.nodes_per_ray;
+    r.prims_per_ray = t.prims_per_ray;
+    r.hit_fraction = t.hit_fraction;
     if (!probes.empty())
       r.ray_double_hits =
-          count_ray_double_hits(triangles, shared_edge_neighbours(triangles), rays, hits, q.triangle_test);
+          count_ray_double_hits(triangles, shared_edge_neighbours(triangles), rays, t.hits, q.triangle_test);
   }
   if (!probes.empty()) r.edges = count_edge_leaks(triangles, probes, q.triangle_test);
   return r;

@@ -6,18 +6,20 @@
 //   total(N) = build_ms + N / rays_per_s.
 // The Pareto front of (build time, trace time) shows which settings are ever
 // worth using; the budget picks one of them.
-#include "core/accel/factory.h"
-#include "core/query/ray_sets.h"
-#include "core/scene/scene.h"
-
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
+
+#include "core/accel/factory.h"
+#include "core/analysis/calibrate.h"
+#include "core/query/ray_sets.h"
+#include "core/scene/scene.h"
 
 namespace accelviz {
 
@@ -136,6 +138,53 @@ struct SweepResult {
   /// build_ms + trace_ms(rays).
   double total_ms(double rays) const { return build_ms + trace_ms(rays); }
 };
+
+/// One structure timed the way `sweep` and `calibrate` time it:
+/// `warmup` untimed rounds (a build and a trace pass each: the first build
+/// and pass touch memory the next ones reuse), `repeat` timed builds (the
+/// builder's own figure; the last tree kept), `repeat` timed closest-hit
+/// passes over `rays` without counters, then a counting pass (outside the
+/// timings). Never two trees in memory at once.
+struct TimedStructure {
+  std::unique_ptr<Accelerator> accel;   ///< the last tree built
+  std::vector<double> build_ms_runs;    ///< one per timed build
+  std::vector<double> rays_per_s_runs;  ///< one per timed pass (empty without rays)
+  std::vector<Hit> hits;                ///< of the counting pass
+  double nodes_per_ray = 0;             ///< counting pass: mean nodes visited
+  double prims_per_ray = 0;             ///< counting pass: mean triangle tests
+  double hit_fraction = 0;
+};
+/// `build(progress)` builds one tree, calling `progress` as builders do
+/// (false cancels). `keep_going` (empty: never cancel) is asked between
+/// builds and passes and during builds; false throws BuildCancelled.
+TimedStructure time_structure(
+    const std::function<std::unique_ptr<Accelerator>(const ProgressCallback& progress)>& build,
+    std::span<const Ray> rays, const QueryOptions& query, unsigned threads, int warmup, int repeat,
+    const std::function<bool()>& keep_going);
+
+/// BVH built with the default constants (1, 1) and with the calibrated ones
+/// (1, C_isect of the query's triangle test), judged by the same yardstick.
+struct CalibratedTree {
+  float c_trav = 1, c_isect = 1;  ///< the constants it was built with
+  double build_ms = 0;            ///< median of `repeat` builds (the builder's own figure)
+  double sah_own = 0;             ///< SAH cost under the constants it was built with
+  double sah_calibrated = 0;      ///< SAH cost under the calibrated constants
+  double rays_per_s = 0;
+  double nodes_per_ray = 0, prims_per_ray = 0;
+  std::uint64_t nodes = 0;
+};
+struct CalibrationReport {
+  Calibration machine;
+  double c_isect = 0;  ///< for the request's triangle test
+  CalibratedTree with_default, with_calibrated;
+};
+
+/// Builds both trees over `triangles` and traces `rays`, each timed by
+/// time_structure() (one untimed round, medians of `repeat` builds and
+/// passes): `accelviz calibrate --scene` and the Cost of accuracy panel.
+CalibrationReport compare_calibrated_bvh(std::span<const Triangle> triangles, std::span<const Ray> rays,
+                                         const Calibration& c, const QueryOptions& query, unsigned threads, int repeat,
+                                         const std::function<bool()>& keep_going = {});
 
 /// Called before each setting with its index and the count; false cancels (BuildCancelled).
 using SweepProgress = std::function<bool(std::size_t index, std::size_t count, const std::string& label)>;

@@ -1,16 +1,13 @@
 #include "ui/app/sweep_worker.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <map>
 #include <stdexcept>
 
 #include "core/accel/bvh/bvh.h"
 #include "core/analysis/sah.h"
-#include "core/query/batch.h"
 #include "core/query/ray_sets.h"
-#include "core/util/parallel.h"
 #include "core/util/timing.h"
 
 namespace accelviz {
@@ -124,75 +121,6 @@ std::vector<SweepSeries> sweep_series(std::span<const SweepResult> results, std:
     series.result.push_back(i);
   }
   return out;
-}
-
-namespace {
-
-CalibratedTree measure_tree(std::span<const Triangle> triangles, std::span<const Ray> rays, float ctrav, float cisect,
-                            double judge_cisect, const QueryOptions& q, unsigned threads, int repeat,
-                            const std::function<bool()>& keep_going) {
-  BvhOptions o;
-  o.cost_traversal = ctrav;
-  o.cost_intersect = cisect;
-  o.compute_epo = false;
-  o.threads = threads;
-  ProgressCallback progress;
-  if (keep_going) progress = [&](double) { return keep_going(); };
-  // A warm-up build, then `repeat` timed ones (median): the tree measured first
-  // must not pay for the memory its builds touch first (the default tree, built
-  // first, read twice the calibrated one's build time on the same teapot).
-  std::unique_ptr<Bvh> built;
-  std::vector<double> build_ms;
-  for (int k = 0; k <= std::max(1, repeat); ++k) {
-    built.reset();  // never two copies in memory
-    built = std::make_unique<Bvh>(triangles, o, progress);
-    if (k > 0) build_ms.push_back(built->build_stats().build_ms);
-  }
-  const Bvh& bvh = *built;
-  CalibratedTree t;
-  t.c_trav = ctrav;
-  t.c_isect = cisect;
-  t.build_ms = median(build_ms);
-  t.nodes = bvh.build_stats().node_count;
-  t.sah_calibrated = bvh_sah_cost(bvh.nodes(), 1.0, judge_cisect);
-  std::vector<Hit> hits(rays.size());
-  std::vector<double> rps;
-  const unsigned n_threads = resolve_threads(threads);
-  for (int k = 0; k <= std::max(1, repeat) && !rays.empty(); ++k) {  // the first pass untimed
-    if (keep_going && !keep_going()) throw BuildCancelled();
-    const auto t0 = std::chrono::steady_clock::now();
-    trace_closest(bvh, rays, hits, q, n_threads);
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (k > 0) rps.push_back(s > 0 ? static_cast<double>(rays.size()) / s : 0.0);
-  }
-  t.rays_per_s = median(rps);
-  if (!rays.empty()) {
-    std::vector<RayStats> stats(rays.size());
-    trace_closest(bvh, rays, hits, q, n_threads, stats);
-    for (const RayStats& s : stats) {
-      t.nodes_per_ray += s.nodes_visited;
-      t.prims_per_ray += s.prim_tests;
-    }
-    t.nodes_per_ray /= static_cast<double>(rays.size());
-    t.prims_per_ray /= static_cast<double>(rays.size());
-  }
-  return t;
-}
-
-}  // namespace
-
-CalibrationReport compare_calibrated_bvh(std::span<const Triangle> triangles, std::span<const Ray> rays,
-                                         const Calibration& c, const QueryOptions& query, unsigned threads, int repeat,
-                                         const std::function<bool()>& keep_going) {
-  CalibrationReport r;
-  r.machine = c;
-  r.c_isect = query.triangle_test == TriangleTest::watertight ? c.c_isect_watertight() : c.c_isect_fast();
-  if (!(r.c_isect > 0) || !std::isfinite(r.c_isect))
-    throw std::runtime_error("calibration gave no usable C_isect (box test time 0?)");
-  r.with_default = measure_tree(triangles, rays, 1.0f, 1.0f, r.c_isect, query, threads, repeat, keep_going);
-  r.with_calibrated =
-      measure_tree(triangles, rays, 1.0f, static_cast<float>(r.c_isect), r.c_isect, query, threads, repeat, keep_going);
-  return r;
 }
 
 double SweepSnapshot::fraction() const {

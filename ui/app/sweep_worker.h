@@ -56,28 +56,6 @@ struct SweepSeries {
 /// Groups `results` for parameter `param` (position in each setting).
 std::vector<SweepSeries> sweep_series(std::span<const SweepResult> results, std::size_t param);
 
-/// BVH built with the default constants (1, 1) and with the calibrated ones
-/// (1, C_isect of the query's triangle test), judged by the same yardstick.
-struct CalibratedTree {
-  float c_trav = 1, c_isect = 1;  ///< the constants it was built with
-  double build_ms = 0;
-  double sah_calibrated = 0;  ///< SAH cost under the calibrated constants
-  double rays_per_s = 0;
-  double nodes_per_ray = 0, prims_per_ray = 0;
-  std::uint64_t nodes = 0;
-};
-struct CalibrationReport {
-  Calibration machine;
-  double c_isect = 0;  ///< for the request's triangle test
-  CalibratedTree with_default, with_calibrated;
-};
-
-/// Builds both trees over `triangles` and traces `rays`: after one untimed build and
-/// pass each, medians of `repeat` builds and passes.
-CalibrationReport compare_calibrated_bvh(std::span<const Triangle> triangles, std::span<const Ray> rays,
-                                         const Calibration& c, const QueryOptions& query, unsigned threads, int repeat,
-                                         const std::function<bool()>& keep_going = {});
-
 struct SweepRequest {
   std::shared_ptr<const LoadedScene> scene;  ///< kept alive while the sweep runs
   std::string structure = "bvh";
