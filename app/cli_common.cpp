@@ -62,7 +62,7 @@ void StructureCli::add_to(CLI::App* app) {
       ->group("Structure");
   app->add_option("--wide", wide,
                   "BVH fast path: width of the SIMD tree the uninstrumented queries walk: 0 = 8 (AVX2) where the "
-                  "CPU has AVX2, else 4 (SSE); 4; 8 (4 without AVX2)")
+                  "CPU has AVX2 and FMA, else 4 (SSE); 4; 8 (4 without AVX2 and FMA)")
       ->check(CLI::IsMember({0, 4, 8}))
       ->capture_default_str()
       ->group("Structure");

@@ -1,11 +1,12 @@
 // accelviz export SCENE OUT.(glb|gltf) [--force]: writes any scene accelviz
 // can load (a built-in generator, a .gltf/.glb, an .obj) as glTF 2.0, so a
 // procedural scene can be opened in other tools or shipped as a small asset.
-#include "app/cli_common.h"
-#include "core/scene/gltf_writer.h"
-
 #include <cstdio>
 #include <memory>
+
+#include "app/cli_common.h"
+#include "core/scene/gltf_writer.h"
+#include "core/util/one_line.h"
 
 namespace accelviz::cli {
 
@@ -27,11 +28,11 @@ int run_export(const ExportOptions& o, const GlobalOptions& global) {
   check_output_path(o.out, o.force);
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
   write_gltf(scene, o.out, binary, o.force);
-  if (!global.quiet) {
-    std::printf("wrote %s: %zu triangles, %zu meshes, %zu instances, %zu lights, %zu cameras\n",
-                absolute_path(o.out).c_str(), scene.triangles.size(), scene.meshes.size(), scene.instances.size(),
-                scene.lights.size(), scene.cameras.size());
-  }
+  // The result goes to stdout whatever -q says (-q silences progress only).
+  std::printf("wrote %s: %s, %s, %s, %s, %s\n", absolute_path(o.out).c_str(),
+              count_of(scene.triangles.size(), "triangle").c_str(), count_of(scene.meshes.size(), "mesh").c_str(),
+              count_of(scene.instances.size(), "instance").c_str(), count_of(scene.lights.size(), "light").c_str(),
+              count_of(scene.cameras.size(), "camera").c_str());
   return 0;
 }
 

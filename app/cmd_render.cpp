@@ -200,7 +200,8 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
   check_output_path(o.out, o.force);  // before any long work
   if (o.view == "raster" && !raster_available()) throw UsageError(needs_renderer("--view raster"));
   if (o.view == "raster") return run_render_raster(o, global);
-  if (o.raster.box_depth >= 0 || o.raster.leaves || !o.ray_pixel.empty() || o.raster.blend > 0.0f || o.raster.wireframe)
+  if (o.raster.box_depth >= 0 || o.raster.box_depth_last >= 0 || o.raster.leaves || !o.ray_pixel.empty() ||
+      o.raster.blend > 0.0f || o.raster.wireframe)
     throw UsageError("--depth, --depth-last, --leaves, --ray-pixel, --blend and --wireframe need --view raster");
   nlohmann::json figures;
   const RgbImage rgb = render_job(o, global, figures);

@@ -373,7 +373,7 @@ Command add_sweep_command(CLI::App& parent, const GlobalOptions& global) {
       ->capture_default_str();
   sub->add_option("--param,-p", o->params,
                   "NAME=V1,V2,... (repeatable; the cartesian product is swept). bvh: buckets (2..256 or exact), "
-                  "splitter (median,binned,exact), leaf, ctrav, cisect; kdtree: depth, ctrav, cisect, leaf, "
+                  "splitter (median,binned,exact,lbvh), leaf, ctrav, cisect; kdtree: depth, ctrav, cisect, leaf, "
                   "mailbox (on,off); grid: lambda, res (NXxNYxNZ); octree: depth, leaf; voxels: level; all: "
                   "triangle (watertight,fast)")
       ->required();

@@ -60,7 +60,7 @@ CompareSide parse_compare_spec(const std::string& spec, const CompareSide& a) {
       if (!known) throw UsageError("--compare: structure=" + value + ": unknown structure");
       b.structure = value;
     } else if (key == "splitter") {
-      require_one_of(key, value, {"binned", "exact", "median"});
+      require_one_of(key, value, {"binned", "exact", "median", "lbvh"});
       b.structure_opts.splitter = value;
     } else if (key == "buckets") {
       const int v = parse_number<int>(key, value);

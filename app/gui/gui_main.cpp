@@ -88,6 +88,8 @@ class Gui final : public ScriptHost {
   std::uint64_t request_flatten(FlattenRequest::Kind kind, std::vector<std::uint32_t> ids);
   /// A finished commit (once): its merged scene is opened and built.
   void take_flatten_commit();
+  /// Keeps the worker's latest result when it is a prediction (flatten_prediction_).
+  void note_flatten_prediction();
   void take_screenshot();
   SavedScreenshot write_frame(const std::optional<std::filesystem::path>& explicit_path);
   void report_errors();
@@ -114,6 +116,10 @@ class Gui final : public ScriptHost {
   panels::FlattenPanelState flatten_panel_;
   std::shared_ptr<const LoadedScene> flatten_scene_;  ///< the scene the selection is of (held: addresses come back)
   std::uint64_t flatten_taken_ = 0;                   ///< the last commit result acted on
+  /// The last prediction finished and its scene's spec: what dump-flatten
+  /// writes, also after a commit has replaced it as the worker's latest.
+  std::shared_ptr<const FlattenResult> flatten_prediction_;
+  std::string flatten_prediction_spec_;
   std::optional<std::uint64_t> flatten_wait_;         ///< script flatten / flatten-commit: the job waited for
   std::optional<SceneEffects> effects_;
   std::shared_ptr<const LoadedScene> effects_scene_;  ///< held: a freed scene's address may come back
@@ -493,6 +499,13 @@ void Gui::take_screenshot() {
   }
 }
 
+void Gui::note_flatten_prediction() {
+  const std::shared_ptr<const FlattenResult> r = flatten_.latest();
+  if (!r || r->kind != FlattenRequest::Kind::preview || r == flatten_prediction_) return;
+  flatten_prediction_ = r;
+  flatten_prediction_spec_ = flatten_scene_ && r->scene == flatten_scene_.get() ? flatten_scene_->spec : std::string();
+}
+
 void Gui::take_flatten_commit() {
   const std::shared_ptr<const FlattenResult> r = flatten_.latest();
   if (!r || r->id <= flatten_taken_ || r->kind != FlattenRequest::Kind::commit) return;
@@ -519,6 +532,7 @@ std::uint64_t Gui::request_flatten(FlattenRequest::Kind kind, std::vector<std::u
 }
 
 void Gui::draw_flatten(const panels::PanelLayout& layout) {
+  note_flatten_prediction();
   take_flatten_commit();
   const std::shared_ptr<const BuiltStructure>& rest = app_.rest();
   if (!rest || !rest->accel || rest->accel->name() != "tlas") return;
@@ -650,6 +664,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       if (!r || r->id < *flatten_wait_) return Status::again;
       flatten_wait_.reset();
       if (!r->error.empty()) throw std::runtime_error(r->error);
+      note_flatten_prediction();
       return Status::done;
     }
     case K::flatten_commit: {
@@ -672,12 +687,21 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       return Status::done;
     }
     case K::dump_flatten: {
+      note_flatten_prediction();
       const std::shared_ptr<const FlattenResult> r = flatten_.latest();
-      if (!r || (!r->figures && r->error.empty()))
-        throw std::runtime_error("dump-flatten: no flatten prediction yet (run flatten IDS first)");
-      const std::string spec =
-          flatten_scene_ && r->scene == flatten_scene_.get() ? flatten_scene_->spec : std::string();
-      fail_if(write_file_atomic(c.arg, flatten_result_json(*r, spec).dump(2) + "\n"));
+      nlohmann::json doc;
+      if (r && !r->error.empty()) {  // the last job failed: say so
+        doc = flatten_result_json(*r, flatten_scene_ && r->scene == flatten_scene_.get() ? flatten_scene_->spec : "");
+      } else {
+        if (!flatten_prediction_)
+          throw std::runtime_error("dump-flatten: no flatten prediction yet (run flatten IDS first)");
+        doc = flatten_result_json(*flatten_prediction_, flatten_prediction_spec_);
+        // A commit of that prediction since: the merged scene it opened.
+        if (r && r->kind == FlattenRequest::Kind::commit && r->committed &&
+            r->instances == flatten_prediction_->instances && r->scene == flatten_prediction_->scene)
+          doc["committed"] = r->committed->spec;
+      }
+      fail_if(write_file_atomic(c.arg, doc.dump(2) + "\n"));
       return Status::done;
     }
     case K::force_effect:

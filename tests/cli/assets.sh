@@ -26,6 +26,12 @@ for f in "$src"/assets/*.glb; do
 done
 [ "$n" -ge 5 ] || { echo "FAIL: only $n assets"; exit 1; }
 
+# export's result line is a result: on stdout under -q too.
+out=$("$accelviz" -q export 'builtin:teapot?size=800' "$tmp/small.glb")
+grep -q "^wrote $tmp/small.glb: 992 triangles, 1 mesh, 1 instance, 1 light, 1 camera$" <<<"$out" || {
+  echo "FAIL: export's line: $out"; exit 1
+}
+
 # export refuses to overwrite, and names the file.
 if "$accelviz" -q export builtin:teapot "$tmp/teapot.glb" 2>"$tmp/err"; then
   echo "FAIL: export overwrote an existing file"; exit 1

@@ -50,6 +50,15 @@ j = json.loads(sys.argv[1])
 assert j["total_b"] > j["total_a"] and j["pixels_b_cheaper"] == 0, j
 PY
 
+# Every splitter the BVH has, LBVH too: B is built with it (a different tree, other totals).
+out=$("$accelviz" -q render "$scene" --size 40x30 --out "$tmp/lbvh.png" --compare 'splitter=lbvh')
+python3 - "$(sed -n 4p <<<"$out")" <<'PY'
+import json, sys
+j = json.loads(sys.argv[1])
+assert j["a"]["splitter"] == "binned" and j["b"]["splitter"] == "lbvh", j
+assert j["a"]["sah_cost"] != j["b"]["sah_cost"], j
+PY
+
 # Never overwrites: any existing output stops the run before work, files untouched.
 before=$(sha256sum "$tmp/cmp-b.png")
 if "$accelviz" -q render "$scene" --size 48x36 --out "$tmp/cmp.png" --compare 'buckets=4' 2>"$tmp/err"; then

@@ -53,8 +53,12 @@ print("picked ray agrees with trace:", prim, t)
 PY
 
 # Usage errors: raster-only options without --view raster, boxes of a structure without any.
-if "$accelviz" -q render "$scene" --depth 2 --out "$tmp/x.png" 2>"$tmp/err"; then echo "FAIL: --depth without raster"; exit 1; fi
-grep -q "need --view raster" "$tmp/err"
+for opt in "--depth 2" "--depth-last 3" "--leaves" "--ray-pixel 1,1" "--blend 0.5" "--wireframe"; do
+  # shellcheck disable=SC2086
+  if "$accelviz" -q render "$scene" $opt --out "$tmp/x.png" 2>"$tmp/err"; then echo "FAIL: $opt without raster"; exit 1; fi
+  grep -q "need --view raster" "$tmp/err" || { echo "FAIL: $opt message"; cat "$tmp/err"; exit 1; }
+  [ ! -e "$tmp/x.png" ] || { echo "FAIL: $opt wrote a picture"; exit 1; }
+done
 if "$accelviz" -q render "$scene" --view raster --structure grid --depth 2 --out "$tmp/y.png" 2>"$tmp/err"; then
   echo "FAIL: grid has no node boxes"; exit 1
 fi

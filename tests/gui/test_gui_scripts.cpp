@@ -769,12 +769,15 @@ TEST_F(GuiScript, HeatmapTracedOnTheGpuCountsWhatTheCpuCounts) {
 
 // Two-level views and the flatten what-if in the window: the `instances`
 // metric counts instances per pixel, `flatten` predicts merging four trees
-// and `flatten-commit` rebuilds the merged scene (three fewer instances).
+// and `flatten-commit` rebuilds the merged scene (three fewer instances);
+// `dump-flatten` after it still writes the prediction, naming that scene.
 TEST_F(GuiScript, InstancesMetricAndFlattenWhatIfCommit) {
-  const RunResult r = run("open builtin:forest?size=1000&seed=4\nstructure tlas\nsize 320 240\nset metric instances\n"
-                          "wait\ndump-stats " +
-                          path("before.json").string() + "\nflatten 0-3\ndump-flatten " + path("what.json").string() +
-                          "\nflatten-commit\ndump-stats " + path("after.json").string() + "\nquit\n");
+  const RunResult r =
+      run("open builtin:forest?size=1000&seed=4\nstructure tlas\nsize 320 240\nset metric instances\n"
+          "wait\ndump-stats " +
+          path("before.json").string() + "\nflatten 0-3\ndump-flatten " + path("what.json").string() +
+          "\nflatten-commit\ndump-stats " + path("after.json").string() + "\ndump-flatten " +
+          path("committed.json").string() + "\nquit\n");
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json before = read_json(path("before.json"));
   EXPECT_EQ(before["view"]["metric"], "instances");
@@ -793,4 +796,9 @@ TEST_F(GuiScript, InstancesMetricAndFlattenWhatIfCommit) {
   EXPECT_NE(after["scene"].get<std::string>().find("[flattened 4 instances]"), std::string::npos) << after["scene"];
   EXPECT_EQ(after["build"]["extra"]["instances"].get<double>(), instances - 3);
   EXPECT_EQ(after["triangles"], before["triangles"]);
+  // After the commit, dump-flatten still has the prediction, and names the scene it opened.
+  nlohmann::json committed = read_json(path("committed.json"));
+  EXPECT_EQ(committed["committed"], after["scene"]);
+  committed.erase("committed");
+  EXPECT_EQ(committed, what);
 }
