@@ -136,7 +136,7 @@ const std::vector<Entry>& entries() {
   static const std::vector<Entry> table = [] {
     std::vector<Entry> t;
     // Structure type.
-    t.push_back({{"structure", "brute|brute-bbox|bvh|kdtree|grid|octree|voxels|embree", "structure to build"},
+    t.push_back({{"structure", "brute|brute-bbox|bvh|kdtree|grid|octree|voxels|tlas|embree", "structure to build"},
                  [](const AppConfig& c) { return c.structure.name; },
                  [](AppConfig& c, std::string_view v) -> std::string {
                    const auto& names = structure_names();
