@@ -34,7 +34,7 @@ CLI::Validator size_validator() {
       "WxH", "size");
 }
 
-void StructureCli::add_to(CLI::App* app) {
+void StructureCli::add_to(CLI::App* app, bool with_embree) {
   app->add_option("--splitter", splitter,
                   "BVH split strategy: binned (binned SAH), exact (full SAH sweep), median, lbvh (Morton codes)")
       ->check(CLI::IsMember({"binned", "exact", "median", "lbvh"}))
@@ -66,6 +66,7 @@ void StructureCli::add_to(CLI::App* app) {
       ->check(CLI::IsMember({0, 4, 8}))
       ->capture_default_str()
       ->group("Structure");
+  if (!with_embree) return;
   app->add_option("--embree-quality", embree_quality, "Embree build quality: low, medium, high")
       ->check(CLI::IsMember({"low", "medium", "high"}))
       ->capture_default_str()

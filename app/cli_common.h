@@ -74,7 +74,8 @@ struct StructureCli {
   bool embree_robust = false;
   std::string embree_isa = "auto";
 
-  void add_to(CLI::App* app);
+  /// Adds the options to `app`; without `with_embree` (a command that builds BVHs only) no --embree-*.
+  void add_to(CLI::App* app, bool with_embree = true);
   /// Options for the factory; `threads` is the build thread count.
   StructureOptions to_options(unsigned threads, bool compute_epo) const;
 };

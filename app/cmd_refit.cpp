@@ -166,7 +166,7 @@ Command add_refit_command(CLI::App& parent, const GlobalOptions& global) {
   sub->add_option("--seed", o->seed, "Seed of the motion")->capture_default_str();
   sub->add_option("--out,-o", o->out, "Output directory (created if missing)")->required();
   sub->add_flag("--force,-f", o->force, "Overwrite the refit files of an earlier run in DIR");
-  o->structure_opts.add_to(sub);
+  o->structure_opts.add_to(sub, /*with_embree=*/false);  // it builds BVHs only
   return {sub, [o, &global] { return run_refit(*o, global); }};
 }
 

@@ -58,6 +58,10 @@ expect 2 "camera" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --camera g
 expect 2 "required" -- trace 'builtin:soup?size=10' --out "$tmp/z.hits"
 expect 2 "nosuchcommand" -- nosuchcommand
 expect 2 "--repeat" -- bench 'builtin:soup?size=10' --repeat 0
+# refit builds BVHs only: Embree's options are not its options.
+expect 2 "--embree-quality" -- refit 'builtin:soup?size=10' --embree-quality high --out "$tmp/refit"
+expect 2 "--rebuild-ratio" -- refit 'builtin:soup?size=10' --rebuild-ratio 0.5 --out "$tmp/refit"
+[ ! -e "$tmp/refit" ] || { echo "FAIL: refit wrote $tmp/refit on a usage error"; fail=1; }
 
 # A PNG under another format's name (or none): refused before any work, nothing written.
 expect 2 "$tmp/heat.jpg: a PNG file's name must end in .png" -- render 'builtin:soup?size=10' --out "$tmp/heat.jpg"
