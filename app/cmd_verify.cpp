@@ -87,8 +87,8 @@ Command add_verify_command(CLI::App& parent, const GlobalOptions& global) {
   sub->add_option("SCENE", o->scene, "Scene file (.gltf, .glb, .obj) or builtin:NAME[?key=value&...]")->required();
   sub->add_option("--rays,-n", o->rays, "Number of rays")->check(CLI::Range(std::size_t{1}, std::size_t{1} << 32))->capture_default_str();
   sub->add_option("--structure,-s", o->structure,
-                  "all, or a comma list of brute, brute-bbox, bvh (binned, exact and median), bvh-binned, bvh-exact, "
-                  "bvh-median, kdtree, "
+                  "all, or a comma list of brute, brute-bbox, bvh (every splitter: binned, exact, median, lbvh), "
+                  "bvh-binned, bvh-exact, bvh-median, bvh-lbvh, kdtree, "
                   "grid, octree, tlas (two-level over the scene's instances; not in all), embree")
       ->capture_default_str();
   sub->add_option("--seed", o->seed, "Seed of the ray generator")->capture_default_str();

@@ -43,6 +43,7 @@ std::vector<VerifyStructure> parse_verify_structures(const std::string& list, un
     if (which == "bvh" || which == "bvh-binned") add("bvh-binned", "bvh", BvhSplitter::binned_sah);
     if (which == "bvh" || which == "bvh-exact") add("bvh-exact", "bvh", BvhSplitter::exact_sah);
     if (which == "bvh" || which == "bvh-median") add("bvh-median", "bvh", BvhSplitter::median);
+    if (which == "bvh" || which == "bvh-lbvh") add("bvh-lbvh", "bvh", BvhSplitter::lbvh);
   };
   for (const std::string& n : names) {
     if (n == "all") {
@@ -52,7 +53,7 @@ std::vector<VerifyStructure> parse_verify_structures(const std::string& list, un
       add("grid", "grid");
       add("octree", "octree");
       if (kHaveEmbree) add("embree", "embree");
-    } else if (n == "bvh" || n == "bvh-binned" || n == "bvh-exact" || n == "bvh-median") {
+    } else if (n == "bvh" || n == "bvh-binned" || n == "bvh-exact" || n == "bvh-median" || n == "bvh-lbvh") {
       add_bvh(n);
     } else if (n == "brute" || n == "brute-bbox" || n == "kdtree" || n == "grid" || n == "octree" || n == "embree") {
       if (n == "embree" && !kHaveEmbree) throw std::invalid_argument("--structure embree: this build has no Embree backend");
@@ -62,9 +63,10 @@ std::vector<VerifyStructure> parse_verify_structures(const std::string& list, un
     } else if (n == "voxels") {
       throw std::invalid_argument("--structure voxels: voxel hits are voxels, not triangles; it cannot be verified against triangles");
     } else {
-      throw std::invalid_argument("--structure: unknown '" + n +
-                                  "' (all, brute, brute-bbox, bvh, bvh-binned, bvh-exact, bvh-median, kdtree, grid, octree, tlas" +
-                                  (kHaveEmbree ? ", embree)" : ")"));
+      throw std::invalid_argument(
+          "--structure: unknown '" + n +
+          "' (all, brute, brute-bbox, bvh, bvh-binned, bvh-exact, bvh-median, bvh-lbvh, kdtree, grid, octree, tlas" +
+          (kHaveEmbree ? ", embree)" : ")"));
     }
   }
   return out;

@@ -19,8 +19,9 @@ struct VerifyStructure {
   StructureOptions options;
 };
 
-/// "all" or a comma list of brute, bvh (every splitter), bvh-binned,
-/// bvh-exact, bvh-median, kdtree, grid, octree, embree. Voxels are refused:
+/// "all" or a comma list of brute, brute-bbox, bvh (every splitter),
+/// bvh-binned, bvh-exact, bvh-median, bvh-lbvh, kdtree, grid, octree, tlas,
+/// embree. Voxels are refused:
 /// their hits are voxels, not triangles. Throws std::invalid_argument.
 std::vector<VerifyStructure> parse_verify_structures(const std::string& list, unsigned threads);
 

@@ -145,7 +145,7 @@ TEST(Verify, StructureListParsing) {
   const auto all = parse_verify_structures("all", 1);
   ASSERT_GE(all.size(), 7u);
   EXPECT_EQ(all[0].label, "brute");
-  EXPECT_EQ(parse_verify_structures("bvh", 1).size(), 3u);
+  EXPECT_EQ(parse_verify_structures("bvh", 1).size(), 4u);  // binned, exact, median, lbvh
   EXPECT_EQ(parse_verify_structures("kdtree,grid,kdtree", 1).size(), 2u);
   EXPECT_THROW(parse_verify_structures("voxels", 1), std::invalid_argument);
   EXPECT_THROW(parse_verify_structures("nope", 1), std::invalid_argument);

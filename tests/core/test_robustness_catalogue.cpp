@@ -144,6 +144,7 @@ std::vector<Structure> all_structures() {
   for (const std::string& n : structure_names()) s.push_back({n, n});
   s.push_back({"bvh-exact", "bvh", BvhSplitter::exact_sah});
   s.push_back({"bvh-median", "bvh", BvhSplitter::median});
+  s.push_back({"bvh-lbvh", "bvh", BvhSplitter::lbvh});
   return s;
 }
 
