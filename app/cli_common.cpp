@@ -10,6 +10,7 @@
 
 #include "core/query/camera.h"
 #include "core/scene/load.h"
+#include "core/util/output_file.h"
 
 namespace accelviz::cli {
 
@@ -157,7 +158,7 @@ std::unique_ptr<Accelerator> build_with_progress(const std::string& structure, c
 void check_output_path(const std::string& path, bool force) {
   std::error_code ec;
   const fs::path p(path);
-  if (fs::is_directory(p, ec)) throw std::runtime_error(path + ": is a directory");
+  if (const std::string problem = output_path_problem(path); !problem.empty()) throw std::runtime_error(problem);
   if (!force && fs::exists(p, ec)) throw std::runtime_error(path + ": exists (use --force to overwrite)");
   const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
   if (!fs::is_directory(dir, ec)) throw std::runtime_error(path + ": directory " + dir.string() + " does not exist");

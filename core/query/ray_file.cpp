@@ -9,6 +9,8 @@
 #include <fstream>
 #include <memory>
 
+#include "core/util/output_file.h"
+
 namespace accelviz {
 
 namespace {
@@ -103,6 +105,8 @@ void write_file(const std::string& path, const char (&magic)[5], std::uint64_t c
   header.insert(header.end(), magic, magic + 4);
   put_u32(header, kRayFileVersion);
   put_u64(header, count);
+  if (const std::string problem = output_path_problem(path); !problem.empty())
+    fail(path, problem.substr(path.size() + 2));
   // "x" (C11, glibc): fail with EEXIST instead of truncating an existing file,
   // so the check and the creation cannot race.
   std::unique_ptr<std::FILE, FileCloser> f(std::fopen(path.c_str(), overwrite ? "wb" : "wbx"));
@@ -195,9 +199,17 @@ void write_rays(const std::string& path, std::span<const Ray> rays, bool overwri
 void write_hits(const std::string& path, std::span<const HitRecord> hits, bool overwrite) {
   std::vector<std::uint8_t> payload;
   payload.reserve(hits.size() * kHitRecordBytes);
-  for (const HitRecord& h : hits) {
+  for (std::size_t i = 0; i < hits.size(); ++i) {
+    const HitRecord& h = hits[i];
+    // 1e30 is the miss's t: a hit there or beyond cannot be told from half a miss.
+    if (h.valid() && !(h.t < kRayFileUnbounded)) {
+      char t[32];
+      std::snprintf(t, sizeof t, "%g", static_cast<double>(h.t));
+      fail(path, "hit " + std::to_string(i) + " at t " + t +
+                     " cannot be written: 1e30 and beyond is the format's miss value (nothing written)");
+    }
     put_u32(payload, h.valid() ? h.prim : kInvalidId);
-    put_f32(payload, h.valid() ? to_file_t(h.t) : kRayFileUnbounded);
+    put_f32(payload, h.valid() ? h.t : kRayFileUnbounded);
   }
   write_file(path, "HITS", hits.size(), payload, overwrite);
 }

@@ -1137,6 +1137,36 @@ std::string tinygltf_problem(const std::string& err) {
   return "invalid glTF: " + line;
 }
 
+// tinygltf's file access for the files a .gltf or .glb names (buffers,
+// images): its own FileExists opens the file and ReadWholeFile reads what
+// ifstream gives, so a FIFO blocked and a directory asked for an allocation
+// of SIZE_MAX. Only regular files of at most kMaxFileBytes are read.
+bool external_file_exists(const std::string& path, void*) {
+  std::error_code ec;
+  return fs::exists(fs::status(path, ec));
+}
+
+bool read_external_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void*) {
+  const auto problem = [&](const std::string& what) {  // tinygltf adds "File read error : PATH : "
+    if (err) *err += what;
+    return false;
+  };
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (ec || !fs::exists(st)) return problem("no such file");
+  if (!fs::is_regular_file(st)) return problem("not a regular file");
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec) return problem("cannot read its size");
+  if (size == 0) return problem("empty file");
+  if (size > kMaxFileBytes) return problem("larger than 4 GiB");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return problem("cannot open for reading");
+  out->resize(static_cast<std::size_t>(size));
+  in.read(reinterpret_cast<char*>(out->data()), static_cast<std::streamsize>(size));
+  if (in.gcount() != static_cast<std::streamsize>(size)) return problem("read error");
+  return true;
+}
+
 }  // namespace
 
 Scene load_gltf(const std::string& path) {
@@ -1147,6 +1177,8 @@ Scene load_gltf(const std::string& path) {
   tinygltf::Model model;
   tinygltf::TinyGLTF gltf;
   gltf.SetImageLoader(&skip_image, nullptr);
+  gltf.SetFsCallbacks(
+      {&external_file_exists, &tinygltf::ExpandFilePath, &read_external_file, &tinygltf::WriteWholeFile, nullptr});
   std::string err, warn;
   const std::string base_dir = fs::path(path).parent_path().string();
   bool ok = false;

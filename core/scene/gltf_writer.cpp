@@ -4,9 +4,6 @@
 // serialised) and lets us validate the Scene as we go.
 #include "core/scene/gltf_writer.h"
 
-#include <glm/gtc/matrix_transform.hpp>
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -14,9 +11,13 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <glm/gtc/matrix_transform.hpp>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
+
+#include "core/util/output_file.h"
 
 namespace accelviz {
 namespace {
@@ -402,6 +403,7 @@ std::string glb_bytes(const std::string& path, std::string json_text, const std:
 void write_gltf(const Scene& scene, const std::string& path, bool binary, bool overwrite) {
   std::error_code ec;
   if (!overwrite && fs::exists(fs::symlink_status(path, ec))) throw SceneError(path + ": already exists");
+  if (const std::string problem = output_path_problem(path); !problem.empty()) throw SceneError(problem);
 
   GltfWriter writer(scene, path);
   json doc = writer.build();

@@ -9,17 +9,15 @@
 //      `f` line has at least three well-formed vertex references that
 //      resolve to existing vertices (negative = relative, OBJ style);
 //      `l`/`p` elements are counted as skipped primitives;
-//   2. tinyobjloader parses the same bytes into shapes (one per o/g group,
-//      split again where `usemtl` changes) without triangulating; a missing
-//      .mtl is only a warning;
+//   2. tinyobjloader parses the same bytes into shapes (one per o/g group;
+//      `usemtl` does not split one) without triangulating; a missing .mtl,
+//      or one that is not a regular file of at most 64 MiB, is only a
+//      warning;
 //   3. each shape becomes one Mesh with its own compacted vertices and an
 //      identity instance; polygons are fan-triangulated (v0, vi, vi+1), so a
 //      polygon of n vertices always gives n-2 triangles in file order;
 //   4. coordinates our scan read as NaN/inf are restored, so flatten() drops
 //      those triangles and counts them instead of placing them at the origin.
-#include "core/scene/load.h"
-#include "core/util/one_line.h"
-
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
@@ -31,10 +29,14 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "core/scene/load.h"
+#include "core/util/one_line.h"
 
 namespace accelviz {
 namespace {
@@ -233,10 +235,44 @@ std::vector<std::string> warning_lines(const std::string& text) {
   return out;
 }
 
+/// tinyobjloader's MaterialFileReader opens the `mtllib` file with ifstream
+/// and reads it line by line: a FIFO blocked, /dev/zero grew a line without
+/// bound. Here only a regular file of at most 64 MiB is read (the materials
+/// are not used: no view draws them); anything else is a warning, as a
+/// missing .mtl is.
+class BoundedMaterialReader : public tinyobj::MaterialReader {
+ public:
+  explicit BoundedMaterialReader(std::string dir) : dir_(std::move(dir)) {}
+  bool operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
+                  std::map<std::string, int>* names, std::string* warn, std::string* err) override {
+    constexpr std::uintmax_t kMaxMtlBytes = std::uintmax_t{64} << 20;
+    const std::string path = dir_ + name;
+    const auto skip = [&](const std::string& why) {
+      if (warn) *warn += "Material file [ " + name + " ] " + why + "\n";
+      return false;
+    };
+    std::error_code ec;
+    const fs::file_status st = fs::status(path, ec);
+    if (ec || !fs::exists(st)) return skip("not found.");
+    if (!fs::is_regular_file(st)) return skip("is not a regular file; materials skipped.");
+    const std::uintmax_t size = fs::file_size(path, ec);
+    if (ec || size > kMaxMtlBytes) return skip("is larger than 64 MiB; materials skipped.");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return skip("cannot be opened.");
+    tinyobj::LoadMtl(names, materials, &in, warn, err);
+    return true;
+  }
+
+ private:
+  std::string dir_;
+};
+
 }  // namespace
 
 Scene load_obj(const std::string& path) {
-  const std::string text = read_text(path);
+  std::string text = read_text(path);
+  // A UTF-8 byte order mark is not part of the first line.
+  if (text.starts_with("\xEF\xBB\xBF")) text.erase(0, 3);
   const ObjScan scan = scan_obj(path, text);
 
   // Step 2: tinyobjloader over the same bytes. Materials are resolved next to
@@ -248,7 +284,7 @@ Scene load_obj(const std::string& path) {
   std::istringstream stream(text);
   std::string base_dir = fs::path(path).parent_path().string();
   if (base_dir.empty()) base_dir = ".";
-  tinyobj::MaterialFileReader material_reader(base_dir + "/");
+  BoundedMaterialReader material_reader(base_dir + "/");
   const bool ok = tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &stream, &material_reader,
                                    /*triangulate=*/false, /*default_vcols_fallback=*/false);
   if (!ok) fail(path, err.empty() ? "tinyobjloader failed" : err);

@@ -6,6 +6,7 @@
 // the accessor/stride/mode/non-finite cases they do not. Every file is made
 // by the test in its own temporary directory.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstring>
@@ -338,4 +339,50 @@ TEST_F(Malformed, GlbChunkTypeAndAlignment) {
   total_short[8] = static_cast<char>(static_cast<unsigned char>(total_short[8]) - 4);
   EXPECT_FALSE(gltf_error(write("total.glb", total_short)).empty());
 }
+
+// ------------------------------------------------------------ files a scene names
+
+// The files a .gltf or an .obj names are read only when they are regular
+// files: a FIFO blocked the loader (tinygltf and tinyobjloader open what they
+// are given), a directory asked for an allocation of SIZE_MAX ("out of
+// memory"), /dev/zero grew an .mtl line without bound.
+TEST_F(Malformed, ExternalFilesThatAreNotRegularFilesNeitherBlockNorAllocate) {
+  ASSERT_EQ(::mkfifo((dir_ / "buf.fifo").c_str(), 0600), 0) << std::strerror(errno);
+  ASSERT_EQ(::mkfifo((dir_ / "m.fifo").c_str(), 0600), 0) << std::strerror(errno);
+  fs::create_directories(dir_ / "adir");
+  Doc d = triangle_doc();
+  for (const char* uri : {"buf.fifo", "adir", "."}) {
+    SCOPED_TRACE(uri);
+    d.j["buffers"][0]["uri"] = uri;
+    expect_gltf_error(write(std::string("ext-") + (uri[0] == '.' ? "dot" : uri) + ".gltf", d.j.dump()),
+                      std::string(uri) + " : not a regular file");
+  }
+  // Images are never decoded: one that is a FIFO or a directory is a warning.
+  Doc img = triangle_doc();
+  img.j["images"] = {{{"uri", "buf.fifo"}}, {{"uri", "adir"}}};
+  const Scene with_images = load_gltf(write("images.gltf", gltf_text(img)));
+  EXPECT_EQ(with_images.triangles.size(), 1u);
+
+  // OBJ: the .mtl named by mtllib is a FIFO, a directory, /dev/zero: a warning each, the geometry loads.
+  const std::string dev_zero = fs::relative("/dev/zero", dir_).string();  // mtllib names are relative to the .obj
+  for (const std::string& mtl : {std::string("m.fifo"), std::string("adir"), dev_zero}) {
+    SCOPED_TRACE(mtl);
+    const Scene s = load_obj(write("m.obj", "mtllib " + mtl + "\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"));
+    EXPECT_EQ(s.triangles.size(), 1u);
+    bool said = false;
+    for (const std::string& w : s.report.warnings)
+      said |= w.find("is not a regular file; materials skipped") != std::string::npos;
+    EXPECT_TRUE(said) << "a warning names the .mtl";
+  }
+}
+
+// An OBJ saved with a UTF-8 byte order mark: the mark is not part of the
+// first `v` line (which was skipped, so an index to the last vertex read as
+// out of range).
+TEST_F(Malformed, ObjWithAByteOrderMarkLoadsEveryVertex) {
+  const Scene s = load_obj(write("bom.obj", "\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n"));
+  ASSERT_EQ(s.triangles.size(), 1u);
+  EXPECT_EQ(s.triangles[0].v0, glm::vec3(0, 0, 0));
+}
+
 }  // namespace unity_test_malformed_files

@@ -670,6 +670,7 @@ TEST(Island, LeftUnflattenedAboveTheLimitWithAWarning) {
   EXPECT_FALSE(s.bounds().is_empty());
   expect_spec_error("island?size=10000001", "island", {"too large", "10000000", "unique"});
   expect_spec_error("island?copies=0", "island", {"copies"});
+  expect_spec_error("island?copies=1.5", "island", {"copies", "whole number"});  // a count: never rounded
 }
 
 TEST(Dynamic, AnimatedBoxesAndWavingGrass) {

@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -156,6 +157,37 @@ TEST_F(RayFileTest, WritersRefuseToOverwriteUnlessForced) {
   std::vector<Hit> hits(1);
   write_hits(path("x.hits"), std::span<const Hit>(hits));
   expect_error(path("x.hits"), "exists", [&] { write_hits(path("x.hits"), std::span<const Hit>(hits)); });
+}
+
+// Outputs are regular files: a FIFO or a device under the output's name is
+// refused before anything is opened (a FIFO blocked the writer; a failed
+// write removed the node), with --force too.
+TEST_F(RayFileTest, WritersRefuseFifosAndDevices) {
+  const std::string fifo = path("out.hits");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0) << std::strerror(errno);
+  std::vector<Hit> hits(1);
+  for (bool force : {false, true}) {
+    expect_error(fifo, "is not a regular file", [&] { write_hits(fifo, std::span<const Hit>(hits), force); });
+    expect_error(fifo, "is not a regular file", [&] { write_rays(fifo, random_rays(2), force); });
+  }
+  EXPECT_TRUE(std::filesystem::is_fifo(fifo)) << "the FIFO is still there";
+  expect_error("/dev/null", "is not a regular file",
+               [&] { write_hits("/dev/null", std::span<const Hit>(hits), /*overwrite=*/true); });
+}
+
+// 1e30 is the miss's t in a HITS file: a hit at or beyond it cannot be
+// written (it was clamped to 1e30 with its id kept, a record read_hits then
+// refused as half a miss).
+TEST_F(RayFileTest, HitsAtOrBeyond1e30AreRefusedNotClamped) {
+  for (float t : {1e30f, 1.06e33f, kInfinity}) {
+    SCOPED_TRACE(t);
+    const std::vector<HitRecord> records{{3, 2.0f}, {7, t}};
+    expect_error(path("far.hits"), "hit 1 at t", [&] { write_hits(path("far.hits"), records); });
+    EXPECT_FALSE(std::filesystem::exists(path("far.hits"))) << "nothing written";
+  }
+  const std::vector<HitRecord> near{{7, 9.9e29f}};
+  write_hits(path("near.hits"), near);
+  EXPECT_EQ(read_hits(path("near.hits")), near);
 }
 
 TEST_F(RayFileTest, MissingFile) {

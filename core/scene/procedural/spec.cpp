@@ -143,6 +143,9 @@ BuiltinArgs resolve_args(const SpecParts& parts, std::string source, std::int64_
       if (!parse_real(value, v) || v < extra[i].min || v > extra[i].max)
         spec_error(parts.name, key + "=" + quoted(value) + " is not a number in [" + number(extra[i].min) + ", " +
                                    number(extra[i].max) + "]");
+      if (extra[i].whole && v != std::floor(v))
+        spec_error(parts.name, key + "=" + quoted(value) + " is not a whole number in [" + number(extra[i].min) + ", " +
+                                   number(extra[i].max) + "]");
       args.reals[i].second = v;
     }
     if (!known) spec_error(parts.name, "unknown key " + quoted(key) + "; valid keys: " + key_list(extra));

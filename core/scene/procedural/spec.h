@@ -25,6 +25,7 @@ struct RealParam {
   double min;
   double max;
   std::string_view help;  ///< one line, for builtin_scenes()
+  bool whole = false;     ///< a count: only whole numbers are accepted
 };
 
 /// A spec cut into its name and its key=value items (in spec order, unvalidated).
