@@ -10,7 +10,7 @@
 
 #include "core/query/camera.h"
 #include "core/scene/load.h"
-#include "core/util/output_file.h"
+#include "core/util/file_checks.h"
 
 namespace accelviz::cli {
 

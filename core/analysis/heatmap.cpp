@@ -19,7 +19,7 @@
 
 #include "core/query/batch.h"
 #include "core/query/camera.h"
-#include "core/util/output_file.h"
+#include "core/util/file_checks.h"
 #include "core/util/parallel.h"
 #include "core/util/timing.h"
 

@@ -9,7 +9,7 @@
 #include <fstream>
 #include <memory>
 
-#include "core/util/output_file.h"
+#include "core/util/file_checks.h"
 
 namespace accelviz {
 
@@ -58,9 +58,10 @@ std::string printable_magic(const std::uint8_t* m) {
 /// The count is compared with the file's length before anything is allocated.
 std::vector<std::uint8_t> read_payload(const std::string& path, const char (&magic)[5], std::size_t record_bytes,
                                        std::uint64_t& count, const char* what) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) fail(path, "no such file");
-  if (!std::filesystem::is_regular_file(path, ec)) fail(path, "not a regular file");
+  std::uintmax_t file_size = 0;
+  if (const std::string problem = input_file_problem(path, std::numeric_limits<std::uintmax_t>::max(), file_size);
+      !problem.empty())
+    fail(path, problem);
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path, std::string("cannot open: ") + std::strerror(errno));
   in.seekg(0, std::ios::end);

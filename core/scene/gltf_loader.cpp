@@ -16,11 +16,12 @@
 //   4. our validation and conversion: meshes, node forest, transforms,
 //      cameras, lights, animations;
 //   5. Scene::flatten() builds world triangles, dropping non-finite ones.
-#include "core/scene/load.h"
-#include "core/util/one_line.h"
-
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
+
+#include "core/scene/load.h"
+#include "core/util/file_checks.h"
+#include "core/util/one_line.h"
 #define GLM_ENABLE_EXPERIMENTAL
 #include <glm/gtx/matrix_decompose.hpp>
 #include <nlohmann/json.hpp>
@@ -1043,14 +1044,11 @@ class GltfConverter {
 }
 
 std::vector<unsigned char> read_file(const std::string& path) {
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (ec || !fs::exists(st)) fail_file(path, "no such file");
-  if (fs::is_directory(st)) fail_file(path, "is a directory, not a file");
-  if (!fs::is_regular_file(st)) fail_file(path, "is not a regular file");
-  const std::uintmax_t size = fs::file_size(path, ec);
-  if (ec) fail_file(path, "cannot read: " + ec.message());
-  if (size > kMaxFileBytes) fail_file(path, "file is larger than 4 GiB, which glTF loading does not support");
+  std::uintmax_t size = 0;
+  if (std::string problem = input_file_problem(path, kMaxFileBytes, size); !problem.empty()) {
+    if (problem.starts_with("is larger")) problem = "file is larger than 4 GiB, which glTF loading does not support";
+    fail_file(path, problem);
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) fail_file(path, "cannot open for reading");
   std::vector<unsigned char> data(static_cast<std::size_t>(size));
@@ -1151,14 +1149,9 @@ bool read_external_file(std::vector<unsigned char>* out, std::string* err, const
     if (err) *err += what;
     return false;
   };
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (ec || !fs::exists(st)) return problem("no such file");
-  if (!fs::is_regular_file(st)) return problem("not a regular file");
-  const std::uintmax_t size = fs::file_size(path, ec);
-  if (ec) return problem("cannot read its size");
+  std::uintmax_t size = 0;
+  if (const std::string p = input_file_problem(path, kMaxFileBytes, size); !p.empty()) return problem(p);
   if (size == 0) return problem("empty file");
-  if (size > kMaxFileBytes) return problem("larger than 4 GiB");
   std::ifstream in(path, std::ios::binary);
   if (!in) return problem("cannot open for reading");
   out->resize(static_cast<std::size_t>(size));

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "core/util/output_file.h"
+#include "core/util/file_checks.h"
 
 namespace accelviz {
 namespace {

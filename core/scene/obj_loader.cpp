@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "core/scene/load.h"
+#include "core/util/file_checks.h"
 #include "core/util/one_line.h"
 
 namespace accelviz {
@@ -203,11 +204,10 @@ ObjScan scan_obj(const std::string& path, const std::string& text) {
 }
 
 std::string read_text(const std::string& path) {
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (ec || !fs::exists(st)) fail(path, "no such file");
-  if (fs::is_directory(st)) fail(path, "is a directory, not a file");
-  if (!fs::is_regular_file(st)) fail(path, "is not a regular file");
+  std::uintmax_t size = 0;
+  if (const std::string problem = input_file_problem(path, std::numeric_limits<std::uintmax_t>::max(), size);
+      !problem.empty())
+    fail(path, problem);
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path, "cannot open for reading");
   std::ostringstream ss;
@@ -251,12 +251,9 @@ class BoundedMaterialReader : public tinyobj::MaterialReader {
       if (warn) *warn += "Material file [ " + name + " ] " + why + "\n";
       return false;
     };
-    std::error_code ec;
-    const fs::file_status st = fs::status(path, ec);
-    if (ec || !fs::exists(st)) return skip("not found.");
-    if (!fs::is_regular_file(st)) return skip("is not a regular file; materials skipped.");
-    const std::uintmax_t size = fs::file_size(path, ec);
-    if (ec || size > kMaxMtlBytes) return skip("is larger than 64 MiB; materials skipped.");
+    std::uintmax_t size = 0;
+    if (const std::string problem = input_file_problem(path, kMaxMtlBytes, size); !problem.empty())
+      return skip(problem == "no such file" ? "not found." : problem + "; materials skipped.");
     std::ifstream in(path, std::ios::binary);
     if (!in) return skip("cannot be opened.");
     tinyobj::LoadMtl(names, materials, &in, warn, err);

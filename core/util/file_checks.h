@@ -1,0 +1,41 @@
+#pragma once
+// Files are read and written only when they are regular files. An input (a
+// scene, a file a scene names, a ray file) that is a FIFO blocks its reader
+// and one that is a directory or a device reads as garbage or without end; an
+// output that is a FIFO blocks its writer, and a failed write or a rename
+// would remove or replace a device node.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+namespace accelviz {
+
+/// "" when `path` names a regular file (a symbolic link counts as what it
+/// names) of at most `max_bytes`, its size then in `size`; else the problem,
+/// without the path: "no such file", "is a directory, not a file", "is not a
+/// regular file", "cannot read its size: ...", "is larger than N bytes".
+inline std::string input_file_problem(const std::string& path, std::uintmax_t max_bytes, std::uintmax_t& size) {
+  std::error_code ec;
+  const std::filesystem::file_status st = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(st)) return "no such file";
+  if (std::filesystem::is_directory(st)) return "is a directory, not a file";
+  if (!std::filesystem::is_regular_file(st)) return "is not a regular file";
+  size = std::filesystem::file_size(path, ec);
+  if (ec) return "cannot read its size: " + ec.message();
+  if (size > max_bytes) return "is larger than " + std::to_string(max_bytes) + " bytes";
+  return {};
+}
+
+/// "" when `path` may be created or overwritten as a file: nothing is there,
+/// or a regular file is (a symbolic link counts as what it names); else
+/// "PATH: is a directory" or "PATH: is not a regular file (a FIFO, device or
+/// socket)".
+inline std::string output_path_problem(const std::string& path) {
+  std::error_code ec;
+  const std::filesystem::file_status st = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(st) || std::filesystem::is_regular_file(st)) return {};
+  if (std::filesystem::is_directory(st)) return path + ": is a directory";
+  return path + ": is not a regular file (a FIFO, device or socket)";
+}
+
+}  // namespace accelviz
