@@ -131,6 +131,13 @@ CLI::Option* add_triangle_test_option(CLI::App* sub, std::string& value, const c
       ->capture_default_str();
 }
 
+void require_flattened(const Scene& scene, const std::string& spec, const char* command) {
+  if (scene.triangles.empty() && !scene.instances.empty())
+    throw std::runtime_error(spec + ": instanced and too large to flatten; " + command +
+                             " measures the flattened triangles (only 'tlas' can hold this scene: render, bench, "
+                             "animate or flatten with -s tlas)");
+}
+
 Scene load_scene_noting_warnings(const std::string& spec, bool quiet) {
   Scene scene = load_scene(spec);
   if (!quiet && !scene.report.warnings.empty())

@@ -93,6 +93,10 @@ TriangleTest parse_triangle_test(const std::string& name);
 
 /// load_scene, then a note on stderr when the loader reported warnings.
 Scene load_scene_noting_warnings(const std::string& spec, bool quiet);
+/// Throws (one line, exit 1) when `scene` is instanced and was left
+/// unflattened (too large: only the two-level structure holds it): `command`
+/// measures the flattened triangle list, which that scene does not have.
+void require_flattened(const Scene& scene, const std::string& spec, const char* command);
 
 /// Fails early (before any long work) when `path` exists and `force` is off,
 /// or its directory does not exist: "<path>: exists (use --force to overwrite)".

@@ -60,6 +60,7 @@ int run_calibrate(const CalibrateCliOptions& o, const GlobalOptions& global) {
   if (!o.scene.empty()) {
     progress.begin("loading " + o.scene);
     const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
+    require_flattened(scene, o.scene, "calibrate --scene");
     progress.end(std::to_string(scene.triangles.size()) + " triangles");
     const std::vector<Ray> rays = primary_rays(camera_for("", scene, size), size.width, size.height);
     progress.begin("BVH with the default and the calibrated constants");

@@ -9,6 +9,7 @@
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -41,8 +42,11 @@ bool is_refit_file(const fs::path& p) {
 
 int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
   const ImageSize size = parse_size(o.size);
-  if (!(o.amplitude >= 0)) throw UsageError("--amplitude must not be negative");
-  if (!(o.rebuild_ratio == 0 || o.rebuild_ratio >= 1)) throw UsageError("--rebuild-ratio must be 0 (never) or >= 1");
+  if (!(o.amplitude >= 0) || !std::isfinite(o.amplitude))
+    throw UsageError("--amplitude must be a finite number >= 0");
+  if (!std::isfinite(o.frame_step)) throw UsageError("--frame-step must be a finite number");
+  if (!(o.rebuild_ratio == 0 || (o.rebuild_ratio >= 1 && std::isfinite(o.rebuild_ratio))))
+    throw UsageError("--rebuild-ratio must be 0 (never) or a finite number >= 1");
   std::error_code ec;
   const fs::path dir(o.out);
   if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) throw std::runtime_error(o.out + ": exists and is not a directory");
@@ -59,6 +63,7 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
   Progress progress(global.quiet);
   progress.begin("loading " + o.scene);
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
+  require_flattened(scene, o.scene, "refit");
   progress.end(std::to_string(scene.triangles.size()) + " triangles");
   // The camera frames the rest pose; the motion is small against the scene, so it stays framed.
   const std::vector<Ray> rays = primary_rays(camera_for("", scene, size), size.width, size.height);

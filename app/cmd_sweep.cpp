@@ -243,6 +243,7 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
 
   progress.begin("loading " + o.scene);
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
+  require_flattened(scene, o.scene, "sweep");
   progress.end(std::to_string(scene.triangles.size()) + " triangles");
 
   progress.begin(std::string("making ") + o.rays + " rays");

@@ -61,7 +61,17 @@ expect 2 "--repeat" -- bench 'builtin:soup?size=10' --repeat 0
 # refit builds BVHs only: Embree's options are not its options.
 expect 2 "--embree-quality" -- refit 'builtin:soup?size=10' --embree-quality high --out "$tmp/refit"
 expect 2 "--rebuild-ratio" -- refit 'builtin:soup?size=10' --rebuild-ratio 0.5 --out "$tmp/refit"
+expect 2 "--frame-step" -- refit 'builtin:soup?size=10' --frame-step nan --out "$tmp/refit"
+expect 2 "--amplitude" -- refit 'builtin:soup?size=10' --amplitude inf --out "$tmp/refit"
+expect 2 "--rebuild-ratio" -- refit 'builtin:soup?size=10' --rebuild-ratio inf --out "$tmp/refit"
 [ ! -e "$tmp/refit" ] || { echo "FAIL: refit wrote $tmp/refit on a usage error"; fail=1; }
+expect 2 "--dt" -- animate 'builtin:dynamic?size=100' --frames 1 --dt nan
+expect 2 "--rebuild-ratio" -- animate 'builtin:dynamic?size=100' --frames 1 --rebuild-ratio nan
+# A scene too large to flatten holds no triangle list: the commands that measure one refuse it.
+island='builtin:island?size=20000&copies=3000'
+expect 1 "only 'tlas' can hold this scene" -- sweep "$island" --param buckets=2 --size 8x6 --repeat 1 --out "$tmp/sw"
+expect 1 "only 'tlas' can hold this scene" -- refit "$island" --frames 1 --size 8x6 --out "$tmp/rf"
+expect 1 "only 'tlas' can hold this scene" -- calibrate --scene "$island" --repeat 1 --size 8x6
 
 # A PNG under another format's name (or none): refused before any work, nothing written.
 expect 2 "$tmp/heat.jpg: a PNG file's name must end in .png" -- render 'builtin:soup?size=10' --out "$tmp/heat.jpg"

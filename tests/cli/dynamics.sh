@@ -49,11 +49,15 @@ assert all(r["overlap_area"] > 0 and r["overlap_pairs"] > 0 for r in rows), rows
 assert len({r["overlap_area"] for r in rows}) > 1, [r["overlap_area"] for r in rows]
 print("animate ok")
 PY
-# A static scene: zero-cost frames and a note.
-"$accelviz" -q animate 'builtin:teapot?size=500' --frames 2 --json 2> "$tmp/err" | python3 -c '
+# A static scene: zero-cost frames and a note; each row still has its time
+# and the instance boxes' overlap (it was 0 on every row).
+"$accelviz" -q animate 'builtin:forest?size=2000' --frames 3 --dt 0.5 --json 2> "$tmp/err" | python3 -c '
 import json, sys
 rows = [json.loads(l) for l in sys.stdin]
 assert all(r["refits"] == 0 and r["moved_instances"] == 0 and not r["tlas_rebuilt"] for r in rows), rows
+assert [r["time"] for r in rows] == [0.0, 0.5, 1.0], rows
+assert all(r["overlap_area"] > 0 and r["overlap_pairs"] > 0 for r in rows), rows
+assert len({r["overlap_area"] for r in rows}) == 1, rows
 print("static animate ok")'
 grep -q "nothing animates" "$tmp/err" || { echo "FAIL: no note for a static scene"; exit 1; }
 
