@@ -480,7 +480,11 @@ SavedScreenshot Gui::write_frame(const std::optional<std::filesystem::path>& exp
   ScreenshotInfo info = app_.screenshot_info(range.x, range.y);
   info.boxes_drawn = view_->boxes_drawn();
   info.boxes_matched = view_->boxes_matched();
-  if (app_.config().view.show_boxes) info.box_node_note = insight_.box_node_note(app_);
+  if (app_.config().view.show_boxes) {
+    info.box_node_note = insight_.box_node_note(app_);
+    info.boxes_of_region = view_->boxes_of_region();
+    info.boxes_by_visits = view_->boxes_by_visits();
+  }
   if (explicit_path) return save_screenshot_as(*explicit_path, frame, info);
   const std::filesystem::path dir = app_.settings().screenshot_dir.empty()
                                         ? default_screenshot_dir()

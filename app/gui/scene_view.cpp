@@ -87,6 +87,8 @@ void SceneView::upload_boxes(const AppState& app) {
   boxes_drawn_ = 0;
   boxes_matched_ = 0;
   boxes_truncated_ = false;
+  boxes_of_region_ = region != nullptr;
+  boxes_by_visits_ = by_visits;
   if (!built || built->nodes.empty()) {
     renderer_.set_boxes({});
     return;

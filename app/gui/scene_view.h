@@ -49,6 +49,10 @@ class SceneView {
   bool boxes_truncated() const { return boxes_truncated_; }
   /// Boxes the selection names (more than drawn when the list was cut at kMaxBoxes).
   std::uint64_t boxes_matched() const { return boxes_matched_; }
+  /// The boxes drawn are a heatmap region's entered nodes (not the View panel's selection).
+  bool boxes_of_region() const { return boxes_of_region_; }
+  /// The boxes are coloured by the insight's visit counts (not by the View panel's choice).
+  bool boxes_by_visits() const { return boxes_by_visits_; }
 
   /// Most boxes drawn at once (llvmpipe draws ~1e5 instanced boxes per frame comfortably).
   static constexpr std::size_t kMaxBoxes = 200000;
@@ -72,6 +76,7 @@ class SceneView {
   bool has_heatmap_ = false;
   std::uint64_t boxes_drawn_ = 0, boxes_matched_ = 0;
   bool boxes_truncated_ = false;
+  bool boxes_of_region_ = false, boxes_by_visits_ = false;
 };
 
 }  // namespace accelviz

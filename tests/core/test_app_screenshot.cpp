@@ -202,6 +202,52 @@ TEST(AppScreenshot, SideCarSaysHowToReproduceThePicture) {
   EXPECT_TRUE(j["reproduce"]["notes"].empty());
 }
 
+// The traversal's order and x-ray are render options: the commands carry
+// them (they were left out, and "unordered is not an option of render" noted:
+// the command then counted another traversal than the picture's).
+TEST(AppScreenshot, TheCommandsCarryTheTraversalOrderAndXray) {
+  ScreenshotInfo info = test_info();
+  QueryOptions& q = info.config.structure.query;
+  q.back_to_front = true;
+  q.xray = true;
+  nlohmann::json j = screenshot_sidecar(info, "shot.png");
+  for (const char* which : {"render_heatmap", "render_raster"}) {
+    const std::string cmd = j["reproduce"][which];
+    EXPECT_NE(cmd.find(" --order back-to-front"), std::string::npos) << cmd;
+    EXPECT_NE(cmd.find(" --xray"), std::string::npos) << cmd;
+  }
+  EXPECT_EQ(j["query"]["back_to_front"], true);
+  EXPECT_EQ(j["query"]["xray"], true);
+  EXPECT_TRUE(j["reproduce"]["notes"].empty()) << j["reproduce"]["notes"];
+  q = QueryOptions{};
+  q.ordered = false;
+  j = screenshot_sidecar(info, "shot.png");
+  const std::string cmd = j["reproduce"]["render_heatmap"];
+  EXPECT_NE(cmd.find(" --order unordered"), std::string::npos) << cmd;
+  EXPECT_EQ(cmd.find(" --xray"), std::string::npos) << cmd;
+}
+
+// Boxes the Predicted vs measured view drew (a region's entered nodes,
+// colours by visits) are said on the caption and in the side-car, and noted
+// as not replayed; a subtree's node note is not claimed for a region's boxes.
+TEST(AppScreenshot, InsightBoxesAreSaidAndNotedAsNotReplayed) {
+  ScreenshotInfo info = test_info();
+  info.box_node_note = "node 1098: a leaf at depth 8, 3 primitives";
+  info.boxes_of_region = true;
+  info.boxes_by_visits = true;
+  const std::string caption = screenshot_caption(info);
+  EXPECT_NE(caption.find(", boxes: the nodes a heatmap region's rays entered, coloured by visits"), std::string::npos)
+      << caption;
+  EXPECT_EQ(caption.find("node 1098"), std::string::npos) << caption;
+  const nlohmann::json j = screenshot_sidecar(info, "shot.png");
+  EXPECT_EQ(j["boxes"]["region"], true);
+  EXPECT_EQ(j["boxes"]["by_visits"], true);
+  EXPECT_EQ(j["boxes"]["node_note"], "");
+  const auto& notes = j["reproduce"]["notes"];
+  ASSERT_EQ(notes.size(), 1u) << notes;
+  EXPECT_NE(notes[0].get<std::string>().find("does not measure or select again"), std::string::npos) << notes;
+}
+
 TEST(AppScreenshot, AThinnedBoxOverlayIsSaidOnThePictureAndInTheSideCar) {
   ScreenshotInfo info = test_info();
   info.boxes_drawn = 200000;

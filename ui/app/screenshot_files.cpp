@@ -166,6 +166,13 @@ std::string render_command(const ScreenshotInfo& info, bool raster, const std::s
   cmd += " --metric " + std::string(metric_name(c.view.metric));
   cmd += " --colormap " + std::string(colormap_name(c.view.colormap));
   cmd += " --triangle-test " + option_value(c, "triangle-test");
+  // The traversal's child order and x-ray counting (render's --order, --xray).
+  const QueryOptions& q = s.query;
+  if (!q.ordered)
+    cmd += " --order unordered";
+  else if (q.back_to_front)
+    cmd += " --order back-to-front";
+  if (q.xray) cmd += " --xray";
   if (!c.view.auto_scale) {
     cmd += " --max " + format_number(c.view.scale_max);
     if (notes && c.view.scale_min != 0.0f)
@@ -186,7 +193,6 @@ std::string render_command(const ScreenshotInfo& info, bool raster, const std::s
                          " is not a command-line option of render (it builds " + s.name +
                          " with defaults): replay the `script` instead");
     }
-    if (!s.query.ordered) notes->push_back("unordered traversal is not a command-line option of render");
   }
   if (raster) {
     cmd += " --view raster";
@@ -226,7 +232,11 @@ std::string screenshot_caption(const ScreenshotInfo& info) {
   std::string s = screenshot_caption(info.config);
   if (info.boxes_drawn < info.boxes_matched)
     s += ", boxes " + std::to_string(info.boxes_drawn) + " of " + std::to_string(info.boxes_matched);
-  if (!info.box_node_note.empty()) s += ", boxes of " + info.box_node_note;
+  if (info.boxes_of_region)
+    s += ", boxes: the nodes a heatmap region's rays entered";
+  else if (!info.box_node_note.empty())
+    s += ", boxes of " + info.box_node_note;
+  if (info.boxes_by_visits) s += ", coloured by visits";
   return s;
 }
 
@@ -245,6 +255,10 @@ nlohmann::json screenshot_sidecar(const ScreenshotInfo& info, const fs::path& pn
   const std::string stem = png.stem().string();
   const std::string heatmap_cmd = render_command(info, false, stem + "-heatmap.png", &notes);
   const std::string raster_cmd = render_command(info, true, stem + "-raster.png", &notes);
+  if (info.boxes_of_region || info.boxes_by_visits)
+    notes.push_back(std::string("boxes: ") +
+                    (info.boxes_of_region ? "a heatmap region's entered nodes" : "coloured by visits") +
+                    " (Predicted vs measured), which the script does not measure or select again");
 
   // A script replays the picture in the app itself, with every option.
   std::vector<std::string> script = {"open " + info.scene,
@@ -260,7 +274,12 @@ nlohmann::json screenshot_sidecar(const ScreenshotInfo& info, const fs::path& pn
   return {
       {"png", fs::absolute(png).string()},
       {"caption", screenshot_caption(info)},
-      {"boxes", {{"drawn", info.boxes_drawn}, {"matched", info.boxes_matched}, {"node_note", info.box_node_note}}},
+      {"boxes",
+       {{"drawn", info.boxes_drawn},
+        {"matched", info.boxes_matched},
+        {"node_note", info.boxes_of_region ? std::string() : info.box_node_note},
+        {"region", info.boxes_of_region},
+        {"by_visits", info.boxes_by_visits}}},
       {"scene", info.scene},
       {"triangles", info.triangles},
       {"size", {{"width", info.width}, {"height", info.height}}},
@@ -271,7 +290,11 @@ nlohmann::json screenshot_sidecar(const ScreenshotInfo& info, const fs::path& pn
         {"up", vec(cam.up)},
         {"yfov_deg", cam.yfov * 180.0 / 3.14159265358979}}},
       {"structure", {{"name", c.structure.name}, {"options", structure_options}}},
-      {"query", {{"triangle_test", option_value(c, "triangle-test")}, {"ordered", c.structure.query.ordered}}},
+      {"query",
+       {{"triangle_test", option_value(c, "triangle-test")},
+        {"ordered", c.structure.query.ordered},
+        {"back_to_front", c.structure.query.back_to_front},
+        {"xray", c.structure.query.xray}}},
       {"heatmap",
        {{"display", heatmap_display_name(c.view.heatmap)},
         {"metric", metric_name(c.view.metric)},

@@ -51,6 +51,10 @@ struct ScreenshotInfo {
   /// Boxes of a selected subtree: what its node id names and, when it was
   /// set in an earlier build, that build ("" otherwise).
   std::string box_node_note;
+  /// The Predicted vs measured view drew the boxes: a heatmap region's
+  /// entered nodes instead of the selection, or colours by visits. Neither is
+  /// a view setting, so the side-car's script does not bring them back.
+  bool boxes_of_region = false, boxes_by_visits = false;
 };
 
 /// screenshot_caption(info.config), ", boxes N of M" when the overlay
