@@ -103,10 +103,13 @@ void InsightViews::select_view_region(AppState& app, int ax, int ay, int bx, int
 }
 
 void InsightViews::draw_labels(const AppState& app, const ViewInsight& v, const panels::PanelLayout& layout) {
-  const std::uint32_t sel = selected_node(app);
-  const std::vector<NodeLabel> labels =
-      node_labels(v.built->nodes, v.visits, v.hot, static_cast<std::size_t>(std::max(0, insight_state_.labels)),
-                  app.config().view.show_boxes ? std::optional<std::uint32_t>(sel) : std::nullopt);
+  // The selected node is labelled as such only while the boxes show its subtree
+  // (box_node is 0, the root, whenever nothing was selected).
+  const ViewSettings& view = app.config().view;
+  const std::vector<NodeLabel> labels = node_labels(
+      v.built->nodes, v.visits, v.hot, static_cast<std::size_t>(std::max(0, insight_state_.labels)),
+      view.show_boxes && view.box_mode == BoxMode::subtree ? std::optional<std::uint32_t>(selected_node(app))
+                                                           : std::nullopt);
   if (labels.empty() || app.view_width() <= 0 || app.view_height() <= 0) return;
   // Behind every window, over the 3D view; framebuffer pixels to ImGui's window units.
   ImDrawList* dl = ImGui::GetBackgroundDrawList();
@@ -410,6 +413,10 @@ ScriptHost::Status InsightViews::execute(AppState& app, const ScriptCommand& c) 
         if (!insight_job_.error().empty()) throw std::runtime_error("insight: " + insight_job_.error());
         if (!shown_insight(app)) return ScriptHost::Status::again;
       }
+      // A measurement asked for above may have finished between two frames: the
+      // request is answered either way (a stale flag made the next dump-insight
+      // write the old figures without measuring).
+      script_insight_requested_ = false;
       select_view_region(app, c.x, c.y, c.x2, c.y2);
       if (!insight_state_.region) throw std::runtime_error("select-region: the rectangle lies outside the view");
       return ScriptHost::Status::done;

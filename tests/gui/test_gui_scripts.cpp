@@ -680,6 +680,21 @@ TEST_F(GuiScript, ATypedNodeIdSaysWhatItNamesAndWhichBuildItWasSetIn) {
   EXPECT_NE(shot["caption"].get<std::string>().find(", boxes of " + grid), std::string::npos) << shot["caption"];
 }
 
+// select-region measures the view first when it must; that request is
+// answered even when the measurement finished between two frames, so a later
+// dump-insight measures the structure shown then (it wrote the grid's hot
+// cells and node counts for brute force).
+TEST_F(GuiScript, DumpInsightAfterSelectRegionMeasuresTheStructureShown) {
+  const RunResult r = run(std::string("open ") + kTeapot + "\nsize 320 240\ncamera " + kCamera +
+                          "\nstructure grid\nwait\nselect-region 100 80 200 160\nstructure brute\nwait\n"
+                          "dump-insight " +
+                          path("brute.json").string() + "\nquit\n");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = read_json(path("brute.json"));
+  EXPECT_TRUE(j["hot"].empty()) << "brute force has no nodes: " << j["hot"];
+  for (const auto& [mode, m] : j["modes"].items()) EXPECT_EQ(m["nodes_per_ray"].get<double>(), 0.0) << mode;
+}
+
 // A/B from a script: A pinned with leaf size 1, B with leaf size 16 on the
 // same view: B tests more primitives and enters fewer nodes. Then x-ray on
 // (the heatmap's traversal toggle): the heatmap and B count more primitive

@@ -49,11 +49,17 @@ RobustnessAction robustness_panel(RobustnessPanelState& st, const RobustnessSnap
   ImGui::InputInt("Rays", &st.rays, 1000, 10000);
   st.rays = std::clamp(st.rays, 4, 1 << 22);
   ImGui::SameLine();
-  const bool voxels = structure == "voxels";
-  if (voxels) st.with_structure = false;
-  ImGui::BeginDisabled(voxels);
-  ImGui::Checkbox(("Also " + structure + "'s own traversal").c_str(), &st.with_structure);
+  // The lab runs the structure's own traversal over the scene's triangles:
+  // voxels hit voxels, and the two-level structure is not one of its variants.
+  // The box stays unticked and disabled there (the choice is kept for the others).
+  const bool unavailable = structure == "voxels" || structure == "tlas";
+  bool with_structure = st.with_structure && !unavailable;
+  ImGui::BeginDisabled(unavailable);
+  if (ImGui::Checkbox(("Also " + structure + "'s own traversal").c_str(), &with_structure))
+    st.with_structure = with_structure;
   ImGui::EndDisabled();
+  if (unavailable && ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip("not for %s: the lab's variants are triangle tests and slab tests", structure.c_str());
   if (busy) {
     if (ImGui::Button("Cancel")) act.cancel = true;
     ImGui::SameLine();
