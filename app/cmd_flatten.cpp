@@ -93,7 +93,7 @@ Command add_flatten_command(CLI::App& parent, const GlobalOptions& global) {
       "flatten", "What-if: merge the listed instances into one BLAS and compare SAH, memory and measured cost per ray");
   sub->add_option("SCENE", o->scene, "Scene file (.gltf, .glb, .obj) or builtin:NAME[?key=value&...]")->required();
   sub->add_option("--instances", o->instances, "Instance ids to merge, e.g. 0,2,5, or 'all'")->required();
-  sub->add_option("--size", o->size, "Primary rays traced, WxH")->capture_default_str();
+  sub->add_option("--size", o->size, "Primary rays traced, WxH")->check(size_validator())->capture_default_str();
   sub->add_option("--camera", o->camera, "Camera spec (default: the scene's default view)");
   sub->add_option("--threads,-j", o->threads, "Build threads (0: all)")->capture_default_str();
   sub->add_flag("--json", o->json, "One JSON object instead of the table");

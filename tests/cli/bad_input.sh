@@ -51,6 +51,7 @@ expect 1 "$tmp/wrong.rays" -- trace 'builtin:soup?size=10' --rays "$tmp/wrong.ra
 
 # Usage errors: exit 2.
 expect 2 "--size" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --size 0x10
+expect 2 "--size" -- flatten 'builtin:forest?size=200' --instances 0 --size 0x3
 expect 2 "--structure" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --structure octopus
 expect 2 "--metric" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --metric colour
 expect 2 "camera" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --camera 1,2,3
