@@ -162,6 +162,9 @@ void apply_sweep_setting(std::string_view structure, const SweepSetting& setting
           r[k++] = parse_int(name, part, 1, 4096);
         }
         if (k != 3) bad_value(name, v, "expected NXxNYxNZ, e.g. 16x16x16");
+        if (static_cast<std::uint64_t>(r[0]) * static_cast<std::uint64_t>(r[1]) * static_cast<std::uint64_t>(r[2]) >
+            kGridMaxCells)
+          bad_value(name, v, "more than 2^26 cells");
         o.grid.resolution = r;
       }
     } else if (structure == "octree") {

@@ -74,4 +74,11 @@ set -e
 [ "$rc" -eq 2 ] || fail "bad value: exit $rc"
 grep -q "4x4" "$tmp/err.txt" || fail "bad value not named: $(cat "$tmp/err.txt")"
 [ ! -e "$tmp/s2" ] || fail "a usage error created the output directory"
+# Each side in range, the product not: still a usage error, before any work.
+set +e
+"$bin" -q sweep 'builtin:soup?size=200' --structure grid --param res=4096x4096x8 --out "$tmp/s3" 2> "$tmp/err.txt"; rc=$?
+set -e
+[ "$rc" -eq 2 ] || fail "too many cells: exit $rc"
+grep -q "more than 2^26 cells" "$tmp/err.txt" || fail "too many cells not said: $(cat "$tmp/err.txt")"
+[ ! -e "$tmp/s3" ] || fail "a usage error created the output directory"
 echo "sweep: ok"
