@@ -62,23 +62,18 @@ grep -q "force" "$tmp/err.txt" || fail "refusal does not mention --force: $(cat 
 [ "$(wc -l < "$out/sweep.csv")" -eq 3 ] || fail "--force run did not replace sweep.csv"
 [ ! -e "$out/sweep-sah_cost-vs-buckets.png" ] || fail "stale chart of the first sweep left behind"
 
-# Usage errors (exit 2) name the parameter or value.
-set +e
-"$bin" -q sweep 'builtin:soup?size=200' --param bukets=2 --out "$tmp/s2" 2> "$tmp/err.txt"; rc=$?
-set -e
-[ "$rc" -eq 2 ] || fail "unknown parameter: exit $rc"
-grep -q "bukets" "$tmp/err.txt" || fail "unknown parameter not named: $(cat "$tmp/err.txt")"
-set +e
-"$bin" -q sweep 'builtin:soup?size=200' --structure grid --param res=4x4 --out "$tmp/s2" 2> "$tmp/err.txt"; rc=$?
-set -e
-[ "$rc" -eq 2 ] || fail "bad value: exit $rc"
-grep -q "4x4" "$tmp/err.txt" || fail "bad value not named: $(cat "$tmp/err.txt")"
-[ ! -e "$tmp/s2" ] || fail "a usage error created the output directory"
-# Each side in range, the product not: still a usage error, before any work.
-set +e
-"$bin" -q sweep 'builtin:soup?size=200' --structure grid --param res=4096x4096x8 --out "$tmp/s3" 2> "$tmp/err.txt"; rc=$?
-set -e
-[ "$rc" -eq 2 ] || fail "too many cells: exit $rc"
-grep -q "more than 2^26 cells" "$tmp/err.txt" || fail "too many cells not said: $(cat "$tmp/err.txt")"
-[ ! -e "$tmp/s3" ] || fail "a usage error created the output directory"
+# Usage errors (exit 2) name the parameter or value, before any work: no output directory.
+# usage_error WHAT NEEDLE -- SWEEP-ARGS...
+usage_error() {
+  local what="$1" needle="$2" rc=0
+  shift 3
+  "$bin" -q sweep "$@" --out "$tmp/bad" 2> "$tmp/err.txt" || rc=$?
+  [ "$rc" -eq 2 ] || fail "$what: exit $rc"
+  grep -qF -- "$needle" "$tmp/err.txt" || fail "$what not said: $(cat "$tmp/err.txt")"
+  [ ! -e "$tmp/bad" ] || fail "$what: a usage error created the output directory"
+}
+usage_error "unknown parameter" "bukets" -- 'builtin:soup?size=200' --param bukets=2
+usage_error "bad value" "4x4" -- 'builtin:soup?size=200' --structure grid --param res=4x4
+# Each side in range, the product not.
+usage_error "too many cells" "more than 2^26 cells" -- 'builtin:soup?size=200' --structure grid --param res=4096x4096x8
 echo "sweep: ok"
