@@ -201,11 +201,14 @@ std::string InsightViews::box_node_note(const AppState& app) const {
   const ViewSettings& v = app.config().view;
   const BuiltStructure* shown = app.current().get();
   if (v.box_mode != BoxMode::subtree || !shown) return "";
-  std::string note;
-  if (shown->nodes.kind() == "tlas" && v.box_level == BoxLevel::blas)
-    note = "BLAS node " + std::to_string(v.box_node) + " of each instance shown";
-  else
-    note = shown->nodes.describe(static_cast<std::uint32_t>(v.box_node));
+  // describe() walks the subtree (the root's is the whole tree): once per build and id, not per frame.
+  const bool blas = shown->nodes.kind() == "tlas" && v.box_level == BoxLevel::blas;
+  if (described_.built.lock() != app.current() || described_.id != v.box_node || described_.blas != blas) {
+    described_ = {app.current(), v.box_node, blas,
+                  blas ? "BLAS node " + std::to_string(v.box_node) + " of each instance shown"
+                       : shown->nodes.describe(static_cast<std::uint32_t>(v.box_node))};
+  }
+  std::string note = described_.text;
   // (An expired build is an earlier one too.)
   if (box_node_seen_ == v.box_node && box_node_set_in_.lock() != app.rest())
     note += "; the id was set in an earlier build (" + box_node_set_in_name_ + "): node ids are per build";

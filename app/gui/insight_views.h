@@ -77,6 +77,14 @@ class InsightViews {
   std::weak_ptr<const BuiltStructure> box_node_set_in_;
   std::string box_node_set_in_name_;
   int box_node_seen_ = -1;
+  /// box_node_note's description of (build, id, level), kept while they stay.
+  struct Described {
+    std::weak_ptr<const BuiltStructure> built;  // (a freed build's address may come back)
+    int id = -1;
+    bool blas = false;
+    std::string text;
+  };
+  mutable Described described_;
   AsyncJob<nlohmann::json> ab_dump_job_;
   bool script_ab_requested_ = false;
   panels::ExplainerState explainer_;
