@@ -162,6 +162,39 @@ std::unique_ptr<Accelerator> build_with_progress(const std::string& structure, c
   return accel;
 }
 
+namespace {
+
+bool is_output_file(const fs::path& p, const std::string& prefix) {
+  const std::string n = p.filename().string();
+  return n == prefix + ".csv" || n == prefix + ".json" || (n.rfind(prefix + "-", 0) == 0 && p.extension() == ".png");
+}
+
+}  // namespace
+
+void check_output_dir(const std::string& dir, const std::string& prefix, bool force) {
+  std::error_code ec;
+  const fs::path p(dir);
+  if (fs::exists(p, ec) && !fs::is_directory(p, ec)) throw std::runtime_error(dir + ": exists and is not a directory");
+  if (force || !fs::is_directory(p, ec)) return;
+  for (const auto& e : fs::directory_iterator(p, ec))
+    if (is_output_file(e.path(), prefix))
+      throw std::runtime_error(dir + ": already holds " + prefix + " files (use --force to overwrite)");
+}
+
+void prepare_output_dir(const std::string& dir, const std::string& prefix, bool force) {
+  check_output_dir(dir, prefix, force);  // again: the folder may have changed during the work
+  std::error_code ec;
+  const fs::path p(dir);
+  if (fs::is_directory(p, ec)) {
+    std::vector<fs::path> stale;
+    for (const auto& e : fs::directory_iterator(p, ec))
+      if (is_output_file(e.path(), prefix)) stale.push_back(e.path());
+    for (const fs::path& f : stale) fs::remove(f, ec);
+    return;
+  }
+  if (!fs::create_directories(p, ec) || ec) throw std::runtime_error(dir + ": cannot create directory");
+}
+
 void check_output_path(const std::string& path, bool force) {
   std::error_code ec;
   const fs::path p(path);

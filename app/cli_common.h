@@ -102,6 +102,16 @@ void require_flattened(const Scene& scene, const std::string& spec, const char* 
 /// or its directory does not exist: "<path>: exists (use --force to overwrite)".
 void check_output_path(const std::string& path, bool force);
 
+/// An output folder for a command's files, the files its `prefix` names:
+/// PREFIX.csv, PREFIX.json, PREFIX-*.png. check_output_dir, before any work:
+/// refused (one line) when `dir` is not a folder, or holds such files and
+/// `force` is off; nothing changes on disk. prepare_output_dir, once the
+/// results are ready to write: removes those files (stale charts of an
+/// earlier run would mislead) and creates the folder. So a run that fails
+/// leaves what was there, and no empty folder.
+void check_output_dir(const std::string& dir, const std::string& prefix, bool force);
+void prepare_output_dir(const std::string& dir, const std::string& prefix, bool force);
+
 /// Absolute, normalised form of a path for messages.
 std::string absolute_path(const std::string& path);
 

@@ -35,11 +35,6 @@ struct RefitCliOptions {
   StructureCli structure_opts;
 };
 
-bool is_refit_file(const fs::path& p) {
-  const std::string n = p.filename().string();
-  return n == "refit.csv" || n == "refit.json" || (n.rfind("refit-", 0) == 0 && p.extension() == ".png");
-}
-
 int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
   const ImageSize size = parse_size(o.size);
   if (!(o.amplitude >= 0) || !std::isfinite(o.amplitude))
@@ -47,18 +42,8 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
   if (!std::isfinite(o.frame_step)) throw UsageError("--frame-step must be a finite number");
   if (!(o.rebuild_ratio == 0 || (o.rebuild_ratio >= 1 && std::isfinite(o.rebuild_ratio))))
     throw UsageError("--rebuild-ratio must be 0 (never) or a finite number >= 1");
-  std::error_code ec;
+  check_output_dir(o.out, "refit", o.force);  // refused before any work; created when the results are ready
   const fs::path dir(o.out);
-  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) throw std::runtime_error(o.out + ": exists and is not a directory");
-  if (fs::is_directory(dir, ec)) {
-    for (const auto& e : fs::directory_iterator(dir, ec))
-      if (is_refit_file(e.path())) {
-        if (!o.force) throw std::runtime_error(o.out + ": already holds refit files (use --force to overwrite)");
-        fs::remove(e.path(), ec);
-      }
-  } else if (!fs::create_directories(dir, ec) || ec) {
-    throw std::runtime_error(o.out + ": cannot create directory");
-  }
 
   Progress progress(global.quiet);
   progress.begin("loading " + o.scene);
@@ -103,6 +88,7 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
                       {"prims_per_ray_fresh", f.prims_per_ray_fresh},
                       {"rebuilt", f.rebuilt}});
   }
+  prepare_output_dir(o.out, "refit", o.force);
   std::ofstream(dir / "refit.csv") << csv.str();
   const nlohmann::json j = {{"scene", o.scene},
                             {"triangles", scene.triangles.size()},

@@ -79,27 +79,6 @@ double load_average() {
   return l;
 }
 
-/// Files a sweep writes: sweep.csv, sweep.json, sweep-*.png.
-bool is_sweep_file(const fs::path& p) {
-  const std::string n = p.filename().string();
-  return n == "sweep.csv" || n == "sweep.json" || (n.rfind("sweep-", 0) == 0 && p.extension() == ".png");
-}
-
-void prepare_out_dir(const std::string& dir, bool force) {
-  std::error_code ec;
-  const fs::path p(dir);
-  if (fs::exists(p, ec) && !fs::is_directory(p, ec)) throw std::runtime_error(dir + ": exists and is not a directory");
-  if (fs::is_directory(p, ec)) {
-    for (const auto& e : fs::directory_iterator(p, ec))
-      if (is_sweep_file(e.path())) {
-        if (!force) throw std::runtime_error(dir + ": already holds sweep files (use --force to overwrite)");
-        fs::remove(e.path(), ec);  // stale charts of an earlier sweep would mislead
-      }
-    return;
-  }
-  if (!fs::create_directories(p, ec) || ec) throw std::runtime_error(dir + ": cannot create directory");
-}
-
 void write_text(const fs::path& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);
   out << text;
@@ -237,7 +216,7 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
   }
   const ImageSize size = parse_size(o.size);
   const RayKind kind = *parse_ray_kind(o.rays);
-  prepare_out_dir(o.out, o.force);
+  check_output_dir(o.out, "sweep", o.force);  // refused before any work; created when the results are ready
   const unsigned threads = resolve_threads(o.threads);
   Progress progress(global.quiet);
 
@@ -288,6 +267,7 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
   const double budgets[] = {1e6, 1e9, o.ray_budget};
 
   // ---- files ----
+  prepare_output_dir(o.out, "sweep", o.force);
   const fs::path dir(o.out);
   write_text(dir / "sweep.csv", sweep_csv(results, o.ray_budget));
   nlohmann::json j;

@@ -73,6 +73,8 @@ island='builtin:island?size=20000&copies=3000'
 expect 1 "only 'tlas' can hold this scene" -- sweep "$island" --param buckets=2 --size 8x6 --repeat 1 --out "$tmp/sw"
 expect 1 "only 'tlas' can hold this scene" -- refit "$island" --frames 1 --size 8x6 --out "$tmp/rf"
 expect 1 "only 'tlas' can hold this scene" -- calibrate --scene "$island" --repeat 1 --size 8x6
+# A run that fails leaves no output folder behind (it is made when the results are written).
+[ ! -e "$tmp/sw" ] && [ ! -e "$tmp/rf" ] || { echo "FAIL: a failed run left an output folder"; fail=1; }
 
 # A PNG under another format's name (or none): refused before any work, nothing written.
 expect 2 "$tmp/heat.jpg: a PNG file's name must end in .png" -- render 'builtin:soup?size=10' --out "$tmp/heat.jpg"

@@ -70,6 +70,7 @@ tail -1 "$tmp/island.out" | python3 -c '
 import json, sys
 j = json.load(sys.stdin)
 assert j["triangles"] == 0 and j["hits"] > 0, j
+assert j["instanced_triangles"] > 50000000, j   # the world triangles the two levels hold
 print("island tlas ok")'
 set +e
 msg=$("$accelviz" -q render "$big" -s bvh --size 64x48 -o "$tmp/island_bvh.png" 2>&1)

@@ -61,6 +61,10 @@ grep -q "force" "$tmp/err.txt" || fail "refusal does not mention --force: $(cat 
 "$bin" -q sweep 'builtin:soup?size=200' --param leaf=1,4 --size 8x8 --repeat 1 --out "$out" --force > /dev/null
 [ "$(wc -l < "$out/sweep.csv")" -eq 3 ] || fail "--force run did not replace sweep.csv"
 [ ! -e "$out/sweep-sah_cost-vs-buckets.png" ] || fail "stale chart of the first sweep left behind"
+# --force on a run that fails (a missing scene) keeps the results that were there.
+before=$(sha256sum "$out/sweep.csv")
+"$bin" -q sweep "$tmp/missing.glb" --param leaf=1 --out "$out" --force 2> /dev/null && fail "a missing scene swept"
+[ "$before" = "$(sha256sum "$out/sweep.csv")" ] || fail "a failed --force run removed or changed sweep.csv"
 
 # Usage errors (exit 2) name the parameter or value, before any work: no output directory.
 # usage_error WHAT NEEDLE -- SWEEP-ARGS...
