@@ -198,7 +198,8 @@ void prepare_output_dir(const std::string& dir, const std::string& prefix, bool 
 void check_output_path(const std::string& path, bool force) {
   std::error_code ec;
   const fs::path p(path);
-  if (const std::string problem = output_path_problem(path); !problem.empty()) throw std::runtime_error(problem);
+  if (const std::string problem = output_path_problem(path); !problem.empty())
+    throw std::runtime_error(path + ": " + problem);
   if (!force && fs::exists(p, ec)) throw std::runtime_error(path + ": exists (use --force to overwrite)");
   const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
   if (!fs::is_directory(dir, ec)) throw std::runtime_error(path + ": directory " + dir.string() + " does not exist");

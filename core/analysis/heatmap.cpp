@@ -521,7 +521,8 @@ std::string png_name_problem(const std::string& path) {
 void write_png(const std::string& path, const RgbImage& img, bool overwrite) {
   if (const std::string problem = png_name_problem(path); !problem.empty()) throw std::runtime_error(problem);
   if (img.width <= 0 || img.height <= 0) throw std::runtime_error(path + ": cannot write an empty image");
-  if (const std::string problem = output_path_problem(path); !problem.empty()) throw std::runtime_error(problem);
+  if (const std::string problem = output_path_problem(path); !problem.empty())
+    throw std::runtime_error(path + ": " + problem);
   // "x": the existence check and the creation are one step (no overwrite race).
   std::unique_ptr<std::FILE, FileCloser> f(std::fopen(path.c_str(), overwrite ? "wb" : "wbx"));
   if (!f) {

@@ -106,8 +106,7 @@ void write_file(const std::string& path, const char (&magic)[5], std::uint64_t c
   header.insert(header.end(), magic, magic + 4);
   put_u32(header, kRayFileVersion);
   put_u64(header, count);
-  if (const std::string problem = output_path_problem(path); !problem.empty())
-    fail(path, problem.substr(path.size() + 2));
+  if (const std::string problem = output_path_problem(path); !problem.empty()) fail(path, problem);
   // "x" (C11, glibc): fail with EEXIST instead of truncating an existing file,
   // so the check and the creation cannot race.
   std::unique_ptr<std::FILE, FileCloser> f(std::fopen(path.c_str(), overwrite ? "wb" : "wbx"));

@@ -27,15 +27,15 @@ inline std::string input_file_problem(const std::string& path, std::uintmax_t ma
 }
 
 /// "" when `path` may be created or overwritten as a file: nothing is there,
-/// or a regular file is (a symbolic link counts as what it names); else
-/// "PATH: is a directory" or "PATH: is not a regular file (a FIFO, device or
-/// socket)".
+/// or a regular file is (a symbolic link counts as what it names); else the
+/// problem, without the path: "is a directory" or "is not a regular file (a
+/// FIFO, device or socket)".
 inline std::string output_path_problem(const std::string& path) {
   std::error_code ec;
   const std::filesystem::file_status st = std::filesystem::status(path, ec);
   if (ec || !std::filesystem::exists(st) || std::filesystem::is_regular_file(st)) return {};
-  if (std::filesystem::is_directory(st)) return path + ": is a directory";
-  return path + ": is not a regular file (a FIFO, device or socket)";
+  if (std::filesystem::is_directory(st)) return "is a directory";
+  return "is not a regular file (a FIFO, device or socket)";
 }
 
 }  // namespace accelviz
