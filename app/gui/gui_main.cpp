@@ -80,6 +80,9 @@ class Gui final : public ScriptHost {
   void draw_panels(const panels::PanelLayout& layout);
   /// The effects of the shown scene under the user's forces (recomputed when either changes).
   const SceneEffects* effects();
+  /// The visit count at the top of the 3D boxes' colour ramp while they are
+  /// shown and coloured by visits (the Tree's swatches then share it).
+  std::optional<std::uint64_t> box_ramp_max() const;
   /// The Dynamics panel: the timeline and per-frame figures while per-frame updates are on.
   void draw_dynamics(const panels::PanelLayout& layout);
   /// The Flatten what-if panel while the structure is tlas; takes a finished commit.
@@ -395,7 +398,7 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
     else
       app_.set_error(err);
   }
-  insight_.draw(app_, layout);
+  insight_.draw(app_, layout, box_ramp_max());
   view_->set_box_insight(insight_.box_insight(app_));
 
   const std::shared_ptr<const RobustnessSnapshot> lab = robustness_.latest();
@@ -414,6 +417,11 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
       robustness_.request(std::move(r));
     }
   }
+}
+
+std::optional<std::uint64_t> Gui::box_ramp_max() const {
+  if (!app_.config().view.show_boxes || !view_->boxes_by_visits()) return std::nullopt;
+  return view_->boxes_visit_max();
 }
 
 const SceneEffects* Gui::effects() {
@@ -636,12 +644,16 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
     case K::dump_stats: {
       nlohmann::json doc = app_.stats_json();
       doc["frames"] = frames_drawn_;
-      view_->sync(app_);  // the overlay as the settings stand now
+      view_->set_box_insight(insight_.box_insight(app_));  // the overlay as the settings and insight stand now
+      view_->sync(app_);
       doc["boxes"] = {{"drawn", view_->boxes_drawn()},
                       {"matched", view_->boxes_matched()},
                       {"truncated", view_->boxes_truncated()},
                       {"instance_colors", view_->instance_colored()},
-                      {"node_note", insight_.box_node_note(app_)}};
+                      {"node_note", insight_.box_node_note(app_)},
+                      {"visit_max", view_->boxes_visit_max()}};
+      doc["tree"] = {{"swatch_max", insight_.tree_swatch_max(app_, box_ramp_max())},
+                     {"swatch_of_boxes", box_ramp_max().has_value()}};
       fail_if(write_file_atomic(c.arg, doc.dump(2) + "\n"));
       return Status::done;
     }

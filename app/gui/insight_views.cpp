@@ -226,7 +226,16 @@ void InsightViews::drop_stale_selection(AppState& app) {
   selection_of_ = nullptr;
 }
 
-void InsightViews::draw(AppState& app, const panels::PanelLayout& layout) {
+std::uint64_t InsightViews::tree_swatch_max(const AppState& app, std::optional<std::uint64_t> box_ramp_max) {
+  if (box_ramp_max) return *box_ramp_max;
+  const auto shown = shown_insight(app);
+  std::uint64_t max = 0;
+  if (shown)
+    for (const std::uint64_t v : shown->visits) max = std::max(max, v);
+  return max;
+}
+
+void InsightViews::draw(AppState& app, const panels::PanelLayout& layout, std::optional<std::uint64_t> box_ramp_max) {
   // A/B.
   const auto ab_result = ab_job_.result();
   const panels::ABAction aa =
@@ -282,7 +291,8 @@ void InsightViews::draw(AppState& app, const panels::PanelLayout& layout) {
   // Tree.
   if (const auto pick =
           panels::tree_panel(app.current() ? &app.current()->nodes : nullptr, shown ? &shown->visits : nullptr,
-                             selected_node(app), scroll_tree_, layout, app.config().view.colormap)) {
+                             selected_node(app), scroll_tree_, layout, app.config().view.colormap,
+                             tree_swatch_max(app, box_ramp_max), box_ramp_max.has_value())) {
     select(app, *pick);
     insight_state_.region.reset();
   }

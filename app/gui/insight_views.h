@@ -20,7 +20,12 @@ namespace accelviz {
 
 class InsightViews {
  public:
-  void draw(AppState& app, const panels::PanelLayout& layout);
+  /// `box_ramp_max`: the visit count at the top of the 3D boxes' colour ramp
+  /// when they are drawn by visits, which the Tree's swatches then share.
+  void draw(AppState& app, const panels::PanelLayout& layout, std::optional<std::uint64_t> box_ramp_max);
+  /// The visit count at the top of the Tree's swatch ramp: `box_ramp_max`
+  /// when set, else the shown insight's largest count (the root's); 0 without one.
+  std::uint64_t tree_swatch_max(const AppState& app, std::optional<std::uint64_t> box_ramp_max);
   /// scenario, dump-scenario, dump-insight, select-region, pin-a, dump-ab.
   ScriptHost::Status execute(AppState& app, const ScriptCommand& c);
   /// What the 3D view shows of the insight: boxes by visits, a region's nodes and primitives.

@@ -86,6 +86,7 @@ void SceneView::upload_boxes(const AppState& app) {
   box_key_ = key;
   boxes_drawn_ = 0;
   boxes_matched_ = 0;
+  boxes_visit_max_ = 0;
   boxes_truncated_ = false;
   boxes_of_region_ = region != nullptr;
   boxes_by_visits_ = by_visits;
@@ -127,6 +128,7 @@ void SceneView::upload_boxes(const AppState& app) {
   // Hot nodes: every box on the colour map by its visits (the hottest on top).
   const std::vector<glm::vec4> hot =
       by_visits ? visit_colors(s.boxes, insight->visits, v.colormap) : std::vector<glm::vec4>();
+  if (by_visits) boxes_visit_max_ = max_visit_count(s.boxes, insight->visits);
   for (std::size_t i = 0; i < s.boxes.size(); ++i) {
     const NodeBox& b = s.boxes[i];
     ColoredBox c;

@@ -53,6 +53,9 @@ class SceneView {
   bool boxes_of_region() const { return boxes_of_region_; }
   /// The boxes are coloured by the insight's visit counts (not by the View panel's choice).
   bool boxes_by_visits() const { return boxes_by_visits_; }
+  /// The visit count at the top of the boxes' colour ramp (the hottest box
+  /// drawn) when they are coloured by visits; else 0.
+  std::uint64_t boxes_visit_max() const { return boxes_visit_max_; }
 
   /// Most boxes drawn at once (llvmpipe draws ~1e5 instanced boxes per frame comfortably).
   static constexpr std::size_t kMaxBoxes = 200000;
@@ -74,7 +77,7 @@ class SceneView {
   int colormap_ = -1;
   bool colored_ = false;  ///< per-instance triangle colours uploaded
   bool has_heatmap_ = false;
-  std::uint64_t boxes_drawn_ = 0, boxes_matched_ = 0;
+  std::uint64_t boxes_drawn_ = 0, boxes_matched_ = 0, boxes_visit_max_ = 0;
   bool boxes_truncated_ = false;
   bool boxes_of_region_ = false, boxes_by_visits_ = false;
 };

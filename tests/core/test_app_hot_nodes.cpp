@@ -47,6 +47,8 @@ TEST(AppHotNodes, BoxColoursFollowVisitsHottestGetsTheTopColour) {
       if (visits[sel.boxes[i].id] < visits[sel.boxes[coldest].id]) coldest = i;
     }
     ASSERT_GT(visits[sel.boxes[hottest].id], visits[sel.boxes[coldest].id]) << "the view must make a difference";
+    EXPECT_EQ(max_visit_count(sel.boxes, visits), visits[sel.boxes[hottest].id]);
+    EXPECT_LT(max_visit_count(sel.boxes, visits), visits[0]) << "the root, not drawn, is hotter";
     EXPECT_EQ(glm::vec3(colors[hottest]), colormap(map, 1.0f));
     EXPECT_NE(glm::vec3(colors[coldest]), colormap(map, 1.0f));
     // Every box's colour is the map at its ramp value, and the ramp orders as the visits do.

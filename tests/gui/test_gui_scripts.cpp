@@ -680,6 +680,29 @@ TEST_F(GuiScript, ATypedNodeIdSaysWhatItNamesAndWhichBuildItWasSetIn) {
   EXPECT_NE(shot["caption"].get<std::string>().find(", boxes of " + grid), std::string::npos) << shot["caption"];
 }
 
+// The Tree's visit swatches share the 3D boxes' colour ramp while the boxes
+// are drawn by visits: its top colour is the hottest box drawn (depth 4 here,
+// cooler than the root), and the root's count when no boxes are shown.
+TEST_F(GuiScript, TreeSwatchesShareTheBoxesVisitRamp) {
+  const RunResult r =
+      run(std::string("open ") + kTeapot + "\nsize 320 240\ncamera " + kCamera + "\nwait\ndump-insight " +
+          path("insight.json").string() + "\nset boxes on\nset box-mode depth\nset box-depth 4\nwait\ndump-stats " +
+          path("depth4.json").string() + "\nset boxes off\nwait\ndump-stats " + path("off.json").string() + "\nquit\n");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json in = read_json(path("insight.json"));
+  const nlohmann::json d4 = read_json(path("depth4.json")), off = read_json(path("off.json"));
+  const std::uint64_t root = in["hot"][0]["visits"].get<std::uint64_t>();
+  ASSERT_EQ(in["hot"][0]["node"], 0);
+  const std::uint64_t box_max = d4["boxes"]["visit_max"].get<std::uint64_t>();
+  EXPECT_GT(d4["boxes"]["drawn"].get<int>(), 1);
+  EXPECT_GT(box_max, 0u);
+  EXPECT_LT(box_max, root) << "no box at depth 4 is entered by every ray the root is";
+  EXPECT_TRUE(d4["tree"]["swatch_of_boxes"].get<bool>());
+  EXPECT_EQ(d4["tree"]["swatch_max"].get<std::uint64_t>(), box_max);
+  EXPECT_FALSE(off["tree"]["swatch_of_boxes"].get<bool>());
+  EXPECT_EQ(off["tree"]["swatch_max"].get<std::uint64_t>(), root);
+}
+
 // select-region measures the view first when it must; that request is
 // answered even when the measurement finished between two frames, so a later
 // dump-insight measures the structure shown then (it wrote the grid's hot

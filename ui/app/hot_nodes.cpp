@@ -12,14 +12,24 @@ float visit_ramp(std::uint64_t visits, std::uint64_t max) {
   return static_cast<float>(std::clamp(t, 0.0, 1.0));
 }
 
+namespace {
+std::uint64_t visit_count(std::span<const std::uint64_t> visits, std::uint32_t id) {
+  return id < visits.size() ? visits[id] : std::uint64_t{0};
+}
+}  // namespace
+
+std::uint64_t max_visit_count(std::span<const NodeBox> boxes, std::span<const std::uint64_t> visits) {
+  std::uint64_t max = 0;
+  for (const NodeBox& b : boxes) max = std::max(max, visit_count(visits, b.id));
+  return max;
+}
+
 std::vector<glm::vec4> visit_colors(std::span<const NodeBox> boxes, std::span<const std::uint64_t> visits,
                                     ColorMap map) {
-  const auto count = [&](std::uint32_t id) { return id < visits.size() ? visits[id] : std::uint64_t{0}; };
-  std::uint64_t max = 0;
-  for (const NodeBox& b : boxes) max = std::max(max, count(b.id));
+  const std::uint64_t max = max_visit_count(boxes, visits);
   std::vector<glm::vec4> out;
   out.reserve(boxes.size());
-  for (const NodeBox& b : boxes) out.emplace_back(colormap(map, visit_ramp(count(b.id), max)), 1.0f);
+  for (const NodeBox& b : boxes) out.emplace_back(colormap(map, visit_ramp(visit_count(visits, b.id), max)), 1.0f);
   return out;
 }
 

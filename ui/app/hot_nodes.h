@@ -24,10 +24,14 @@ namespace accelviz {
 /// apart; 0 for max == 0. Monotone; `visits == max` gives 1.
 float visit_ramp(std::uint64_t visits, std::uint64_t max);
 
+/// The largest visit count among `boxes` (ids past `visits` count as 0): the
+/// count that visit_colors() puts at the top of the ramp.
+std::uint64_t max_visit_count(std::span<const NodeBox> boxes, std::span<const std::uint64_t> visits);
+
 /// One colour per box (same order), from its node's visit count through
-/// `map` (core/analysis/colormap.h) on visit_ramp() over the largest count
-/// among `boxes`: the hottest box gets colormap(map, 1), unvisited ones
-/// colormap(map, 0). Ids past `visits` count as 0.
+/// `map` (core/analysis/colormap.h) on visit_ramp() over max_visit_count():
+/// the hottest box gets colormap(map, 1), unvisited ones colormap(map, 0).
+/// Ids past `visits` count as 0.
 std::vector<glm::vec4> visit_colors(std::span<const NodeBox> boxes, std::span<const std::uint64_t> visits,
                                     ColorMap map);
 

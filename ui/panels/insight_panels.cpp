@@ -377,8 +377,8 @@ bool on_path(const StructureNodes& nodes, std::uint32_t id, std::uint32_t select
   return selected == id;
 }
 
-/// How rows show visits: the boxes' colour ramp (ui/app/hot_nodes.h) over the
-/// tree's largest count, as a swatch before the row.
+/// How rows show visits: the boxes' colour ramp (ui/app/hot_nodes.h) up to
+/// `max_visits`, as a swatch before the row.
 struct RowColors {
   ColorMap map;
   std::uint64_t max_visits;
@@ -429,7 +429,7 @@ void tree_rows(const StructureNodes& nodes, const std::vector<std::uint64_t>* vi
 
 std::optional<std::uint32_t> tree_panel(const StructureNodes* nodes, const std::vector<std::uint64_t>* visits,
                                         std::uint32_t selected, bool& scroll_to_selected, const PanelLayout& layout,
-                                        ColorMap map) {
+                                        ColorMap map, std::uint64_t ramp_max, bool ramp_of_boxes) {
   std::optional<std::uint32_t> clicked;
   if (!begin_panel("Tree", layout, 330.0f, 180.0f, 420.0f, 420.0f, true)) return clicked;
   if (!nodes || nodes->empty() || nodes->kind() == "grid") {
@@ -437,10 +437,13 @@ std::optional<std::uint32_t> tree_panel(const StructureNodes* nodes, const std::
   } else {
     ImGui::TextDisabled("%s, %llu nodes; click a row to select its subtree in the 3D view", nodes->kind().c_str(),
                         static_cast<unsigned long long>(nodes->size()));
-    RowColors rc{map, 0};
-    if (visits)
-      for (const std::uint64_t v : *visits) rc.max_visits = std::max(rc.max_visits, v);
-    if (visits) ImGui::TextDisabled("swatch: visits on the boxes' colour ramp (hottest node = top colour)");
+    const RowColors rc{map, ramp_max};
+    if (visits && ramp_of_boxes)
+      ImGui::TextDisabled("swatch: the 3D boxes' colours, top colour from %llu visits (the hottest box drawn)",
+                          static_cast<unsigned long long>(ramp_max));
+    else if (visits)
+      ImGui::TextDisabled("swatch: visits on the boxes' colour ramp, top colour %llu visits (the root's)",
+                          static_cast<unsigned long long>(ramp_max));
     tree_rows(*nodes, visits, rc, 0, selected, clicked, scroll_to_selected, 128);
   }
   ImGui::End();

@@ -63,9 +63,13 @@ bool explainer_panel(ExplainerState& state, const SplitExplanation* e, std::uint
 /// with a swatch of the colour `map` gives the node's box by visits); the
 /// path to `selected` is opened (and scrolled to when `scroll_to_selected`
 /// is set; it is cleared once done). Returns a node the user clicked.
+/// `ramp_max`: the visit count at the top of the swatches' ramp; with
+/// `ramp_of_boxes` it is the 3D boxes' (SceneView::boxes_visit_max), so a
+/// row's swatch is its box's colour (hotter rows, above the boxes drawn, take
+/// the top colour), else the tree's largest count (the root's).
 std::optional<std::uint32_t> tree_panel(const StructureNodes* nodes, const std::vector<std::uint64_t>* visits,
                                         std::uint32_t selected, bool& scroll_to_selected, const PanelLayout& layout,
-                                        ColorMap map = ColorMap::viridis);
+                                        ColorMap map, std::uint64_t ramp_max, bool ramp_of_boxes);
 
 // ---- Scenarios ------------------------------------------------------------------------------
 struct ScenarioPanelState {
