@@ -93,6 +93,8 @@ class Gui final : public ScriptHost {
   void take_flatten_commit();
   /// Keeps the worker's latest result when it is a prediction (flatten_prediction_).
   void note_flatten_prediction();
+  /// The spec of the scene `r` was computed on when that is the flatten panel's scene, else "".
+  std::string flatten_spec_of(const FlattenResult& r) const;
   void take_screenshot();
   SavedScreenshot write_frame(const std::optional<std::filesystem::path>& explicit_path);
   void report_errors();
@@ -412,8 +414,8 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
       RobustnessRequest r;
       r.scene = app_.current()->scene;
       r.options.rays = static_cast<std::size_t>(robustness_panel_.rays);
-      r.options.structure = robustness_panel_.with_structure ? app_.config().structure.name : "";
-      if (r.options.structure == "voxels" || r.options.structure == "tlas") r.options.structure.clear();
+      const std::string& shown = app_.config().structure.name;
+      r.options.structure = robustness_panel_.with_structure && lab_times_own_traversal(shown) ? shown : "";
       robustness_.request(std::move(r));
     }
   }
@@ -511,11 +513,15 @@ void Gui::take_screenshot() {
   }
 }
 
+std::string Gui::flatten_spec_of(const FlattenResult& r) const {
+  return flatten_scene_ && r.scene == flatten_scene_.get() ? flatten_scene_->spec : std::string();
+}
+
 void Gui::note_flatten_prediction() {
   const std::shared_ptr<const FlattenResult> r = flatten_.latest();
   if (!r || r->kind != FlattenRequest::Kind::preview || r == flatten_prediction_) return;
   flatten_prediction_ = r;
-  flatten_prediction_spec_ = flatten_scene_ && r->scene == flatten_scene_.get() ? flatten_scene_->spec : std::string();
+  flatten_prediction_spec_ = flatten_spec_of(*r);
 }
 
 void Gui::take_flatten_commit() {
@@ -707,7 +713,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       const std::shared_ptr<const FlattenResult> r = flatten_.latest();
       nlohmann::json doc;
       if (r && !r->error.empty()) {  // the last job failed: say so
-        doc = flatten_result_json(*r, flatten_scene_ && r->scene == flatten_scene_.get() ? flatten_scene_->spec : "");
+        doc = flatten_result_json(*r, flatten_spec_of(*r));
       } else {
         if (!flatten_prediction_)
           throw std::runtime_error("dump-flatten: no flatten prediction yet (run flatten IDS first)");

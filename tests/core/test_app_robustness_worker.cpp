@@ -5,6 +5,7 @@
 #include <chrono>
 #include <thread>
 
+#include "core/accel/factory.h"
 #include "core/scene/load.h"
 #include "ui/app/robustness_worker.h"
 
@@ -73,6 +74,24 @@ TEST(RobustnessWorker, BadStructureFailsWithOneLine) {
   EXPECT_EQ(snap->state, RobustnessSnapshot::State::failed);
   EXPECT_NE(snap->error.find("voxels"), std::string::npos);
   EXPECT_EQ(snap->error.find('\n'), std::string::npos);
+}
+
+// The panel offers the own-traversal box for every structure but voxels and
+// tlas, and the lab runs each structure it is offered for.
+TEST(RobustnessWorker, TheOwnTraversalIsOfferedWhereTheLabRunsIt) {
+  EXPECT_FALSE(lab_times_own_traversal("voxels"));
+  EXPECT_FALSE(lab_times_own_traversal("tlas"));
+  const auto scene = teapot();
+  for (const std::string& name : structure_names()) {
+    if (!lab_times_own_traversal(name)) continue;
+    LabOptions o;
+    o.rays = 200;
+    o.structure = name;
+    const LabResult res = run_robustness_lab(scene->scene.triangles, o);
+    bool own = false;
+    for (const LabVariant& v : res.variants) own |= v.own_structure;
+    EXPECT_TRUE(own) << name;
+  }
 }
 
 TEST(RobustnessWorker, ANewRequestSupersedesAndCancelStops) {

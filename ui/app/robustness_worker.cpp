@@ -3,6 +3,10 @@
 #include <exception>
 
 namespace accelviz {
+
+bool lab_times_own_traversal(std::string_view structure) {
+  return structure != "voxels" && structure != "tlas";
+}
 namespace {
 
 using Worker = LatestJobWorker<RobustnessRequest, std::shared_ptr<const RobustnessSnapshot>>;

@@ -7,12 +7,20 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "core/analysis/robustness_lab.h"
 #include "ui/app/build_worker.h"
 #include "ui/app/latest_job_worker.h"
 
 namespace accelviz {
+
+/// Whether the GUI's lab can also time the shown structure's own traversal:
+/// the lab runs it over the scene's triangles, so not for voxels (their hits
+/// are voxels) nor tlas (the lab's would be one instance of the triangles, not
+/// the scene's instances). The panel's box is disabled and the request leaves
+/// the structure out for these.
+bool lab_times_own_traversal(std::string_view structure);
 
 struct RobustnessRequest {
   std::shared_ptr<const LoadedScene> scene;  ///< kept alive while the lab runs

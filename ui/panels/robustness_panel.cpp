@@ -49,10 +49,9 @@ RobustnessAction robustness_panel(RobustnessPanelState& st, const RobustnessSnap
   ImGui::InputInt("Rays", &st.rays, 1000, 10000);
   st.rays = std::clamp(st.rays, 4, 1 << 22);
   ImGui::SameLine();
-  // The lab runs the structure's own traversal over the scene's triangles:
-  // voxels hit voxels, and the two-level structure is not one of its variants.
-  // The box stays unticked and disabled there (the choice is kept for the others).
-  const bool unavailable = structure == "voxels" || structure == "tlas";
+  // The box stays unticked and disabled where the lab cannot time the
+  // structure's own traversal (the choice is kept for the others).
+  const bool unavailable = !lab_times_own_traversal(structure);
   bool with_structure = st.with_structure && !unavailable;
   ImGui::BeginDisabled(unavailable);
   if (ImGui::Checkbox(("Also " + structure + "'s own traversal").c_str(), &with_structure))
