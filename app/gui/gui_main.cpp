@@ -3,9 +3,8 @@
 // frame. Builds and heatmaps run on worker threads, so a frame never waits
 // for them; scripts are run between frames through the same calls as the
 // mouse and keyboard.
-#include "app/gui/gui.h"
-
 #include "app/gui/gpu_heatmap.h"
+#include "app/gui/gui.h"
 #include "app/gui/insight_views.h"
 #include "app/gui/scene_view.h"
 #include "core/accel/tlas/tlas.h"
@@ -15,9 +14,10 @@
 #include "ui/app/dynamics.h"
 #include "ui/app/flatten_worker.h"
 #include "ui/app/script.h"
-#include "ui/app/sweep_worker.h"
 #include "ui/app/settings.h"
+#include "ui/app/sweep_worker.h"
 #include "ui/gl/glfw_context.h"
+#include "ui/gl/shader.h"
 #include "ui/imgui/imgui_context.h"
 #include "ui/panels/panels.h"
 #include "ui/render/screenshot.h"
@@ -96,6 +96,9 @@ class Gui final : public ScriptHost {
   /// The spec of the scene `r` was computed on when that is the flatten panel's scene, else "".
   std::string flatten_spec_of(const FlattenResult& r) const;
   void take_screenshot();
+  /// Rebuilds the shader programs (from `dir` when given: it becomes the
+  /// override folder). Returns "" or the one-line error; the old programs stay on error.
+  std::string reload_shaders(const std::optional<std::string>& dir = std::nullopt);
   SavedScreenshot write_frame(const std::optional<std::filesystem::path>& explicit_path);
   void report_errors();
   void save_settings_now();
@@ -295,6 +298,9 @@ void Gui::handle_input(int fbw, int fbh, int ww, int wh) {
         if (repeat) break;  // only the arrows repeat
         if (k.key == GLFW_KEY_F) app_.frame_selection();
         if (k.key == GLFW_KEY_R || k.key == GLFW_KEY_HOME) app_.reset_camera();
+        if (k.key == GLFW_KEY_F5) {
+          if (const std::string err = reload_shaders(); !err.empty()) app_.set_error(err);
+        }
         if (k.key == GLFW_KEY_F12) take_screenshot();
         if (k.key == GLFW_KEY_H || k.key == GLFW_KEY_F1) show_help_ = !show_help_;
     }
@@ -502,6 +508,23 @@ SavedScreenshot Gui::write_frame(const std::optional<std::filesystem::path>& exp
   return save_screenshot(dir, frame, info, std::time(nullptr));
 }
 
+std::string Gui::reload_shaders(const std::optional<std::string>& dir) {
+  if (dir) {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(*dir, ec)) return "reload-shaders: " + *dir + ": not a folder";
+    set_shader_dir(*dir);
+  }
+  try {
+    view_->renderer().reload_shaders();
+  } catch (const std::exception& e) {
+    return std::string("shaders not reloaded: ") + e.what();
+  }
+  const std::string from = shader_dir();
+  app_.set_message(from.empty() ? "shaders reloaded (built-in)"
+                                : "shaders reloaded (files in " + from + " over the built-in ones)");
+  return "";
+}
+
 void Gui::take_screenshot() {
   const SavedScreenshot r = write_frame(std::nullopt);
   if (r.ok) {
@@ -639,6 +662,11 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       if (!r.ok) throw std::runtime_error(r.error);
       last_screenshot_ = r.png.string();
       if (!options_.quiet) std::printf("%s\n", r.png.string().c_str());
+      return Status::done;
+    }
+    case K::reload_shaders: {
+      const std::string err = reload_shaders(c.arg.empty() ? std::nullopt : std::optional<std::string>(c.arg));
+      if (!err.empty()) throw std::runtime_error(err);
       return Status::done;
     }
     case K::dump_ray: {

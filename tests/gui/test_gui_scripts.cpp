@@ -231,6 +231,39 @@ TEST_F(GuiScript, ScreenshotShowsTheMeshAndTheLegend) {
   EXPECT_FALSE(fs::exists(dir_ / "pictures")) << "explicit paths only";
 }
 
+// reload-shaders (F5 in the window): a folder's files win over the built-in
+// shaders from then on. A mesh shader that paints everything magenta turns the
+// teapot magenta; a broken one is refused with its file named, and the script
+// stops there (exit 1).
+TEST_F(GuiScript, ReloadShadersTakesTheFolderOrNamesTheBrokenFile) {
+  fs::create_directories(path("magenta"));
+  std::ofstream(path("magenta") / "mesh.frag") << "#version 450 core\nout vec4 frag_color;\n"
+                                                  "void main() { frag_color = vec4(1.0, 0.0, 1.0, 1.0); }\n";
+  fs::create_directories(path("broken"));
+  std::ofstream(path("broken") / "mesh.frag") << "#version 450 core\nout vec4 frag_color;\nvoid main( {\n";
+  const std::string head =
+      std::string("open ") + kTeapot + "\nsize 320 240\ncamera " + kCamera + "\nset boxes off\nwait\n";
+  const RunResult r =
+      run(head + "screenshot " + path("before.png").string() + "\nreload-shaders " + path("magenta").string() +
+          "\nscreenshot " + path("after.png").string() + "\ndump-stats " + path("stats.json").string() + "\nquit\n");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const RgbImage before = read_png(path("before.png").string()), after = read_png(path("after.png").string());
+  const glm::u8vec3 magenta(255, 0, 255);
+  EXPECT_EQ(count_near(before, 0, 0, 320, 240, magenta, 30), 0);
+  EXPECT_GT(count_near(after, 0, 0, 320, 240, magenta, 30), 320 * 240 / 20) << "the teapot is drawn magenta";
+  EXPECT_NE(read_json(path("stats.json"))["message"].get<std::string>().find("shaders reloaded (files in " +
+                                                                             path("magenta").string()),
+            std::string::npos);
+
+  const RunResult bad = run(head + "reload-shaders " + path("broken").string() + "\nquit\n");
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_NE(bad.err.find((path("broken") / "mesh.frag").string() + ":3:"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("shaders not reloaded"), std::string::npos) << bad.err;
+  const RunResult missing = run(head + "reload-shaders " + path("nowhere").string() + "\nquit\n");
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_NE(missing.err.find("nowhere: not a folder"), std::string::npos) << missing.err;
+}
+
 TEST_F(GuiScript, ClickCastsThePixelRayAndReplaysItsTraversal) {
   const RunResult r = run(std::string("open ") + kTeapot + "\n" +
                           "size 640 480\n"

@@ -99,6 +99,7 @@ constexpr NamedKind kCommands[] = {
     {"flatten", ScriptCommand::Kind::flatten},
     {"flatten-commit", ScriptCommand::Kind::flatten_commit},
     {"dump-flatten", ScriptCommand::Kind::dump_flatten},
+    {"reload-shaders", ScriptCommand::Kind::reload_shaders},
 };
 
 }  // namespace
@@ -130,12 +131,11 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
     const std::string_view word = first_word(line, rest);
     const auto it =
         std::find_if(std::begin(kCommands), std::end(kCommands), [&](const NamedKind& c) { return c.name == word; });
-    if (it == std::end(kCommands))
-      fail("unknown command '" + std::string(word) +
-           "' (valid: open, structure, set, camera, size, wait, click, step, screenshot, dump-ray, dump-stats, quit, "
-           "scenario, dump-scenario, "
-           "dump-insight, force-effect, play, dump-dynamics, select-region, pin-a, dump-ab, frames, flatten, "
-           "flatten-commit, dump-flatten)");
+    if (it == std::end(kCommands)) {
+      std::string valid;
+      for (const NamedKind& k : kCommands) valid += (valid.empty() ? "" : ", ") + std::string(k.name);
+      fail("unknown command '" + std::string(word) + "' (valid: " + valid + ")");
+    }
 
     ScriptCommand c;
     c.kind = it->kind;
@@ -233,6 +233,9 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
       case ScriptCommand::Kind::pin_a:
       case ScriptCommand::Kind::flatten_commit:
         no_rest();
+        break;
+      case ScriptCommand::Kind::reload_shaders:
+        c.arg = std::string(rest);  // optional: the folder whose files win over the built-in shaders
         break;
       case ScriptCommand::Kind::flatten:
         // The ids are checked against the scene's instance count when it runs.

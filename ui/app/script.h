@@ -38,6 +38,7 @@ struct ScriptCommand {
     flatten,        ///< arg: instance ids ("0,2,5-9", "all"); predicts the flatten what-if on this view, waits
     flatten_commit,  ///< commits the last prediction (its instances merged) and waits for the merged scene's build
     dump_flatten,    ///< arg: path; the last prediction's figures as JSON
+    reload_shaders,  ///< arg: "" or a folder (then the shader override folder); rebuilds the shader programs
   };
   Kind kind = Kind::wait;
   int line = 0;        ///< 1-based line in the script file

@@ -22,6 +22,8 @@ inline constexpr Shortcut kShortcuts[] = {
     {"F", "frame the selected node (subtree mode) or the scene"},
     {"R, Home", "reset the view (the scene's first camera, else the framing view)"},
     {"Left, Right", "step the ray replay back / forward"},
+    {"F5",
+     "reload the shaders (files in ACCELVIZ_SHADER_DIR win over the built-in ones; on an error the old ones stay)"},
     {"F12", "screenshot (PNG + JSON side-car) into the screenshot folder"},
     {"H, F1", "show or hide this help"},
     {"Ctrl+Q", "quit"},

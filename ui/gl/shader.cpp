@@ -1,18 +1,35 @@
 #include "ui/gl/shader.h"
 
-#include <glm/gtc/type_ptr.hpp>
-
 #include <charconv>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <glm/gtc/type_ptr.hpp>
+#include <optional>
 #include <sstream>
 #include <utility>
 
 namespace accelviz {
 
+namespace {
+std::optional<std::string>& shader_dir_override() {
+  static std::optional<std::string> dir;  // GL thread only, as every shader build
+  return dir;
+}
+}  // namespace
+
+std::string shader_dir() {
+  if (shader_dir_override()) return *shader_dir_override();
+  const char* dir = std::getenv("ACCELVIZ_SHADER_DIR");
+  return dir ? dir : "";
+}
+
+void set_shader_dir(std::string dir) {
+  shader_dir_override() = std::move(dir);
+}
+
 ShaderSource load_shader_source(std::string_view name) {
-  if (const char* dir = std::getenv("ACCELVIZ_SHADER_DIR"); dir && *dir) {
+  if (const std::string dir = shader_dir(); !dir.empty()) {
     const std::filesystem::path path = std::filesystem::path(dir) / std::string(name);
     std::ifstream in(path, std::ios::binary);
     if (in) {
@@ -24,7 +41,7 @@ ShaderSource load_shader_source(std::string_view name) {
   for (const EmbeddedShader& s : embedded_shaders()) {
     if (name == s.name) return {std::string(name), "shaders/" + std::string(name), s.source};
   }
-  throw ShaderError("shaders/" + std::string(name) + ": no such shader (neither embedded nor in ACCELVIZ_SHADER_DIR)",
+  throw ShaderError("shaders/" + std::string(name) + ": no such shader (neither embedded nor in the shader folder)",
                     "shaders/" + std::string(name));
 }
 

@@ -33,9 +33,17 @@ struct ShaderSource {
   std::string text;
 };
 
-/// `name` from $ACCELVIZ_SHADER_DIR when set and the file exists there,
-/// otherwise the embedded copy. Throws ShaderError when neither has it.
+/// `name` from the override folder (shader_dir()) when there is one and the
+/// file exists there, otherwise the embedded copy. Throws ShaderError when
+/// neither has it.
 ShaderSource load_shader_source(std::string_view name);
+
+/// The folder whose files win over the embedded shaders: the one set by
+/// set_shader_dir(), else $ACCELVIZ_SHADER_DIR; "" for none.
+std::string shader_dir();
+/// Sets the override folder for this process (replacing $ACCELVIZ_SHADER_DIR);
+/// it applies to programs built from then on (Renderer::reload_shaders).
+void set_shader_dir(std::string dir);
 
 /// A compile or link failure. what() is one line,
 /// "<file>:<line>:<column>: error: <driver message>" for compile errors
