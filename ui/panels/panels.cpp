@@ -151,6 +151,32 @@ SceneAction scene_panel(std::string& path_field, const std::vector<std::string>&
 
 // ---- Structure -------------------------------------------------------------------------
 
+namespace {
+
+/// The BVH's build options (a bvh, and each BLAS and the TLAS of a tlas).
+bool bvh_option_widgets(BvhOptions& b) {
+  bool changed = false;
+  int splitter = static_cast<int>(b.splitter);
+  if (combo("Splitter", splitter, {"binned SAH", "exact SAH", "median", "LBVH (Morton)"})) {
+    b.splitter = static_cast<BvhSplitter>(splitter);
+    changed = true;
+  }
+  if (b.splitter == BvhSplitter::binned_sah)
+    changed |= slider_int("Buckets", b.buckets, 2, 256, "binned SAH bucket count");
+  if (slider_int("Max leaf size", b.max_leaf_size, 1, 255, "nodes with at most this many triangles are leaves")) {
+    b.leaf_size_cap = std::max(b.leaf_size_cap, b.max_leaf_size);
+    changed = true;
+  }
+  changed |= slider_int("Leaf size cap", b.leaf_size_cap, b.max_leaf_size, 255,
+                        "largest leaf the SAH may keep when cheaper than a split");
+  changed |= float_positive("C_trav", b.cost_traversal, 0.01f, "SAH cost of an inner-node visit");
+  changed |= float_positive("C_isect", b.cost_intersect, 0.01f, "SAH cost of a triangle test");
+  changed |= checkbox("EPO", b.compute_epo, "compute the effective primitive overlap (Aila 2013) after the build");
+  return changed;
+}
+
+}  // namespace
+
 bool structure_panel(StructureChoice& choice, const BuildProgress& progress, bool& cancel, const PanelLayout& layout) {
   cancel = false;
   bool changed = false;
@@ -167,23 +193,10 @@ bool structure_panel(StructureChoice& choice, const BuildProgress& progress, boo
 
   StructureOptions& o = choice.options;
   if (choice.name == "bvh") {
-    BvhOptions& b = o.bvh;
-    int splitter = static_cast<int>(b.splitter);
-    if (combo("Splitter", splitter, {"binned SAH", "exact SAH", "median", "LBVH (Morton)"})) {
-      b.splitter = static_cast<BvhSplitter>(splitter);
-      changed = true;
-    }
-    if (b.splitter == BvhSplitter::binned_sah)
-      changed |= slider_int("Buckets", b.buckets, 2, 256, "binned SAH bucket count");
-    if (slider_int("Max leaf size", b.max_leaf_size, 1, 255, "nodes with at most this many triangles are leaves")) {
-      b.leaf_size_cap = std::max(b.leaf_size_cap, b.max_leaf_size);
-      changed = true;
-    }
-    changed |= slider_int("Leaf size cap", b.leaf_size_cap, b.max_leaf_size, 255,
-                          "largest leaf the SAH may keep when cheaper than a split");
-    changed |= float_positive("C_trav", b.cost_traversal, 0.01f, "SAH cost of an inner-node visit");
-    changed |= float_positive("C_isect", b.cost_intersect, 0.01f, "SAH cost of a triangle test");
-    changed |= checkbox("EPO", b.compute_epo, "compute the effective primitive overlap (Aila 2013) after the build");
+    changed |= bvh_option_widgets(o.bvh);
+  } else if (choice.name == "tlas") {
+    ImGui::TextDisabled("BVH options, for each BLAS and the TLAS");
+    changed |= bvh_option_widgets(o.bvh);
   } else if (choice.name == "kdtree") {
     KdTreeOptions& k = o.kdtree;
     changed |= float_positive("C_trav", k.cost_traversal, 0.01f, nullptr);
