@@ -1,0 +1,104 @@
+#!/usr/bin/env bash
+# The headline table of docs/performance.md: our BVH beside Embree, in one
+# process per cell, on the shared meshes and the 10M-triangle soup.
+#
+#   bench/headline.sh [ACCELVIZ] [OUT_DIR]
+#
+# ACCELVIZ: the accelviz binary (default build/release/app/accelviz); OUT_DIR
+# (default: a new folder under /tmp) keeps each run's `bench --json` output
+# and the table, table.md, which is also printed.
+#
+# Per mesh and thread count T (1 and 2): `bench MESH -s bvh,embree -n 5
+# --warmup 1 -j T --no-epo`, once with our watertight test against Embree's
+# robust mode (--embree-robust) and once with our fast test (Moller-Trumbore)
+# against Embree's default mode (--triangle-test fast). The soup: `-n 3
+# --warmup 1 --rays primary --size 64x48` in those two pairings and in our
+# watertight test against Embree's default mode.
+#
+# Cells are ours / Embree from the same run: build (Embree's time over ours:
+# the medians, then the best runs), SAH cost and memory (ours over Embree's:
+# lower is better), and Mrays/s of the run's T threads (the `_nt` figures) for
+# closest and any hits (higher is better).
+#
+# Environment (for a quick run; the defaults are the documented headline):
+#   HEADLINE_MESHES   space-separated scenes (default: bunny, dragon and
+#                     kitchen_partial from $ACCELVIZ_ASSETS, default ../shared/assets)
+#   HEADLINE_SOUP     the soup's scene (default builtin:soup?size=10000000; "" skips it)
+#   HEADLINE_THREADS  thread counts (default "1 2")
+#   HEADLINE_REPEAT   runs per figure of the meshes (default 5); the soup's is 3 unless this is lower
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+bin="${1:-$root/build/release/app/accelviz}"
+out="${2:-$(mktemp -d /tmp/accelviz-headline-XXXXXX)}"
+[ -x "$bin" ] || { echo "headline: $bin: not an executable (build first, or pass the accelviz binary)" >&2; exit 2; }
+mkdir -p "$out"
+assets="${ACCELVIZ_ASSETS:-$root/../shared/assets}"
+meshes="${HEADLINE_MESHES-$assets/bunny.glb $assets/dragon.glb $assets/kitchen_partial.glb}"
+soup="${HEADLINE_SOUP-builtin:soup?size=10000000}"
+threads="${HEADLINE_THREADS:-1 2}"
+repeat="${HEADLINE_REPEAT:-5}"
+soup_repeat=$((repeat < 3 ? repeat : 3))
+
+run() {  # FILE ARGS...: one bench run, its JSON kept
+  local file="$1"
+  shift
+  echo "headline: accelviz -q bench $*" >&2
+  "$bin" -q bench "$@" --json > "$out/$file"
+}
+
+i=0
+rows=()
+for scene in $meshes; do
+  for t in $threads; do
+    i=$((i + 1))
+    run "$i-robust.json" "$scene" -s bvh,embree -n "$repeat" --warmup 1 -j "$t" --no-epo --embree-robust
+    rows+=("$i-robust.json|watertight vs robust")
+    run "$i-fast.json" "$scene" -s bvh,embree -n "$repeat" --warmup 1 -j "$t" --no-epo --triangle-test fast
+    rows+=("$i-fast.json|fast vs default")
+  done
+done
+if [ -n "$soup" ]; then
+  for t in $threads; do
+    i=$((i + 1))
+    common=(-s bvh,embree -n "$soup_repeat" --warmup 1 -j "$t" --no-epo --rays primary --size 64x48)
+    run "$i-robust.json" "$soup" "${common[@]}" --embree-robust
+    rows+=("$i-robust.json|watertight vs robust")
+    run "$i-fast.json" "$soup" "${common[@]}" --triangle-test fast
+    rows+=("$i-fast.json|fast vs default")
+    run "$i-default.json" "$soup" "${common[@]}"
+    rows+=("$i-default.json|watertight vs default")
+  done
+fi
+
+python3 - "$out" "${rows[@]}" > "$out/table.md" <<'PY'
+import json, os, sys
+
+out, rows = sys.argv[1], sys.argv[2:]
+
+def fmt(x):
+    return "" if x is None else f"{x:.2f}"
+
+print("| scene | mode | threads | build (median / best) | SAH | memory | primary closest / any "
+      "| diffuse closest / any | shadow closest / any |")
+print("|---|---|---|---|---|---|---|---|---|")
+for row in rows:
+    file, mode = row.split("|", 1)
+    j = json.load(open(os.path.join(out, file)))
+    s = {x["name"]: x for x in j["structures"]}
+    ours, emb = s["bvh"], s["embree"]
+    ob, eb = ours["build"], emb["build"]
+    build = f"{eb['build_ms'] / ob['build_ms']:.2f} / {min(eb['build_ms_runs']) / min(ob['build_ms_runs']):.2f}"
+    sah = f"{ours['embree_binary_bvh']['sah_ratio_ours_over_embree']:.4f}"
+    mem = f"{ob['memory_bytes'] / eb['memory_bytes']:.2f}"
+    cells = []
+    for rs in ("primary", "diffuse", "shadow"):
+        if rs not in ours["rays"]:
+            cells.append("")
+            continue
+        o, e = ours["rays"][rs], emb["rays"][rs]
+        cells.append(f"{o['closest_mrays_nt'] / e['closest_mrays_nt']:.2f} / {o['any_mrays_nt'] / e['any_mrays_nt']:.2f}")
+    name = os.path.splitext(os.path.basename(j["scene"]))[0] if not j["scene"].startswith("builtin:") else j["scene"]
+    print(f"| {name} | {mode} | {j['threads']} | {build} | {sah} | {mem} | " + " | ".join(cells) + " |")
+PY
+cat "$out/table.md"
+echo "headline: the runs' JSON and table.md are in $out" >&2

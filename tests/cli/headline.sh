@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# bench/headline.sh (docs/performance.md's headline table) on a tiny
+# configuration: every run it documents is made, and table.md has one row per
+# scene, pairing and thread count with positive ratios in each filled cell.
+# Skipped (passes with a note) in a build without Embree.
+set -euo pipefail
+accelviz="$(realpath "$1")"
+src="$2"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+"$accelviz" bench --help > "$tmp/help.txt"
+if ! grep -q embree-medium "$tmp/help.txt"; then
+  echo "headline: built without Embree, nothing to compare"
+  exit 0
+fi
+HEADLINE_MESHES='builtin:teapot?size=800' HEADLINE_SOUP='builtin:soup?size=2000' HEADLINE_THREADS='1 2' \
+  HEADLINE_REPEAT=1 bash "$src/bench/headline.sh" "$accelviz" "$tmp/out" > "$tmp/stdout.md" 2> "$tmp/stderr.txt"
+cmp -s "$tmp/stdout.md" "$tmp/out/table.md" || fail "the table printed is not table.md"
+[ "$(ls "$tmp/out"/*.json | wc -l)" -eq 10 ] || fail "expected 10 bench runs: $(ls "$tmp/out")"
+grep -q -- "--embree-robust" "$tmp/stderr.txt" || fail "the commands are not echoed"
+python3 - "$tmp/out/table.md" <<'PY'
+import sys
+lines = open(sys.argv[1]).read().splitlines()
+assert lines[0].startswith("| scene | mode | threads | build"), lines[0]
+rows = [l.strip("|").split("|") for l in lines[2:]]
+assert len(rows) == 10, len(rows)
+want = {("builtin:teapot?size=800", m, t) for m in ("watertight vs robust", "fast vs default") for t in ("1", "2")}
+want |= {("builtin:soup?size=2000", m, t)
+         for m in ("watertight vs robust", "fast vs default", "watertight vs default") for t in ("1", "2")}
+got = {(r[0].strip(), r[1].strip(), r[2].strip()) for r in rows}
+assert got == want, got ^ want
+for r in rows:
+    cells = [c.strip() for c in r[3:]]
+    is_soup = r[0].strip().startswith("builtin:soup")
+    assert len(cells) == 6, r
+    for i, c in enumerate(cells):
+        if is_soup and i >= 4:
+            assert c == "", (r, "the soup traces primary rays only")
+            continue
+        for x in c.split(" / "):
+            assert float(x) > 0, (r, c)
+PY
+echo "headline: ok"
