@@ -3,8 +3,9 @@
 // frame. Builds and heatmaps run on worker threads, so a frame never waits
 // for them; scripts are run between frames through the same calls as the
 // mouse and keyboard.
-#include "app/gui/gpu_heatmap.h"
 #include "app/gui/gui.h"
+
+#include "app/gui/gpu_heatmap.h"
 #include "app/gui/insight_views.h"
 #include "app/gui/scene_view.h"
 #include "core/accel/tlas/tlas.h"

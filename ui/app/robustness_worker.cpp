@@ -7,6 +7,7 @@ namespace accelviz {
 bool lab_times_own_traversal(std::string_view structure) {
   return structure != "voxels" && structure != "tlas";
 }
+
 namespace {
 
 using Worker = LatestJobWorker<RobustnessRequest, std::shared_ptr<const RobustnessSnapshot>>;
