@@ -24,6 +24,13 @@
 // (what the worker does), 0: new frames. Counter setup_ms: the job's time
 // outside its tracing (the levels' set-up).
 //
+// InstanceOverlap/F: instance_overlap() (core/accel/tlas/tlas_overlap.h) of
+// builtin:dynamic's 6,252 instances after SceneAnimator::step at frames
+// 0..F (dt 0.04 s): what `animate` and the Dynamics panel measure per frame
+// outside the frame's timings (docs/dynamics.md). Counter tlas_rebuild_ms:
+// that frame's TLAS rebuild, to set the overlap's time beside; pairs and
+// area_ratio: the overlap measured.
+//
 // ACCELVIZ_BENCH_PAIRING: which of our triangle tests meets which Embree
 // mode (the pairs of `accelviz bench`): unset or `default`, our watertight
 // test against Embree's default mode; `robust`, watertight against Embree's
@@ -44,9 +51,12 @@
 #include "core/accel/bvh/bvh.h"
 #include "core/accel/embree_backend.h"
 #include "core/accel/factory.h"
+#include "core/accel/tlas/tlas.h"
+#include "core/accel/tlas/tlas_overlap.h"
 #include "core/query/batch.h"
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
+#include "core/scene/animation.h"
 #include "core/scene/load.h"
 #include "core/util/timing.h"
 #ifdef ACCELVIZ_GBENCH_HEATMAP
@@ -213,6 +223,24 @@ void heatmap_job(benchmark::State& state) {
 }
 #endif
 
+/// range(0) = the last frame stepped (frames 0..F at 0.04 s).
+void instance_overlap_bench(benchmark::State& state) {
+  static const Scene scene = make_builtin("builtin:dynamic");
+  Tlas tlas(scene);
+  SceneAnimator animator(scene, tlas);
+  FrameStats frame;
+  for (std::int64_t f = 0; f <= state.range(0); ++f) frame = animator.step(static_cast<float>(f) * 0.04f);
+  InstanceOverlap o;
+  for (auto _ : state) {
+    o = instance_overlap(tlas);
+    benchmark::DoNotOptimize(o);
+  }
+  state.counters["tlas_rebuild_ms"] = frame.tlas_rebuild_ms;
+  state.counters["pairs"] = static_cast<double>(o.overlapping_pairs);
+  state.counters["area_ratio"] = o.area_ratio;
+  state.counters["instances"] = static_cast<double>(o.instances);
+}
+
 void register_all() {
   std::vector<std::string> names = {"bvh", "lbvh"};
   if (kHaveEmbree) names.push_back("embree");
@@ -236,6 +264,10 @@ void register_all() {
           ->UseRealTime();
     }
   }
+  benchmark::RegisterBenchmark("InstanceOverlap", instance_overlap_bench)
+      ->DenseRange(0, 5)
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime();
 #ifdef ACCELVIZ_GBENCH_HEATMAP
   benchmark::RegisterBenchmark("HeatmapJob", heatmap_job)
       ->ArgsProduct({{0, 1}, {1280}, {720}})

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <vector>
 
 #include "core/accel/tlas/flatten_what_if.h"
@@ -48,6 +49,49 @@ TEST(InstanceOverlap, ThreeNestedCopiesCountEveryPair) {
   EXPECT_EQ(o.overlapping_pairs, 3u);
   EXPECT_DOUBLE_EQ(o.area_ratio, 3.0);
   EXPECT_DOUBLE_EQ(o.volume_ratio, 3.0);
+}
+
+// Many boxes (long ones whose x-extents reach past hundreds of others, so
+// the sweep's candidate chunks fill and wrap; flat ones that only touch;
+// repeats) against every pair tested directly.
+TEST(InstanceOverlap, ManyBoxesAgreeWithEveryPairTestedDirectly) {
+  std::uint64_t state = 12345;
+  const auto next = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<float>((state >> 40) & 0xFFFF) / 65535.0f;
+  };
+  std::vector<Aabb> boxes;
+  for (int i = 0; i < 1500; ++i) {
+    const glm::vec3 lo(next() * 100.0f, next() * 20.0f, next() * 20.0f);
+    glm::vec3 size(next() * 3.0f, next() * 3.0f, next() * 3.0f);
+    if (i % 50 == 0) size.x = 60.0f;  // long in x: hundreds of candidates each
+    if (i % 7 == 0) size.y = 0.0f;    // flat: overlaps have no volume, and touch-only pairs count nothing
+    boxes.push_back(Aabb{lo, lo + size});
+  }
+  boxes.push_back(boxes[3]);  // a repeat
+  boxes.push_back(Aabb{});    // empty: skipped
+  const auto area = [](const Aabb& b) {
+    const glm::dvec3 e = glm::dvec3(b.hi) - glm::dvec3(b.lo);
+    return 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
+  };
+  std::uint64_t pairs = 0;
+  double area_sum = 0.0, volume_sum = 0.0;
+  for (std::size_t i = 0; i + 1 < boxes.size(); ++i)
+    for (std::size_t j = i + 1; j < boxes.size(); ++j) {
+      if (boxes[i].is_empty() || boxes[j].is_empty()) continue;
+      const Aabb c = Aabb::intersection(boxes[i], boxes[j]);
+      if (c.is_empty() || !(area(c) > 0.0)) continue;
+      ++pairs;
+      area_sum += area(c);
+      const glm::dvec3 e = glm::dvec3(c.hi) - glm::dvec3(c.lo);
+      volume_sum += e.x * e.y * e.z;
+    }
+  const InstanceOverlap o = instance_overlap(boxes);
+  EXPECT_EQ(o.instances, boxes.size() - 1);
+  ASSERT_GT(pairs, 500u) << "the boxes must overlap a lot for the test to mean something";
+  EXPECT_EQ(o.overlapping_pairs, pairs);
+  EXPECT_NEAR(o.area_sum, area_sum, 1e-9 * area_sum);
+  EXPECT_NEAR(o.volume_sum, volume_sum, 1e-9 * volume_sum);
 }
 
 TEST(InstanceOverlap, TheTlasReportsItsInstancesOverlapAtBuild) {
