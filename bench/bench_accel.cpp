@@ -24,6 +24,12 @@
 // (what the worker does), 0: new frames. Counter setup_ms: the job's time
 // outside its tracing (the levels' set-up).
 //
+// Refit: Bvh::refit of our BVH over the scene's triangles (what a deforming
+// mesh's BLAS gets per frame, docs/dynamics.md), alternating between the
+// triangles as loaded and a copy whose every vertex moved by up to 1 % of
+// the bounds' diagonal; counter build_ms: one fresh one-thread build of the
+// same tree, to set the refit beside.
+//
 // InstanceOverlap/F: instance_overlap() (core/accel/tlas/tlas_overlap.h) of
 // builtin:dynamic's 6,252 instances after SceneAnimator::step at frames
 // 0..F (dt 0.04 s): what `animate` and the Dynamics panel measure per frame
@@ -39,6 +45,8 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <bit>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -223,6 +231,36 @@ void heatmap_job(benchmark::State& state) {
 }
 #endif
 
+void refit(benchmark::State& state) {
+  const std::vector<Triangle>& rest = fixture().scene.triangles;
+  std::vector<Triangle> moved = rest;
+  const Aabb b = fixture().scene.bounds();
+  const float step = 0.01f * glm::length(b.hi - b.lo);
+  for (Triangle& t : moved)
+    for (glm::vec3* v : {&t.v0, &t.v1, &t.v2}) {
+      // A shared vertex moves alike in every triangle: the offset hashes its position.
+      const std::uint32_t h = std::bit_cast<std::uint32_t>(v->x) * 73856093u ^
+                              std::bit_cast<std::uint32_t>(v->y) * 19349663u ^
+                              std::bit_cast<std::uint32_t>(v->z) * 83492791u;
+      *v += step * glm::vec3(static_cast<float>(h & 1023u) / 1023.0f - 0.5f,
+                             static_cast<float>((h >> 10) & 1023u) / 1023.0f - 0.5f,
+                             static_cast<float>((h >> 20) & 1023u) / 1023.0f - 0.5f);
+    }
+  BvhOptions o;
+  o.compute_epo = false;
+  o.threads = 1;
+  const auto t0 = std::chrono::steady_clock::now();
+  Bvh bvh(rest, o);
+  const double build_ms = ms_since(t0);
+  bool at_rest = true;
+  for (auto _ : state) {
+    at_rest = !at_rest;
+    bvh.refit(at_rest ? rest : moved);
+  }
+  state.counters["build_ms"] = build_ms;
+  state.counters["triangles"] = static_cast<double>(rest.size());
+}
+
 /// range(0) = the last frame stepped (frames 0..F at 0.04 s).
 void instance_overlap_bench(benchmark::State& state) {
   static const Scene scene = make_builtin("builtin:dynamic");
@@ -264,6 +302,7 @@ void register_all() {
           ->UseRealTime();
     }
   }
+  benchmark::RegisterBenchmark("Refit", refit)->Unit(benchmark::kMillisecond)->UseRealTime();
   benchmark::RegisterBenchmark("InstanceOverlap", instance_overlap_bench)
       ->DenseRange(0, 5)
       ->Unit(benchmark::kMillisecond)
