@@ -37,6 +37,18 @@ void GpuHeatmap::start(const HeatmapRequest& r, std::uint64_t id) {
   // this one's first band (a camera being dragged restarts every frame).
 }
 
+std::unique_ptr<GpuBvhTracer> GpuHeatmap::fresh_tracer() const {
+  return tracer_ ? std::make_unique<GpuBvhTracer>() : nullptr;
+}
+
+void GpuHeatmap::replace_tracer(std::unique_ptr<GpuBvhTracer> fresh) {
+  if (!fresh) return;
+  running_ = false;
+  frames_.release_requests();
+  uploaded_.reset();
+  tracer_ = std::move(fresh);
+}
+
 std::shared_ptr<const HeatmapFrame> GpuHeatmap::step(double budget_ms) {
   if (!running_) return nullptr;
   try {

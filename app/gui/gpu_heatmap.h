@@ -26,6 +26,15 @@ class GpuHeatmap final : public GpuHeatmapJob {
   bool busy() const override { return running_; }
   Progress progress() const override { return progress_; }
 
+  /// For a shader reload (F5, `reload-shaders`): a tracer built from the
+  /// shader files as they are now, or null when no trace has been made yet
+  /// (the first one reads them anyway). Throws ShaderError/GlError; nothing
+  /// is replaced until replace_tracer().
+  std::unique_ptr<GpuBvhTracer> fresh_tracer() const;
+  /// Takes `fresh` (from fresh_tracer(); null: nothing to do): a trace in
+  /// progress is cancelled and the BVH is uploaded again at the next start.
+  void replace_tracer(std::unique_ptr<GpuBvhTracer> fresh);
+
   /// The whole request in one go (start, then bands until done).
   std::shared_ptr<const HeatmapFrame> trace(const HeatmapRequest& r, std::uint64_t id);
 

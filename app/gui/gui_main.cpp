@@ -516,7 +516,14 @@ std::string Gui::reload_shaders(const std::optional<std::string>& dir) {
     set_shader_dir(*dir);
   }
   try {
+    // Everything is built before anything is replaced: the GPU heatmap's
+    // trace (when one has been made) and the 3D view's programs.
+    std::unique_ptr<GpuBvhTracer> tracer = gpu_heatmap_ ? gpu_heatmap_->fresh_tracer() : nullptr;
     view_->renderer().reload_shaders();
+    if (tracer) {
+      gpu_heatmap_->replace_tracer(std::move(tracer));
+      app_.retrace_heatmap();
+    }
   } catch (const std::exception& e) {
     return std::string("shaders not reloaded: ") + e.what();
   }

@@ -838,6 +838,35 @@ TEST_F(GuiScript, HeatmapTracedOnTheGpuCountsWhatTheCpuCounts) {
   EXPECT_EQ(grid["complete"], true);
 }
 
+// reload-shaders rebuilds the GPU heatmap's trace too once it has been used:
+// a broken trace_bvh.comp in the folder is named (and refused) then, not
+// before; a good copy of it is taken and the view traced again on the GPU
+// with the same counts (the BVH uploaded to the new tracer).
+TEST_F(GuiScript, ReloadShadersRebuildsTheGpuTraceOnceItIsUsed) {
+  fs::create_directories(path("broken"));
+  std::ofstream(path("broken") / "trace_bvh.comp") << "#version 450 core\nvoid main( {\n";
+  fs::create_directories(path("good"));
+  fs::copy_file(fs::path(ACCELVIZ_SOURCE_DIR) / "shaders" / "trace_bvh.comp", path("good") / "trace_bvh.comp");
+  const std::string head =
+      std::string("open ") + kTeapot + "\nsize 160 120\ncamera " + kCamera + "\nset heatmap full\nwait\n";
+  // Not used yet: nothing of the GPU trace to rebuild, so the broken file is not read.
+  const RunResult unused = run(head + "reload-shaders " + path("broken").string() + "\nquit\n");
+  EXPECT_EQ(unused.code, 0) << unused.err;
+  const RunResult good =
+      run(head + "set heatmap-gpu on\nwait\ndump-stats " + path("before.json").string() + "\nreload-shaders " +
+          path("good").string() + "\nwait\ndump-stats " + path("after.json").string() + "\nquit\n");
+  ASSERT_EQ(good.code, 0) << good.err;
+  const nlohmann::json before = read_json(path("before.json"))["view"], after = read_json(path("after.json"))["view"];
+  EXPECT_EQ(before["device"], "gpu") << before["gpu_note"];
+  EXPECT_EQ(after["device"], "gpu") << after["gpu_note"];
+  EXPECT_EQ(after["complete"], true);
+  for (const char* k : {"hits", "mean_nodes", "max_nodes", "mean_prims", "max_prims"})
+    EXPECT_EQ(after[k], before[k]) << k;
+  const RunResult bad = run(head + "set heatmap-gpu on\nwait\nreload-shaders " + path("broken").string() + "\nquit\n");
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_NE(bad.err.find((path("broken") / "trace_bvh.comp").string() + ":2:"), std::string::npos) << bad.err;
+}
+
 // Two-level views and the flatten what-if in the window: the `instances`
 // metric counts instances per pixel, `flatten` predicts merging four trees
 // and `flatten-commit` rebuilds the merged scene (three fewer instances);

@@ -90,6 +90,9 @@ class AppState {
   /// once per frame within heatmap-gpu-ms and shows its frame once complete.
   /// Not owned; null removes it.
   void set_gpu_heatmap_tracer(GpuHeatmapJob* job) { gpu_job_ = job; }
+  /// Traces the view's heatmap again at the next update, as if something it
+  /// shows had changed (e.g. the GPU trace's shader was reloaded).
+  void retrace_heatmap() { heatmap_requested_.reset(); }
   /// Why heatmap-gpu is on but the CPU traced the heatmap ("" otherwise).
   const std::string& gpu_heatmap_note() const { return gpu_note_; }
   /// The heatmap shown was traced on the GPU.

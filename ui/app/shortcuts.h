@@ -23,7 +23,8 @@ inline constexpr Shortcut kShortcuts[] = {
     {"R, Home", "reset the view (the scene's first camera, else the framing view)"},
     {"Left, Right", "step the ray replay back / forward"},
     {"F5",
-     "reload the shaders (files in ACCELVIZ_SHADER_DIR win over the built-in ones; on an error the old ones stay)"},
+     "reload the shaders, the GPU heatmap's included (files in ACCELVIZ_SHADER_DIR win over the built-in ones; on "
+     "an error the old ones stay)"},
     {"F12", "screenshot (PNG + JSON side-car) into the screenshot folder"},
     {"H, F1", "show or hide this help"},
     {"Ctrl+Q", "quit"},
