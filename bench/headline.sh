@@ -75,9 +75,6 @@ import json, os, sys
 
 out, rows = sys.argv[1], sys.argv[2:]
 
-def fmt(x):
-    return "" if x is None else f"{x:.2f}"
-
 print("| scene | mode | threads | build (median / best) | SAH | memory | primary closest / any "
       "| diffuse closest / any | shadow closest / any |")
 print("|---|---|---|---|---|---|---|---|---|")

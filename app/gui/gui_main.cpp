@@ -84,6 +84,9 @@ class Gui final : public ScriptHost {
   /// The visit count at the top of the 3D boxes' colour ramp while they are
   /// shown and coloured by visits (the Tree's swatches then share it).
   std::optional<std::uint64_t> box_ramp_max() const;
+  /// Uploads the overlay as the settings and the insight stand now (before a
+  /// screenshot or a dump reads it, rather than as of the last frame).
+  void sync_overlay();
   /// The Dynamics panel: the timeline and per-frame figures while per-frame updates are on.
   void draw_dynamics(const panels::PanelLayout& layout);
   /// The Flatten what-if panel while the structure is tlas; takes a finished commit.
@@ -428,6 +431,11 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
   }
 }
 
+void Gui::sync_overlay() {
+  view_->set_box_insight(insight_.box_insight(app_));
+  view_->sync(app_);
+}
+
 std::optional<std::uint64_t> Gui::box_ramp_max() const {
   if (!app_.config().view.show_boxes || !view_->boxes_by_visits()) return std::nullopt;
   return view_->boxes_visit_max();
@@ -489,8 +497,7 @@ SavedScreenshot Gui::write_frame(const std::optional<std::filesystem::path>& exp
   // Draw the current state now, so the file is exactly what the view shows
   // after this frame's changes (uploads included).
   const int w = window_->width(), h = window_->height();
-  view_->set_box_insight(insight_.box_insight(app_));
-  view_->sync(app_);
+  sync_overlay();
   view_->draw(app_, w, h);
   const RgbImage frame = to_rgb(view_->renderer().read_pixels());
   const glm::vec2 range = view_->heatmap_range(app_);
@@ -686,16 +693,16 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
     case K::dump_stats: {
       nlohmann::json doc = app_.stats_json();
       doc["frames"] = frames_drawn_;
-      view_->set_box_insight(insight_.box_insight(app_));  // the overlay as the settings and insight stand now
-      view_->sync(app_);
+      sync_overlay();
+      const std::optional<std::uint64_t> ramp_max = box_ramp_max();
       doc["boxes"] = {{"drawn", view_->boxes_drawn()},
                       {"matched", view_->boxes_matched()},
                       {"truncated", view_->boxes_truncated()},
                       {"instance_colors", view_->instance_colored()},
                       {"node_note", insight_.box_node_note(app_)},
                       {"visit_max", view_->boxes_visit_max()}};
-      doc["tree"] = {{"swatch_max", insight_.tree_swatch_max(app_, box_ramp_max())},
-                     {"swatch_of_boxes", box_ramp_max().has_value()}};
+      doc["tree"] = {{"swatch_max", insight_.tree_swatch_max(app_, ramp_max)},
+                     {"swatch_of_boxes", ramp_max.has_value()}};
       fail_if(write_file_atomic(c.arg, doc.dump(2) + "\n"));
       return Status::done;
     }
