@@ -49,6 +49,8 @@ constexpr std::uint64_t kMaxWorldTriangles = std::uint64_t{1} << 28;
 constexpr std::size_t kMaxJsonDepth = 256;
 /// tinygltf takes the file size as `unsigned int`; GLB lengths are 32-bit.
 constexpr std::uint64_t kMaxFileBytes = std::numeric_limits<std::uint32_t>::max();
+/// The problem named for a file (the scene, or a buffer or image it names) over kMaxFileBytes.
+constexpr std::string_view kTooLarge = "file is larger than 4 GiB, which glTF loading does not support";
 
 constexpr std::uint32_t kGlbMagic = 0x46546C67;      // "glTF"
 constexpr std::uint32_t kGlbChunkJson = 0x4E4F534A;  // "JSON"
@@ -1045,10 +1047,8 @@ class GltfConverter {
 
 std::vector<unsigned char> read_file(const std::string& path) {
   std::uintmax_t size = 0;
-  if (std::string problem = input_file_problem(path, kMaxFileBytes, size); !problem.empty()) {
-    if (problem.starts_with("is larger")) problem = "file is larger than 4 GiB, which glTF loading does not support";
+  if (const std::string problem = input_file_problem(path, kMaxFileBytes, size, kTooLarge); !problem.empty())
     fail_file(path, problem);
-  }
   std::ifstream in(path, std::ios::binary);
   if (!in) fail_file(path, "cannot open for reading");
   std::vector<unsigned char> data(static_cast<std::size_t>(size));
@@ -1150,7 +1150,7 @@ bool read_external_file(std::vector<unsigned char>* out, std::string* err, const
     return false;
   };
   std::uintmax_t size = 0;
-  if (const std::string p = input_file_problem(path, kMaxFileBytes, size); !p.empty()) return problem(p);
+  if (const std::string p = input_file_problem(path, kMaxFileBytes, size, kTooLarge); !p.empty()) return problem(p);
   if (size == 0) return problem("empty file");
   std::ifstream in(path, std::ios::binary);
   if (!in) return problem("cannot open for reading");

@@ -7,14 +7,18 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
 
 namespace accelviz {
 
 /// "" when `path` names a regular file (a symbolic link counts as what it
 /// names) of at most `max_bytes`, its size then in `size`; else the problem,
 /// without the path: "no such file", "is a directory, not a file", "is not a
-/// regular file", "cannot read its size: ...", "is larger than N bytes".
-inline std::string input_file_problem(const std::string& path, std::uintmax_t max_bytes, std::uintmax_t& size) {
+/// regular file", "cannot read its size: ...", and for a larger file
+/// `too_large` (a reader's own words for its limit), by default "is larger
+/// than N bytes".
+inline std::string input_file_problem(const std::string& path, std::uintmax_t max_bytes, std::uintmax_t& size,
+                                      std::string_view too_large = {}) {
   std::error_code ec;
   const std::filesystem::file_status st = std::filesystem::status(path, ec);
   if (ec || !std::filesystem::exists(st)) return "no such file";
@@ -22,7 +26,8 @@ inline std::string input_file_problem(const std::string& path, std::uintmax_t ma
   if (!std::filesystem::is_regular_file(st)) return "is not a regular file";
   size = std::filesystem::file_size(path, ec);
   if (ec) return "cannot read its size: " + ec.message();
-  if (size > max_bytes) return "is larger than " + std::to_string(max_bytes) + " bytes";
+  if (size > max_bytes)
+    return too_large.empty() ? "is larger than " + std::to_string(max_bytes) + " bytes" : std::string(too_large);
   return {};
 }
 

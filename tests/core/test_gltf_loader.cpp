@@ -600,6 +600,24 @@ TEST_F(GltfLoader, TruncatedGlb) {
   expect_error(path("tiny.glb"), "truncated GLB");
 }
 
+// A file over 4 GiB (sparse: no disk is used) is refused with the glTF
+// loader's own words for its limit, not the generic size message.
+TEST_F(GltfLoader, FileOver4GiBIsRefusedByName) {
+  write_file(dir_ / "huge.glb", one_triangle().glb_bytes());
+  fs::resize_file(dir_ / "huge.glb", (std::uintmax_t{1} << 32) + 1);
+  expect_error(path("huge.glb"), "file is larger than 4 GiB, which glTF loading does not support");
+}
+
+TEST_F(GltfLoader, ExternalBufferOver4GiBIsRefusedByName) {
+  GltfBuilder b = one_triangle();
+  write_file(dir_ / "huge.bin", std::string(b.bin.begin(), b.bin.end()));
+  fs::resize_file(dir_ / "huge.bin", (std::uintmax_t{1} << 32) + 1);
+  json d = b.doc;
+  d["buffers"] = json::array({json{{"byteLength", b.bin.size()}, {"uri", "huge.bin"}}});
+  write_file(dir_ / "external.gltf", d.dump());
+  expect_error(path("external.gltf"), "file is larger than 4 GiB, which glTF loading does not support");
+}
+
 TEST_F(GltfLoader, WrongMagic) {
   std::string bytes = one_triangle().glb_bytes();
   bytes[3] = 'X';
