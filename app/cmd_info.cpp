@@ -34,6 +34,9 @@ int run_info(const InfoOptions& o, const GlobalOptions& global) {
     nlohmann::json j;
     j["scene"] = o.scene;
     j["triangles"] = scene.triangles.size();
+    j["flattened"] = scene.flattened();
+    j["instanced_triangles"] = scene.instanced_triangle_count();
+    j["unique_triangles"] = scene.unique_triangle_count();
     j["meshes"] = scene.meshes.size();
     j["instances"] = scene.instances.size();
     j["nodes"] = scene.nodes.size();
@@ -54,7 +57,7 @@ int run_info(const InfoOptions& o, const GlobalOptions& global) {
     return 0;
   }
   std::printf("scene          %s\n", o.scene.c_str());
-  std::printf("triangles      %zu\n", scene.triangles.size());
+  std::printf("triangles      %s\n", triangle_count_text(scene).c_str());
   std::printf("meshes         %zu\n", scene.meshes.size());
   std::printf("instances      %zu (instancing: %s)\n", scene.instances.size(), scene.has_instancing() ? "yes" : "no");
   std::printf("nodes          %zu\n", scene.nodes.size());

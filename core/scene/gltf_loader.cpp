@@ -1024,8 +1024,7 @@ class GltfConverter {
   }
 
   void check_world_triangle_count() const {
-    std::uint64_t total = 0;
-    for (const Instance& inst : scene_.instances) total += scene_.meshes[inst.mesh].indices.size();
+    const std::uint64_t total = scene_.instanced_triangle_count();
     if (total > kMaxWorldTriangles)
       fail("instances expand to " + std::to_string(total) + " world triangles, more than the limit of " +
            std::to_string(kMaxWorldTriangles));

@@ -60,15 +60,54 @@ bool Scene::has_instancing() const {
   return false;
 }
 
+std::uint64_t Scene::instanced_triangle_count() const {
+  std::uint64_t total = 0;
+  for (const Instance& inst : instances) total += meshes[inst.mesh].indices.size();
+  return total;
+}
+
+/// Calls f(mesh) once for every mesh some instance references, in the order of first reference.
+template <class F>
+static void for_each_referenced_mesh(const Scene& scene, const F& f) {
+  std::vector<bool> used(scene.meshes.size(), false);
+  for (const Instance& inst : scene.instances)
+    if (!used[inst.mesh]) {
+      used[inst.mesh] = true;
+      f(scene.meshes[inst.mesh]);
+    }
+}
+
+std::uint64_t Scene::unique_triangle_count() const {
+  std::uint64_t total = 0;
+  for_each_referenced_mesh(*this, [&](const Mesh& m) { total += m.indices.size(); });
+  return total;
+}
+
+std::size_t Scene::referenced_mesh_count() const {
+  std::size_t count = 0;
+  for_each_referenced_mesh(*this, [&](const Mesh&) { ++count; });
+  return count;
+}
+
+std::string triangle_count_text(const Scene& scene) {
+  const auto unique = [&] {
+    const std::size_t meshes = scene.referenced_mesh_count();
+    return std::to_string(scene.unique_triangle_count()) + " unique in " + std::to_string(meshes) +
+           (meshes == 1 ? " mesh" : " meshes");
+  };
+  if (!scene.flattened())
+    return std::to_string(scene.instanced_triangle_count()) + " instanced, not flattened (" + unique() + ")";
+  if (scene.has_instancing()) return std::to_string(scene.triangles.size()) + " (from " + unique() + ")";
+  return std::to_string(scene.triangles.size());
+}
+
 static bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 void Scene::flatten() {
   triangles.clear();
   report.dropped_nonfinite = 0;
   report.degenerate = 0;
-  std::size_t total = 0;
-  for (const Instance& inst : instances) total += meshes[inst.mesh].indices.size();
-  triangles.reserve(total);
+  triangles.reserve(static_cast<std::size_t>(instanced_triangle_count()));
   for (Instance& inst : instances) {
     const Mesh& mesh = meshes[inst.mesh];
     inst.first_triangle = static_cast<std::uint32_t>(triangles.size());

@@ -147,9 +147,28 @@ struct Scene {
   Aabb bounds() const;
   /// True when some mesh is referenced by more than one instance.
   bool has_instancing() const;
+  /// Triangles the instances expand to: each instance's mesh triangles, as
+  /// flatten() would make them before dropping non-finite ones (so for a
+  /// flattened scene triangles.size() + report.dropped_nonfinite). Counted
+  /// also when the scene is too large to flatten (builtin:island).
+  std::uint64_t instanced_triangle_count() const;
+  /// Triangles of the meshes some instance references, each mesh once: what
+  /// a two-level structure's BLASes are built from.
+  std::uint64_t unique_triangle_count() const;
+  /// Meshes some instance references.
+  std::size_t referenced_mesh_count() const;
+  /// False for a scene left unflattened because it is too large
+  /// (`triangles` empty though its instances have triangles).
+  bool flattened() const { return !triangles.empty() || instanced_triangle_count() == 0; }
   /// Rebuilds `triangles` and every instance's range from meshes + instances,
   /// dropping non-finite triangles (counted in report) and counting degenerate ones.
   void flatten();
 };
+
+/// A scene's triangle count in words (`accelviz info`, the app's Scene
+/// panel): the world triangles; with instancing, "N (from U unique in M
+/// meshes)"; for a scene too large to flatten, "N instanced, not flattened
+/// (U unique in M meshes)".
+std::string triangle_count_text(const Scene& scene);
 
 }  // namespace accelviz

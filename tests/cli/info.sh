@@ -29,3 +29,23 @@ import json, sys
 j = json.load(sys.stdin)
 assert j["has_instancing"] is True, j
 print("forest instancing ok")'
+
+# Instanced scenes: the world triangles with the unique ones they come from;
+# an island too large to flatten reports its instanced count, not 0.
+out=$("$accelviz" info builtin:island)
+grep -Eq '^triangles +370530 \(from 100194 unique in 9 meshes\)$' <<<"$out" ||
+  { echo "FAIL: island triangle line: $(grep '^triangles' <<<"$out")"; exit 1; }
+out=$("$accelviz" info 'builtin:island?size=2000000&copies=560')
+grep -Eq '^triangles +1005314592 instanced, not flattened \(1994560 unique in 9 meshes\)$' <<<"$out" ||
+  { echo "FAIL: large island triangle line: $(grep '^triangles' <<<"$out")"; exit 1; }
+"$accelviz" info --json 'builtin:island?size=2000000&copies=560' | python3 -c '
+import json, sys
+j = json.load(sys.stdin)
+assert j["flattened"] is False and j["triangles"] == 0, j
+assert j["instanced_triangles"] == 1005314592 and j["unique_triangles"] == 1994560, j
+print("unflattened island counts ok")'
+"$accelviz" info --json 'builtin:soup?size=1234' | python3 -c '
+import json, sys
+j = json.load(sys.stdin)
+assert j["flattened"] is True and j["triangles"] == j["instanced_triangles"] == j["unique_triangles"] == 1234, j
+print("soup counts ok")'

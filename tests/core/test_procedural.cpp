@@ -8,6 +8,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <glm/gtc/matrix_transform.hpp>
+#include <limits>
 #include <map>
 #include <set>
 #include <string>
@@ -655,15 +657,60 @@ TEST(Island, EightSpeciesInstancedCopiesTimes) {
   EXPECT_EQ(refs[0], 1);
   for (std::size_t m = 1; m < refs.size(); ++m) EXPECT_EQ(refs[m], 3) << m;
   EXPECT_TRUE(s.has_instancing());
-  std::int64_t unique = 0;
+  std::int64_t unique = 0, instanced = 0;
   for (const Mesh& m : s.meshes) unique += static_cast<std::int64_t>(m.indices.size());
+  for (const Instance& inst : s.instances) instanced += static_cast<std::int64_t>(s.meshes[inst.mesh].indices.size());
   EXPECT_NEAR(static_cast<double>(unique), 20000.0, 2000.0);
+  EXPECT_EQ(s.unique_triangle_count(), static_cast<std::uint64_t>(unique));  // every mesh is referenced
+  EXPECT_EQ(s.referenced_mesh_count(), 9u);
+  EXPECT_EQ(s.instanced_triangle_count(), static_cast<std::uint64_t>(instanced));
+  EXPECT_EQ(s.instanced_triangle_count(), s.triangles.size() + s.report.dropped_nonfinite);
+  EXPECT_TRUE(s.flattened());
+}
+
+// Scene's counts on a hand-made scene: a mesh instanced three times, one
+// once, one not at all; a non-finite vertex dropped by flatten().
+TEST(SceneCounts, InstancedUniqueReferencedAndFlattened) {
+  Scene s;
+  EXPECT_TRUE(s.flattened());  // nothing to flatten
+  const auto mesh = [](int triangles, bool poisoned) {
+    Mesh m;
+    for (int i = 0; i < triangles; ++i) {
+      const float x = static_cast<float>(i);
+      const auto base = static_cast<unsigned>(m.positions.size());
+      m.positions.insert(m.positions.end(), {{x, 0, 0}, {x + 1, 0, 0}, {x, 1, 0}});
+      m.indices.push_back({base, base + 1, base + 2});
+    }
+    if (poisoned) m.positions[0].x = std::numeric_limits<float>::quiet_NaN();
+    return m;
+  };
+  s.meshes = {mesh(3, false), mesh(2, true), mesh(5, false)};
+  for (std::uint32_t m : {0u, 1u, 0u, 0u}) {
+    Instance inst;
+    inst.mesh = m;
+    inst.node = static_cast<std::uint32_t>(s.instances.size());
+    inst.transform = glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 0.0f, static_cast<float>(s.instances.size())));
+    s.instances.push_back(inst);
+  }
+  EXPECT_EQ(s.instanced_triangle_count(), 3u * 3u + 2u);
+  EXPECT_EQ(s.unique_triangle_count(), 3u + 2u);  // mesh 2 is not referenced
+  EXPECT_EQ(s.referenced_mesh_count(), 2u);
+  EXPECT_FALSE(s.flattened());  // instances with triangles, none made yet
+  s.flatten();
+  EXPECT_EQ(s.triangles.size(), 10u);  // mesh 1's first triangle has a NaN vertex
+  EXPECT_EQ(s.report.dropped_nonfinite, 1u);
+  EXPECT_EQ(s.instanced_triangle_count(), s.triangles.size() + s.report.dropped_nonfinite);
+  EXPECT_TRUE(s.flattened());
 }
 
 TEST(Island, LeftUnflattenedAboveTheLimitWithAWarning) {
   // 9 * 0.9 * 1e5 ... = about 0.9 * 100000 * 600 = 54M instanced triangles: over the 50M limit.
   const Scene s = make_builtin("island?size=100000&copies=600");
   EXPECT_TRUE(s.triangles.empty());
+  EXPECT_FALSE(s.flattened());
+  EXPECT_GT(s.instanced_triangle_count(), 50000000u);
+  EXPECT_NE(s.report.warnings.at(0).find(std::to_string(s.instanced_triangle_count()) + " instanced triangles"),
+            std::string::npos);
   ASSERT_EQ(s.report.warnings.size(), 1u);
   EXPECT_NE(s.report.warnings[0].find("not flattened"), std::string::npos);
   EXPECT_NE(s.report.warnings[0].find("tlas"), std::string::npos);

@@ -128,8 +128,8 @@ SceneAction scene_panel(std::string& path_field, const std::vector<std::string>&
 
   if (scene) {
     ImGui::Separator();
-    ImGui::Text("%zu triangles, %zu meshes, %zu instances", scene->triangles.size(), scene->meshes.size(),
-                scene->instances.size());
+    ImGui::Text("%s triangles", triangle_count_text(*scene).c_str());
+    ImGui::Text("%zu meshes, %zu instances", scene->meshes.size(), scene->instances.size());
     ImGui::Text("%zu lights, %zu cameras", scene->lights.size(), scene->cameras.size());
     if (scene->report.dropped_nonfinite || scene->report.degenerate)
       ImGui::Text("%" PRIu64 " dropped (non-finite), %" PRIu64 " degenerate", scene->report.dropped_nonfinite,

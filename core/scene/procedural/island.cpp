@@ -166,8 +166,7 @@ Scene make_island(const BuiltinArgs& args) {
   scene.cameras.push_back(frame_box("overview", box, glm::vec3(0.6f, 0.45f, 1.0f)));
   scene.lights.push_back(directional_light("sun", glm::vec3(-0.4f, -1.0f, -0.3f), 3.0f));
 
-  std::uint64_t instanced = 0;
-  for (const Instance& inst : scene.instances) instanced += scene.meshes[inst.mesh].indices.size();
+  const std::uint64_t instanced = scene.instanced_triangle_count();
   if (instanced <= static_cast<std::uint64_t>(kIslandFlattenLimit)) {
     finish(scene, args);
   } else {
