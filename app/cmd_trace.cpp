@@ -36,6 +36,11 @@ int run_trace(const TraceOptions& o, const GlobalOptions& global) {
   const std::unique_ptr<Accelerator> accel =
       build_with_progress(o.structure, scene, o.structure_opts.to_options(o.threads, /*compute_epo=*/false), progress);
   const double build_ms = accel->build_stats().build_ms;
+  // A ray the structure cannot take (Embree's limits) is named with its file
+  // and index before any tracing.
+  for (std::size_t i = 0; i < rays.size(); ++i)
+    if (const std::string problem = accel->ray_problem(rays[i]); !problem.empty())
+      throw std::runtime_error(o.rays + ": ray " + std::to_string(i) + ": " + o.structure + " " + problem);
 
   QueryOptions q;
   q.triangle_test = parse_triangle_test(o.triangle_test);

@@ -152,6 +152,13 @@ class Accelerator {
 
   virtual const BuildStats& build_stats() const = 0;
 
+  /// Why this structure cannot trace `ray` ("" when it can): every structure
+  /// of ours takes any ray; Embree refuses a few (EmbreeAccelerator). The
+  /// queries throw std::invalid_argument with this text on such a ray; a
+  /// caller that knows where the rays came from (a ray file) checks first to
+  /// name the file and the ray.
+  virtual std::string ray_problem(const Ray& /*ray*/) const { return {}; }
+
  protected:
   /// closest_hits after its size checks; the default calls closest_hit per ray.
   virtual void closest_hits_span(std::span<const Ray> rays, std::span<Hit> hits, const QueryOptions& opts,

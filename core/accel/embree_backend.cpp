@@ -53,6 +53,8 @@ std::optional<EmbreeIsa> parse_embree_isa(std::string_view name) {
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <mutex>
 #include <new>
 #include <stdexcept>
@@ -204,10 +206,75 @@ struct EmbreeAccelerator::Impl {
   std::vector<std::uint32_t> indices;  ///< 0, 1, 2, ...: triangle i uses corners 3i..3i+2
 };
 
+namespace {
+
+/// Embree's FLT_LARGE: "we consider floating point numbers in that range as
+/// valid input numbers" (its kernels' Ray::valid; its builders leave out a
+/// primitive with a coordinate beyond it).
+constexpr float kEmbreeLarge = 1.844e18f;
+
+bool within_embree_range(const glm::vec3& v) {
+  return std::abs(v.x) <= kEmbreeLarge && std::abs(v.y) <= kEmbreeLarge && std::abs(v.z) <= kEmbreeLarge;
+}
+
+std::string num_text(float x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", x);
+  return buf;
+}
+
+std::string vec_text(const glm::vec3& v) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "(%g, %g, %g)", v.x, v.y, v.z);
+  return buf;
+}
+
+/// What the queries throw for a ray Embree cannot take (out of line: the
+/// check in the queries is a predictable branch).
+[[noreturn, gnu::cold, gnu::noinline]] void refuse_ray(const EmbreeAccelerator& embree, const Ray& ray) {
+  throw std::invalid_argument("embree: " + embree.ray_problem(ray));
+}
+
+/// Whether Embree takes the ray (ray_problem's test, without the words).
+[[gnu::always_inline]] inline bool embree_takes(const Ray& ray) {
+  return ray.tmin >= 0.0f && ray.tmax == ray.tmax && within_embree_range(ray.origin) &&
+         within_embree_range(ray.direction);
+}
+
+}  // namespace
+
+std::string EmbreeAccelerator::ray_problem(const Ray& ray) const {
+  std::string why;
+  if (!(ray.tmin >= 0.0f))
+    why = "tmin " + num_text(ray.tmin) + " is not >= 0";
+  else if (ray.tmax != ray.tmax)
+    why = "tmax is NaN";
+  else if (!within_embree_range(ray.origin))
+    why = "origin " + vec_text(ray.origin) + " has a component";
+  else if (!within_embree_range(ray.direction))
+    why = "direction " + vec_text(ray.direction) + " has a component";
+  else
+    return {};
+  if (why.ends_with("component")) why += " that is NaN or beyond ±1.844e18";
+  return "cannot trace a ray whose " + why +
+         " (Embree's kernels assume 0 <= tmin and finite origins and directions within ±1.844e18; "
+         "the other structures trace it)";
+}
+
 EmbreeAccelerator::EmbreeAccelerator(std::span<const Triangle> triangles, const EmbreeOptions& opts)
     : impl_(std::make_unique<Impl>(opts.threads, opts.isa)) {
   const auto t0 = Clock::now();
   const std::size_t n = triangles.size();
+  std::size_t out_of_range = 0, first_out = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!within_embree_range(triangles[i].v0) || !within_embree_range(triangles[i].v1) ||
+        !within_embree_range(triangles[i].v2))
+      if (out_of_range++ == 0) first_out = i;
+  if (out_of_range > 0)
+    throw std::runtime_error("embree: " + std::to_string(out_of_range) + " triangle(s) (the first: triangle " +
+                             std::to_string(first_out) +
+                             ") have a vertex coordinate beyond ±1.844e18, which Embree's build leaves out; "
+                             "the other structures keep them");
   impl_->vertices.resize(9 * n + 3, 0.0f);
   impl_->indices.resize(3 * n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -267,6 +334,8 @@ void fill_ray(RTCRay& r, const Ray& ray) {
 }  // namespace
 
 Hit EmbreeAccelerator::closest_hit(const Ray& ray, const QueryOptions&, RayStats*, VisitTrace*) const {
+  if (!embree_takes(ray)) [[unlikely]]
+    refuse_ray(*this, ray);
   RTCRayHit rh;
   fill_ray(rh.ray, ray);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -340,7 +409,11 @@ void EmbreeAccelerator::closest_packets_span(std::span<const Ray> rays, std::spa
   for_each_packet8(rays.size(), [&](std::size_t b, int count, const int* valid) {
     RTCRayHit8 rh;
     for (int l = 0; l < 8; ++l) {
-      if (l < count) fill_lane(rh.ray, l, rays[b + l]);
+      if (l < count) {
+        if (!embree_takes(rays[b + l])) [[unlikely]]
+          refuse_ray(*this, rays[b + l]);
+        fill_lane(rh.ray, l, rays[b + l]);
+      }
       rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
       rh.hit.primID[l] = RTC_INVALID_GEOMETRY_ID;
       rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
@@ -370,13 +443,19 @@ void EmbreeAccelerator::any_packets_span(std::span<const Ray> rays, std::span<st
   rtcInitIntersectContext(&context);
   for_each_packet8(rays.size(), [&](std::size_t b, int count, const int* valid) {
     RTCRay8 r;
-    for (int l = 0; l < count; ++l) fill_lane(r, l, rays[b + l]);
+    for (int l = 0; l < count; ++l) {
+      if (!embree_takes(rays[b + l])) [[unlikely]]
+        refuse_ray(*this, rays[b + l]);
+      fill_lane(r, l, rays[b + l]);
+    }
     rtcOccluded8(valid, impl_->scene, &context, &r);
     for (int l = 0; l < count; ++l) occluded[b + l] = r.tfar[l] == -kInfinity ? 1 : 0;
   });
 }
 
 bool EmbreeAccelerator::any_hit(const Ray& ray, const QueryOptions&, RayStats*) const {
+  if (!embree_takes(ray)) [[unlikely]]
+    refuse_ray(*this, ray);
   RTCRay r;
   fill_ray(r, ray);
   RTCIntersectContext context;

@@ -67,12 +67,20 @@ bool embree_cpu_has(EmbreeIsa isa);
 /// Embree and stay 0.
 class EmbreeAccelerator final : public Accelerator {
  public:
+  /// Throws std::runtime_error ("embree: ...") when Embree reports an error,
+  /// and when a triangle has a vertex coordinate beyond ±1.844e18, which
+  /// Embree's build would silently leave out (the other structures keep it).
   EmbreeAccelerator(std::span<const Triangle> triangles, const EmbreeOptions& opts = {});
   ~EmbreeAccelerator() override;
   EmbreeAccelerator(const EmbreeAccelerator&) = delete;
   EmbreeAccelerator& operator=(const EmbreeAccelerator&) = delete;
 
   std::string name() const override { return "embree"; }
+  /// Embree's kernels assert on (and, without assertions, mistrace) a ray
+  /// with tmin < 0 or NaN, a NaN tmax, or an origin or direction component
+  /// that is NaN or beyond ±1.844e18 (Embree's FLT_LARGE): those are refused
+  /// (the queries throw std::invalid_argument "embree: ..."), never traced.
+  std::string ray_problem(const Ray& ray) const override;
   Hit closest_hit(const Ray& ray, const QueryOptions& opts, RayStats* stats = nullptr,
                   VisitTrace* trace = nullptr) const override;
   bool any_hit(const Ray& ray, const QueryOptions& opts, RayStats* stats = nullptr) const override;

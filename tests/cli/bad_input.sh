@@ -84,6 +84,27 @@ for f in heat.jpg heat heat-a heat-b heat-diff; do
   [ ! -e "$tmp/$f" ] || { echo "FAIL: render wrote $tmp/$f under a name that is not .png"; fail=1; }
 done
 
+# Rays Embree's kernels cannot take (they abort on them): refused with one
+# line, the ray file and the ray named, nothing written; a scene Embree's
+# build would silently thin out is refused too.
+help="$("$accelviz" render --help)"  # into a variable: `grep -q` on a pipe could end it early (pipefail)
+if grep -q embree <<<"$help"; then
+  python3 -c "import struct,sys; open(sys.argv[1],'wb').write(b'RAYS'+struct.pack('<IQ',1,2)+struct.pack('<8f',0,0,-5,0,0,0,1,9)+struct.pack('<8f',0,0,-5,-100,0,0,1,9))" "$tmp/negtmin.rays"
+  expect 1 "$tmp/negtmin.rays: ray 1: embree cannot trace a ray whose tmin -100 is not >= 0" -- \
+    trace 'builtin:soup?size=10' -s embree --rays "$tmp/negtmin.rays" --out "$tmp/e.hits"
+  expect 1 "$tmp/negtmin.rays: ray 1: embree" -- \
+    trace 'builtin:soup?size=10' -s embree --any --rays "$tmp/negtmin.rays" --out "$tmp/e.occl"
+  [ ! -e "$tmp/e.hits" ] && [ ! -e "$tmp/e.occl" ] || { echo "FAIL: embree wrote hits for rays it refused"; fail=1; }
+  "$accelviz" -q trace 'builtin:soup?size=10' -s bvh --rays "$tmp/negtmin.rays" --out "$tmp/b.hits" >/dev/null ||
+    { echo "FAIL: the bvh refused a ray with tmin < 0"; fail=1; }
+  expect 1 "embree: cannot trace a ray whose origin (2e+18, 1, 1)" -- \
+    render 'builtin:soup?size=10' -s embree --size 8x6 --camera 2e18,1,1,0,0,0 --out "$tmp/e.png"
+  printf 'v 0 0 0\nv 1e19 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\n' >"$tmp/far.obj"
+  expect 1 "embree: 1 triangle(s) (the first: triangle 0) have a vertex coordinate beyond" -- \
+    render "$tmp/far.obj" -s embree --size 8x6 --out "$tmp/f.png"
+  [ ! -e "$tmp/e.png" ] && [ ! -e "$tmp/f.png" ] || { echo "FAIL: embree wrote a PNG it could not trace"; fail=1; }
+fi
+
 # Missing output directory.
 expect 1 "$tmp/no/dir/a.png" -- render 'builtin:soup?size=10' --out "$tmp/no/dir/a.png"
 

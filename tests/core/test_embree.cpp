@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -263,6 +264,74 @@ TEST(Embree, LeavesRayStatsAtZero) {
   EXPECT_EQ(st.nodes_visited + st.prim_tests + st.box_tests, 0u);
   EXPECT_GT(embree.build_stats().memory_bytes, 100u * sizeof(Triangle));
   EXPECT_GE(embree.build_stats().build_ms, 0.0);
+}
+
+// Embree's kernels assert on these rays (an abort with Debian's build):
+// every query refuses them with one line, and ray_problem names the cause;
+// rays at the limits are traced.
+TEST(Embree, RaysItsKernelsCannotTakeAreRefusedNotTraced) {
+  const std::vector<Triangle> tris = random_soup(100, 3);
+  const EmbreeAccelerator embree(tris);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  struct Case {
+    Ray ray;
+    const char* says;
+  };
+  const Case refused[] = {
+      {Ray({0, 0, -5}, {0, 0, 1}, -100.0f, kInfinity), "tmin -100 is not >= 0"},
+      {Ray({0, 0, -5}, {0, 0, 1}, -kInfinity, kInfinity), "tmin -inf is not >= 0"},
+      {Ray({0, 0, -5}, {0, 0, 1}, nan, kInfinity), "tmin nan is not >= 0"},
+      {Ray({0, 0, -5}, {0, 0, 1}, 0.0f, nan), "tmax is NaN"},
+      {Ray({2e18f, 0, -5}, {0, 0, 1}), "origin (2e+18, 0, -5) has a component that is NaN or beyond"},
+      {Ray({0, 0, -5}, {0, 0, -3e38f}), "direction (0, 0, -3e+38) has a component"},
+  };
+  for (const Case& c : refused) {
+    SCOPED_TRACE(c.says);
+    EXPECT_NE(embree.ray_problem(c.ray).find(c.says), std::string::npos) << embree.ray_problem(c.ray);
+    EXPECT_THROW(embree.closest_hit(c.ray, {}), std::invalid_argument);
+    EXPECT_THROW(embree.any_hit(c.ray, {}), std::invalid_argument);
+    // In a packet, after a good ray.
+    const std::vector<Ray> rays = {Ray({0, 0, -5}, {0, 0, 1}), c.ray};
+    std::vector<Hit> hits(rays.size());
+    std::vector<std::uint8_t> occluded(rays.size());
+    EXPECT_THROW(embree.closest_hits_packets(rays, hits, {}), std::invalid_argument);
+    EXPECT_THROW(embree.any_hits_packets(rays, occluded, {}), std::invalid_argument);
+    try {
+      embree.closest_hit(c.ray, {});
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(e.what()), "embree: " + embree.ray_problem(c.ray));
+    }
+  }
+  // At the limits: traced, and the same as the BVH's answer.
+  const Bvh bvh(tris);
+  for (const Ray& r : {Ray({0, 0, -5}, {0, 0, 1}, 0.0f, kInfinity), Ray({0, 0, -1.8e18f}, {0, 0, 1.8e18f}),
+                       Ray({0, 0, -5}, {0, 0, 1}, -0.0f, 1e30f)}) {
+    EXPECT_EQ(embree.ray_problem(r), "");
+    EXPECT_EQ(embree.closest_hit(r, {}).valid(), bvh.closest_hit(r, {}).valid());
+    EXPECT_EQ(embree.any_hit(r, {}), bvh.any_hit(r, {}));
+  }
+  // Our structures take every one of them.
+  for (const Case& c : refused) EXPECT_EQ(bvh.ray_problem(c.ray), "");
+}
+
+// Embree's build silently leaves out a triangle with a coordinate beyond
+// ±1.844e18: the accelerator refuses the scene instead of missing it.
+TEST(Embree, TrianglesItsBuildWouldLeaveOutAreRefused) {
+  std::vector<Triangle> tris = random_soup(10, 3);
+  tris.push_back({{0, 0, 0}, {1.9e18f, 0, 0}, {0, 1, 0}});
+  tris.push_back({{0, 0, 0}, {0, -1e30f, 0}, {0, 0, 1}});
+  try {
+    const EmbreeAccelerator embree(tris);
+    ADD_FAILURE() << "built a scene whose triangles 10 and 11 Embree leaves out";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("embree: 2 triangle(s) (the first: triangle 10) have a vertex coordinate "
+                                         "beyond ±1.844e18"),
+              std::string::npos)
+        << e.what();
+  }
+  tris.resize(10);
+  tris.push_back({{0, 0, 0}, {1.8e18f, 0, 0}, {0, 1, 0}});  // within the limit: built
+  EXPECT_NO_THROW(EmbreeAccelerator{tris});
 }
 
 TEST(Embree, EmptySceneMissesEverything) {
