@@ -10,7 +10,9 @@
 //      resolve to existing vertices (negative = relative, OBJ style);
 //      `l`/`p` elements are counted as skipped primitives;
 //   2. tinyobjloader parses the same bytes into shapes (one per o/g group;
-//      `usemtl` does not split one) without triangulating; a missing .mtl,
+//      `usemtl` does not split one) without triangulating (a face of more
+//      than 255 vertices first rewritten as faces of at most 255 with the
+//      same fan: split_long_faces); a missing .mtl,
 //      or one that is not a regular file of at most 64 MiB, is only a
 //      warning;
 //   3. each shape becomes one Mesh with its own compacted vertices and an
@@ -112,9 +114,61 @@ bool parse_integer(std::string_view token, long long& value) {
   return true;
 }
 
+/// Calls f(line, number) for every line of `text` (numbered from 1): lines
+/// end in \n, \r\n or a lone \r, as tinyobjloader reads them.
+template <class F>
+void for_each_line(const std::string& text, const F& f) {
+  std::size_t line_number = 0, pos = 0;
+  while (pos < text.size()) {
+    std::size_t end = text.find_first_of("\r\n", pos);
+    if (end == std::string::npos) end = text.size();
+    const std::string_view line(text.data() + pos, end - pos);
+    pos = end + (text.compare(end, 2, "\r\n") == 0 ? 2 : 1);
+    f(line, ++line_number);
+  }
+}
+
+/// tinyobjloader keeps a face's vertex count in an unsigned char: a face of
+/// more vertices comes back with its count modulo 256, and the faces after
+/// it are misread (silently wrong triangles).
+constexpr std::size_t kMaxTinyObjFace = 255;
+
+/// `text` with every face of more than kMaxTinyObjFace vertices written as
+/// consecutive faces of at most that many that share its first vertex, each
+/// starting at the previous one's last: their fans (v0, vi, vi+1) together
+/// are the whole face's fan, the same n-2 triangles in the same order. Other
+/// lines are kept as they are; relative (negative) indices stay valid, as
+/// no vertex line moves.
+std::string split_long_faces(const std::string& text) {
+  std::string out;
+  out.reserve(text.size() + text.size() / 64);
+  for_each_line(text, [&](std::string_view line, std::size_t) {
+    const std::vector<std::string_view> tok = tokens_of(line);
+    if (tok.empty() || tok[0] != "f" || tok.size() - 1 <= kMaxTinyObjFace) {
+      out.append(line);
+      out += '\n';
+      return;
+    }
+    const std::size_t n = tok.size() - 1;  // references tok[1..n]
+    for (std::size_t i = 2; i < n;) {      // a chunk: tok[1], tok[i .. j]
+      const std::size_t j = std::min(i + kMaxTinyObjFace - 2, n);
+      out += "f ";
+      out.append(tok[1]);
+      for (std::size_t k = i; k <= j; ++k) {
+        out += ' ';
+        out.append(tok[k]);
+      }
+      out += '\n';
+      i = j;
+    }
+  });
+  return out;
+}
+
 struct ObjScan {
   std::size_t vertex_count = 0;
   std::size_t face_count = 0;
+  std::size_t long_faces = 0;  ///< faces of more than kMaxTinyObjFace vertices (split_long_faces)
   std::uint64_t lines_and_points = 0;
   /// (vertex index, xyz as read) for every vertex with a NaN/inf coordinate.
   std::vector<std::pair<std::size_t, glm::vec3>> nonfinite;
@@ -127,17 +181,9 @@ ObjScan scan_obj(const std::string& path, const std::string& text) {
   ObjScan scan;
   long long max_forward = 0;
   std::size_t max_forward_line = 0;
-  std::size_t line_number = 0;
-  std::size_t pos = 0;
-  while (pos < text.size()) {
-    // Lines end in \n, \r\n or a lone \r, as tinyobjloader reads them.
-    std::size_t end = text.find_first_of("\r\n", pos);
-    if (end == std::string::npos) end = text.size();
-    const std::string_view line(text.data() + pos, end - pos);
-    pos = end + (text.compare(end, 2, "\r\n") == 0 ? 2 : 1);
-    ++line_number;
+  for_each_line(text, [&](std::string_view line, std::size_t line_number) {
     const std::vector<std::string_view> tok = tokens_of(line);
-    if (tok.empty() || tok[0][0] == '#') continue;
+    if (tok.empty() || tok[0][0] == '#') return;
     const std::string where = "line " + std::to_string(line_number) + ": ";
 
     if (tok[0] == "v") {
@@ -146,14 +192,15 @@ ObjScan scan_obj(const std::string& path, const std::string& text) {
       double xyz[3] = {0, 0, 0};
       for (std::size_t k = 1; k < tok.size(); ++k) {
         double value = 0;
-        if (!parse_coordinate(tok[k], value)) fail(path, where + "vertex coordinate " + quoted(tok[k]) + " is not a number");
+        if (!parse_coordinate(tok[k], value))
+          fail(path, where + "vertex coordinate " + quoted(tok[k]) + " is not a number");
         if (k <= 3) xyz[k - 1] = value;
       }
       if (!std::isfinite(xyz[0]) || !std::isfinite(xyz[1]) || !std::isfinite(xyz[2]))
         scan.nonfinite.emplace_back(scan.vertex_count, glm::vec3(float(xyz[0]), float(xyz[1]), float(xyz[2])));
       ++scan.vertex_count;
       if (scan.vertex_count > std::size_t(INT_MAX)) fail(path, where + "more than 2^31 vertices");
-      continue;
+      return;
     }
 
     const bool face = tok[0] == "f";
@@ -179,7 +226,8 @@ ObjScan scan_obj(const std::string& path, const std::string& text) {
         for (std::size_t p = 1; p < count; ++p) {
           if (parts[p].empty() && p == 1 && count == 3) continue;
           if (!parse_integer(parts[p], other)) fail(path, where + "malformed vertex reference " + quoted(ref));
-          if (other == 0) fail(path, where + "texture/normal index 0 in " + quoted(ref) + " is invalid (OBJ indices start at 1)");
+          if (other == 0)
+            fail(path, where + "texture/normal index 0 in " + quoted(ref) + " is invalid (OBJ indices start at 1)");
         }
         if (v == 0) fail(path, where + "vertex index 0 is invalid (OBJ indices start at 1)");
         if (v < 0 && -v > static_cast<long long>(scan.vertex_count))
@@ -192,11 +240,12 @@ ObjScan scan_obj(const std::string& path, const std::string& text) {
       }
       if (face) {
         ++scan.face_count;
+        if (refs > kMaxTinyObjFace) ++scan.long_faces;
       } else {
         ++scan.lines_and_points;
       }
     }
-  }
+  });
   if (max_forward > static_cast<long long>(scan.vertex_count))
     fail(path, "line " + std::to_string(max_forward_line) + ": vertex index " + std::to_string(max_forward) +
                    " is out of range (the file has " + std::to_string(scan.vertex_count) + " vertices)");
@@ -271,6 +320,7 @@ Scene load_obj(const std::string& path) {
   // A UTF-8 byte order mark is not part of the first line.
   if (text.starts_with("\xEF\xBB\xBF")) text.erase(0, 3);
   const ObjScan scan = scan_obj(path, text);
+  if (scan.long_faces > 0) text = split_long_faces(text);
 
   // Step 2: tinyobjloader over the same bytes. Materials are resolved next to
   // the .obj; a missing .mtl only adds a warning.

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -81,6 +82,42 @@ TEST_F(ObjLoader, PolygonsAreFanTriangulatedInFileOrder) {
   EXPECT_EQ(m.indices[2], glm::uvec3(4, 5, 6));
   EXPECT_EQ(m.indices[4], glm::uvec3(4, 7, 8));
   EXPECT_EQ(s.triangles.size(), 5u);
+}
+
+// tinyobjloader keeps a face's vertex count in an unsigned char: a face of
+// 256 or more vertices lost triangles (300 gave 42) and misread the faces
+// after it. Such faces are split before it reads them, into fans that make
+// the same n - 2 triangles in the same order.
+TEST_F(ObjLoader, FacesOfMoreThan255VerticesKeepEveryTriangle) {
+  for (const int n : {255, 256, 257, 258, 300, 509, 1000}) {
+    SCOPED_TRACE(n);
+    std::string text;
+    for (int i = 0; i < n; ++i) {
+      const double a = 6.283185307179586 * i / n;
+      text += "v " + std::to_string(std::cos(a)) + " " + std::to_string(std::sin(a)) + " 0\n";
+    }
+    text += "v 5 0 0\nv 6 0 0\nv 5 1 0\n";  // a triangle after the polygon
+    std::string face = "f";
+    for (int i = 1; i <= n; ++i) {
+      face += ' ';
+      face += std::to_string(i);
+      if (i % 2 == 1) face += "/1";  // some references carry the texture coordinate
+    }
+    const std::string relative = "f -3 -2 -1\n";  // the triangle's vertices, counted back from here
+    const Scene s = load_obj(write(text + "vt 0 0\n" + face + "\n" + relative, "poly" + std::to_string(n) + ".obj"));
+    ASSERT_EQ(s.meshes.size(), 1u);
+    const Mesh& m = s.meshes[0];
+    ASSERT_EQ(m.indices.size(), static_cast<std::size_t>(n - 2 + 1));
+    for (int k = 0; k < n - 2; ++k)
+      ASSERT_EQ(m.indices[static_cast<std::size_t>(k)],
+                glm::uvec3(0, static_cast<unsigned>(k + 1), static_cast<unsigned>(k + 2)))
+          << "triangle " << k;
+    const glm::uvec3 last = m.indices.back();
+    expect_vec3_near(m.positions[last.x], {5, 0, 0});
+    expect_vec3_near(m.positions[last.y], {6, 0, 0});
+    expect_vec3_near(m.positions[last.z], {5, 1, 0});
+    EXPECT_TRUE(s.report.warnings.empty()) << s.report.warnings.front();
+  }
 }
 
 TEST_F(ObjLoader, OneMeshPerShapeWithCompactedVertices) {
