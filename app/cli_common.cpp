@@ -11,6 +11,7 @@
 #include "core/query/camera.h"
 #include "core/scene/load.h"
 #include "core/util/file_checks.h"
+#include "core/util/output_file.h"
 
 namespace accelviz::cli {
 
@@ -131,6 +132,10 @@ CLI::Option* add_triangle_test_option(CLI::App* sub, std::string& value, const c
       ->capture_default_str();
 }
 
+CLI::Option* add_threads_option(CLI::App* sub, unsigned& value, const char* help) {
+  return sub->add_option("--threads,-j", value, help)->check(CLI::Range(0u, kMaxThreads))->capture_default_str();
+}
+
 void require_flattened(const Scene& scene, const std::string& spec, const char* command) {
   if (scene.triangles.empty() && !scene.instances.empty())
     throw std::runtime_error(spec + ": instanced and too large to flatten; " + command +
@@ -175,10 +180,21 @@ void check_output_dir(const std::string& dir, const std::string& prefix, bool fo
   std::error_code ec;
   const fs::path p(dir);
   if (fs::exists(p, ec) && !fs::is_directory(p, ec)) throw std::runtime_error(dir + ": exists and is not a directory");
-  if (force || !fs::is_directory(p, ec)) return;
+  if (!fs::is_directory(p, ec)) return;
+  for (const auto& e : fs::directory_iterator(p, ec))
+    if (is_output_file(e.path(), prefix))
+      // Not even --force replaces a FIFO, device or socket (or a folder) by such a name.
+      if (const std::string problem = output_path_problem(e.path().string()); !problem.empty())
+        throw std::runtime_error(e.path().string() + ": " + problem);
+  if (force) return;
   for (const auto& e : fs::directory_iterator(p, ec))
     if (is_output_file(e.path(), prefix))
       throw std::runtime_error(dir + ": already holds " + prefix + " files (use --force to overwrite)");
+}
+
+void write_output_text(const fs::path& path, const std::string& text) {
+  const OutputWrite w = write_output_file(path.string(), {text}, /*overwrite=*/true);
+  if (!w.ok()) throw std::runtime_error(path.string() + ": " + w.problem);
 }
 
 void prepare_output_dir(const std::string& dir, const std::string& prefix, bool force) {

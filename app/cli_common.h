@@ -3,6 +3,7 @@
 // file rules, progress on stderr, timing. Thin: the work happens in core/.
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <filesystem>
 #include <functional>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -86,6 +87,14 @@ Camera camera_for(const std::string& spec, const Scene& scene, const ImageSize& 
 /// Adds --triangle-test (watertight | fast, the names parse_triangle_test
 /// reads) to `sub`, stored in `value`; `help` replaces the usual help text.
 CLI::Option* add_triangle_test_option(CLI::App* sub, std::string& value, const char* help = nullptr);
+
+/// Most threads a command takes: more than any machine has cores, few
+/// enough that creating them cannot exhaust the process's limits (100,000
+/// threads could fail to start, or crash, instead of running).
+inline constexpr unsigned kMaxThreads = 1024;
+
+/// `--threads,-j N` (0: all hardware threads), checked to 0..kMaxThreads.
+CLI::Option* add_threads_option(CLI::App* sub, unsigned& value, const char* help);
 /// --triangle-test watertight|fast.
 TriangleTest parse_triangle_test(const std::string& name);
 
@@ -111,6 +120,11 @@ void check_output_path(const std::string& path, bool force);
 /// leaves what was there, and no empty folder.
 void check_output_dir(const std::string& dir, const std::string& prefix, bool force);
 void prepare_output_dir(const std::string& dir, const std::string& prefix, bool force);
+
+/// Writes one of those files (a folder prepare_output_dir made ready) through
+/// core's write_output_file: a temporary beside it, then its name. Throws
+/// std::runtime_error "<path>: <problem>".
+void write_output_text(const std::filesystem::path& path, const std::string& text);
 
 /// Absolute, normalised form of a path for messages.
 std::string absolute_path(const std::string& path);

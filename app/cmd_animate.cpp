@@ -102,7 +102,7 @@ Command add_animate_command(CLI::App& parent, const GlobalOptions& global) {
   sub->add_option("--rebuild-ratio", o->rebuild_ratio,
                   "Rebuild a deforming BLAS when refit SAH / fresh SAH exceeds this (0: always refit)")
       ->capture_default_str();
-  sub->add_option("--threads,-j", o->threads, "Build threads (0: all)")->capture_default_str();
+  add_threads_option(sub, o->threads, "Build threads (0: all)");
   sub->add_flag("--json", o->json, "One JSON object per frame instead of the table");
   return {sub, [o, &global] { return run_animate(*o, global); }};
 }

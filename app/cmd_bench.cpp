@@ -488,9 +488,7 @@ Command add_bench_command(CLI::App& parent, const GlobalOptions& global) {
                   "(first runs in a process can be slower: cold caches, fresh memory)")
       ->check(CLI::Range(0, 100))
       ->capture_default_str();
-  sub->add_option("--threads,-j", o->threads,
-                  "Threads of the all-threads figures and of builds (0: all hardware threads)")
-      ->capture_default_str();
+  add_threads_option(sub, o->threads, "Threads of the all-threads figures and of builds (0: all hardware threads)");
   sub->add_flag("--json", o->json, "Print one JSON document instead of text");
   sub->add_option("--camera", o->camera,
                   "View: ex,ey,ez,tx,ty,tz[,fovdeg] or gltf:N; default: the scene's first camera, else a framing view");

@@ -110,7 +110,7 @@ Command add_calibrate_command(CLI::App& parent, const GlobalOptions& global) {
   sub->add_option("--size", o->size, "--scene: primary rays, one per pixel of a WxH image")
       ->check(size_validator())
       ->capture_default_str();
-  sub->add_option("--threads,-j", o->threads, "--scene: build and trace threads (0: all)")->capture_default_str();
+  add_threads_option(sub, o->threads, "--scene: build and trace threads (0: all)");
   add_triangle_test_option(sub, o->triangle_test, "--scene: which test's constant to build with and trace");
   return {sub, [o, &global] { return run_calibrate(*o, global); }};
 }

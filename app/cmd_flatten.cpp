@@ -95,7 +95,7 @@ Command add_flatten_command(CLI::App& parent, const GlobalOptions& global) {
   sub->add_option("--instances", o->instances, "Instance ids to merge, e.g. 0,2,5, or 'all'")->required();
   sub->add_option("--size", o->size, "Primary rays traced, WxH")->check(size_validator())->capture_default_str();
   sub->add_option("--camera", o->camera, "Camera spec (default: the scene's default view)");
-  sub->add_option("--threads,-j", o->threads, "Build threads (0: all)")->capture_default_str();
+  add_threads_option(sub, o->threads, "Build threads (0: all)");
   sub->add_flag("--json", o->json, "One JSON object instead of the table");
   return {sub, [o, &global] { return run_flatten(*o, global); }};
 }

@@ -97,7 +97,7 @@ Command add_rays_command(CLI::App& parent, const GlobalOptions& global) {
   sub->add_option("--structure,-s", o->structure, "Structure that finds the primary hits (diffuse, shadow)")
       ->check(CLI::IsMember(structure_names()))
       ->capture_default_str();
-  sub->add_option("--threads,-j", o->threads, "Threads (0: all hardware threads)")->capture_default_str();
+  add_threads_option(sub, o->threads, "Threads (0: all hardware threads)");
   sub->add_flag("--force,-f", o->force, "Overwrite an existing output file");
   return {sub, [o, &global] { return run_rays(*o, global); }};
 }

@@ -89,7 +89,7 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
                       {"rebuilt", f.rebuilt}});
   }
   prepare_output_dir(o.out, "refit", o.force);
-  std::ofstream(dir / "refit.csv") << csv.str();
+  write_output_text(dir / "refit.csv", csv.str());
   const nlohmann::json j = {{"scene", o.scene},
                             {"triangles", scene.triangles.size()},
                             {"frames", o.frames},
@@ -100,7 +100,7 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
                             {"seed", o.seed},
                             {"rebuilds", r.rebuilds},
                             {"per_frame", frames}};
-  std::ofstream(dir / "refit.json") << j.dump(2) << "\n";
+  write_output_text(dir / "refit.json", j.dump(2) + "\n");
 
   ChartSeries refit{"refitted", {}, {}, {}, {214, 39, 40}, true, true, 2};
   ChartSeries fresh{"fresh build", {}, {}, {}, {31, 119, 180}, true, true, 2};
@@ -153,7 +153,7 @@ Command add_refit_command(CLI::App& parent, const GlobalOptions& global) {
                   "Rebuild when refit SAH / fresh SAH exceeds this (0: never)")
       ->capture_default_str();
   sub->add_option("--size", o->size, "Primary rays for the traversal figures: WxH")->check(size_validator())->capture_default_str();
-  sub->add_option("--threads,-j", o->threads, "Build and trace threads (0: all)")->capture_default_str();
+  add_threads_option(sub, o->threads, "Build and trace threads (0: all)");
   sub->add_option("--seed", o->seed, "Seed of the motion")->capture_default_str();
   sub->add_option("--out,-o", o->out, "Output directory (created if missing)")->required();
   sub->add_flag("--force,-f", o->force, "Overwrite the refit files of an earlier run in DIR");

@@ -278,8 +278,7 @@ Command add_render_command(CLI::App& parent, const GlobalOptions& global) {
   sub->add_option("--legend", o->legend, "Legend bar placement: bottom, right, none")
       ->check(CLI::IsMember({"bottom", "right", "none"}))
       ->capture_default_str();
-  sub->add_option("--threads,-j", o->threads, "Threads for building and tracing (0: all hardware threads)")
-      ->capture_default_str();
+  add_threads_option(sub, o->threads, "Threads for building and tracing (0: all hardware threads)");
   add_triangle_test_option(sub, o->triangle_test);
   sub->add_flag("--force,-f", o->force, "Overwrite an existing output file");
   sub->add_option("--order", o->order,

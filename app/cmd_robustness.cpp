@@ -119,8 +119,7 @@ Command add_robustness_command(CLI::App& parent, const GlobalOptions& global) {
   sub->add_option("--structure,-s", o->structure,
                   "Also trace with this structure's own traversal, both triangle tests (not voxels)");
   sub->add_option("--seed", o->seed, "Seed of the ray generator")->capture_default_str();
-  sub->add_option("--threads,-j", o->threads, "Threads for the builds and the reference (0: all)")
-      ->capture_default_str();
+  add_threads_option(sub, o->threads, "Threads for the builds and the reference (0: all)");
   sub->add_flag("--json", o->json, "One JSON line instead of the table");
   return {sub, [o, &global] { return run_robustness(*o, global); }};
 }

@@ -79,12 +79,6 @@ double load_average() {
   return l;
 }
 
-void write_text(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  if (!out) throw std::runtime_error(path.string() + ": cannot write");
-}
-
 const glm::u8vec3 kPalette[] = {{31, 119, 180}, {255, 127, 14}, {44, 160, 44}, {214, 39, 40}, {148, 103, 189},
                                 {140, 86, 75},  {227, 119, 194}, {127, 127, 127}, {188, 189, 34}, {23, 190, 207}};
 
@@ -269,7 +263,7 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
   // ---- files ----
   prepare_output_dir(o.out, "sweep", o.force);
   const fs::path dir(o.out);
-  write_text(dir / "sweep.csv", sweep_csv(results, o.ray_budget));
+  write_output_text(dir / "sweep.csv", sweep_csv(results, o.ray_budget));
   nlohmann::json j;
   const std::string cmdline = command_line();
   j["machine"] = {{"cpu_model", cpu_model()},
@@ -297,7 +291,7 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
     const SweepResult& r = results[best_for_budget(results, b)];
     j["best_for_budget"].push_back({{"rays", b}, {"setting", setting_label(r.setting)}, {"total_ms", r.total_ms(b)}});
   }
-  write_text(dir / "sweep.json", j.dump(2) + "\n");
+  write_output_text(dir / "sweep.json", j.dump(2) + "\n");
 
   std::vector<std::string> charts;
   auto chart = [&](const std::string& name, const RgbImage& img) {
@@ -368,7 +362,7 @@ Command add_sweep_command(CLI::App& parent, const GlobalOptions& global) {
   sub->add_option("--warmup", o->warmup, "Untimed builds and passes per setting before the timed ones")
       ->check(CLI::Range(0, 100))
       ->capture_default_str();
-  sub->add_option("--threads,-j", o->threads, "Build and trace threads (0: all hardware threads)")->capture_default_str();
+  add_threads_option(sub, o->threads, "Build and trace threads (0: all hardware threads)");
   sub->add_option("--ray-budget", o->ray_budget, "Rays N of total time = build + N / (rays/s)")->capture_default_str();
   sub->add_option("--camera", o->camera, "View: ex,ey,ez,tx,ty,tz[,fovdeg] or gltf:N");
   sub->add_option("--seed", o->seed, "Seed of diffuse directions and edge probes")->capture_default_str();

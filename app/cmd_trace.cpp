@@ -97,8 +97,7 @@ Command add_trace_command(CLI::App& parent, const GlobalOptions& global) {
   sub->add_option("--structure,-s", o->structure, "Acceleration structure")
       ->check(CLI::IsMember(structure_names()))
       ->capture_default_str();
-  sub->add_option("--threads,-j", o->threads, "Threads for building and tracing (0: all hardware threads)")
-      ->capture_default_str();
+  add_threads_option(sub, o->threads, "Threads for building and tracing (0: all hardware threads)");
   add_triangle_test_option(sub, o->triangle_test);
   sub->add_flag("--force,-f", o->force, "Overwrite an existing output file");
   o->structure_opts.add_to(sub);

@@ -92,7 +92,7 @@ Command add_verify_command(CLI::App& parent, const GlobalOptions& global) {
                   "grid, octree, tlas (two-level over the scene's instances; not in all), embree")
       ->capture_default_str();
   sub->add_option("--seed", o->seed, "Seed of the ray generator")->capture_default_str();
-  sub->add_option("--threads,-j", o->threads, "Threads (0: all hardware threads)")->capture_default_str();
+  add_threads_option(sub, o->threads, "Threads (0: all hardware threads)");
   sub->add_flag("--json", o->json, "One JSON line with per-structure counts instead of the summary line");
   return {sub, [o, &global] { return run_verify(*o, global); }};
 }

@@ -20,6 +20,7 @@
 #include "core/query/batch.h"
 #include "core/query/camera.h"
 #include "core/util/file_checks.h"
+#include "core/util/output_file.h"
 #include "core/util/parallel.h"
 #include "core/util/timing.h"
 
@@ -490,27 +491,6 @@ RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
 
 // ---- PNG I/O ---------------------------------------------------------------------
 
-namespace {
-
-struct FileCloser {
-  void operator()(std::FILE* f) const {
-    if (f) std::fclose(f);
-  }
-};
-
-struct WriteContext {
-  std::FILE* file;
-  bool ok;
-};
-
-void write_to_file(void* context, void* data, int size) {
-  auto* ctx = static_cast<WriteContext*>(context);
-  if (ctx->ok && size > 0)
-    ctx->ok = std::fwrite(data, 1, static_cast<std::size_t>(size), ctx->file) == static_cast<std::size_t>(size);
-}
-
-}  // namespace
-
 std::string png_name_problem(const std::string& path) {
   const std::string ext = std::filesystem::path(path).extension().string();
   const bool png =
@@ -521,24 +501,18 @@ std::string png_name_problem(const std::string& path) {
 void write_png(const std::string& path, const RgbImage& img, bool overwrite) {
   if (const std::string problem = png_name_problem(path); !problem.empty()) throw std::runtime_error(problem);
   if (img.width <= 0 || img.height <= 0) throw std::runtime_error(path + ": cannot write an empty image");
-  if (const std::string problem = output_path_problem(path); !problem.empty())
-    throw std::runtime_error(path + ": " + problem);
-  // "x": the existence check and the creation are one step (no overwrite race).
-  std::unique_ptr<std::FILE, FileCloser> f(std::fopen(path.c_str(), overwrite ? "wb" : "wbx"));
-  if (!f) {
-    if (errno == EEXIST) throw FileExistsError(path + ": exists (use --force to overwrite)");
-    throw std::runtime_error(path + ": cannot create: " + std::strerror(errno));
-  }
-  WriteContext ctx{f.get(), true};
-  const int encoded =
-      stbi_write_png_to_func(write_to_file, &ctx, img.width, img.height, 3, img.pixels.data(), img.width * 3);
-  const bool closed = std::fclose(f.release()) == 0;
-  if (!encoded || !ctx.ok || !closed) {
-    const int err = errno;
-    std::error_code ec;
-    std::filesystem::remove(path, ec);
-    throw std::runtime_error(path + ": write failed" + (err ? std::string(": ") + std::strerror(err) : ""));
-  }
+  // Encoded in memory, then written through a temporary beside the file
+  // (write_output_file): a failed write never costs the file that was there.
+  std::string bytes;
+  const int encoded = stbi_write_png_to_func(
+      [](void* context, void* data, int size) {
+        if (size > 0) static_cast<std::string*>(context)->append(static_cast<const char*>(data), std::size_t(size));
+      },
+      &bytes, img.width, img.height, 3, img.pixels.data(), img.width * 3);
+  if (!encoded) throw std::runtime_error(path + ": the PNG could not be encoded");
+  const OutputWrite w = write_output_file(path, {bytes}, overwrite);
+  if (w.exists) throw FileExistsError(path + ": exists (use --force to overwrite)");
+  if (!w.ok()) throw std::runtime_error(path + ": " + w.problem);
 }
 
 RgbImage read_png(const std::string& path) {

@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "core/util/file_checks.h"
+#include "core/util/output_file.h"
 
 namespace accelviz {
 
@@ -92,37 +93,21 @@ std::vector<std::uint8_t> read_payload(const std::string& path, const char (&mag
   return payload;
 }
 
-struct FileCloser {
-  void operator()(std::FILE* f) const {
-    if (f) std::fclose(f);
-  }
-};
-
-/// Creates `path` (exclusively unless `overwrite`) and writes header + payload.
+/// Writes header + payload to `path` (write_output_file: a fresh temporary
+/// beside it, then its name; exclusively unless `overwrite`).
 void write_file(const std::string& path, const char (&magic)[5], std::uint64_t count,
                 const std::vector<std::uint8_t>& payload, bool overwrite) {
-  std::vector<std::uint8_t> header;
+  std::string header;
   header.reserve(kRayFileHeaderBytes);
-  header.insert(header.end(), magic, magic + 4);
-  put_u32(header, kRayFileVersion);
-  put_u64(header, count);
-  if (const std::string problem = output_path_problem(path); !problem.empty()) fail(path, problem);
-  // "x" (C11, glibc): fail with EEXIST instead of truncating an existing file,
-  // so the check and the creation cannot race.
-  std::unique_ptr<std::FILE, FileCloser> f(std::fopen(path.c_str(), overwrite ? "wb" : "wbx"));
-  if (!f) {
-    if (errno == EEXIST) fail(path, "exists (use --force to overwrite)");
-    fail(path, std::string("cannot create: ") + std::strerror(errno));
-  }
-  bool ok = std::fwrite(header.data(), 1, header.size(), f.get()) == header.size();
-  if (ok && !payload.empty()) ok = std::fwrite(payload.data(), 1, payload.size(), f.get()) == payload.size();
-  ok = (std::fclose(f.release()) == 0) && ok;
-  if (!ok) {
-    const int err = errno;
-    std::error_code ec;
-    std::filesystem::remove(path, ec);  // leave no truncated file behind
-    fail(path, std::string("write failed: ") + std::strerror(err));
-  }
+  header.append(magic, 4);
+  std::vector<std::uint8_t> fields;
+  put_u32(fields, kRayFileVersion);
+  put_u64(fields, count);
+  header.append(reinterpret_cast<const char*>(fields.data()), fields.size());
+  const OutputWrite w = write_output_file(
+      path, {header, std::string_view(reinterpret_cast<const char*>(payload.data()), payload.size())}, overwrite);
+  if (w.exists) fail(path, "exists (use --force to overwrite)");
+  if (!w.ok()) fail(path, w.problem);
 }
 
 }  // namespace

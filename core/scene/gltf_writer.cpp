@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "core/util/file_checks.h"
+#include "core/util/output_file.h"
 
 namespace accelviz {
 namespace {
@@ -419,25 +420,12 @@ void write_gltf(const Scene& scene, const std::string& path, bool binary, bool o
     bytes = doc.dump(1) + "\n";
   }
 
-  // Write beside the target, then rename: a failure never leaves a partial
-  // file under the real name.
-  const std::string temp = path + ".part";
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) throw SceneError(path + ": cannot write (" + std::strerror(errno) + ")");
-    out.write(bytes.data(), std::streamsize(bytes.size()));
-    out.close();
-    if (!out) {
-      fs::remove(temp, ec);
-      throw SceneError(path + ": write failed");
-    }
-  }
-  fs::rename(temp, path, ec);
-  if (ec) {
-    const std::string reason = ec.message();
-    fs::remove(temp, ec);
-    throw SceneError(path + ": cannot move into place (" + reason + ")");
-  }
+  // A fresh temporary beside the target, then its name (write_output_file):
+  // a failure never leaves a partial file under the real name, and never
+  // writes through a link or FIFO that happens to be there.
+  const OutputWrite w = write_output_file(path, {bytes}, overwrite);
+  if (w.exists) throw SceneError(path + ": already exists");
+  if (!w.ok()) throw SceneError(path + ": " + w.problem);
 }
 
 }  // namespace accelviz

@@ -53,6 +53,8 @@ expect 1 "$tmp/wrong.rays" -- trace 'builtin:soup?size=10' --rays "$tmp/wrong.ra
 expect 2 "--size" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --size 0x10
 expect 2 "--size" -- flatten 'builtin:forest?size=200' --instances 0 --size 0x3
 expect 2 "--structure" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --structure octopus
+expect 2 "--threads: Value 100000 not in range 0 to 1024" -- bench 'builtin:soup?size=10' -s bvh -j 100000
+expect 2 "--threads" -- render 'builtin:soup?size=10' --out "$tmp/y.png" -j 4294967295
 expect 2 "--metric" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --metric colour
 expect 2 "camera" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --camera 1,2,3
 expect 2 "camera" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --camera gltf:4
@@ -104,6 +106,34 @@ if grep -q embree <<<"$help"; then
     render "$tmp/far.obj" -s embree --size 8x6 --out "$tmp/f.png"
   [ ! -e "$tmp/e.png" ] && [ ! -e "$tmp/f.png" ] || { echo "FAIL: embree wrote a PNG it could not trace"; fail=1; }
 fi
+
+# Outputs never cost what was there (write_output_file): a link or FIFO
+# named OUT.part (export's old temporary) is not followed or waited on, and
+# a --force write that fails (here a file-size limit) keeps the old file.
+echo precious >"$tmp/victim.txt"
+ln -s victim.txt "$tmp/p.glb.part"
+mkfifo "$tmp/q.glb.part"
+for out in p.glb q.glb; do
+  timeout 60 "$accelviz" -q export 'builtin:soup?size=20' "$tmp/$out" >/dev/null ||
+    { echo "FAIL: export beside $out.part"; fail=1; }
+done
+[ "$(cat "$tmp/victim.txt")" = precious ] || { echo "FAIL: export wrote through $tmp/p.glb.part"; fail=1; }
+"$accelviz" -q rays 'builtin:soup?size=2000' --size 256x192 --out "$tmp/keep.rays" >/dev/null
+for kind in png rays hits; do
+  old="$tmp/old.$kind"
+  echo ORIGINAL >"$old"
+  case $kind in
+    png) cmd=(render 'builtin:soup?size=2000' --size 256x192 -f -o "$old") ;;
+    rays) cmd=(rays 'builtin:soup?size=2000' --size 256x192 -f --out "$old") ;;
+    hits) cmd=(trace 'builtin:soup?size=2000' --rays "$tmp/keep.rays" -f --out "$old") ;;
+  esac
+  (trap '' XFSZ; ulimit -f 1; "$accelviz" -q "${cmd[@]}") >/dev/null 2>"$tmp/stderr" &&
+    { echo "FAIL: $kind written past the file-size limit"; fail=1; }
+  grep -q "write failed: File too large" "$tmp/stderr" || { echo "FAIL: $kind: $(cat "$tmp/stderr")"; fail=1; }
+  [ "$(cat "$old")" = ORIGINAL ] || { echo "FAIL: a failed $kind write lost the old file"; fail=1; }
+done
+leftovers=$(find "$tmp" -name '.*.tmp-*')
+[ -z "$leftovers" ] || { echo "FAIL: temporaries left behind: $leftovers"; fail=1; }
 
 # Missing output directory.
 expect 1 "$tmp/no/dir/a.png" -- render 'builtin:soup?size=10' --out "$tmp/no/dir/a.png"

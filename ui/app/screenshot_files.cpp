@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
-#include <cstdio>
 #include <cstdlib>
 #include <memory>
+
+#include "core/util/output_file.h"
 
 namespace accelviz {
 namespace fs = std::filesystem;
@@ -24,17 +24,12 @@ std::string shell_quote(const std::string& s) {
   return q + "'";
 }
 
-struct FileCloser {
-  void operator()(std::FILE* f) const { std::fclose(f); }
-};
-
 // Creates `path` exclusively and writes `text`; "" or one line of error
 // (EEXIST is reported as "exists (not overwritten)").
 std::string write_text_exclusive(const fs::path& path, const std::string& text) {
-  std::unique_ptr<std::FILE, FileCloser> f(std::fopen(path.c_str(), "wbx"));
-  if (!f) return path.string() + (errno == EEXIST ? ": exists (not overwritten)" : ": cannot be created");
-  if (std::fwrite(text.data(), 1, text.size(), f.get()) != text.size()) return path.string() + ": write failed";
-  return {};
+  const OutputWrite w = write_output_file(path.string(), {text}, /*overwrite=*/false);
+  if (w.exists) return path.string() + ": exists (not overwritten)";
+  return w.ok() ? std::string() : path.string() + ": " + w.problem;
 }
 
 std::string heatmap_display_name(HeatmapDisplay d) {

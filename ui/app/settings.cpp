@@ -1,14 +1,11 @@
 #include "ui/app/settings.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <cstdlib>
-#include <cstring>
 #include <fstream>
 #include <sstream>
+
+#include "core/util/output_file.h"
 
 namespace accelviz {
 
@@ -135,35 +132,10 @@ std::string write_file_atomic(const std::filesystem::path& file, std::string_vie
   const fs::path dir = file.has_parent_path() ? file.parent_path() : fs::path(".");
   fs::create_directories(dir, ec);
   if (ec) return dir.string() + ": " + ec.message();
-  // Same folder as the target, so rename() stays within one file system and
-  // is atomic; the pid keeps two running instances from sharing a name.
-  std::string tmp_name = ".";
-  tmp_name += file.filename().string();
-  tmp_name += ".tmp-";
-  tmp_name += std::to_string(::getpid());
-  const fs::path tmp = dir / tmp_name;
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) return tmp.string() + ": " + std::strerror(errno);
-  const char* p = content.data();
-  std::size_t left = content.size();
-  std::string error;
-  while (left > 0) {
-    const ssize_t n = ::write(fd, p, left);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      error = tmp.string() + ": " + std::strerror(errno);
-      break;
-    }
-    p += n;
-    left -= static_cast<std::size_t>(n);
-  }
-  // fsync before rename: otherwise a crash can leave the new name pointing at
-  // an empty file on some file systems.
-  if (error.empty() && ::fsync(fd) != 0) error = tmp.string() + ": " + std::strerror(errno);
-  if (::close(fd) != 0 && error.empty()) error = tmp.string() + ": " + std::strerror(errno);
-  if (error.empty() && std::rename(tmp.c_str(), file.c_str()) != 0) error = file.string() + ": " + std::strerror(errno);
-  if (!error.empty()) fs::remove(tmp, ec);
-  return error;
+  // A fresh temporary in the same folder, flushed, then renamed over the
+  // file (write_output_file): a crash or a full disk keeps the old settings.
+  const OutputWrite w = write_output_file(file.string(), {content}, /*overwrite=*/true);
+  return w.ok() ? std::string() : file.string() + ": " + w.problem;
 }
 
 std::string save_settings(const std::filesystem::path& file, const AppSettings& s) {

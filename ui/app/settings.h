@@ -61,8 +61,9 @@ struct LoadedSettings {
 /// malformed one gives defaults and "<file>: <problem> (using defaults)".
 LoadedSettings load_settings(const std::filesystem::path& file);
 
-/// Writes `content` to `file` atomically: a temporary file in the same
-/// folder (created if missing), flushed, then renamed over `file`. Returns
+/// Writes `content` to `file` atomically: core's write_output_file (a fresh
+/// temporary file in the same folder, flushed, then renamed over `file`),
+/// the folder created if missing. Returns
 /// "" on success, else one line "<file>: <problem>"; never leaves the
 /// temporary file behind.
 std::string write_file_atomic(const std::filesystem::path& file, std::string_view content);

@@ -1,0 +1,145 @@
+// write_output_file (core/util/output_file.h): what every output of the
+// tool goes through. Nothing the user had is lost: an existing file is kept
+// unless overwriting is asked for, a failed write keeps the old file, and
+// nothing already beside the target (a link, a FIFO, a leftover) is followed.
+#include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/util/output_file.h"
+
+// Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
+namespace unity_test_output_file {
+
+using namespace accelviz;
+namespace fs = std::filesystem;
+
+class OutputFile : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() / ("accelviz_test_output_file_" + std::to_string(::getpid())) / info->name();
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_.parent_path(), ec);
+  }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  static std::string read(const std::string& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }
+  static void put(const std::string& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+  /// Names in the folder other than `keep`: a temporary left behind shows here.
+  std::vector<std::string> others(std::initializer_list<std::string> keep) const {
+    std::vector<std::string> out;
+    for (const auto& e : fs::directory_iterator(dir_)) {
+      const std::string n = e.path().filename().string();
+      if (std::find(keep.begin(), keep.end(), n) == keep.end()) out.push_back(n);
+    }
+    return out;
+  }
+  fs::path dir_;
+};
+
+TEST_F(OutputFile, WritesThePartsAndLeavesNoTemporary) {
+  const OutputWrite w = write_output_file(path("a.bin"), {"head", "", "er+body"}, false);
+  ASSERT_TRUE(w.ok()) << w.problem;
+  EXPECT_EQ(read(path("a.bin")), "header+body");
+  EXPECT_TRUE(others({"a.bin"}).empty());
+}
+
+TEST_F(OutputFile, AnExistingFileIsKeptUnlessOverwriteIsAsked) {
+  put(path("a.png"), "mine");
+  const OutputWrite refused = write_output_file(path("a.png"), {"new"}, false);
+  EXPECT_TRUE(refused.exists);
+  EXPECT_EQ(refused.problem, "exists");
+  EXPECT_EQ(read(path("a.png")), "mine");
+  EXPECT_TRUE(others({"a.png"}).empty());
+  const OutputWrite replaced = write_output_file(path("a.png"), {"new"}, true);
+  ASSERT_TRUE(replaced.ok()) << replaced.problem;
+  EXPECT_EQ(read(path("a.png")), "new");
+  EXPECT_TRUE(others({"a.png"}).empty());
+}
+
+TEST_F(OutputFile, ADanglingLinkCountsAsExisting) {
+  fs::create_symlink(path("nowhere"), path("a.png"));
+  EXPECT_TRUE(write_output_file(path("a.png"), {"new"}, false).exists);
+  EXPECT_FALSE(fs::exists(path("nowhere")));
+}
+
+TEST_F(OutputFile, OverwritingThroughALinkReplacesTheFileItNames) {
+  put(path("real.json"), "old");
+  fs::create_symlink("real.json", path("link.json"));
+  const OutputWrite w = write_output_file(path("link.json"), {"new"}, true);
+  ASSERT_TRUE(w.ok()) << w.problem;
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(path("link.json"))));
+  EXPECT_EQ(read(path("real.json")), "new");
+}
+
+// What lies beside the target under the names a writer might have used for
+// its temporary (export used OUT.part: a link there made it overwrite the
+// file the link named, a FIFO there made it hang) is never opened.
+TEST_F(OutputFile, LinksAndFifosBesideTheTargetAreNotFollowed) {
+  put(path("victim.txt"), "precious");
+  fs::create_symlink("victim.txt", path("a.glb.part"));
+  ASSERT_EQ(::mkfifo(path("b.glb.part").c_str(), 0644), 0);
+  for (const char* name : {"a.glb", "b.glb"}) {
+    const OutputWrite w = write_output_file(path(name), {"glb bytes"}, false);
+    ASSERT_TRUE(w.ok()) << w.problem;
+    EXPECT_EQ(read(path(name)), "glb bytes");
+  }
+  EXPECT_EQ(read(path("victim.txt")), "precious");
+  EXPECT_TRUE(others({"victim.txt", "a.glb.part", "b.glb.part", "a.glb", "b.glb"}).empty());
+}
+
+TEST_F(OutputFile, AFifoOrAFolderAsTheTargetIsRefused) {
+  ASSERT_EQ(::mkfifo(path("pipe.png").c_str(), 0644), 0);
+  fs::create_directories(path("folder.png"));
+  for (const bool overwrite : {false, true}) {
+    EXPECT_EQ(write_output_file(path("pipe.png"), {"x"}, overwrite).problem,
+              "is not a regular file (a FIFO, device or socket)");
+    EXPECT_EQ(write_output_file(path("folder.png"), {"x"}, overwrite).problem, "is a directory");
+  }
+  EXPECT_TRUE(others({"pipe.png", "folder.png"}).empty());
+}
+
+TEST_F(OutputFile, AMissingFolderIsNamed) {
+  const OutputWrite w = write_output_file(path("no/such/a.png"), {"x"}, false);
+  EXPECT_FALSE(w.ok());
+  EXPECT_EQ(w.problem, "cannot create: No such file or directory");
+}
+
+// A write that fails part-way (here a file-size limit, as a full disk would)
+// keeps the file that was there and leaves no temporary.
+TEST_F(OutputFile, AFailedWriteKeepsTheOldFile) {
+  put(path("big.png"), "ORIGINAL");
+  struct rlimit old {};
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old), 0);
+  void (*old_handler)(int) = std::signal(SIGXFSZ, SIG_IGN);  // EFBIG instead of the signal
+  struct rlimit small = old;
+  small.rlim_cur = 1024;
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+  const std::string big(4096, 'x');
+  const OutputWrite w = write_output_file(path("big.png"), {big}, true);
+  ::setrlimit(RLIMIT_FSIZE, &old);
+  std::signal(SIGXFSZ, old_handler);
+  EXPECT_EQ(w.problem, "write failed: File too large");
+  EXPECT_EQ(read(path("big.png")), "ORIGINAL");
+  EXPECT_TRUE(others({"big.png"}).empty());
+}
+
+}  // namespace unity_test_output_file
