@@ -972,7 +972,14 @@ class GltfConverter {
            component_type_name(in.component_type) + " (expected SCALAR/FLOAT)");
     if (in.count == 0) fail(where + " has no keyframes");
     ch.times.resize(in.count);
-    for (std::size_t i = 0; i < in.count; ++i) ch.times[i] = read_normalized(in, i, 0);
+    for (std::size_t i = 0; i < in.count; ++i) {
+      ch.times[i] = read_normalized(in, i, 0);
+      // A NaN or infinite time would make every sample of the channel NaN
+      // (and the instance's transform with it), far from here.
+      if (!std::isfinite(ch.times[i]))
+        fail(where + ": keyframe " + std::to_string(i) + " has time " + std::to_string(ch.times[i]) +
+             " (times must be finite)");
+    }
     if (!std::is_sorted(ch.times.begin(), ch.times.end()))
       warn(where + ": keyframe times are not increasing");
 
@@ -1001,7 +1008,12 @@ class GltfConverter {
     const std::size_t ncomp = component_count(out.type);
     ch.values.resize(out.count, glm::vec4(0.0f));
     for (std::size_t i = 0; i < out.count; ++i)
-      for (std::size_t k = 0; k < ncomp; ++k) ch.values[i][int(k)] = read_normalized(out, i, k);
+      for (std::size_t k = 0; k < ncomp; ++k) {
+        ch.values[i][int(k)] = read_normalized(out, i, k);
+        if (!std::isfinite(ch.values[i][int(k)]))
+          fail(where + ": output value " + std::to_string(i) + " (keyframe " +
+               std::to_string(i / (out.count / in.count)) + ") is not finite");
+      }
   }
 
   // --- checks --------------------------------------------------------------

@@ -479,6 +479,27 @@ TEST_F(GltfLoader, PunctualLightsConvertedToWorldSpace) {
   EXPECT_EQ(s.nodes[std::size_t(spot)].light, 1);
 }
 
+// A NaN or infinite keyframe time or value made every sample of its channel
+// NaN, and the two-level structure then failed far from the file: refused
+// at load, naming the file, the animation's channel and the keyframe.
+TEST_F(GltfLoader, NonFiniteKeyframeTimesAndValuesAreRefused) {
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  const auto with = [&](std::vector<float> times, std::vector<float> values, const std::string& name) {
+    GltfBuilder b = one_triangle();
+    const int in = b.floats(times, "SCALAR", 1);
+    const int out = b.floats(values, "VEC3", 3);
+    b.doc["animations"] =
+        json::array({json{{"samplers", {{{"input", in}, {"output", out}}}},
+                          {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}}}}});
+    return write_glb(b, name);
+  };
+  expect_error(with({0.0f, nan}, {0, 0, 0, 1, 1, 1}, "nan_time.glb"), "keyframe 1 has time nan (times must be finite)");
+  expect_error(with({-inf, 1.0f}, {0, 0, 0, 1, 1, 1}, "inf_time.glb"), "keyframe 0 has time -inf");
+  expect_error(with({0.0f, 1.0f}, {0, 0, 0, 1, nan, 1}, "nan_value.glb"), "output value 1 (keyframe 1) is not finite");
+  expect_error(with({0.0f, 1.0f}, {inf, 0, 0, 1, 1, 1}, "inf_value.glb"), "output value 0 (keyframe 0) is not finite");
+  EXPECT_EQ(load_gltf(with({0.0f, 1.0f}, {0, 0, 0, 1, 1, 1}, "fine.glb")).animations.size(), 1u);
+}
+
 TEST_F(GltfLoader, AnimationsAreKeptAsData) {
   GltfBuilder b = one_triangle();
   const int times = b.floats({0.0f, 1.0f}, "SCALAR", 1);

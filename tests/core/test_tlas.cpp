@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <glm/gtc/matrix_transform.hpp>
+#include <limits>
 #include <mutex>
 #include <random>
 #include <string>
@@ -418,8 +419,41 @@ TEST(Tlas, FactoryBuildsFromTheSceneOrOneInstance) {
 
 TEST(Tlas, SingularTransformIsRefused) {
   Scene s = make_instanced_scene(0, 1);
+  const auto message = [&] {
+    try {
+      Tlas t(s);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("(built)");
+  };
   s.instances[0].transform = glm::scale(glm::mat4(1.0f), glm::vec3(1.0f, 0.0f, 1.0f));
-  EXPECT_THROW(Tlas{s}, std::invalid_argument);
+  EXPECT_NE(message().find("tlas: instance 0: its transform is singular (determinant 0"), std::string::npos)
+      << message();
+  s.instances[0].transform[3][1] = std::numeric_limits<float>::quiet_NaN();  // it said "not invertible (determinant 1)"
+  EXPECT_EQ(message(), "tlas: instance 0: its transform has a non-finite entry");
+}
+
+// A frame with one bad transform is refused whole: the instances stay where they were.
+TEST(Tlas, ARefusedFrameMovesNoInstance) {
+  Scene s = make_instanced_scene(40, 4);
+  Tlas two(s);
+  std::vector<glm::mat4> moved;
+  for (const Instance& inst : s.instances) moved.push_back(glm::translate(glm::mat4(1.0f), {3, 0, 0}) * inst.transform);
+  moved.back() = glm::mat4(0.0f);
+  try {
+    two.update_transforms(moved);
+    ADD_FAILURE() << "a singular transform was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("tlas: instance " + std::to_string(moved.size() - 1) + ": "),
+              std::string::npos)
+        << e.what();
+  }
+  s.flatten();
+  const Bvh flat(s.triangles);
+  Comparison c;
+  compare(s, flat, two, make_rays(s, 5000, 8), c);
+  EXPECT_EQ(c.unexplained.load(), 0u) << c.report();
 }
 
 // Rigid motion: new transforms, TLAS rebuilt only; equals a fresh flattened build.

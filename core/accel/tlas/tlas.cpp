@@ -64,6 +64,29 @@ BvhOptions quiet(BvhOptions o) {
 
 }  // namespace
 
+namespace {
+
+/// Why the two-level structure cannot carry an instance with this transform
+/// ("" when it can): rays go into the instance's space through its inverse.
+std::string transform_problem(const glm::mat4& to_world) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(to_world[c][r])) return "its transform has a non-finite entry";
+  const float det = glm::determinant(glm::mat3(to_world));
+  if (!std::isfinite(det) || det == 0.0f)
+    return "its transform is singular (determinant " + std::to_string(det) +
+           ": a scale of 0 flattens it), so rays cannot be carried into its space; the single-level "
+           "structures (bvh, ...) take the scene";
+  return {};
+}
+
+std::string instance_problem(std::size_t index, const glm::mat4& to_world) {
+  const std::string problem = transform_problem(to_world);
+  return problem.empty() ? problem : "tlas: instance " + std::to_string(index) + ": " + problem;
+}
+
+}  // namespace
+
 Tlas::Tlas(const Scene& scene, const TlasOptions& opts, const ProgressCallback& progress) : opts_(opts) {
   const auto t0 = Clock::now();
   validate(opts_.blas);
@@ -85,6 +108,8 @@ Tlas::Tlas(const Scene& scene, const TlasOptions& opts, const ProgressCallback& 
     inst.blas = static_cast<std::uint32_t>(b);
     inst.first_prim = flattened ? si.first_triangle : next;
     next += kept[inst.blas];
+    if (const std::string problem = instance_problem(instances_.size(), si.transform); !problem.empty())
+      throw std::invalid_argument(problem);
     set_instance_transform(inst, si.transform);
     instances_.push_back(inst);
   }
@@ -160,12 +185,9 @@ int Tlas::blas_of_mesh(std::uint32_t mesh) const {
 }
 
 void Tlas::set_instance_transform(TlasInstance& inst, const glm::mat4& to_world) {
+  if (const std::string problem = transform_problem(to_world); !problem.empty())
+    throw std::invalid_argument("tlas: " + problem);
   const float det = glm::determinant(glm::mat3(to_world));
-  bool ok = std::isfinite(det) && det != 0.0f;
-  for (int c = 0; c < 4 && ok; ++c)
-    for (int r = 0; r < 4; ++r) ok = ok && std::isfinite(to_world[c][r]);
-  if (!ok)
-    throw std::invalid_argument("tlas: instance transform is not invertible (determinant " + std::to_string(det) + ")");
   inst.to_world = to_world;
   // The inverse in double: nearly singular transforms (a 1e-4 squash) keep
   // their digits.
@@ -360,6 +382,10 @@ TlasUpdateStats Tlas::update_transforms(std::span<const glm::mat4> to_world) {
   if (to_world.size() != instances_.size())
     throw std::invalid_argument("tlas: " + std::to_string(to_world.size()) + " transforms for " +
                                 std::to_string(instances_.size()) + " instances");
+  // All checked first: a refused frame leaves every instance where it was.
+  for (std::size_t i = 0; i < instances_.size(); ++i)
+    if (const std::string problem = instance_problem(i, to_world[i]); !problem.empty())
+      throw std::invalid_argument(problem);
   for (std::size_t i = 0; i < instances_.size(); ++i) set_instance_transform(instances_[i], to_world[i]);
   TlasUpdateStats s;
   s.tlas_rebuild_ms = build_top();
