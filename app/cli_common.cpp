@@ -115,6 +115,8 @@ Camera camera_for(const std::string& spec, const Scene& scene, const ImageSize& 
     return camera_from_spec(spec, scene, static_cast<float>(size.width) / static_cast<float>(size.height));
   } catch (const std::invalid_argument& e) {
     throw UsageError(std::string("--camera: ") + e.what());
+  } catch (const std::range_error& e) {  // the framing camera of a scene near the float range: not a usage error
+    throw std::runtime_error(scene.source + ": " + e.what() + " (give a camera with --camera)");
   }
 }
 

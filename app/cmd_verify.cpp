@@ -40,7 +40,12 @@ int run_verify(const VerifyOptions& o, const GlobalOptions& global) {
                              "brute-force reference");
 
   progress.begin("verifying " + std::to_string(structures.size()) + " structures");
-  const std::vector<Ray> rays = verify_rays(scene.triangles, o.rays, o.seed);
+  std::vector<Ray> rays;
+  try {
+    rays = verify_rays(scene.triangles, o.rays, o.seed);
+  } catch (const std::range_error& e) {  // bounds near the float range: no camera rays can be made
+    throw std::runtime_error(o.scene + ": " + e.what());
+  }
   // "tlas": two levels from the scene's instances, checked against the flattened brute force.
   const VerifyResult r = verify_structures(scene.triangles, rays, structures, o.threads, &scene);
   progress.end(std::to_string(static_cast<long long>(r.total_ms)) + " ms");

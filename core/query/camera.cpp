@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -96,7 +97,17 @@ Camera frame_bounds(const Aabb& bounds, float aspect, float yfov_radians) {
   const float half = std::min(half_v, half_h);
   const float distance = radius / std::sin(half);
   const glm::vec3 from = glm::normalize(glm::vec3(1.0f, 0.6f, 1.4f));
-  Camera cam = look_at(centre + from * distance, centre, yfov_radians);
+  const glm::vec3 eye = centre + from * distance;
+  // Bounds near the float range (coordinates of 1e38, say) overflow the
+  // radius or the camera's distance: no float camera sees them.
+  if (!finite3(centre) || !std::isfinite(distance) || !finite3(eye)) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "(%g, %g, %g) .. (%g, %g, %g)", bounds.lo.x, bounds.lo.y, bounds.lo.z, bounds.hi.x,
+                  bounds.hi.y, bounds.hi.z);
+    throw std::range_error(std::string("cannot frame the scene: a camera that sees its bounds ") + buf +
+                           " would stand beyond the float range");
+  }
+  Camera cam = look_at(eye, centre, yfov_radians);
   cam.name = "framed";
   return cam;
 }

@@ -31,6 +31,8 @@ Ray primary_ray(const Camera& cam, int x, int y, int width, int height);
 /// normalised, towards the box centre, far enough that the box's bounding
 /// sphere fits both the vertical and the horizontal field of view. An empty
 /// box gives the default camera.
+/// Throws std::range_error ("cannot frame the scene: ...") for bounds so
+/// large that the camera would stand beyond the float range.
 Camera frame_bounds(const Aabb& bounds, float aspect, float yfov_radians = Camera{}.yfov);
 
 /// The `--camera` option:

@@ -135,6 +135,14 @@ done
 leftovers=$(find "$tmp" -name '.*.tmp-*')
 [ -z "$leftovers" ] || { echo "FAIL: temporaries left behind: $leftovers"; fail=1; }
 
+# A scene near the float range cannot be framed: one line naming the scene
+# (it was reported as a --camera usage error), nothing written.
+printf 'v -3e38 0 0\nv 3e38 0 0\nv 0 3e38 0\nf 1 2 3\n' >"$tmp/huge.obj"
+expect 1 "$tmp/huge.obj: cannot frame the scene: a camera that sees its bounds" -- \
+  render "$tmp/huge.obj" --size 8x6 --out "$tmp/huge.png"
+expect 1 "$tmp/huge.obj: cannot frame the scene" -- verify "$tmp/huge.obj" --rays 100
+[ ! -e "$tmp/huge.png" ] || { echo "FAIL: a PNG of an unframable scene"; fail=1; }
+
 # Missing output directory.
 expect 1 "$tmp/no/dir/a.png" -- render 'builtin:soup?size=10' --out "$tmp/no/dir/a.png"
 

@@ -139,6 +139,18 @@ TEST(OrbitCamera, FromCameraSeesWhatTheCameraSees) {
   EXPECT_FLOAT_EQ(o.yfov, 0.8f);
 }
 
+// A scene near the float range cannot be framed: the app keeps the orbit's
+// default view and says why on the status line, instead of failing.
+TEST(ViewCamera, DefaultOfAnUnframableSceneSaysWhy) {
+  Scene s;
+  s.triangles = {{{-3e38f, 0, 0}, {3e38f, 0, 0}, {0, 3e38f, 0}}};
+  const ViewCamera v = ViewCamera::scene_default(s, 1.0f);
+  EXPECT_NE(v.framing_problem.find("cannot frame the scene"), std::string::npos) << v.framing_problem;
+  EXPECT_TRUE(v.is_default);
+  EXPECT_TRUE(std::isfinite(v.camera().position.x));
+  EXPECT_TRUE(ViewCamera::scene_default(box_scene(), 1.0f).framing_problem.empty());
+}
+
 TEST(ViewCamera, DefaultIsWhatRenderShowsWithoutACamera) {
   Scene s = box_scene();
   const float aspect = 4.0f / 3.0f;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "core/accel/brute_force.h"
 #include "core/query/batch.h"
@@ -84,6 +86,23 @@ TEST(Camera, ExplicitAspectOverridesImage) {
   EXPECT_FLOAT_EQ(camera_aspect(cam, 200, 100), 2.0f);
   cam.aspect = 1.0f;
   EXPECT_FLOAT_EQ(camera_aspect(cam, 200, 100), 1.0f);
+}
+
+// Bounds near the float range overflow the framing camera's distance: a
+// range_error that says so (the CLI named it a --camera usage error before).
+TEST(Camera, FrameBoundsOfHugeBoundsIsARangeError) {
+  const Aabb huge{{-3e38f, -3e38f, 0.0f}, {3e38f, 3e38f, 3e38f}};
+  try {
+    frame_bounds(huge, 1.0f);
+    ADD_FAILURE() << "framed bounds of 3e38";
+  } catch (const std::range_error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot frame the scene: a camera that sees its bounds (-3e+38, -3e+38, 0)"),
+              std::string::npos)
+        << e.what();
+  }
+  const Aabb big{{-1e18f, -1e18f, -1e18f}, {1e18f, 1e18f, 1e18f}};  // large, but its camera fits
+  const Camera cam = frame_bounds(big, 1.0f);
+  EXPECT_TRUE(std::isfinite(cam.position.x) && std::isfinite(cam.position.y) && std::isfinite(cam.position.z));
 }
 
 TEST(Camera, FrameBoundsContainsBoundingSphere) {

@@ -139,6 +139,7 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
         if (!scene.report.warnings.empty())
           m += ", " + std::to_string(scene.report.warnings.size()) +
                " loader warning(s): " + scene.report.warnings.front();
+        if (!camera_.framing_problem.empty()) m += "; " + camera_.framing_problem;
         set_message(m);
       } else {
         set_message("built " + describe_structure(current_->choice) + " in " +

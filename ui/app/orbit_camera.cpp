@@ -1,10 +1,11 @@
 #include "ui/app/orbit_camera.h"
 
-#include "core/query/camera.h"
-#include "ui/app/app_config.h"
-
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+
+#include "core/query/camera.h"
+#include "ui/app/app_config.h"
 
 namespace accelviz {
 namespace {
@@ -103,7 +104,14 @@ ViewCamera ViewCamera::scene_default(const Scene& scene, float aspect) {
   }
   ViewCamera v;
   const Aabb bounds = scene.bounds();
-  const Camera framed = frame_bounds(bounds, aspect, v.orbit.yfov);
+  Camera framed;
+  try {
+    framed = frame_bounds(bounds, aspect, v.orbit.yfov);
+  } catch (const std::range_error& e) {
+    v.framing_problem = e.what();
+    v.is_default = true;
+    return v;
+  }
   v.orbit = OrbitCamera::from_camera(framed, bounds.is_empty() ? 5.0f : glm::length(bounds.center() - framed.position));
   if (!bounds.is_empty()) v.orbit.pivot = bounds.center();
   v.fixed = framed;

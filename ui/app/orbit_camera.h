@@ -58,6 +58,9 @@ struct ViewCamera {
   int scene_camera = -1;     ///< index into Scene::cameras while `fixed` is one of them
   bool is_default = false;   ///< `fixed` is the default view (what `render` shows without --camera)
   std::string command_spec;  ///< `fixed` came from a --camera style spec (script `camera`): that spec
+  /// scene_default could not frame the scene (bounds near the float range):
+  /// why, for the status line; the view is then the orbit's default.
+  std::string framing_problem;
 
   Camera camera() const { return fixed ? *fixed : orbit.camera(); }
   /// Leaves the fixed camera for the orbit (called before every user move).
