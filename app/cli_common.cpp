@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -55,11 +56,11 @@ void StructureCli::add_to(CLI::App* app, bool with_embree) {
       ->capture_default_str()
       ->group("Structure");
   app->add_option("--ctrav", ctrav, "SAH cost of visiting an inner node (C_trav)")
-      ->check(CLI::PositiveNumber)
+      ->check(finite_positive())
       ->capture_default_str()
       ->group("Structure");
   app->add_option("--cisect", cisect, "SAH cost of one ray-triangle test (C_isect)")
-      ->check(CLI::PositiveNumber)
+      ->check(finite_positive())
       ->capture_default_str()
       ->group("Structure");
   app->add_option("--wide", wide,
@@ -132,6 +133,51 @@ CLI::Option* add_triangle_test_option(CLI::App* sub, std::string& value, const c
                    help ? help : "Ray-triangle test: watertight (Woop et al. 2013) or fast (Moller-Trumbore)")
       ->check(CLI::IsMember({"watertight", "fast"}))
       ->capture_default_str();
+}
+
+namespace {
+
+/// The number an option's text holds, if it is one (with nothing after it).
+bool option_number(const std::string& text, double& value) {
+  std::size_t used = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    return false;
+  }
+  return used == text.size();
+}
+
+std::string number_text(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", x);
+  return buf;
+}
+
+}  // namespace
+
+CLI::Validator finite_positive() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        double v = 0.0;
+        if (!option_number(text, v)) return "expected a number, got '" + text + "'";
+        if (!std::isfinite(v) || !(v > 0.0) || !std::isfinite(static_cast<float>(v)))
+          return "must be a finite number > 0, got " + text;
+        return {};
+      },
+      "POSITIVE");
+}
+
+CLI::Validator finite_range(double lo, double hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& text) -> std::string {
+        double v = 0.0;
+        if (!option_number(text, v)) return "expected a number, got '" + text + "'";
+        if (!std::isfinite(v) || v < lo || v > hi)
+          return "must be a number from " + number_text(lo) + " to " + number_text(hi) + ", got " + text;
+        return {};
+      },
+      "[" + number_text(lo) + " - " + number_text(hi) + "]");
 }
 
 CLI::Option* add_threads_option(CLI::App* sub, unsigned& value, const char* help) {

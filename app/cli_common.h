@@ -93,6 +93,12 @@ CLI::Option* add_triangle_test_option(CLI::App* sub, std::string& value, const c
 /// threads could fail to start, or crash, instead of running).
 inline constexpr unsigned kMaxThreads = 1024;
 
+/// CLI11 checks for floating-point options: a finite number > 0, a finite
+/// number in [lo, hi]. (CLI::PositiveNumber and CLI::Range let nan and inf
+/// through, and word the positive range as "0.000000 to 1797693...".)
+CLI::Validator finite_positive();
+CLI::Validator finite_range(double lo, double hi);
+
 /// `--threads,-j N` (0: all hardware threads), checked to 0..kMaxThreads.
 CLI::Option* add_threads_option(CLI::App* sub, unsigned& value, const char* help);
 /// --triangle-test watertight|fast.

@@ -226,6 +226,13 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   if (o.structures.empty())
     o.structures = kHaveEmbree ? std::vector<std::string>{"bvh", "embree"} : std::vector<std::string>{"bvh"};
   if (o.repeat < 1) throw UsageError("--repeat must be at least 1");
+  // Each structure is one row: a name twice would build and time it twice.
+  for (std::size_t i = 0; i < o.structures.size(); ++i) {
+    if (o.structures[i].empty()) throw UsageError("--structure: an empty name in the list");
+    for (std::size_t j = 0; j < i; ++j)
+      if (o.structures[j] == o.structures[i])
+        throw UsageError("--structure: '" + o.structures[i] + "' is listed twice");
+  }
   const ImageSize size = parse_size(o.size);
   const unsigned all = resolve_threads(o.threads);
   QueryOptions q;

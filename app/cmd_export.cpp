@@ -1,7 +1,9 @@
 // accelviz export SCENE OUT.(glb|gltf) [--force]: writes any scene accelviz
 // can load (a built-in generator, a .gltf/.glb, an .obj) as glTF 2.0, so a
 // procedural scene can be opened in other tools or shipped as a small asset.
+#include <cctype>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 
 #include "app/cli_common.h"
@@ -18,13 +20,18 @@ struct ExportOptions {
   bool force = false;
 };
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+/// The output's extension in lower case ("" for none; a name that is only
+/// an extension, like ".glb", has none), as render reads a PNG's.
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
 }
 
 int run_export(const ExportOptions& o, const GlobalOptions& global) {
-  const bool binary = ends_with(o.out, ".glb");
-  if (!binary && !ends_with(o.out, ".gltf")) throw UsageError(o.out + ": the output must end in .glb or .gltf");
+  const std::string ext = lower_extension(o.out);
+  const bool binary = ext == ".glb";
+  if (!binary && ext != ".gltf") throw UsageError(o.out + ": the output's name must end in .glb or .gltf");
   check_output_path(o.out, o.force);
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
   write_gltf(scene, o.out, binary, o.force);
@@ -42,7 +49,7 @@ Command add_export_command(CLI::App& parent, const GlobalOptions& global) {
   sub->add_option("SCENE", o->scene, "Scene file (.gltf, .glb, .obj) or builtin:NAME[?key=value&...]")->required();
   sub->add_option("OUT", o->out, "Output file; .glb writes binary glTF, .gltf embeds the buffer as base64")
       ->required();
-  sub->add_flag("--force", o->force, "Replace OUT if it exists");
+  sub->add_flag("--force,-f", o->force, "Replace OUT if it exists");
   return {sub, [o, &global] { return run_export(*o, global); }};
 }
 

@@ -274,7 +274,7 @@ Command add_render_command(CLI::App& parent, const GlobalOptions& global) {
       ->check(CLI::IsMember({"viridis", "inferno", "turbo"}))
       ->capture_default_str();
   sub->add_option("--max", o->max, "Top of the colour scale (default: the image's maximum); values above are clamped")
-      ->check(CLI::PositiveNumber);
+      ->check(finite_positive());
   sub->add_option("--legend", o->legend, "Legend bar placement: bottom, right, none")
       ->check(CLI::IsMember({"bottom", "right", "none"}))
       ->capture_default_str();
@@ -308,7 +308,7 @@ Command add_render_command(CLI::App& parent, const GlobalOptions& global) {
                   "it entered in order and the primitives it tested");
   sub->add_option("--blend", o->raster.blend,
                   "raster: blend the --metric heatmap over the mesh with this opacity (0: none, 1: full screen)")
-      ->check(CLI::Range(0.0f, 1.0f));
+      ->check(finite_range(0.0, 1.0));
   sub->add_flag("--wireframe", o->raster.wireframe, "raster: draw triangle edges over the mesh");
   sub->add_option("--device", o->device,
                   "Where the heatmap's rays are traced: cpu (all threads), gpu (an OpenGL 4.5 compute shader "

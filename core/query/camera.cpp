@@ -45,7 +45,9 @@ Camera look_at(const glm::vec3& eye, const glm::vec3& target, float yfov_radians
   if (!finite3(eye) || !finite3(target)) throw std::invalid_argument("camera: eye and target must be finite");
   const glm::vec3 d = target - eye;
   const float len = glm::length(d);
-  if (!(len > 0.0f) || !std::isfinite(len)) throw std::invalid_argument("camera: eye and target are the same point");
+  if (!(len > 0.0f)) throw std::invalid_argument("camera: eye and target are the same point");
+  if (!std::isfinite(len))
+    throw std::invalid_argument("camera: eye and target lie too far apart (their distance overflows float)");
   if (!(yfov_radians > 0.0f && yfov_radians < kPi))
     throw std::invalid_argument("camera: vertical field of view must lie strictly between 0 and 180 degrees");
   Camera cam;

@@ -1105,6 +1105,8 @@ GlbLayout check_glb(const std::string& path, const std::vector<unsigned char>& d
     if (chunk == 0) {
       if (chunk_type != kGlbChunkJson)
         fail_file(path, "malformed GLB: first chunk has type " + hex32(chunk_type) + " (expected JSON)");
+      // Said here: the bytes after an empty JSON chunk would be read as the next chunk's header.
+      if (chunk_length == 0) fail_file(path, "malformed GLB: empty JSON chunk");
       layout.json_offset = offset + 8;
       layout.json_length = chunk_length;
     } else if (chunk == 1 && chunk_type != kGlbChunkBin) {

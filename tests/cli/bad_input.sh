@@ -55,8 +55,17 @@ expect 2 "--size" -- flatten 'builtin:forest?size=200' --instances 0 --size 0x3
 expect 2 "--structure" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --structure octopus
 expect 2 "--threads: Value 100000 not in range 0 to 1024" -- bench 'builtin:soup?size=10' -s bvh -j 100000
 expect 2 "--threads" -- render 'builtin:soup?size=10' --out "$tmp/y.png" -j 4294967295
+# Floating-point options: NaN, infinity and overflow are refused, in words
+# (CLI11's own checks let nan through and printed 0.000000 to 1797693...).
+expect 2 "--ctrav: must be a finite number > 0, got nan" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --ctrav nan
+expect 2 "--cisect: must be a finite number > 0, got 1e308" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --cisect 1e308
+expect 2 "--max: must be a finite number > 0, got nan" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --max nan
+expect 2 "--blend: must be a number from 0 to 1, got nan" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --view raster --blend nan
+expect 2 "--structure: 'bvh' is listed twice" -- bench 'builtin:soup?size=10' -s bvh,bvh -n 1 --size 4x4
 expect 2 "--metric" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --metric colour
 expect 2 "camera" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --camera 1,2,3
+expect 2 "eye and target lie too far apart" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --camera 1e30,0,0,0,0,0
+expect 2 "eye and target are the same point" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --camera 1,2,3,1,2,3
 expect 2 "camera" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --camera gltf:4
 expect 2 "required" -- trace 'builtin:soup?size=10' --out "$tmp/z.hits"
 expect 2 "nosuchcommand" -- nosuchcommand
@@ -142,6 +151,15 @@ expect 1 "$tmp/huge.obj: cannot frame the scene: a camera that sees its bounds" 
   render "$tmp/huge.obj" --size 8x6 --out "$tmp/huge.png"
 expect 1 "$tmp/huge.obj: cannot frame the scene" -- verify "$tmp/huge.obj" --rays 100
 [ ! -e "$tmp/huge.png" ] || { echo "FAIL: a PNG of an unframable scene"; fail=1; }
+
+# export: the extension in any case, -f for --force; a name that is only
+# an extension, or another extension, is a usage error before any work.
+"$accelviz" -q export 'builtin:soup?size=20' "$tmp/UP.GLB" >/dev/null || { echo "FAIL: export to .GLB"; fail=1; }
+expect 1 "$tmp/UP.GLB: exists (use --force to overwrite)" -- export 'builtin:soup?size=20' "$tmp/UP.GLB"
+"$accelviz" -q export 'builtin:soup?size=20' "$tmp/UP.GLB" -f >/dev/null || { echo "FAIL: export -f"; fail=1; }
+expect 2 "$tmp/.glb: the output's name must end in .glb or .gltf" -- export 'builtin:soup?size=20' "$tmp/.glb"
+expect 2 "$tmp/x.obj: the output's name must end in .glb or .gltf" -- export 'builtin:soup?size=20' "$tmp/x.obj"
+[ ! -e "$tmp/.glb" ] && [ ! -e "$tmp/x.obj" ] || { echo "FAIL: export wrote under a refused name"; fail=1; }
 
 # Missing output directory.
 expect 1 "$tmp/no/dir/a.png" -- render 'builtin:soup?size=10' --out "$tmp/no/dir/a.png"

@@ -639,6 +639,17 @@ TEST_F(GltfLoader, ExternalBufferOver4GiBIsRefusedByName) {
   expect_error(path("external.gltf"), "file is larger than 4 GiB, which glTF loading does not support");
 }
 
+// A JSON chunk of length 0 followed by more bytes: those bytes were read as
+// the next chunk's header ("chunk 1 length 1935745659 ...").
+TEST_F(GltfLoader, EmptyJsonChunkIsNamed) {
+  const std::string bytes = one_triangle().glb_bytes();
+  std::string glb = bytes;
+  const std::uint32_t zero = 0;
+  std::memcpy(&glb[12], &zero, 4);
+  write_file(dir_ / "empty_json.glb", glb);
+  expect_error(path("empty_json.glb"), "malformed GLB: empty JSON chunk");
+}
+
 TEST_F(GltfLoader, WrongMagic) {
   std::string bytes = one_triangle().glb_bytes();
   bytes[3] = 'X';
