@@ -1,13 +1,12 @@
 // accelviz export SCENE OUT.(glb|gltf) [--force]: writes any scene accelviz
 // can load (a built-in generator, a .gltf/.glb, an .obj) as glTF 2.0, so a
 // procedural scene can be opened in other tools or shipped as a small asset.
-#include <cctype>
 #include <cstdio>
-#include <filesystem>
 #include <memory>
 
 #include "app/cli_common.h"
 #include "core/scene/gltf_writer.h"
+#include "core/util/file_checks.h"
 #include "core/util/one_line.h"
 
 namespace accelviz::cli {
@@ -19,14 +18,6 @@ struct ExportOptions {
   std::string out;
   bool force = false;
 };
-
-/// The output's extension in lower case ("" for none; a name that is only
-/// an extension, like ".glb", has none), as render reads a PNG's.
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
 
 int run_export(const ExportOptions& o, const GlobalOptions& global) {
   const std::string ext = lower_extension(o.out);

@@ -492,10 +492,7 @@ RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
 // ---- PNG I/O ---------------------------------------------------------------------
 
 std::string png_name_problem(const std::string& path) {
-  const std::string ext = std::filesystem::path(path).extension().string();
-  const bool png =
-      ext.size() == 4 && ext[0] == '.' && (ext[1] | 0x20) == 'p' && (ext[2] | 0x20) == 'n' && (ext[3] | 0x20) == 'g';
-  return png ? std::string() : path + ": a PNG file's name must end in .png";
+  return lower_extension(path) == ".png" ? std::string() : path + ": a PNG file's name must end in .png";
 }
 
 void write_png(const std::string& path, const RgbImage& img, bool overwrite) {

@@ -81,12 +81,6 @@ std::string hex32(std::uint32_t v) {
   return s;
 }
 
-std::string lower_extension(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  return ext;
-}
-
 // --- Step 2: SAX pre-pass over the JSON ------------------------------------
 
 /// Walks the JSON without building it: records the first syntax error, stops

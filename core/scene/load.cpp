@@ -2,9 +2,10 @@
 // SCENE argument to the built-in generators or to a file loader.
 #include "core/scene/load.h"
 
-#include <algorithm>
 #include <filesystem>
 #include <string>
+
+#include "core/util/file_checks.h"
 
 namespace accelviz {
 
@@ -18,8 +19,7 @@ Scene load_scene(const std::string& spec) {
   // "unsupported file type" would hide it.
   if (ec || !fs::exists(st)) throw SceneError(spec + ": no such file");
 
-  std::string ext = fs::path(spec).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  const std::string ext = lower_extension(spec);
   if (ext == ".gltf" || ext == ".glb") return load_gltf(spec);
   if (ext == ".obj") return load_obj(spec);
   const std::string shown = ext.empty() ? std::string("(no extension)") : "'" + ext + "'";

@@ -4,6 +4,7 @@
 // and one that is a directory or a device reads as garbage or without end; an
 // output that is a FIFO blocks its writer, and a failed write or a rename
 // would remove or replace a device node.
+#include <cctype>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -29,6 +30,15 @@ inline std::string input_file_problem(const std::string& path, std::uintmax_t ma
   if (size > max_bytes)
     return too_large.empty() ? "is larger than " + std::to_string(max_bytes) + " bytes" : std::string(too_large);
   return {};
+}
+
+/// The extension of `path`'s file name in lower case, with its dot (".glb");
+/// "" when it has none, as for a name that is only an extension (".glb").
+/// What the loaders dispatch on and the writers check output names with.
+inline std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
 }
 
 /// "" when `path` may be created or overwritten as a file: nothing is there,

@@ -62,10 +62,6 @@ BvhOptions quiet(BvhOptions o) {
   return o;
 }
 
-}  // namespace
-
-namespace {
-
 /// Why the two-level structure cannot carry an instance with this transform
 /// ("" when it can): rays go into the instance's space through its inverse.
 std::string transform_problem(const glm::mat4& to_world) {
