@@ -1156,6 +1156,10 @@ bool read_external_file(std::vector<unsigned char>* out, std::string* err, const
     if (err) *err += what;
     return false;
   };
+  // A URI's %00 (or a malformed escape, which tinygltf decodes to 0) puts a
+  // NUL in the name: the file system would read only what comes before it.
+  if (path.find('\0') != std::string::npos)
+    return problem("its name holds a NUL byte (a %00 or malformed escape in the URI)");
   std::uintmax_t size = 0;
   if (const std::string p = input_file_problem(path, kMaxFileBytes, size, kTooLarge); !p.empty()) return problem(p);
   if (size == 0) return problem("empty file");

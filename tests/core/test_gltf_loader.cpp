@@ -811,6 +811,16 @@ TEST_F(GltfLoader, UnsupportedRequiredExtensionMeshopt) {
   expect_error(write_gltf(b), "requires extension 'EXT_meshopt_compression'");
 }
 
+// A malformed escape in a buffer's URI decodes to a NUL: the message named a
+// folder ("File read error : g/") and stopped there.
+TEST_F(GltfLoader, ExternalBufferUriWithANulIsNamed) {
+  GltfBuilder b = one_triangle();
+  json d = b.doc;
+  d["buffers"] = json::array({json{{"byteLength", b.bin.size()}, {"uri", "%ZZ.bin"}}});
+  write_file(dir_ / "pct.gltf", d.dump());
+  expect_error(path("pct.gltf"), "?.bin : its name holds a NUL byte (a %00 or malformed escape in the URI)");
+}
+
 TEST_F(GltfLoader, MissingExternalBufferFile) {
   GltfBuilder b = one_triangle();
   json d = b.doc;
