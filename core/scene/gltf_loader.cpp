@@ -322,6 +322,9 @@ class GltfConverter {
     traverse(roots);
     convert_animations();
     warn_ignored_extensions();
+    // tinygltf reads any version; a major version other than 2 is another format.
+    if (const std::string& v = model_.asset.version; !v.starts_with("2.") && v != "2")
+      warn("asset.version is '" + v + "', not 2.x; read as glTF 2.0");
     check_world_triangle_count();
     scene_.flatten();
     if (scene_.triangles.empty()) fail(no_triangles_message(scene_.report));
@@ -609,6 +612,14 @@ class GltfConverter {
         if (g.matrix.size() != 16)
           fail(name + " has a matrix of " + std::to_string(g.matrix.size()) + " numbers (expected 16)");
         node.local = column_major(g.matrix);
+        // glTF requires an affine matrix (last row 0, 0, 0, 1): vertices are
+        // transformed as points without a division, so a projective part is
+        // ignored; say so rather than draw something else silently.
+        if (node.local[0][3] != 0.0f || node.local[1][3] != 0.0f || node.local[2][3] != 0.0f ||
+            node.local[3][3] != 1.0f)
+          warn(name +
+               " has a matrix whose last row is not (0, 0, 0, 1); glTF allows only affine matrices, "
+               "so its projective part is ignored");
         node.has_matrix = true;
         decompose_for_display(node);
       } else {

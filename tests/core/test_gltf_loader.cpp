@@ -236,6 +236,23 @@ TEST_F(GltfLoader, TwoNodesSharingAMeshBecomeInstances) {
   expect_vec3_near(s.meshes[0].positions[0], {0, 0, 0});
 }
 
+// Files that are valid JSON but not what glTF 2.0 allows are loaded with a
+// warning that says what was assumed, not silently.
+TEST_F(GltfLoader, ProjectiveMatrixAndOtherAssetVersionsAreWarnedAbout) {
+  const auto warnings_of = [](const Scene& s) {
+    std::string all;
+    for (const std::string& w : s.report.warnings) all += w + "|";
+    return all;
+  };
+  GltfBuilder b = one_triangle();
+  EXPECT_EQ(warnings_of(load_gltf(write_gltf(b, "plain.gltf"))), "");
+  b.doc["asset"]["version"] = "3.0";
+  b.doc["nodes"][0]["matrix"] = {1, 0, 0, 0.5, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};  // column 0 row 3: projective
+  const std::string w = warnings_of(load_gltf(write_gltf(b, "odd.gltf")));
+  EXPECT_NE(w.find("asset.version is '3.0', not 2.x; read as glTF 2.0"), std::string::npos) << w;
+  EXPECT_NE(w.find("node 0 has a matrix whose last row is not (0, 0, 0, 1)"), std::string::npos) << w;
+}
+
 TEST_F(GltfLoader, TrsAndMatrixGiveTheSameWorldTriangles) {
   const glm::vec3 t(1, 2, 3), sc(2, 2, 2);
   const glm::quat r = glm::angleAxis(glm::radians(90.0f), glm::vec3(0, 0, 1));
