@@ -104,7 +104,9 @@ Command add_calibrate_command(CLI::App& parent, const GlobalOptions& global) {
   CLI::App* sub = parent.add_subcommand(
       "calibrate", "Measure this machine's ray-box and ray-triangle test costs and the SAH constants they imply; "
                    "with --scene, compare the BVH built with default and calibrated constants");
-  sub->add_option("--scene", o->scene, "Scene to compare default and calibrated BVH constants on");
+  sub->add_option("--scene", o->scene, "Scene to compare default and calibrated BVH constants on")
+      ->check(CLI::Validator(
+          [](std::string& v) { return v.empty() ? std::string("an empty scene name") : std::string(); }, "SCENE"));
   sub->add_flag("--json", o->json, "Print one JSON document instead of text");
   sub->add_option("--repeat,-n", o->repeat, "Timed loops per figure (median)")->check(CLI::Range(1, 100))->capture_default_str();
   sub->add_option("--size", o->size, "--scene: primary rays, one per pixel of a WxH image")

@@ -199,7 +199,6 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
   use_fixed_malloc_thresholds();  // the settings' builds compare fairly from the first on
   // ---- everything that can be a usage error, before any long work ----
   if (o.params.empty()) throw UsageError("sweep: give at least one --param NAME=V1,V2,...");
-  if (!(o.ray_budget > 0) || !std::isfinite(o.ray_budget)) throw UsageError("--ray-budget must be positive");
   std::vector<SweepParam> params;
   std::vector<SweepSetting> settings;
   try {
@@ -363,7 +362,9 @@ Command add_sweep_command(CLI::App& parent, const GlobalOptions& global) {
       ->check(CLI::Range(0, 100))
       ->capture_default_str();
   add_threads_option(sub, o->threads, "Build and trace threads (0: all hardware threads)");
-  sub->add_option("--ray-budget", o->ray_budget, "Rays N of total time = build + N / (rays/s)")->capture_default_str();
+  sub->add_option("--ray-budget", o->ray_budget, "Rays N of total time = build + N / (rays/s)")
+      ->check(finite_positive())
+      ->capture_default_str();
   sub->add_option("--camera", o->camera, "View: ex,ey,ez,tx,ty,tz[,fovdeg] or gltf:N");
   sub->add_option("--seed", o->seed, "Seed of diffuse directions and edge probes")->capture_default_str();
   sub->add_option("--edge-probes", o->edge_probes,

@@ -41,7 +41,7 @@ float parse_positive(const std::string& name, const std::string& v) {
   float out = 0;
   const auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), out);
   if (ec != std::errc() || p != v.data() + v.size() || !std::isfinite(out) || out <= 0)
-    bad_value(name, v, "expected a positive number");
+    bad_value(name, v, "expected a finite number > 0");
   return out;
 }
 

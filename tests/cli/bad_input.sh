@@ -62,6 +62,8 @@ expect 2 "--cisect: must be a finite number > 0, got 1e308" -- render 'builtin:s
 expect 2 "--max: must be a finite number > 0, got nan" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --max nan
 expect 2 "--blend: must be a number from 0 to 1, got nan" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --view raster --blend nan
 expect 2 "--structure: 'bvh' is listed twice" -- bench 'builtin:soup?size=10' -s bvh,bvh -n 1 --size 4x4
+expect 2 "--ray-budget: must be a finite number > 0, got inf" -- sweep 'builtin:soup?size=10' -p leaf=2 --ray-budget inf --out "$tmp/swb"
+expect 2 "--scene: an empty scene name" -- calibrate --scene ""
 expect 2 "--metric" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --metric colour
 expect 2 "camera" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --camera 1,2,3
 expect 2 "eye and target lie too far apart" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --camera 1e30,0,0,0,0,0
