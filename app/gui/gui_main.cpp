@@ -187,6 +187,7 @@ Gui::Gui(const GuiOptions& options, AppSettings settings, std::optional<ScriptRu
   // Stepped from app_.update() on this thread, with the window's context current.
   app_.set_gpu_heatmap_tracer(gpu_heatmap_.get());
   if (!settings_error.empty()) app_.set_error(settings_error);
+  if (!imgui_->load_problem().empty()) app_.set_error(imgui_->load_problem());
 }
 
 Gui::~Gui() {

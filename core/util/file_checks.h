@@ -7,6 +7,7 @@
 #include <cctype>
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <string_view>
 
@@ -29,6 +30,21 @@ inline std::string input_file_problem(const std::string& path, std::uintmax_t ma
   if (ec) return "cannot read its size: " + ec.message();
   if (size > max_bytes)
     return too_large.empty() ? "is larger than " + std::to_string(max_bytes) + " bytes" : std::string(too_large);
+  return {};
+}
+
+/// Reads a small text file the app keeps or is given (settings, the panel
+/// layout, a shader, a script) into `text`: "" on success, else the problem
+/// without the path, as input_file_problem words it ("no such file", "is
+/// not a regular file" for a FIFO, which would block the reader, "is
+/// larger than N bytes", ...) or "read error".
+inline std::string read_text_file(const std::string& path, std::uintmax_t max_bytes, std::string& text) {
+  std::uintmax_t size = 0;
+  if (std::string problem = input_file_problem(path, max_bytes, size); !problem.empty()) return problem;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return "cannot be opened for reading";
+  text.assign(static_cast<std::size_t>(size), '\0');
+  if (size > 0 && !in.read(text.data(), static_cast<std::streamsize>(size))) return "read error";
   return {};
 }
 

@@ -2,10 +2,12 @@
 // file and line) and the runner's sequencing over a host that may need more
 // frames, fails, or never finishes.
 #include <gtest/gtest.h>
-
-#include "ui/app/script.h"
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <functional>
+
+#include "ui/app/script.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_app_script {
@@ -170,8 +172,47 @@ TEST(AppScript, MissingFileIsAnError) {
     load_script("/nonexistent/dir/script.txt");
     FAIL() << "no error";
   } catch (const ScriptError& e) {
-    EXPECT_STREQ(e.what(), "/nonexistent/dir/script.txt:0: cannot be read");
+    EXPECT_STREQ(e.what(), "/nonexistent/dir/script.txt:0: cannot be read: no such file");
   }
+}
+
+// Odd bytes: a NUL ended the message ("unknown command 'si"), a 10 MB
+// argument was echoed whole, a byte order mark made the first command unknown.
+TEST(AppScript, OddBytesGiveOneShortLine) {
+  try {
+    parse_script(std::string("size 320 240\nsi\0ze 320 240\n", 27), "nul.txt");
+    ADD_FAILURE() << "no error";
+  } catch (const ScriptError& e) {
+    EXPECT_EQ(std::string(e.what()).substr(0, 36), "nul.txt:2: unknown command 'si?ze' (") << e.what();
+  }
+  try {
+    parse_script("set buckets " + std::string(10'000'000, '9') + "\n", "long.txt");
+    ADD_FAILURE() << "no error";
+  } catch (const ScriptError& e) {
+    EXPECT_LE(std::string(e.what()).size(), 400u);
+    EXPECT_TRUE(std::string(e.what()).ends_with("...")) << e.what();
+  }
+  const auto cmds = parse_script("\xEF\xBB\xBFopen builtin:teapot\nquit\n", "bom.txt");
+  ASSERT_EQ(cmds.size(), 2u);
+  EXPECT_EQ(cmds[0].kind, ScriptCommand::Kind::open);
+  EXPECT_EQ(cmds[0].arg, "builtin:teapot");
+}
+
+// A folder ran as an empty script (exit 0, nothing said); a FIFO would block.
+TEST(AppScript, AFolderOrAFifoIsNotAScript) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("accelviz_script_kinds_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "dir.txt");
+  ASSERT_EQ(::mkfifo((dir / "fifo.txt").c_str(), 0644), 0);
+  for (const char* name : {"dir.txt", "fifo.txt"}) {
+    try {
+      load_script(dir / name);
+      ADD_FAILURE() << name << " was read as a script";
+    } catch (const ScriptError& e) {
+      EXPECT_NE(std::string(e.what()).find(":0: cannot be read: is "), std::string::npos) << e.what();
+    }
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(AppScript, RunnerRetriesCommandsThatNeedMoreFrames) {

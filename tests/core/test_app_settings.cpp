@@ -1,6 +1,7 @@
 // Settings on disk: round trip, atomic replacement, the XDG location, and
 // unusable files reported in one line and replaced by defaults.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -110,7 +111,12 @@ TEST(AppSettings, CorruptedFileIsReportedAndReplacedByDefaults) {
            Case{"{\"version\": 7}", "unsupported version 7"},
            Case{"{\"recent\": \"x\"}", "recent: expected an array of strings"},
            Case{"{\"last_scene\": 3}", "last_scene: expected a string"},
-           Case{"{\"window\": {\"width\": 5}}", "window.width: expected an integer in 100..16384"},
+           Case{"{\"window\": {\"width\": 5}}", "window.width: expected an integer in 100..8192"},
+           Case{"{\"window\": {\"width\": 16384}}", "window.width: expected an integer in 100..8192"},
+           Case{"{\"window\": \"big\"}", "window: expected an object with width and height"},
+           Case{"{\"window\": {\"depth\": 3}}", "window: unknown key 'depth'"},
+           Case{"{\"bogus\": 1}", "unknown key 'bogus'"},
+           Case{"{\"version\": 4294967297}", "unsupported version 4294967297"},
            Case{"{\"options\": {\"buckets\": \"1\"}}", "options.buckets: expected an integer in 2..256, got '1'"},
            Case{"{\"options\": {\"buckets\": 16}}", "options.buckets: expected a string"},
            Case{"{\"options\": {\"wobble\": \"on\"}}", "options: unknown option 'wobble'"},
@@ -127,6 +133,22 @@ TEST(AppSettings, CorruptedFileIsReportedAndReplacedByDefaults) {
   // Saving afterwards replaces the bad file with a readable one.
   ASSERT_EQ(save_settings(file, load_settings(file).settings), "");
   EXPECT_EQ(load_settings(file).error, "");
+}
+
+// A FIFO blocked the app's start; a folder read as a parse error; a huge
+// file was read whole. Each is one line and the defaults.
+TEST(AppSettings, AFifoFolderOrHugeFileIsReportedNotRead) {
+  TempDir dir;
+  ASSERT_EQ(::mkfifo((dir.path() / "fifo.json").c_str(), 0644), 0);
+  fs::create_directories(dir.path() / "dir.json");
+  write(dir.path() / "huge.json", "{\"last_scene\": \"" + std::string(kMaxSettingsBytes, 'x') + "\"}");
+  for (const auto& [name, problem] :
+       {std::pair{"fifo.json", "is not a regular file"}, std::pair{"dir.json", "is a directory, not a file"},
+        std::pair{"huge.json", "is larger than 1048576 bytes"}}) {
+    const LoadedSettings loaded = load_settings(dir.path() / name);
+    EXPECT_EQ(loaded.error, (dir.path() / name).string() + ": " + problem + " (using defaults)");
+    EXPECT_EQ(loaded.settings.last_scene, "");
+  }
 }
 
 TEST(AppSettings, AtomicWriteReplacesWholeFilesAndLeavesNoTemporary) {

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "core/util/file_checks.h"
 #include "core/util/output_file.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
@@ -140,6 +141,23 @@ TEST_F(OutputFile, AFailedWriteKeepsTheOldFile) {
   EXPECT_EQ(w.problem, "write failed: File too large");
   EXPECT_EQ(read(path("big.png")), "ORIGINAL");
   EXPECT_TRUE(others({"big.png"}).empty());
+}
+
+// read_text_file: what the app's own small files (settings, layout, shaders,
+// scripts) are read with. A FIFO would block the reader, a folder read as
+// empty, a huge file would be read whole.
+TEST_F(OutputFile, ReadTextFileTakesOnlySmallRegularFiles) {
+  put(path("ok.ini"), "[Window][A]\n");
+  ASSERT_EQ(::mkfifo(path("fifo.ini").c_str(), 0644), 0);
+  fs::create_directories(path("dir.ini"));
+  put(path("big.ini"), std::string(2048, 'x'));
+  std::string text;
+  EXPECT_EQ(read_text_file(path("ok.ini"), 1024, text), "");
+  EXPECT_EQ(text, "[Window][A]\n");
+  EXPECT_EQ(read_text_file(path("fifo.ini"), 1024, text), "is not a regular file");
+  EXPECT_EQ(read_text_file(path("dir.ini"), 1024, text), "is a directory, not a file");
+  EXPECT_EQ(read_text_file(path("big.ini"), 1024, text), "is larger than 1024 bytes");
+  EXPECT_EQ(read_text_file(path("none.ini"), 1024, text), "no such file");
 }
 
 }  // namespace unity_test_output_file

@@ -1,10 +1,12 @@
 // Shader compile and link errors name the file and the line; the override
 // directory (ACCELVIZ_SHADER_DIR) replaces embedded shaders, also live.
-#include "gl_fixture.h"
+#include <sys/stat.h>
 
-#include "ui/gl/shader.h"
-
+#include <filesystem>
 #include <fstream>
+
+#include "gl_fixture.h"
+#include "ui/gl/shader.h"
 
 namespace accelviz::test {
 namespace {
@@ -96,6 +98,23 @@ TEST_F(ShaderErrors, OverrideDirectoryWinsOnlyForFilesItHas) {
   ShaderDirOverride env(dir_.path());
   EXPECT_EQ(load_shader_source("color.frag").path, (dir_.path() / "color.frag").string());
   EXPECT_EQ(load_shader_source("mesh.vert").path, "shaders/mesh.vert");
+}
+
+// A shader file in the override folder that is a FIFO blocked the reload
+// (the window stopped); one that is a folder read as an empty shader.
+TEST_F(ShaderErrors, AFifoOrFolderInTheOverrideFolderIsNamedNotRead) {
+  ASSERT_EQ(::mkfifo((dir_.path() / "mesh.frag").c_str(), 0644), 0);
+  std::filesystem::create_directories(dir_.path() / "color.frag");
+  ShaderDirOverride env(dir_.path());
+  for (const auto& [name, problem] :
+       {std::pair{"mesh.frag", "is not a regular file"}, std::pair{"color.frag", "is a directory, not a file"}}) {
+    try {
+      (void)load_shader_source(name);
+      ADD_FAILURE() << name << " was read";
+    } catch (const ShaderError& e) {
+      EXPECT_EQ(std::string(e.what()), (dir_.path() / name).string() + ": " + problem);
+    }
+  }
 }
 
 TEST_F(ShaderErrors, LiveReloadKeepsOldProgramsOnErrorAndPicksUpFixes) {

@@ -9,6 +9,7 @@
 
 #include "core/accel/factory.h"
 #include "core/analysis/heatmap.h"
+#include "core/util/file_checks.h"
 #include "ui/app/app_config.h"
 #include "ui/app/dynamics.h"
 #include "ui/app/flatten_worker.h"
@@ -118,6 +119,7 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
   AppConfig scratch;
   int line_no = 0;
   std::size_t pos = 0;
+  if (text.starts_with("\xEF\xBB\xBF")) pos = 3;  // a UTF-8 byte order mark is not part of the first command
   while (pos <= text.size()) {
     const auto nl = text.find('\n', pos);
     const std::string_view raw = text.substr(pos, nl == std::string_view::npos ? std::string_view::npos : nl - pos);
@@ -291,11 +293,12 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
 }
 
 std::vector<ScriptCommand> load_script(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ScriptError(path.string(), 0, "cannot be read");
-  std::stringstream text;
-  text << in.rdbuf();
-  return parse_script(text.str(), path.string());
+  // A regular file (a folder ran as an empty script, a FIFO would block) of
+  // at most 16 MiB.
+  std::string text;
+  if (const std::string problem = read_text_file(path.string(), std::uintmax_t{16} << 20, text); !problem.empty())
+    throw ScriptError(path.string(), 0, "cannot be read: " + problem);
+  return parse_script(text, path.string());
 }
 
 ScriptRunner::ScriptRunner(std::vector<ScriptCommand> commands, std::string file, double timeout_s)

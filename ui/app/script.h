@@ -9,6 +9,8 @@
 #include <string_view>
 #include <vector>
 
+#include "core/util/one_line.h"
+
 namespace accelviz {
 
 struct ScriptCommand {
@@ -56,8 +58,10 @@ std::string_view command_name(ScriptCommand::Kind kind);
 /// A parse or run error; what() is "FILE:LINE: message".
 class ScriptError : public std::runtime_error {
  public:
+  /// The message is made one line (first_line: control bytes such as a NUL
+  /// shown as '?', at most 300 characters), whatever the script held.
   ScriptError(const std::string& file, int line, const std::string& message)
-      : std::runtime_error(file + ":" + std::to_string(line) + ": " + message), line_(line) {}
+      : std::runtime_error(file + ":" + std::to_string(line) + ": " + first_line(message)), line_(line) {}
   int line() const { return line_; }
 
  private:

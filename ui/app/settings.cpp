@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/util/file_checks.h"
 #include "core/util/output_file.h"
 
 namespace accelviz {
@@ -43,8 +44,15 @@ AppSettings settings_from_json(const nlohmann::json& j) {
   using std::runtime_error;
   if (!j.is_object()) throw runtime_error("not a JSON object");
   AppSettings s;
-  if (j.contains("version") && (!j["version"].is_number_integer() || j["version"].get<int>() != 1))
+  // get<long long>: get<int> cut 4294967297 down to 1.
+  if (j.contains("version") && (!j["version"].is_number_integer() || j["version"].get<long long>() != 1))
     throw runtime_error("unsupported version " + j["version"].dump());
+  // Keys settings_to_json writes; anything else is a typo or another program's file, said rather than ignored.
+  for (const auto& [key, value] : j.items())
+    if (key != "version" && key != "last_scene" && key != "recent" && key != "screenshot_dir" && key != "window" &&
+        key != "options" && key != "effects")
+      throw runtime_error("unknown key '" + key +
+                          "' (valid: version, last_scene, recent, screenshot_dir, window, options, effects)");
   auto string_field = [&](const char* key, std::string& out) {
     if (!j.contains(key)) return;
     if (!j[key].is_string()) throw runtime_error(std::string(key) + ": expected a string");
@@ -61,10 +69,15 @@ AppSettings settings_from_json(const nlohmann::json& j) {
   }
   if (j.contains("window")) {
     const auto& w = j["window"];
+    if (!w.is_object()) throw runtime_error("window: expected an object with width and height");
+    for (const auto& [key, value] : w.items())
+      if (key != "width" && key != "height")
+        throw runtime_error("window: unknown key '" + key + "' (valid: width, height)");
+    // At most 8192: a 16384-pixel window's multisampled target was incomplete on llvmpipe.
     auto side = [&](const char* key, int& out) {
-      if (!w.is_object() || !w.contains(key)) return;
-      if (!w[key].is_number_integer() || w[key].get<long long>() < 100 || w[key].get<long long>() > 16384)
-        throw runtime_error(std::string("window.") + key + ": expected an integer in 100..16384");
+      if (!w.contains(key)) return;
+      if (!w[key].is_number_integer() || w[key].get<long long>() < 100 || w[key].get<long long>() > 8192)
+        throw runtime_error(std::string("window.") + key + ": expected an integer in 100..8192");
       out = w[key].get<int>();
     };
     side("width", s.window_width);
@@ -107,16 +120,15 @@ AppSettings settings_from_json(const nlohmann::json& j) {
 
 LoadedSettings load_settings(const std::filesystem::path& file) {
   LoadedSettings out;
-  std::ifstream in(file, std::ios::binary);
-  if (!in) {
-    std::error_code ec;
-    if (std::filesystem::exists(file, ec)) out.error = file.string() + ": cannot be read (using defaults)";
+  // A regular file of at most 1 MiB (a few KB in use): a FIFO would block the
+  // app's start and a huge file would be read whole.
+  std::string text;
+  if (const std::string problem = read_text_file(file.string(), kMaxSettingsBytes, text); !problem.empty()) {
+    if (problem != "no such file") out.error = file.string() + ": " + problem + " (using defaults)";
     return out;
   }
-  std::stringstream text;
-  text << in.rdbuf();
   try {
-    out.settings = settings_from_json(nlohmann::json::parse(text.str()));
+    out.settings = settings_from_json(nlohmann::json::parse(text));
   } catch (const std::exception& e) {
     std::string what = e.what();
     std::replace(what.begin(), what.end(), '\n', ' ');

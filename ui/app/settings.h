@@ -7,14 +7,14 @@
 // cannot be read is reported in one line and replaced by defaults.
 //
 // Precedence: defaults < settings file < command line < interactive changes.
-#include "ui/app/app_config.h"
-
-#include <nlohmann/json.hpp>
-
+#include <cstdint>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "ui/app/app_config.h"
 
 namespace accelviz {
 
@@ -57,8 +57,12 @@ struct LoadedSettings {
   AppSettings settings;  ///< defaults when the file is missing or unusable
   std::string error;     ///< one line when the file exists but was unusable ("" otherwise)
 };
+/// Largest settings file read (and imgui.ini): both are a few KB.
+inline constexpr std::uintmax_t kMaxSettingsBytes = std::uintmax_t{1} << 20;
+
 /// Reads `file`. A missing file gives defaults without an error; a
-/// malformed one gives defaults and "<file>: <problem> (using defaults)".
+/// malformed one, or one that is not a regular file of at most
+/// kMaxSettingsBytes, gives defaults and "<file>: <problem> (using defaults)".
 LoadedSettings load_settings(const std::filesystem::path& file);
 
 /// Writes `content` to `file` atomically: core's write_output_file (a fresh

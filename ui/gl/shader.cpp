@@ -9,6 +9,8 @@
 #include <sstream>
 #include <utility>
 
+#include "core/util/file_checks.h"
+
 namespace accelviz {
 
 namespace {
@@ -31,12 +33,13 @@ void set_shader_dir(std::string dir) {
 ShaderSource load_shader_source(std::string_view name) {
   if (const std::string dir = shader_dir(); !dir.empty()) {
     const std::filesystem::path path = std::filesystem::path(dir) / std::string(name);
-    std::ifstream in(path, std::ios::binary);
-    if (in) {
-      std::ostringstream text;
-      text << in.rdbuf();
-      return {std::string(name), path.string(), text.str()};
-    }
+    // A file the folder does not have comes from the embedded copies; one it
+    // has must be a regular file (a FIFO blocked the reload, a folder read
+    // as an empty shader).
+    std::string text;
+    const std::string problem = read_text_file(path.string(), std::uintmax_t{1} << 20, text);
+    if (problem.empty()) return {std::string(name), path.string(), std::move(text)};
+    if (problem != "no such file") throw ShaderError(path.string() + ": " + problem, path.string());
   }
   for (const EmbeddedShader& s : embedded_shaders()) {
     if (name == s.name) return {std::string(name), "shaders/" + std::string(name), s.source};

@@ -1,5 +1,6 @@
 #include "ui/imgui/imgui_context.h"
 
+#include "core/util/file_checks.h"
 #include "ui/app/settings.h"
 #include "ui/gl/gl.h"
 
@@ -25,13 +26,13 @@ ImGuiContextGuard::ImGuiContextGuard(GLFWwindow* window, std::optional<std::file
   // keyboard (WantCaptureKeyboard) and the view shortcuts would stop working
   // after a click on a panel.
   if (ini_) {
-    std::ifstream in(*ini_, std::ios::binary);
-    if (in) {
-      std::stringstream text;
-      text << in.rdbuf();
-      const std::string s = text.str();
+    // A regular file of at most 1 MiB (a layout is a few KB): a FIFO blocked
+    // the start, and ImGui took half a minute over 10 MB of sections.
+    std::string s;
+    if (const std::string problem = read_text_file(ini_->string(), std::uintmax_t{1} << 20, s); problem.empty())
       ImGui::LoadIniSettingsFromMemory(s.c_str(), s.size());
-    }
+    else if (problem != "no such file")
+      load_problem_ = ini_->string() + ": " + problem + " (the default layout is used)";
   }
   // HiDPI: GLFW reports the monitor's content scale (2 on a "Retina" or
   // 200 % display). The framebuffer is already in pixels; ImGui's sizes are

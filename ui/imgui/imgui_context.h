@@ -33,9 +33,12 @@ class ImGuiContextGuard {
 
   /// The content scale the UI was sized for.
   float scale() const { return scale_; }
+  /// Why the layout file was not read ("" when it was, or is absent).
+  const std::string& load_problem() const { return load_problem_; }
 
  private:
   std::optional<std::filesystem::path> ini_;
+  std::string load_problem_;
   float scale_ = 1.0f;
 };
 
