@@ -1,11 +1,13 @@
 #include "core/analysis/epo.h"
 
-#include "core/util/parallel.h"
-
+#include <algorithm>
+#include <atomic>
 #include <glm/glm.hpp>
-
+#include <mutex>
 #include <stdexcept>
 #include <vector>
+
+#include "core/util/parallel.h"
 
 namespace accelviz {
 
@@ -51,7 +53,7 @@ double clipped_triangle_area(const Triangle& tri, const Aabb& box) {
 }
 
 double bvh_epo_leaf_order(std::span<const BvhNode> nodes, std::span<const Triangle> tris, double cost_traversal,
-                          double cost_intersect, unsigned threads) {
+                          double cost_intersect, unsigned threads, const ProgressCallback& progress) {
   if (nodes.empty() || tris.empty()) return 0.0;
   // 1. Leaf-position range [first, end) of every subtree, bottom-up
   //    (children are stored after their parents).
@@ -80,10 +82,25 @@ double bvh_epo_leaf_order(std::span<const BvhNode> nodes, std::span<const Triang
   //    Per-triangle results are summed in order afterwards, so the total
   //    does not depend on the thread count.
   std::vector<double> per_tri(tris.size(), 0.0), tri_area(tris.size(), 0.0);
+  // Progress and cancellation: each chunk of triangles reports, one thread
+  // at a time (try_lock: a busy callback is skipped, not waited for); a
+  // false answer makes every thread skip the rest.
+  std::atomic<bool> cancelled{false};
+  std::atomic<std::size_t> done{0};
+  std::mutex progress_mutex;
   parallel_for(tris.size(), threads, 256, [&](std::size_t b, std::size_t e, unsigned) {
     std::vector<std::uint32_t> stack;
     stack.reserve(2 * kBvhMaxDepth);
     for (std::size_t k = b; k < e; ++k) {
+      if (progress && (k - b) % 256 == 0) {  // (one thread runs the whole range in one call)
+        if (cancelled.load(std::memory_order_relaxed)) return;
+        const std::size_t before = done.fetch_add(std::min<std::size_t>(256, e - k), std::memory_order_relaxed);
+        std::unique_lock lock(progress_mutex, std::try_to_lock);
+        if (lock.owns_lock() && !progress(static_cast<double>(before) / static_cast<double>(tris.size()))) {
+          cancelled.store(true);
+          return;
+        }
+      }
       const Triangle& t = tris[k];
       tri_area[k] = 0.5 * glm::length(glm::cross(glm::dvec3(t.v1) - glm::dvec3(t.v0), glm::dvec3(t.v2) - glm::dvec3(t.v0)));
       if (!(tri_area[k] > 0.0)) continue;
@@ -110,6 +127,7 @@ double bvh_epo_leaf_order(std::span<const BvhNode> nodes, std::span<const Triang
       per_tri[k] = sum;
     }
   });
+  if (cancelled.load()) throw BuildCancelled();
   double total = 0.0, area = 0.0;
   for (std::size_t k = 0; k < tris.size(); ++k) {
     total += per_tri[k];
@@ -119,7 +137,8 @@ double bvh_epo_leaf_order(std::span<const BvhNode> nodes, std::span<const Triang
 }
 
 double bvh_epo(std::span<const BvhNode> nodes, std::span<const std::uint32_t> prim_indices,
-               std::span<const Triangle> triangles, double cost_traversal, double cost_intersect, unsigned threads) {
+               std::span<const Triangle> triangles, double cost_traversal, double cost_intersect, unsigned threads,
+               const ProgressCallback& progress) {
   if (prim_indices.size() != triangles.size())
     throw std::invalid_argument("bvh_epo: prim_indices and triangles differ in size");
   std::vector<Triangle> leaf_order(triangles.size());
@@ -127,7 +146,7 @@ double bvh_epo(std::span<const BvhNode> nodes, std::span<const std::uint32_t> pr
     if (prim_indices[k] >= triangles.size()) throw std::invalid_argument("bvh_epo: primitive index out of range");
     leaf_order[k] = triangles[prim_indices[k]];
   }
-  return bvh_epo_leaf_order(nodes, leaf_order, cost_traversal, cost_intersect, threads);
+  return bvh_epo_leaf_order(nodes, leaf_order, cost_traversal, cost_intersect, threads, progress);
 }
 
 }  // namespace accelviz

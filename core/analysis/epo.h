@@ -31,13 +31,21 @@ double clipped_triangle_area(const Triangle& tri, const Aabb& box);
 /// contiguous in prim_indices, as every top-down build leaves them
 /// (std::invalid_argument otherwise). 0 when the scene has no area.
 /// Work is spread over `threads` (0 = all); the result does not depend on it.
+///
+/// Its cost grows with the overlap: on degenerate scenes (every centroid
+/// equal) it is quadratic and takes seconds where the build took
+/// milliseconds. `progress`, when given, is called now and then (from one
+/// working thread at a time) with the fraction of triangles done; returning
+/// false stops it, and bvh_epo throws BuildCancelled (so quitting the app or
+/// opening another scene does not wait for it).
 double bvh_epo(std::span<const BvhNode> nodes, std::span<const std::uint32_t> prim_indices,
-               std::span<const Triangle> triangles, double cost_traversal, double cost_intersect,
-               unsigned threads = 0);
+               std::span<const Triangle> triangles, double cost_traversal, double cost_intersect, unsigned threads = 0,
+               const ProgressCallback& progress = {});
 
 /// Same, with the triangles already in leaf order (leaf_triangles[k] is the
 /// primitive at leaf position k), as class Bvh keeps them.
 double bvh_epo_leaf_order(std::span<const BvhNode> nodes, std::span<const Triangle> leaf_triangles,
-                          double cost_traversal, double cost_intersect, unsigned threads = 0);
+                          double cost_traversal, double cost_intersect, unsigned threads = 0,
+                          const ProgressCallback& progress = {});
 
 }  // namespace accelviz

@@ -3,6 +3,7 @@
 // polygon clipping), never the library's own helpers.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -235,6 +236,41 @@ TEST(Epo, IndependentOfThreadCount) {
   const double one = bvh_epo(bvh.nodes(), bvh.prim_indices(), tris, 1, 1, 1);
   EXPECT_EQ(bvh_epo(bvh.nodes(), bvh.prim_indices(), tris, 1, 1, 2), one);
   EXPECT_EQ(bvh_epo(bvh.nodes(), bvh.prim_indices(), tris, 1, 1, 4), one);
+}
+
+// EPO can take seconds where the build took milliseconds (quadratic when
+// every centroid is equal): the app's quit and a newer request waited for it.
+// It now asks the build's progress callback whether to go on.
+TEST(Epo, ProgressReportsAndCancels) {
+  const auto tris = soup(5000, 6, 0.05f);
+  BvhOptions o;
+  o.compute_epo = false;
+  const Bvh bvh(tris, o);
+  for (const unsigned threads : {1u, 2u}) {
+    SCOPED_TRACE(threads);
+    std::atomic<int> calls{0};
+    std::atomic<bool> ordered{true};
+    std::atomic<double> last{-1.0};
+    const double value = bvh_epo(bvh.nodes(), bvh.prim_indices(), tris, 1, 1, threads, [&](double f) {
+      ++calls;
+      if (!(f >= 0.0 && f < 1.0)) ordered = false;
+      last = f;
+      return true;
+    });
+    EXPECT_EQ(value, bvh_epo(bvh.nodes(), bvh.prim_indices(), tris, 1, 1, threads));
+    EXPECT_GE(calls.load(), 2) << "5000 triangles in chunks of 256";
+    EXPECT_TRUE(ordered.load());
+    std::atomic<int> asked{0};
+    EXPECT_THROW(bvh_epo(bvh.nodes(), bvh.prim_indices(), tris, 1, 1, threads, [&](double) { return ++asked < 3; }),
+                 BuildCancelled);
+  }
+  // Through the Bvh: a callback that stops once the build has reported 1.0
+  // cancels the measurement that follows.
+  BvhOptions with = o;
+  with.compute_epo = true;
+  int after_build = 0;
+  EXPECT_THROW(Bvh(tris, with, [&](double f) { return f < 1.0 || ++after_build < 2; }), BuildCancelled);
+  EXPECT_EQ(after_build, 2);
 }
 
 TEST(Epo, MedianSplitsOverlapMoreThanSah) {

@@ -139,7 +139,7 @@ Bvh::Bvh(std::span<const Triangle> triangles, const BvhOptions& opts, const Prog
   stats_.extra["build_topology_ms"] = topology_ms;
   stats_.extra["build_wide_ms"] = wide_ms;
   stats_.extra["build_blocks_ms"] = stats_.build_ms - topology_ms - wide_ms;
-  update_epo(triangles);  // sah_cost: the builder's, over these nodes
+  update_epo(triangles, progress);  // sah_cost: the builder's, over these nodes
 }
 
 Bvh::~Bvh() = default;
@@ -156,13 +156,15 @@ Bvh::Bvh(const Bvh& o)
 Bvh::Bvh(Bvh&&) noexcept = default;
 Bvh& Bvh::operator=(Bvh&&) noexcept = default;
 
-void Bvh::update_epo(std::span<const Triangle> triangles) {
+void Bvh::update_epo(std::span<const Triangle> triangles, const ProgressCallback& progress) {
   if (opts_.compute_epo) {
     // Not part of build_ms: it is a measurement of the tree, not a step of
-    // making it; its own time is reported beside it.
+    // making it; its own time is reported beside it. The build's progress
+    // stays at 1 meanwhile; the callback is asked only whether to go on.
     const auto t0 = std::chrono::steady_clock::now();
+    const ProgressCallback go_on = progress ? ProgressCallback([&](double) { return progress(1.0); }) : nullptr;
     stats_.extra["epo"] =
-        bvh_epo(nodes_, prim_indices_, triangles, opts_.cost_traversal, opts_.cost_intersect, opts_.threads);
+        bvh_epo(nodes_, prim_indices_, triangles, opts_.cost_traversal, opts_.cost_intersect, opts_.threads, go_on);
     stats_.extra["epo_ms"] = ms_since(t0);
   }
 }

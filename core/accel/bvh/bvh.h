@@ -145,8 +145,9 @@ class Bvh final : public Accelerator {
                         const QueryOptions& qo) const override;
 
  private:
-  /// With compute_epo: epo (and epo_ms) over `triangles` in scene order.
-  void update_epo(std::span<const Triangle> triangles);
+  /// With compute_epo: epo (and epo_ms) over `triangles` in scene order;
+  /// `progress` may cancel it (BuildCancelled), as it may the build.
+  void update_epo(std::span<const Triangle> triangles, const ProgressCallback& progress = {});
 
   HugePageVector<BvhNode> nodes_;
   HugePageVector<std::uint32_t> prim_indices_;
