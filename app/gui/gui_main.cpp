@@ -688,7 +688,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
     case K::dump_ray: {
       const auto& insp = app_.inspection();
       if (!insp) throw std::runtime_error("no ray cast yet (use click first)");
-      fail_if(write_file_atomic(c.arg, inspection_json(*insp, app_.replay_step()).dump(2) + "\n"));
+      fail_if(write_new_file(c.arg, inspection_json(*insp, app_.replay_step()).dump(2) + "\n"));
       return Status::done;
     }
     case K::dump_stats: {
@@ -704,7 +704,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
                       {"visit_max", view_->boxes_visit_max()}};
       doc["tree"] = {{"swatch_max", insight_.tree_swatch_max(app_, ramp_max)},
                      {"swatch_of_boxes", ramp_max.has_value()}};
-      fail_if(write_file_atomic(c.arg, doc.dump(2) + "\n"));
+      fail_if(write_new_file(c.arg, doc.dump(2) + "\n"));
       return Status::done;
     }
     case K::frames:
@@ -767,7 +767,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
             r->instances == flatten_prediction_->instances && r->scene == flatten_prediction_->scene)
           doc["committed"] = r->committed->spec;
       }
-      fail_if(write_file_atomic(c.arg, doc.dump(2) + "\n"));
+      fail_if(write_new_file(c.arg, doc.dump(2) + "\n"));
       return Status::done;
     }
     case K::force_effect:
@@ -835,7 +835,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       } else {
         doc["dynamics"] = nullptr;
       }
-      fail_if(write_file_atomic(c.arg, doc.dump(2) + "\n"));
+      fail_if(write_new_file(c.arg, doc.dump(2) + "\n"));
       return Status::done;
     }
     case K::scenario:

@@ -394,7 +394,7 @@ ScriptHost::Status InsightViews::execute(AppState& app, const ScriptCommand& c) 
       if (scenario_job_.busy()) return ScriptHost::Status::again;
       if (!scenario_job_.error().empty()) throw std::runtime_error("scenario: " + scenario_job_.error());
       if (!scenario_job_.figures()) throw std::runtime_error("dump-scenario: no scenario run yet (use scenario first)");
-      if (const std::string err = write_file_atomic(c.arg, figures_json(*scenario_job_.figures()).dump(2) + "\n");
+      if (const std::string err = write_new_file(c.arg, figures_json(*scenario_job_.figures()).dump(2) + "\n");
           !err.empty())
         throw std::runtime_error(err);
       return ScriptHost::Status::done;
@@ -409,7 +409,7 @@ ScriptHost::Status InsightViews::execute(AppState& app, const ScriptCommand& c) 
       if (insight_job_.busy()) return ScriptHost::Status::again;
       script_insight_requested_ = false;
       if (!insight_job_.error().empty()) throw std::runtime_error("insight: " + insight_job_.error());
-      if (const std::string err = write_file_atomic(c.arg, insight_json(app).dump(2) + "\n"); !err.empty())
+      if (const std::string err = write_new_file(c.arg, insight_json(app).dump(2) + "\n"); !err.empty())
         throw std::runtime_error(err);
       return ScriptHost::Status::done;
     }
@@ -469,7 +469,7 @@ ScriptHost::Status InsightViews::execute(AppState& app, const ScriptCommand& c) 
       script_ab_requested_ = false;
       if (!ab_dump_job_.error().empty()) throw std::runtime_error("A/B: " + ab_dump_job_.error());
       if (!ab_dump_job_.result()) throw std::runtime_error("A/B: no result");
-      if (const std::string err = write_file_atomic(c.arg, ab_dump_job_.result()->dump(2) + "\n"); !err.empty())
+      if (const std::string err = write_new_file(c.arg, ab_dump_job_.result()->dump(2) + "\n"); !err.empty())
         throw std::runtime_error(err);
       return ScriptHost::Status::done;
     }

@@ -281,6 +281,27 @@ TEST_F(GuiScript, ANewerOpenAndQuitDoNotWaitForTheEpoMeasurement) {
   EXPECT_LT(seconds, 60.0);
 }
 
+// Dumps, like screenshots, never replace a file: a dump-stats named after a
+// screenshot's side-car silently replaced it.
+TEST_F(GuiScript, DumpsNeverReplaceAFile) {
+  const std::string head = std::string("open ") + kTeapot + "\nsize 320 240\ncamera " + kCamera + "\nwait\n";
+  const RunResult shot = run(head + "screenshot " + path("a.png").string() + "\nquit\n");
+  ASSERT_EQ(shot.code, 0) << shot.err;
+  const std::string sidecar = read_text(path("a.json"));
+  ASSERT_FALSE(sidecar.empty());
+  const RunResult r = run(head + "dump-stats " + path("a.json").string() + "\nquit\n");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find(path("a.json").string() + ": exists (not overwritten)"), std::string::npos) << r.err;
+  EXPECT_EQ(read_text(path("a.json")), sidecar);
+  std::ofstream(path("precious.json")) << "mine";
+  const RunResult ray = run(head + "click 160 120\ndump-ray " + path("precious.json").string() + "\nquit\n");
+  EXPECT_EQ(ray.code, 1);
+  EXPECT_EQ(read_text(path("precious.json")), "mine");
+  const RunResult deep = run(head + "dump-stats " + path("no/such/x.json").string() + "\nquit\n");
+  EXPECT_EQ(deep.code, 1) << "a missing folder is an error, as for screenshots";
+  EXPECT_FALSE(fs::exists(path("no")));
+}
+
 TEST_F(GuiScript, ClickCastsThePixelRayAndReplaysItsTraversal) {
   const RunResult r = run(std::string("open ") + kTeapot + "\n" +
                           "size 640 480\n"
@@ -525,14 +546,14 @@ TEST_F(GuiScript, EveryScenarioSliderMovesItsFiguresTheDocumentedWay) {
 TEST_F(GuiScript, TwoLevelBoxLevelsInstanceColoursAndPlayedFrames) {
   const RunResult r =
       run("open builtin:dynamic?size=1200\nstructure tlas\nsize 320 240\nset box-mode leaves\nwait\nscreenshot " +
-          path("top.png").string() + "\ndump-stats " + path("top.json").string() +
+          path("top.png").string() + "\ndump-stats " + path("top-stats.json").string() +
           "\nset box-level blas\nset instance-colors on\nwait\nscreenshot " + path("blas.png").string() +
-          "\ndump-stats " + path("blas.json").string() + "\nset box-instance 0\nwait\ndump-stats " +
+          "\ndump-stats " + path("blas-stats.json").string() + "\nset box-instance 0\nwait\ndump-stats " +
           path("one.json").string() + "\nplay 2\nwait\ndump-dynamics " + path("dyn.json").string() + "\nscreenshot " +
           path("played.png").string() + "\nquit\n");
   ASSERT_EQ(r.code, 0) << r.err;
-  const nlohmann::json top = read_json(path("top.json"));
-  const nlohmann::json blas = read_json(path("blas.json"));
+  const nlohmann::json top = read_json(path("top-stats.json"));
+  const nlohmann::json blas = read_json(path("blas-stats.json"));
   const nlohmann::json one = read_json(path("one.json"));
   ASSERT_EQ(top["structure"], "tlas") << top.dump();
   // Leaves: one box per instance at the top level; every instance's BLAS

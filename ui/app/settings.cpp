@@ -150,6 +150,12 @@ std::string write_file_atomic(const std::filesystem::path& file, std::string_vie
   return w.ok() ? std::string() : file.string() + ": " + w.problem;
 }
 
+std::string write_new_file(const std::filesystem::path& file, std::string_view content) {
+  const OutputWrite w = write_output_file(file.string(), {content}, /*overwrite=*/false);
+  if (w.exists) return file.string() + ": exists (not overwritten)";
+  return w.ok() ? std::string() : file.string() + ": " + w.problem;
+}
+
 std::string save_settings(const std::filesystem::path& file, const AppSettings& s) {
   return write_file_atomic(file, settings_to_json(s).dump(2) + "\n");
 }

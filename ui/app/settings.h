@@ -72,6 +72,12 @@ LoadedSettings load_settings(const std::filesystem::path& file);
 /// temporary file behind.
 std::string write_file_atomic(const std::filesystem::path& file, std::string_view content);
 
+/// Writes a file the user asked for by name (a script's dump-* commands)
+/// as a new file: an existing one is never replaced ("<file>: exists (not
+/// overwritten)"), and, as for screenshots, a missing folder is an error.
+/// Through core's write_output_file. Returns "" or one line.
+std::string write_new_file(const std::filesystem::path& file, std::string_view content);
+
 /// settings_to_json, pretty-printed, through write_file_atomic.
 std::string save_settings(const std::filesystem::path& file, const AppSettings& s);
 
