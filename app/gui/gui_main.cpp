@@ -734,6 +734,10 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       return Status::done;
     }
     case K::flatten_commit: {
+      // After `open`, the commit is of the new scene's prediction (there is
+      // none yet): wait for the scene, as flatten and camera do, rather than
+      // merge the old scene and throw the open away.
+      if (!flatten_wait_ && app_.loading_scene()) return Status::again;
       if (!flatten_wait_) {
         const std::shared_ptr<const FlattenResult> r = flatten_.latest();
         if (!r || !r->figures || !app_.rest() || r->scene != app_.rest()->scene.get())

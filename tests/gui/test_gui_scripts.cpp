@@ -281,6 +281,21 @@ TEST_F(GuiScript, ANewerOpenAndQuitDoNotWaitForTheEpoMeasurement) {
   EXPECT_LT(seconds, 60.0);
 }
 
+// flatten-commit right after an open committed the old scene's prediction
+// and threw the open away: it now waits for the scene, which has none.
+TEST_F(GuiScript, FlattenCommitAfterAnOpenDoesNotDropTheOpen) {
+  const RunResult r =
+      run(std::string("open builtin:forest?size=5000\nsize 320 240\nstructure tlas\nwait\nflatten 0\n") + "open " +
+          kTeapot + "\nflatten-commit\nquit\n");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("flatten-commit: no prediction of the shown scene"), std::string::npos) << r.err;
+  const RunResult after =
+      run(std::string("open builtin:forest?size=5000\nsize 320 240\nstructure tlas\nwait\n") + "flatten 0\nopen " +
+          kTeapot + "\nwait\ndump-stats " + path("s.json").string() + "\nquit\n");
+  ASSERT_EQ(after.code, 0) << after.err;
+  EXPECT_EQ(read_json(path("s.json"))["scene"], kTeapot);
+}
+
 // Dumps, like screenshots, never replace a file: a dump-stats named after a
 // screenshot's side-car silently replaced it.
 TEST_F(GuiScript, DumpsNeverReplaceAFile) {
