@@ -7,7 +7,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <memory>
 
 #include "core/util/file_checks.h"
 #include "core/util/output_file.h"

@@ -4,8 +4,6 @@
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
-#include <sstream>
 
 #include "core/accel/factory.h"
 #include "core/analysis/heatmap.h"

@@ -3,10 +3,8 @@
 #include <charconv>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <glm/gtc/type_ptr.hpp>
 #include <optional>
-#include <sstream>
 #include <utility>
 
 #include "core/util/file_checks.h"

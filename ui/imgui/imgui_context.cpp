@@ -11,8 +11,6 @@
 #include <imgui_impl_opengl3.h>
 
 #include <algorithm>
-#include <fstream>
-#include <sstream>
 
 namespace accelviz {
 
