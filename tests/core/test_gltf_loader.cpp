@@ -164,6 +164,15 @@ class GltfLoader : public ::testing::Test {
     return path(name);
   }
 
+  /// one_triangle() as a .gltf whose buffer is the external file `uri`.
+  std::string write_gltf_with_buffer_uri(const std::string& uri, const std::string& name = "external.gltf") {
+    const GltfBuilder b = one_triangle();
+    json d = b.doc;
+    d["buffers"] = json::array({json{{"byteLength", b.bin.size()}, {"uri", uri}}});
+    write_file(dir_ / name, d.dump());
+    return path(name);
+  }
+
   /// Loads `file`, expecting a SceneError that names the file, contains
   /// `problem` and is a single line.
   void expect_error(const std::string& file, const std::string& problem) {
@@ -561,12 +570,9 @@ TEST_F(GltfLoader, AnimationsAreKeptAsData) {
 }
 
 TEST_F(GltfLoader, ExternalBufferFileNextToTheGltf) {
-  GltfBuilder b = one_triangle();
+  const GltfBuilder b = one_triangle();
   write_file(dir_ / "data.bin", std::string(b.bin.begin(), b.bin.end()));
-  json d = b.doc;
-  d["buffers"] = json::array({json{{"byteLength", b.bin.size()}, {"uri", "data.bin"}}});
-  write_file(dir_ / "external.gltf", d.dump());
-  EXPECT_EQ(load_gltf(path("external.gltf")).triangles.size(), 1u);
+  EXPECT_EQ(load_gltf(write_gltf_with_buffer_uri("data.bin")).triangles.size(), 1u);
 }
 
 TEST_F(GltfLoader, NonFiniteTrianglesAreDroppedAndCounted) {
@@ -647,13 +653,11 @@ TEST_F(GltfLoader, FileOver4GiBIsRefusedByName) {
 }
 
 TEST_F(GltfLoader, ExternalBufferOver4GiBIsRefusedByName) {
-  GltfBuilder b = one_triangle();
+  const GltfBuilder b = one_triangle();
   write_file(dir_ / "huge.bin", std::string(b.bin.begin(), b.bin.end()));
   fs::resize_file(dir_ / "huge.bin", (std::uintmax_t{1} << 32) + 1);
-  json d = b.doc;
-  d["buffers"] = json::array({json{{"byteLength", b.bin.size()}, {"uri", "huge.bin"}}});
-  write_file(dir_ / "external.gltf", d.dump());
-  expect_error(path("external.gltf"), "file is larger than 4 GiB, which glTF loading does not support");
+  expect_error(write_gltf_with_buffer_uri("huge.bin"),
+               "file is larger than 4 GiB, which glTF loading does not support");
 }
 
 // A JSON chunk of length 0 followed by more bytes: those bytes were read as
@@ -831,19 +835,13 @@ TEST_F(GltfLoader, UnsupportedRequiredExtensionMeshopt) {
 // A malformed escape in a buffer's URI decodes to a NUL: the message named a
 // folder ("File read error : g/") and stopped there.
 TEST_F(GltfLoader, ExternalBufferUriWithANulIsNamed) {
-  GltfBuilder b = one_triangle();
-  json d = b.doc;
-  d["buffers"] = json::array({json{{"byteLength", b.bin.size()}, {"uri", "%ZZ.bin"}}});
-  write_file(dir_ / "pct.gltf", d.dump());
-  expect_error(path("pct.gltf"), "?.bin : its name holds a NUL byte (a %00 or malformed escape in the URI)");
+  expect_error(write_gltf_with_buffer_uri("%ZZ.bin", "pct.gltf"),
+               "?.bin : its name holds a NUL byte (a %00 or malformed escape in the URI)");
 }
 
 TEST_F(GltfLoader, MissingExternalBufferFile) {
-  GltfBuilder b = one_triangle();
-  json d = b.doc;
-  d["buffers"] = json::array({json{{"byteLength", b.bin.size()}, {"uri", "geometry_missing.bin"}}});
-  write_file(dir_ / "external.gltf", d.dump());
-  expect_error(path("external.gltf"), "external buffer file 'geometry_missing.bin' not found");
+  expect_error(write_gltf_with_buffer_uri("geometry_missing.bin"),
+               "external buffer file 'geometry_missing.bin' not found");
 }
 
 TEST_F(GltfLoader, EmptySceneIsAnError) {
