@@ -34,8 +34,7 @@ int write_all(int fd, std::string_view bytes) {
 
 }  // namespace
 
-OutputWrite write_output_file(const std::string& path, std::initializer_list<std::string_view> parts,
-                              bool overwrite) {
+OutputWrite write_output_file(const std::string& path, std::initializer_list<std::string_view> parts, bool overwrite) {
   OutputWrite r;
   const auto fail = [&](const std::string& problem) {
     r.problem = problem;

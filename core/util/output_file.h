@@ -26,7 +26,6 @@ struct OutputWrite {
 
 /// Writes the concatenation of `parts` to `path` (see above). Never throws
 /// for I/O problems: the caller words them as its own error type.
-OutputWrite write_output_file(const std::string& path, std::initializer_list<std::string_view> parts,
-                              bool overwrite);
+OutputWrite write_output_file(const std::string& path, std::initializer_list<std::string_view> parts, bool overwrite);
 
 }  // namespace accelviz
