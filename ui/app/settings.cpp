@@ -45,12 +45,19 @@ AppSettings settings_from_json(const nlohmann::json& j) {
   // get<long long>: get<int> cut 4294967297 down to 1.
   if (j.contains("version") && (!j["version"].is_number_integer() || j["version"].get<long long>() != 1))
     throw runtime_error("unsupported version " + j["version"].dump());
-  // Keys settings_to_json writes; anything else is a typo or another program's file, said rather than ignored.
-  for (const auto& [key, value] : j.items())
-    if (key != "version" && key != "last_scene" && key != "recent" && key != "screenshot_dir" && key != "window" &&
-        key != "options" && key != "effects")
-      throw runtime_error("unknown key '" + key +
-                          "' (valid: version, last_scene, recent, screenshot_dir, window, options, effects)");
+  // The keys settings_to_json writes (taken from it, so the two cannot
+  // drift); anything else is a typo or another program's file, said rather
+  // than ignored.
+  const nlohmann::json known = settings_to_json(AppSettings{});
+  const auto check_keys = [](const nlohmann::json& given, const nlohmann::json& valid, const std::string& where) {
+    for (const auto& [key, value] : given.items())
+      if (!valid.contains(key)) {
+        std::string names;
+        for (const auto& [k, v] : valid.items()) names += (names.empty() ? "" : ", ") + k;
+        throw runtime_error(where + "unknown key '" + key + "' (valid: " + names + ")");
+      }
+  };
+  check_keys(j, known, "");
   auto string_field = [&](const char* key, std::string& out) {
     if (!j.contains(key)) return;
     if (!j[key].is_string()) throw runtime_error(std::string(key) + ": expected a string");
@@ -68,9 +75,7 @@ AppSettings settings_from_json(const nlohmann::json& j) {
   if (j.contains("window")) {
     const auto& w = j["window"];
     if (!w.is_object()) throw runtime_error("window: expected an object with width and height");
-    for (const auto& [key, value] : w.items())
-      if (key != "width" && key != "height")
-        throw runtime_error("window: unknown key '" + key + "' (valid: width, height)");
+    check_keys(w, known["window"], "window: ");
     // At most 8192: a 16384-pixel window's multisampled target was incomplete on llvmpipe.
     auto side = [&](const char* key, int& out) {
       if (!w.contains(key)) return;
