@@ -1,7 +1,8 @@
 #pragma once
 // Small scene builders and a seeded random source shared by the tests of the
 // space-partitioning structures (K-D tree, grid, octree, voxels) and their
-// differential test, and the triangle-box overlap test: one definition instead of one per test file.
+// differential test, the triangle-box overlap test and the robustness tests:
+// one definition instead of one per test file.
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <vector>
@@ -62,6 +63,32 @@ inline void box(std::vector<Triangle>& s, const glm::vec3& lo, const glm::vec3& 
   quad(s, p[3], p[2], p[6], p[7]);
   quad(s, p[0], p[3], p[7], p[4]);
   quad(s, p[1], p[2], p[6], p[5]);
+}
+
+// A closed axis-aligned cube [lo, lo+size]^3, each face an n x n grid of quads
+// (two triangles each); grid vertices are computed once, so shared vertices
+// and edges are bit-identical.
+inline std::vector<Triangle> subdivided_cube(glm::vec3 lo, float size, int n) {
+  std::vector<Triangle> out;
+  auto coord = [&](int i) { return i == n ? size : size * static_cast<float>(i) / static_cast<float>(n); };
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int side = 0; side < 2; ++side) {
+      const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+      auto p = [&](int i, int j) {
+        glm::vec3 q;
+        q[axis] = lo[axis] + (side ? size : 0.0f);
+        q[u] = lo[u] + coord(i);
+        q[w] = lo[w] + coord(j);
+        return q;
+      };
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+          out.push_back({p(i, j), p(i + 1, j), p(i + 1, j + 1)});
+          out.push_back({p(i, j), p(i + 1, j + 1), p(i, j + 1)});
+        }
+    }
+  }
+  return out;
 }
 
 }  // namespace accelviz::test_scenes

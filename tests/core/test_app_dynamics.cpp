@@ -17,6 +17,7 @@
 #include "core/scene/animation.h"
 #include "core/scene/effects.h"
 #include "core/scene/load.h"
+#include "tests/support/temp_dir.h"
 #include "ui/app/app_state.h"
 #include "ui/app/dynamics.h"
 #include "ui/app/instance_colors.h"
@@ -354,16 +355,14 @@ TEST(AppShadowRays, SceneLightsAreUsedAsTheyAre) {
 }
 
 TEST(AppEffectSettings, ForcesAreSavedAndRestored) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("accelviz_effects_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
+  const test_support::TempDir tmp("effects");
+  const std::filesystem::path dir = tmp.path() / "accelviz";  // not there yet: saving makes it
   AppSettings s;
   ASSERT_EQ(force_effect(s.config, "shadow-rays", true), "");
   ASSERT_EQ(force_effect(s.config, "two-level", true), "");
   const std::filesystem::path file = settings_file(dir);
   ASSERT_EQ(save_settings(file, s), "");
   const LoadedSettings loaded = load_settings(file);
-  std::filesystem::remove_all(dir);
   EXPECT_EQ(loaded.error, "");
   EXPECT_TRUE(loaded.settings.config.effects.shadow_rays);
   EXPECT_FALSE(loaded.settings.config.effects.per_frame_updates);

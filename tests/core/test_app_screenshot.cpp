@@ -5,9 +5,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "core/query/camera.h"
+#include "tests/support/temp_dir.h"
 #include "ui/app/screenshot_files.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
@@ -18,25 +18,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-class TempDir {
- public:
-  TempDir() {
-    std::string tmpl = (fs::temp_directory_path() / "accelviz-shots-XXXXXX").string();
-    path_ = mkdtemp(tmpl.data());
-  }
-  ~TempDir() { fs::remove_all(path_); }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
-
-std::string read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test_support::read_file;
+using test_support::TempDir;
 
 RgbImage test_frame(int w, int h) {
   RgbImage img(w, h);
@@ -67,7 +50,7 @@ ScreenshotInfo test_info() {
 }  // namespace
 
 TEST(AppScreenshot, NamesAreTimeStampedAndSkipTakenStems) {
-  TempDir dir;
+  TempDir dir("shots");
   const std::time_t t = 1700000000;
   const std::string stamp = screenshot_timestamp(t);
   ASSERT_EQ(stamp.size(), 15u);  // YYYYmmdd-HHMMSS
@@ -83,32 +66,32 @@ TEST(AppScreenshot, NamesAreTimeStampedAndSkipTakenStems) {
 }
 
 TEST(AppScreenshot, SavingTwiceInTheSameSecondNeverOverwrites) {
-  TempDir dir;
+  TempDir dir("shots");
   const fs::path folder = dir.path() / "created" / "on demand";
   const std::time_t t = 1700000000;
   const SavedScreenshot a = save_screenshot(folder, test_frame(64, 48), test_info(), t);
   ASSERT_TRUE(a.ok) << a.error;
-  const std::string first_png = read(a.png), first_json = read(a.json);
+  const std::string first_png = read_file(a.png), first_json = read_file(a.json);
   const SavedScreenshot b = save_screenshot(folder, test_frame(64, 48), test_info(), t);
   ASSERT_TRUE(b.ok) << b.error;
   EXPECT_NE(a.png, b.png);
   EXPECT_NE(a.json, b.json);
-  EXPECT_EQ(read(a.png), first_png) << "the first picture is untouched";
-  EXPECT_EQ(read(a.json), first_json);
+  EXPECT_EQ(read_file(a.png), first_png) << "the first picture is untouched";
+  EXPECT_EQ(read_file(a.json), first_json);
   EXPECT_EQ(b.png.stem().string(), a.png.stem().string() + "-2");
 }
 
 TEST(AppScreenshot, ExplicitPathRefusesExistingFiles) {
-  TempDir dir;
+  TempDir dir("shots");
   const fs::path png = dir.path() / "figure.png";
   const SavedScreenshot a = save_screenshot_as(png, test_frame(64, 48), test_info());
   ASSERT_TRUE(a.ok) << a.error;
   EXPECT_EQ(a.json, dir.path() / "figure.json");
-  const std::string before = read(png);
+  const std::string before = read_file(png);
   const SavedScreenshot b = save_screenshot_as(png, test_frame(32, 32), test_info());
   EXPECT_FALSE(b.ok);
   EXPECT_EQ(b.error, png.string() + ": exists (not overwritten)");
-  EXPECT_EQ(read(png), before);
+  EXPECT_EQ(read_file(png), before);
   // The side-car is checked too, before anything is written.
   fs::remove(png);
   const SavedScreenshot c = save_screenshot_as(png, test_frame(64, 48), test_info());

@@ -7,6 +7,7 @@
 
 #include <functional>
 
+#include "tests/support/temp_dir.h"
 #include "ui/app/script.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
@@ -200,8 +201,8 @@ TEST(AppScript, OddBytesGiveOneShortLine) {
 
 // A folder ran as an empty script (exit 0, nothing said); a FIFO would block.
 TEST(AppScript, AFolderOrAFifoIsNotAScript) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("accelviz_script_kinds_" + std::to_string(::getpid()));
+  const test_support::TempDir tmp("script-kinds");
+  const std::filesystem::path& dir = tmp.path();
   std::filesystem::create_directories(dir / "dir.txt");
   ASSERT_EQ(::mkfifo((dir / "fifo.txt").c_str(), 0644), 0);
   for (const char* name : {"dir.txt", "fifo.txt"}) {
@@ -212,7 +213,6 @@ TEST(AppScript, AFolderOrAFifoIsNotAScript) {
       EXPECT_NE(std::string(e.what()).find(":0: cannot be read: is "), std::string::npos) << e.what();
     }
   }
-  std::filesystem::remove_all(dir);
 }
 
 TEST(AppScript, RunnerRetriesCommandsThatNeedMoreFrames) {

@@ -5,9 +5,8 @@
 
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
+#include "tests/support/temp_dir.h"
 #include "ui/app/settings.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
@@ -18,29 +17,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-class TempDir {
- public:
-  TempDir() {
-    std::string tmpl = (fs::temp_directory_path() / "accelviz-settings-XXXXXX").string();
-    path_ = mkdtemp(tmpl.data());
-  }
-  ~TempDir() { fs::remove_all(path_); }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
-
-std::string read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void write(const fs::path& p, const std::string& text) {
-  std::ofstream(p, std::ios::binary) << text;
-}
+using test_support::read_file;
+using test_support::TempDir;
+using test_support::write_file;
 
 // Restores an environment variable on scope exit.
 class EnvGuard {
@@ -63,7 +42,7 @@ class EnvGuard {
 }  // namespace
 
 TEST(AppSettings, RoundTrip) {
-  TempDir dir;
+  TempDir dir("settings");
   AppSettings s;
   s.last_scene = "/data/bunny.glb";
   s.recent = {"/data/bunny.glb", "builtin:teapot?size=5000"};
@@ -90,7 +69,7 @@ TEST(AppSettings, RoundTrip) {
 }
 
 TEST(AppSettings, MissingFileGivesDefaultsSilently) {
-  TempDir dir;
+  TempDir dir("settings");
   const LoadedSettings loaded = load_settings(dir.path() / "none" / "settings.json");
   EXPECT_EQ(loaded.error, "");
   EXPECT_EQ(option_values(loaded.settings.config), option_values(AppConfig{}));
@@ -98,7 +77,7 @@ TEST(AppSettings, MissingFileGivesDefaultsSilently) {
 }
 
 TEST(AppSettings, CorruptedFileIsReportedAndReplacedByDefaults) {
-  TempDir dir;
+  TempDir dir("settings");
   const fs::path file = dir.path() / "settings.json";
   struct Case {
     const char* text;
@@ -121,7 +100,7 @@ TEST(AppSettings, CorruptedFileIsReportedAndReplacedByDefaults) {
            Case{"{\"options\": {\"buckets\": 16}}", "options.buckets: expected a string"},
            Case{"{\"options\": {\"wobble\": \"on\"}}", "options: unknown option 'wobble'"},
        }) {
-    write(file, c.text);
+    write_file(file, c.text);
     const LoadedSettings loaded = load_settings(file);
     EXPECT_EQ(loaded.error.rfind(file.string() + ": ", 0), 0u) << loaded.error;
     EXPECT_NE(loaded.error.find(c.problem), std::string::npos) << c.text << " -> " << loaded.error;
@@ -138,10 +117,10 @@ TEST(AppSettings, CorruptedFileIsReportedAndReplacedByDefaults) {
 // A FIFO blocked the app's start; a folder read as a parse error; a huge
 // file was read whole. Each is one line and the defaults.
 TEST(AppSettings, AFifoFolderOrHugeFileIsReportedNotRead) {
-  TempDir dir;
+  TempDir dir("settings");
   ASSERT_EQ(::mkfifo((dir.path() / "fifo.json").c_str(), 0644), 0);
   fs::create_directories(dir.path() / "dir.json");
-  write(dir.path() / "huge.json", "{\"last_scene\": \"" + std::string(kMaxSettingsBytes, 'x') + "\"}");
+  write_file(dir.path() / "huge.json", "{\"last_scene\": \"" + std::string(kMaxSettingsBytes, 'x') + "\"}");
   for (const auto& [name, problem] :
        {std::pair{"fifo.json", "is not a regular file"}, std::pair{"dir.json", "is a directory, not a file"},
         std::pair{"huge.json", "is larger than 1048576 bytes"}}) {
@@ -152,21 +131,21 @@ TEST(AppSettings, AFifoFolderOrHugeFileIsReportedNotRead) {
 }
 
 TEST(AppSettings, AtomicWriteReplacesWholeFilesAndLeavesNoTemporary) {
-  TempDir dir;
+  TempDir dir("settings");
   const fs::path file = dir.path() / "sub" / "dir" / "f.txt";
   ASSERT_EQ(write_file_atomic(file, "first version, rather long\n"), "");
-  EXPECT_EQ(read(file), "first version, rather long\n");
+  EXPECT_EQ(read_file(file), "first version, rather long\n");
   ASSERT_EQ(write_file_atomic(file, "second\n"), "");
-  EXPECT_EQ(read(file), "second\n") << "replaced, not overwritten in place (no tail of the old text)";
+  EXPECT_EQ(read_file(file), "second\n") << "replaced, not overwritten in place (no tail of the old text)";
   ASSERT_EQ(write_file_atomic(file, ""), "");
-  EXPECT_EQ(read(file), "");
+  EXPECT_EQ(read_file(file), "");
   std::size_t entries = 0;
   for ([[maybe_unused]] const auto& e : fs::directory_iterator(file.parent_path())) ++entries;
   EXPECT_EQ(entries, 1u) << "no temporary file left next to it";
 }
 
 TEST(AppSettings, AtomicWriteFailureIsOneLineAndKeepsTheOldFile) {
-  TempDir dir;
+  TempDir dir("settings");
   // A directory where the file should be: rename() cannot replace it.
   const fs::path target = dir.path() / "taken";
   fs::create_directories(target / "inside");
@@ -177,7 +156,7 @@ TEST(AppSettings, AtomicWriteFailureIsOneLineAndKeepsTheOldFile) {
   for ([[maybe_unused]] const auto& x : fs::directory_iterator(dir.path())) ++entries;
   EXPECT_EQ(entries, 1u) << "the temporary file was removed";
   // A parent that is a file cannot become a folder.
-  write(dir.path() / "plain", "x");
+  write_file(dir.path() / "plain", "x");
   EXPECT_NE(write_file_atomic(dir.path() / "plain" / "f.txt", "text"), "");
 }
 

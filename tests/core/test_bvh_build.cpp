@@ -19,6 +19,7 @@
 #include "core/accel/bvh/bvh.h"
 #include "core/accel/bvh/bvh_build.h"
 #include "core/analysis/sah.h"
+#include "tests/core/mt_random.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_bvh_build {
@@ -27,11 +28,7 @@ using namespace accelviz;
 
 namespace {
 
-/// Uniform float in [0, 1) from the raw engine output (std::uniform_real_distribution
-/// is implementation-defined; this keeps scenes identical across standard libraries).
-float uniform(std::mt19937& rng) {
-  return static_cast<float>(rng() >> 8) * (1.0f / 16777216.0f);
-}
+using test_random::uniform;
 
 std::vector<Triangle> random_soup(std::size_t n, std::uint32_t seed, float size = 0.05f) {
   std::mt19937 rng(seed);

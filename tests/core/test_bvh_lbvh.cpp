@@ -9,6 +9,7 @@
 #include "core/accel/bvh/bvh.h"
 #include "core/accel/bvh/bvh_build.h"
 #include "core/scene/load.h"
+#include "tests/core/mt_random.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_bvh_lbvh {
@@ -18,9 +19,7 @@ using namespace accelviz::bvh_detail;
 
 namespace {
 
-float uniform(std::mt19937& rng) {
-  return static_cast<float>(rng() >> 8) * (1.0f / 16777216.0f);
-}
+using test_random::uniform;
 
 std::vector<BuildPrim> random_prims(std::size_t n, std::uint32_t seed) {
   std::mt19937 rng(seed);

@@ -14,6 +14,7 @@
 #include "core/accel/bvh/bvh.h"
 #include "core/accel/bvh/bvh_slab.h"
 #include "core/accel/bvh/bvh_wide.h"
+#include "tests/core/mt_random.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_bvh_query {
@@ -22,17 +23,8 @@ using namespace accelviz;
 
 namespace {
 
-float uniform(std::mt19937& rng) {
-  return static_cast<float>(rng() >> 8) * (1.0f / 16777216.0f);
-}
-
-glm::vec3 random_direction(std::mt19937& rng) {
-  for (;;) {
-    const glm::vec3 d(2 * uniform(rng) - 1, 2 * uniform(rng) - 1, 2 * uniform(rng) - 1);
-    const float l = glm::length(d);
-    if (l > 0.05f && l <= 1.0f) return d / l;
-  }
-}
+using test_random::random_direction;
+using test_random::uniform;
 
 std::vector<Triangle> soup(std::size_t n, std::uint32_t seed, float size = 0.08f) {
   std::mt19937 rng(seed);

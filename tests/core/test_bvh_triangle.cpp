@@ -17,6 +17,7 @@
 #include "core/accel/bvh/bvh_tri8.h"
 #include "core/accel/bvh/bvh_triangle.h"
 #include "core/accel/bvh/bvh_wide.h"
+#include "tests/core/mt_random.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_bvh_triangle {
@@ -25,9 +26,7 @@ using namespace accelviz;
 
 namespace {
 
-float uniform(std::mt19937& rng) {
-  return static_cast<float>(rng() >> 8) * (1.0f / 16777216.0f);
-}
+using test_random::uniform;
 
 bool same_bits(float a, float b) {
   return std::memcmp(&a, &b, sizeof a) == 0;

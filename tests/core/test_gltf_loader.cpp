@@ -16,6 +16,7 @@
 
 #include "core/scene/load.h"
 #include "tests/core/base64.h"
+#include "tests/support/temp_dir.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_gltf_loader {
@@ -142,19 +143,8 @@ void expect_vec3_near(const glm::vec3& a, const glm::vec3& b, float eps = 1e-5f)
   EXPECT_NEAR(a.z, b.z, eps);
 }
 
-class GltfLoader : public ::testing::Test {
+class GltfLoader : public test_support::TempDirTest {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("accelviz_test_gltf_loader_" + std::to_string(::getpid())) / info->name();
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_.parent_path(), ec);
-  }
-
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
   std::string write_gltf(const GltfBuilder& b, const std::string& name = "scene.gltf") {
     write_file(dir_ / name, b.gltf_text());
     return path(name);
@@ -187,8 +177,6 @@ class GltfLoader : public ::testing::Test {
       EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
     }
   }
-
-  fs::path dir_;
 };
 
 // --- valid files -------------------------------------------------------------

@@ -12,6 +12,7 @@
 
 #include "core/scene/gltf_writer.h"
 #include "core/scene/load.h"
+#include "tests/support/temp_dir.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_gltf_writer {
@@ -22,10 +23,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string read_bytes(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using test_support::read_file;
 
 std::uint32_t u32_at(const std::string& s, std::size_t offset) {
   std::uint32_t v;
@@ -112,21 +110,7 @@ Scene sample_scene() {
   return s;
 }
 
-class GltfWriter : public ::testing::Test {
- protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("accelviz_test_gltf_writer_" + std::to_string(::getpid())) / info->name();
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_.parent_path(), ec);
-  }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-
-  fs::path dir_;
-};
+class GltfWriter : public test_support::TempDirTest {};
 
 TEST_F(GltfWriter, RoundTripGlbGivesTheSameTriangles) {
   const Scene original = sample_scene();
@@ -181,7 +165,7 @@ TEST_F(GltfWriter, RoundTripOfALoadedFileIsStable) {
   // Cameras and lights are re-emitted as fresh root nodes each time, so only
   // the geometry-carrying part is compared byte for byte: same size and same
   // BIN chunk.
-  const std::string b = read_bytes(dir_ / "b.glb"), c = read_bytes(dir_ / "c.glb");
+  const std::string b = read_file(dir_ / "b.glb"), c = read_file(dir_ / "c.glb");
   const std::size_t bin_b = 20 + u32_at(b, 12), bin_c = 20 + u32_at(c, 12);
   EXPECT_EQ(b.substr(bin_b), c.substr(bin_c));
 }
@@ -226,7 +210,7 @@ TEST_F(GltfWriter, InstanceThatDisagreesWithItsNodeGetsItsOwnNode) {
 
 TEST_F(GltfWriter, GlbLayoutAndAccessorBounds) {
   write_gltf(sample_scene(), path("layout.glb"), true);
-  const std::string bytes = read_bytes(dir_ / "layout.glb");
+  const std::string bytes = read_file(dir_ / "layout.glb");
   ASSERT_GE(bytes.size(), 28u);
   EXPECT_EQ(bytes.substr(0, 4), "glTF");
   EXPECT_EQ(u32_at(bytes, 4), 2u);
@@ -264,7 +248,7 @@ TEST_F(GltfWriter, NonFinitePositionsAreWrittenButLeftOutOfMinMax) {
   s.instances = {Instance{}};
   s.flatten();
   write_gltf(s, path("nan.gltf"), false);
-  const json doc = json::parse(read_bytes(dir_ / "nan.gltf"));
+  const json doc = json::parse(read_file(dir_ / "nan.gltf"));
   EXPECT_EQ(doc["accessors"][0]["max"], json({1.0, 1.0, 0.0}));
   const Scene back = load_gltf(path("nan.gltf"));
   EXPECT_EQ(back.triangles.size(), 1u);
@@ -274,7 +258,7 @@ TEST_F(GltfWriter, NonFinitePositionsAreWrittenButLeftOutOfMinMax) {
 TEST_F(GltfWriter, RefusesToOverwriteUnlessAsked) {
   const Scene s = sample_scene();
   write_gltf(s, path("x.glb"), true);
-  const std::string before = read_bytes(dir_ / "x.glb");
+  const std::string before = read_file(dir_ / "x.glb");
   Scene smaller = s;
   smaller.instances.resize(1);
   smaller.flatten();
@@ -284,7 +268,7 @@ TEST_F(GltfWriter, RefusesToOverwriteUnlessAsked) {
   } catch (const SceneError& e) {
     EXPECT_EQ(std::string(e.what()), path("x.glb") + ": already exists");
   }
-  EXPECT_EQ(read_bytes(dir_ / "x.glb"), before);
+  EXPECT_EQ(read_file(dir_ / "x.glb"), before);
   write_gltf(smaller, path("x.glb"), true, /*overwrite=*/true);
   EXPECT_EQ(load_gltf(path("x.glb")).triangles.size(), 2u);
   EXPECT_FALSE(fs::exists(dir_ / "x.glb.part"));

@@ -17,6 +17,7 @@
 #include "core/query/batch.h"
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
+#include "tests/support/temp_dir.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_heatmap {
@@ -39,10 +40,6 @@ std::vector<Triangle> tiny_scene() {
 
 Camera tiny_camera() {
   return look_at({0.3f, 0.2f, 8.0f}, {0.0f, 0.0f, 0.0f}, 0.9f);
-}
-
-std::string temp_png(const std::string& name) {
-  return (fs::temp_directory_path() / ("accelviz_test_heatmap_" + std::to_string(::getpid()) + "_" + name)).string();
 }
 
 }  // namespace
@@ -121,14 +118,14 @@ TEST(Heatmap, PngHasTheColourTheMapGives) {
   opts.width = 40;
   opts.height = 30;
   const MetricImage img = render_metric(accel, tiny_camera(), opts);
+  const test_support::TempDir tmp("heatmap");
   for (ColorMap map : {ColorMap::viridis, ColorMap::turbo}) {
     ColorizeOptions co;
     co.map = map;
     const RgbImage rgb = colorize(img, co);
     EXPECT_EQ(rgb.width, 40);
     EXPECT_GT(rgb.height, 30);  // legend below
-    const std::string path = temp_png(std::string(colormap_name(map)) + ".png");
-    fs::remove(path);
+    const std::string path = tmp.file(std::string(colormap_name(map)) + ".png");
     write_png(path, rgb);
     const RgbImage back = read_png(path);
     ASSERT_EQ(back.width, rgb.width);
@@ -139,7 +136,6 @@ TEST(Heatmap, PngHasTheColourTheMapGives) {
       const glm::u8vec3 expected = to_rgb8(colormap(map, img.at(x, y) / max));
       EXPECT_EQ(back.at(x, y), expected) << "pixel " << x << "," << y;
     }
-    fs::remove(path);
   }
 }
 
@@ -186,9 +182,9 @@ TEST(Heatmap, LegendPlacements) {
 
 TEST(Heatmap, WritePngTakesOnlyPngNames) {
   const RgbImage img(4, 4, {10, 20, 30});
+  const test_support::TempDir tmp("heatmap");
   for (const char* name : {"heat.jpg", "heat", "heat.png.txt", "heat.pn"}) {
-    const std::string path = temp_png(name);
-    fs::remove(path);
+    const std::string path = tmp.file(name);
     EXPECT_EQ(png_name_problem(path), path + ": a PNG file's name must end in .png");
     try {
       write_png(path, img);
@@ -199,18 +195,16 @@ TEST(Heatmap, WritePngTakesOnlyPngNames) {
     EXPECT_FALSE(fs::exists(path)) << path;
   }
   for (const char* name : {"upper.PNG", "mixed.Png", "two.dots.png"}) {
-    const std::string path = temp_png(name);
-    fs::remove(path);
+    const std::string path = tmp.file(name);
     EXPECT_EQ(png_name_problem(path), "");
     write_png(path, img);
     EXPECT_EQ(read_png(path).width, 4) << path;
-    fs::remove(path);
   }
 }
 
 TEST(Heatmap, WritePngRefusesToOverwrite) {
-  const std::string path = temp_png("exists.png");
-  fs::remove(path);
+  const test_support::TempDir tmp("heatmap");
+  const std::string path = tmp.file("exists.png");
   const RgbImage img(4, 4, {10, 20, 30});
   write_png(path, img);
   try {

@@ -19,6 +19,7 @@
 #include "core/query/ray_file.h"
 #include "core/scene/load.h"
 #include "tests/core/base64.h"
+#include "tests/support/temp_dir.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_malformed_files {
@@ -29,16 +30,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-class Malformed : public testing::Test {
+class Malformed : public test_support::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("accelviz-malformed-" + std::to_string(::getpid()) + "-" +
-                                        testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   std::string write(const std::string& name, const std::string& bytes) {
     const fs::path p = dir_ / name;
     std::ofstream(p, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
@@ -73,8 +66,6 @@ class Malformed : public testing::Test {
     const std::string msg = gltf_error(file);
     EXPECT_NE(msg.find(problem), std::string::npos) << "message: '" << msg << "'\nexpected: " << problem;
   }
-
-  fs::path dir_;
 };
 
 std::string u32(std::uint32_t v) {

@@ -17,6 +17,7 @@
 #include "core/scene/effects.h"
 #include "core/scene/load.h"
 #include "tests/core/base64.h"
+#include "tests/support/temp_dir.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_morph_targets {
@@ -58,12 +59,6 @@ struct MorphGltf {
   }
 };
 
-fs::path morph_temp_dir() {
-  const fs::path d = fs::temp_directory_path() / ("accelviz_test_morph_" + std::to_string(::getpid()));
-  fs::create_directories(d);
-  return d;
-}
-
 const std::vector<glm::vec3> kQuad = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
 const std::vector<glm::vec3> kLift = {{0, 0, 0}, {0, 0, 0}, {0, 0, 1}, {0, 0, 1}};     // target 0: top edge up in z
 const std::vector<glm::vec3> kWiden = {{-1, 0, 0}, {1, 0, 0}, {1, 0, 0}, {-1, 0, 0}};  // target 1: wider in x
@@ -104,9 +99,8 @@ void expect_positions(const std::vector<glm::vec3>& got, const std::vector<float
 }
 
 TEST(MorphTargets, LoadedSampledAndAppliedToTheMesh) {
-  const fs::path dir = morph_temp_dir();
-  const Scene s = load_gltf(morph_quad_file().write(dir / "morph.gltf"));
-  fs::remove_all(dir);
+  const test_support::TempDir dir("morph");
+  const Scene s = load_gltf(morph_quad_file().write(dir.path() / "morph.gltf"));
   ASSERT_EQ(s.meshes.size(), 1u);
   const Mesh& m = s.meshes[0];
   ASSERT_EQ(m.morph_deltas.size(), 2u);
@@ -177,8 +171,8 @@ TEST(MorphTargets, WeightCountMismatchIsAOneLineError) {
   const int three = g.scalars({0.0f, 0.0f, 0.0f, 1.0f, 1.0f, 1.0f});
   g.doc["animations"][0]["samplers"].push_back({{"input", times}, {"output", three}});
   g.doc["animations"][0]["channels"][0]["sampler"] = 1;
-  const fs::path dir = morph_temp_dir();
-  const std::string file = g.write(dir / "bad.gltf");
+  const test_support::TempDir dir("morph");
+  const std::string file = g.write(dir.path() / "bad.gltf");
   try {
     load_gltf(file);
     ADD_FAILURE() << "no error";
@@ -188,7 +182,6 @@ TEST(MorphTargets, WeightCountMismatchIsAOneLineError) {
     EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
     EXPECT_NE(msg.find("6 weights for 2 keyframes of the 2 morph targets"), std::string::npos) << msg;
   }
-  fs::remove_all(dir);
 }
 
 /// A wavy grid (N x N quads) whose one morph target bumps it in z, and a

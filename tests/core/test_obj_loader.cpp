@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/scene/load.h"
+#include "tests/support/temp_dir.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_obj_loader {
@@ -23,18 +24,8 @@ void expect_vec3_near(const glm::vec3& a, const glm::vec3& b, float eps = 1e-6f)
   EXPECT_NEAR(a.z, b.z, eps);
 }
 
-class ObjLoader : public ::testing::Test {
+class ObjLoader : public test_support::TempDirTest {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("accelviz_test_obj_loader_" + std::to_string(::getpid())) / info->name();
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_.parent_path(), ec);
-  }
-
   std::string write(const std::string& text, const std::string& name = "scene.obj") {
     std::ofstream out(dir_ / name, std::ios::binary);
     out << text;
@@ -53,8 +44,6 @@ class ObjLoader : public ::testing::Test {
       EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
     }
   }
-
-  fs::path dir_;
 };
 
 TEST_F(ObjLoader, SingleTriangle) {

@@ -10,40 +10,23 @@
 #include <algorithm>
 #include <csignal>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "core/util/file_checks.h"
 #include "core/util/output_file.h"
+#include "tests/support/temp_dir.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_output_file {
 
 using namespace accelviz;
 namespace fs = std::filesystem;
+using test_support::read_file;
+using test_support::write_file;
 
-class OutputFile : public ::testing::Test {
+class OutputFile : public test_support::TempDirTest {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("accelviz_test_output_file_" + std::to_string(::getpid())) / info->name();
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_.parent_path(), ec);
-  }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  static std::string read(const std::string& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-  }
-  static void put(const std::string& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
   /// Names in the folder other than `keep`: a temporary left behind shows here.
   std::vector<std::string> others(std::initializer_list<std::string> keep) const {
     std::vector<std::string> out;
@@ -53,26 +36,25 @@ class OutputFile : public ::testing::Test {
     }
     return out;
   }
-  fs::path dir_;
 };
 
 TEST_F(OutputFile, WritesThePartsAndLeavesNoTemporary) {
   const OutputWrite w = write_output_file(path("a.bin"), {"head", "", "er+body"}, false);
   ASSERT_TRUE(w.ok()) << w.problem;
-  EXPECT_EQ(read(path("a.bin")), "header+body");
+  EXPECT_EQ(read_file(path("a.bin")), "header+body");
   EXPECT_TRUE(others({"a.bin"}).empty());
 }
 
 TEST_F(OutputFile, AnExistingFileIsKeptUnlessOverwriteIsAsked) {
-  put(path("a.png"), "mine");
+  write_file(path("a.png"), "mine");
   const OutputWrite refused = write_output_file(path("a.png"), {"new"}, false);
   EXPECT_TRUE(refused.exists);
   EXPECT_EQ(refused.problem, "exists");
-  EXPECT_EQ(read(path("a.png")), "mine");
+  EXPECT_EQ(read_file(path("a.png")), "mine");
   EXPECT_TRUE(others({"a.png"}).empty());
   const OutputWrite replaced = write_output_file(path("a.png"), {"new"}, true);
   ASSERT_TRUE(replaced.ok()) << replaced.problem;
-  EXPECT_EQ(read(path("a.png")), "new");
+  EXPECT_EQ(read_file(path("a.png")), "new");
   EXPECT_TRUE(others({"a.png"}).empty());
 }
 
@@ -83,27 +65,27 @@ TEST_F(OutputFile, ADanglingLinkCountsAsExisting) {
 }
 
 TEST_F(OutputFile, OverwritingThroughALinkReplacesTheFileItNames) {
-  put(path("real.json"), "old");
+  write_file(path("real.json"), "old");
   fs::create_symlink("real.json", path("link.json"));
   const OutputWrite w = write_output_file(path("link.json"), {"new"}, true);
   ASSERT_TRUE(w.ok()) << w.problem;
   EXPECT_TRUE(fs::is_symlink(fs::symlink_status(path("link.json"))));
-  EXPECT_EQ(read(path("real.json")), "new");
+  EXPECT_EQ(read_file(path("real.json")), "new");
 }
 
 // What lies beside the target under the names a writer might have used for
 // its temporary (export used OUT.part: a link there made it overwrite the
 // file the link named, a FIFO there made it hang) is never opened.
 TEST_F(OutputFile, LinksAndFifosBesideTheTargetAreNotFollowed) {
-  put(path("victim.txt"), "precious");
+  write_file(path("victim.txt"), "precious");
   fs::create_symlink("victim.txt", path("a.glb.part"));
   ASSERT_EQ(::mkfifo(path("b.glb.part").c_str(), 0644), 0);
   for (const char* name : {"a.glb", "b.glb"}) {
     const OutputWrite w = write_output_file(path(name), {"glb bytes"}, false);
     ASSERT_TRUE(w.ok()) << w.problem;
-    EXPECT_EQ(read(path(name)), "glb bytes");
+    EXPECT_EQ(read_file(path(name)), "glb bytes");
   }
-  EXPECT_EQ(read(path("victim.txt")), "precious");
+  EXPECT_EQ(read_file(path("victim.txt")), "precious");
   EXPECT_TRUE(others({"victim.txt", "a.glb.part", "b.glb.part", "a.glb", "b.glb"}).empty());
 }
 
@@ -127,7 +109,7 @@ TEST_F(OutputFile, AMissingFolderIsNamed) {
 // A write that fails part-way (here a file-size limit, as a full disk would)
 // keeps the file that was there and leaves no temporary.
 TEST_F(OutputFile, AFailedWriteKeepsTheOldFile) {
-  put(path("big.png"), "ORIGINAL");
+  write_file(path("big.png"), "ORIGINAL");
   struct rlimit old {};
   ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old), 0);
   void (*old_handler)(int) = std::signal(SIGXFSZ, SIG_IGN);  // EFBIG instead of the signal
@@ -139,7 +121,7 @@ TEST_F(OutputFile, AFailedWriteKeepsTheOldFile) {
   ::setrlimit(RLIMIT_FSIZE, &old);
   std::signal(SIGXFSZ, old_handler);
   EXPECT_EQ(w.problem, "write failed: File too large");
-  EXPECT_EQ(read(path("big.png")), "ORIGINAL");
+  EXPECT_EQ(read_file(path("big.png")), "ORIGINAL");
   EXPECT_TRUE(others({"big.png"}).empty());
 }
 
@@ -147,10 +129,10 @@ TEST_F(OutputFile, AFailedWriteKeepsTheOldFile) {
 // scripts) are read with. A FIFO would block the reader, a folder read as
 // empty, a huge file would be read whole.
 TEST_F(OutputFile, ReadTextFileTakesOnlySmallRegularFiles) {
-  put(path("ok.ini"), "[Window][A]\n");
+  write_file(path("ok.ini"), "[Window][A]\n");
   ASSERT_EQ(::mkfifo(path("fifo.ini").c_str(), 0644), 0);
   fs::create_directories(path("dir.ini"));
-  put(path("big.ini"), std::string(2048, 'x'));
+  write_file(path("big.ini"), std::string(2048, 'x'));
   std::string text;
   EXPECT_EQ(read_text_file(path("ok.ini"), 1024, text), "");
   EXPECT_EQ(text, "[Window][A]\n");

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "core/query/ray_file.h"
+#include "tests/support/temp_dir.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_ray_file {
@@ -19,20 +20,7 @@ namespace fs = std::filesystem;
 namespace {
 
 /// A fresh directory per test under the system temp dir, removed afterwards.
-class RayFileTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("accelviz_test_ray_file_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-
-  fs::path dir_;
-};
+class RayFileTest : public test_support::TempDirTest {};
 
 std::vector<std::uint8_t> slurp(const std::string& p) {
   std::ifstream in(p, std::ios::binary);

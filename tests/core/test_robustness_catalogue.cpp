@@ -36,6 +36,7 @@
 #include "core/geometry/shapes.h"
 #include "core/util/parallel.h"
 #include "core/util/random.h"
+#include "tests/core/spatial_test_scenes.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_robustness_catalogue {
@@ -86,31 +87,7 @@ std::vector<Triangle> icosphere(int levels, glm::dvec3 centre, double radius) {
   return out;
 }
 
-// A closed axis-aligned cube [lo, lo+size]^3, each face an n x n grid of quads
-// (two triangles each); grid vertices are computed once, so shared vertices
-// and edges are bit-identical.
-std::vector<Triangle> subdivided_cube(glm::vec3 lo, float size, int n) {
-  std::vector<Triangle> out;
-  auto coord = [&](int i) { return i == n ? size : size * static_cast<float>(i) / static_cast<float>(n); };
-  for (int axis = 0; axis < 3; ++axis) {
-    for (int side = 0; side < 2; ++side) {
-      const int u = (axis + 1) % 3, w = (axis + 2) % 3;
-      auto p = [&](int i, int j) {
-        glm::vec3 q;
-        q[axis] = lo[axis] + (side ? size : 0.0f);
-        q[u] = lo[u] + coord(i);
-        q[w] = lo[w] + coord(j);
-        return q;
-      };
-      for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) {
-          out.push_back({p(i, j), p(i + 1, j), p(i + 1, j + 1)});
-          out.push_back({p(i, j), p(i + 1, j + 1), p(i, j + 1)});
-        }
-    }
-  }
-  return out;
-}
+using test_scenes::subdivided_cube;
 
 // 3x3x3 small axis-aligned cubes with gaps plus a soup of random triangles
 // around them: box faces, leaf bounds and split planes fall on many shared

@@ -7,6 +7,7 @@
 #include "core/accel/accel.h"
 #include "core/analysis/robustness_lab.h"
 #include "core/scene/load.h"
+#include "tests/core/spatial_test_scenes.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_robustness_lab {
@@ -18,25 +19,7 @@ namespace {
 // A closed axis-aligned cube [0,1]^3, each face an n x n grid of quads with
 // bit-identical shared vertices: no ray entering it may find a hole.
 std::vector<Triangle> closed_cube(int n) {
-  std::vector<Triangle> out;
-  auto c = [&](int i) { return static_cast<float>(i) / static_cast<float>(n); };
-  for (int axis = 0; axis < 3; ++axis)
-    for (int side = 0; side < 2; ++side) {
-      const int u = (axis + 1) % 3, w = (axis + 2) % 3;
-      auto p = [&](int i, int j) {
-        glm::vec3 q;
-        q[axis] = static_cast<float>(side);
-        q[u] = c(i);
-        q[w] = c(j);
-        return q;
-      };
-      for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) {
-          out.push_back({p(i, j), p(i + 1, j), p(i + 1, j + 1)});
-          out.push_back({p(i, j), p(i + 1, j + 1), p(i, j + 1)});
-        }
-    }
-  return out;
+  return test_scenes::subdivided_cube(glm::vec3(0.0f), 1.0f, n);
 }
 
 std::uint64_t count_status(const LabVariant& v, std::uint8_t s) {

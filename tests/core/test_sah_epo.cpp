@@ -11,6 +11,7 @@
 #include "core/accel/bvh/bvh.h"
 #include "core/analysis/epo.h"
 #include "core/analysis/sah.h"
+#include "tests/core/mt_random.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_sah_epo {
@@ -19,9 +20,7 @@ using namespace accelviz;
 
 namespace {
 
-float uniform(std::mt19937& rng) {
-  return static_cast<float>(rng() >> 8) * (1.0f / 16777216.0f);
-}
+using test_random::uniform;
 
 std::vector<Triangle> soup(std::size_t n, std::uint32_t seed, float size) {
   std::mt19937 rng(seed);

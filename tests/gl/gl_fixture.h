@@ -1,11 +1,6 @@
 #pragma once
 // Shared by the tests in tests/gl: an OSMesa GL 4.5 core context per test,
 // a renderer on it, small synthetic scenes, and pixel helpers.
-#include "core/geometry/triangle.h"
-#include "ui/gl/osmesa_context.h"
-#include "ui/render/image.h"
-#include "ui/render/renderer.h"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,6 +12,12 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "core/geometry/triangle.h"
+#include "tests/support/temp_dir.h"
+#include "ui/gl/osmesa_context.h"
+#include "ui/render/image.h"
+#include "ui/render/renderer.h"
 
 namespace accelviz::test {
 
@@ -108,21 +109,6 @@ inline std::string describe(glm::u8vec4 c) {
 }
 
 /// A fresh empty directory under the system temp dir, removed by the destructor.
-class TempDir {
- public:
-  explicit TempDir(const std::string& tag) {
-    std::string pattern = (std::filesystem::temp_directory_path() / ("accelviz-" + tag + "-XXXXXX")).string();
-    if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
+using test_support::TempDir;
 
 }  // namespace accelviz::test

@@ -2,70 +2,19 @@
 // renderer draws the same frame in a GLFW window as headless, and what the
 // window shows is exactly what read_pixels returns.
 #include "gl_fixture.h"
-
+#include "tests/support/xvfb_server.h"
 #include "ui/gl/glfw_context.h"
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 
-#include <csignal>
 #include <cstring>
-
-#include <fcntl.h>
-#include <poll.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 namespace accelviz::test {
 namespace {
 
-// Starts Xvfb for this process and points DISPLAY at it. With -displayfd
-// the server takes the first free display number itself and writes it to
-// the pipe, so parallel test runs never race for a number.
-class PrivateXServer : public ::testing::Environment {
- public:
-  void SetUp() override {
-    int fds[2];
-    ASSERT_EQ(pipe(fds), 0);
-    pid_ = fork();
-    ASSERT_GE(pid_, 0);
-    if (pid_ == 0) {
-      close(fds[0]);
-      const int devnull = open("/dev/null", O_WRONLY);
-      dup2(devnull, STDOUT_FILENO);
-      dup2(devnull, STDERR_FILENO);
-      const std::string fd = std::to_string(fds[1]);
-      // -noreset: without it the server resets whenever its last client
-      // leaves (each test closes GLFW), and a test connecting during the
-      // reset fails to open the display.
-      execl(ACCELVIZ_XVFB, "Xvfb", "-displayfd", fd.c_str(), "-screen", "0", "640x480x24", "-nolisten", "tcp",
-            "-noreset", static_cast<char*>(nullptr));
-      _exit(127);
-    }
-    close(fds[1]);
-    std::string number;
-    pollfd p{fds[0], POLLIN, 0};
-    while (poll(&p, 1, 20000) > 0) {
-      char c = 0;
-      if (read(fds[0], &c, 1) != 1 || c == '\n') break;
-      number += c;
-    }
-    close(fds[0]);
-    ASSERT_FALSE(number.empty()) << "Xvfb (" << ACCELVIZ_XVFB << ") did not start";
-    setenv("DISPLAY", (":" + number).c_str(), 1);
-  }
-  void TearDown() override {
-    if (pid_ > 0) {
-      kill(pid_, SIGTERM);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-
- private:
-  pid_t pid_ = -1;
-};
-
-[[maybe_unused]] ::testing::Environment* const x_server = ::testing::AddGlobalTestEnvironment(new PrivateXServer);
+[[maybe_unused]] ::testing::Environment* const x_server =
+    ::testing::AddGlobalTestEnvironment(new test_support::PrivateXServer(ACCELVIZ_XVFB, "640x480x24"));
 
 // A frame with mesh, wireframe, boxes and a translucent quad.
 RenderView sample_scene(Renderer& r) {

@@ -4,16 +4,14 @@
 // build's tests/gl/golden-out/. To accept an intended change:
 //   ACCELVIZ_UPDATE_GOLDEN=1 ctest --test-dir <build> -R 'gl\.Golden\.'
 // then look at the new PNGs before committing them.
-#include "gl_fixture.h"
+#include <cstdlib>
 
 #include "core/accel/brute_force.h"
 #include "core/analysis/heatmap.h"
 #include "core/query/camera.h"
+#include "gl_fixture.h"
+#include "load_png.h"
 #include "ui/render/screenshot.h"
-
-#include <stb_image.h>
-
-#include <cstdlib>
 
 namespace accelviz::test {
 namespace {
@@ -25,16 +23,6 @@ constexpr double kMaxOffFraction = 0.005;
 bool updating_goldens() {
   const char* v = std::getenv("ACCELVIZ_UPDATE_GOLDEN");
   return v && std::string(v) == "1";
-}
-
-Rgba8Image load_png(const std::filesystem::path& p) {
-  int w = 0, h = 0, n = 0;
-  unsigned char* data = stbi_load(p.string().c_str(), &w, &h, &n, 4);
-  if (!data) return {};
-  Rgba8Image img(w, h);
-  std::copy(data, data + static_cast<std::size_t>(w) * h * 4, img.pixels.begin());
-  stbi_image_free(data);
-  return img;
 }
 
 // Off pixels in red (brighter = larger difference) over a dim copy of the golden.

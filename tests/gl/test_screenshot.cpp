@@ -1,33 +1,15 @@
 // Screenshots hold exactly the frame (legend included), round-trip through
 // PNG, and never overwrite a file unless asked.
-#include "gl_fixture.h"
-
-#include "ui/render/screenshot.h"
-
-#include <stb_image.h>
-
 #include <fstream>
-#include <sstream>
+
+#include "gl_fixture.h"
+#include "load_png.h"
+#include "ui/render/screenshot.h"
 
 namespace accelviz::test {
 namespace {
 
-std::string file_bytes(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-Rgba8Image load_png(const std::filesystem::path& p) {
-  int w = 0, h = 0, n = 0;
-  unsigned char* data = stbi_load(p.string().c_str(), &w, &h, &n, 4);
-  if (!data) return {};
-  Rgba8Image img(w, h);
-  std::copy(data, data + static_cast<std::size_t>(w) * h * 4, img.pixels.begin());
-  stbi_image_free(data);
-  return img;
-}
+using test_support::read_file;
 
 class Screenshot : public GlTest {
  protected:
@@ -97,7 +79,7 @@ TEST_F(Screenshot, RefusesToOverwriteUnlessAsked) {
   const SaveResult refused = write_screenshot_png(path, frame);
   EXPECT_FALSE(refused);
   EXPECT_EQ(refused.error, path.string() + ": exists (not overwritten)");
-  EXPECT_EQ(file_bytes(path), "precious");
+  EXPECT_EQ(read_file(path), "precious");
 
   const SaveResult forced = write_screenshot_png(path, frame, /*overwrite=*/true);
   ASSERT_TRUE(forced) << forced.error;

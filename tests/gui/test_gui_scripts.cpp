@@ -3,63 +3,39 @@
 // loop, and the test checks what it wrote: screenshots pixel by pixel, the
 // picked ray against a brute-force trace computed here, the stats of each
 // structure, and that bad input is reported while the app carries on.
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <poll.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
-#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
-#include <sstream>
 
 #include "core/accel/brute_force.h"
 #include "core/analysis/heatmap.h"
 #include "core/query/camera.h"
 #include "core/scene/load.h"
+#include "tests/support/temp_dir.h"
+#include "tests/support/xvfb_server.h"
 
 namespace fs = std::filesystem;
 using namespace accelviz;
 
 namespace {
 
-// Xvfb for this process, on the display number it picks itself (-displayfd).
-class PrivateXServer : public ::testing::Environment {
+// Xvfb for this process, on the display number it picks itself (-displayfd),
+// and the environment the app's window needs.
+class GuiXServer : public test_support::PrivateXServer {
  public:
+  GuiXServer() : PrivateXServer(ACCELVIZ_XVFB, "1280x800x24") {}
   void SetUp() override {
-    int fds[2];
-    ASSERT_EQ(pipe(fds), 0);
-    pid_ = fork();
-    ASSERT_GE(pid_, 0);
-    if (pid_ == 0) {
-      close(fds[0]);
-      const int devnull = open("/dev/null", O_WRONLY);
-      dup2(devnull, STDOUT_FILENO);
-      dup2(devnull, STDERR_FILENO);
-      const std::string fd = std::to_string(fds[1]);
-      // -noreset: the server must survive each run's window closing.
-      execl(ACCELVIZ_XVFB, "Xvfb", "-displayfd", fd.c_str(), "-screen", "0", "1280x800x24", "-nolisten", "tcp",
-            "-noreset", static_cast<char*>(nullptr));
-      _exit(127);
-    }
-    close(fds[1]);
-    std::string number;
-    pollfd p{fds[0], POLLIN, 0};
-    while (poll(&p, 1, 20000) > 0) {
-      char c = 0;
-      if (read(fds[0], &c, 1) != 1 || c == '\n') break;
-      number += c;
-    }
-    close(fds[0]);
-    ASSERT_FALSE(number.empty()) << "Xvfb (" << ACCELVIZ_XVFB << ") did not start";
-    setenv("DISPLAY", (":" + number).c_str(), 1);
+    PrivateXServer::SetUp();
+    if (::testing::Test::HasFatalFailure()) return;
     unsetenv("WAYLAND_DISPLAY");
     // The window's GL comes from Mesa's libGL: llvmpipe, two rasteriser
     // threads (the CI machines have two cores).
@@ -74,32 +50,18 @@ class PrivateXServer : public ::testing::Environment {
     setenv("ASAN_OPTIONS", "detect_leaks=0", 1);
 #endif
   }
-  void TearDown() override {
-    if (pid_ > 0) {
-      kill(pid_, SIGTERM);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-
- private:
-  pid_t pid_ = -1;
 };
 
-[[maybe_unused]] ::testing::Environment* const x_server = ::testing::AddGlobalTestEnvironment(new PrivateXServer);
+[[maybe_unused]] ::testing::Environment* const x_server = ::testing::AddGlobalTestEnvironment(new GuiXServer);
 
 constexpr const char* kTeapot = "builtin:teapot?size=2000";
 // Eye, target, fov: the teapot's body fills the middle of a 640×480 view.
 constexpr const char* kCamera = "6,4,8,0,1.2,0,40";
 
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test_support::read_file;
 
 nlohmann::json read_json(const fs::path& p) {
-  const std::string text = read_text(p);
+  const std::string text = read_file(p);
   if (text.empty()) ADD_FAILURE() << p << " is missing or empty";
   return nlohmann::json::parse(text.empty() ? "null" : text);
 }
@@ -136,8 +98,8 @@ class GuiScript : public ::testing::Test {
     const int status = std::system(cmd.c_str());
     RunResult r;
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = read_text(out);
-    r.err = read_text(err);
+    r.out = read_file(out);
+    r.err = read_file(err);
     return r;
   }
 
@@ -302,16 +264,16 @@ TEST_F(GuiScript, DumpsNeverReplaceAFile) {
   const std::string head = std::string("open ") + kTeapot + "\nsize 320 240\ncamera " + kCamera + "\nwait\n";
   const RunResult shot = run(head + "screenshot " + path("a.png").string() + "\nquit\n");
   ASSERT_EQ(shot.code, 0) << shot.err;
-  const std::string sidecar = read_text(path("a.json"));
+  const std::string sidecar = read_file(path("a.json"));
   ASSERT_FALSE(sidecar.empty());
   const RunResult r = run(head + "dump-stats " + path("a.json").string() + "\nquit\n");
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find(path("a.json").string() + ": exists (not overwritten)"), std::string::npos) << r.err;
-  EXPECT_EQ(read_text(path("a.json")), sidecar);
+  EXPECT_EQ(read_file(path("a.json")), sidecar);
   std::ofstream(path("precious.json")) << "mine";
   const RunResult ray = run(head + "click 160 120\ndump-ray " + path("precious.json").string() + "\nquit\n");
   EXPECT_EQ(ray.code, 1);
-  EXPECT_EQ(read_text(path("precious.json")), "mine");
+  EXPECT_EQ(read_file(path("precious.json")), "mine");
   const RunResult deep = run(head + "dump-stats " + path("no/such/x.json").string() + "\nquit\n");
   EXPECT_EQ(deep.code, 1) << "a missing folder is an error, as for screenshots";
   EXPECT_FALSE(fs::exists(path("no")));
@@ -446,7 +408,7 @@ TEST_F(GuiScript, ScriptErrorsNameTheLineAndExitWithOne) {
   EXPECT_NE(r.err.find(":3: screenshot: " + path("taken.png").string() + ": exists (not overwritten)"),
             std::string::npos)
       << r.err;
-  EXPECT_EQ(read_text(path("taken.png")), "mine");
+  EXPECT_EQ(read_file(path("taken.png")), "mine");
 }
 
 TEST_F(GuiScript, SceneArgumentOpensBeforeTheScript) {
