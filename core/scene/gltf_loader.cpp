@@ -90,9 +90,10 @@ class JsonPrecheck final : public nlohmann::json_sax<nlohmann::json> {
   std::vector<std::string> required;
   std::string error;  ///< empty when the JSON is acceptable
 
-  bool null() override { return value(); }
-  bool boolean(bool) override { return value(); }
+  bool null() override { return element(false) && value(); }
+  bool boolean(bool) override { return element(false) && value(); }
   bool number_integer(number_integer_t v) override {
+    if (!element(true)) return false;
     // tinygltf silently ignores a negative index, offset, length or count
     // (keeping its default 0), which would load other bytes than the file
     // names; reject them here (found by tests/core/test_malformed_files.cpp).
@@ -102,18 +103,19 @@ class JsonPrecheck final : public nlohmann::json_sax<nlohmann::json> {
     }
     return value();
   }
-  bool number_unsigned(number_unsigned_t) override { return value(); }
-  bool number_float(number_float_t, const string_t&) override { return value(); }
-  bool binary(binary_t&) override { return value(); }
+  bool number_unsigned(number_unsigned_t) override { return element(true) && value(); }
+  bool number_float(number_float_t, const string_t&) override { return element(true) && value(); }
+  bool binary(binary_t&) override { return element(false) && value(); }
   bool string(string_t& s) override {
+    if (!element(false)) return false;
     if (in_required_ && depth_ == 2) required.push_back(s);
     return value();
   }
-  bool start_object(std::size_t) override { return open(true); }
+  bool start_object(std::size_t) override { return element(false) && open(true); }
   bool end_object() override { return close(); }
   bool start_array(std::size_t) override {
     const bool entering_required = depth_ == 1 && key_ == "extensionsRequired";
-    if (!open(false)) return false;
+    if (!element(false, true) || !open(false)) return false;
     if (entering_required) in_required_ = true;
     return true;
   }
@@ -124,6 +126,7 @@ class JsonPrecheck final : public nlohmann::json_sax<nlohmann::json> {
   bool key(string_t& k) override {
     if (depth_ == 1) key_ = k;
     last_key_ = k;
+    if (!frames_.empty()) frames_.back().key = k;
     return true;
   }
   bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& ex) override {
@@ -151,6 +154,38 @@ class JsonPrecheck final : public nlohmann::json_sax<nlohmann::json> {
   }
   std::string last_key_;  ///< the most recent key at any depth (the one a scalar or array element belongs to)
 
+  /// An open object or array: its current key, or how many elements it has begun.
+  struct Frame {
+    bool array = false;
+    std::size_t elements = 0;
+    std::string key;
+  };
+  std::vector<Frame> frames_;  ///< the open containers, the root first
+
+  /// Called for every value before it opens: counts array elements and
+  /// type-checks the number arrays of nodes and meshes, which tinygltf reads
+  /// loosely (`"rotation": "abc"` as no rotation; a string inside a matrix
+  /// skipped, so the matrix is reported one number short).
+  bool element(bool is_number, bool is_array = false) {
+    const std::size_t d = frames_.size();
+    std::size_t position = 0;
+    if (d > 0 && frames_.back().array) position = frames_.back().elements++;
+    if (d < 3 || d > 4 || !frames_[1].array || frames_[2].array) return true;
+    const std::string& list = frames_[0].key;
+    const std::string& field = frames_[2].key;
+    const bool node = list == "nodes";
+    const bool checked = node ? (field == "matrix" || field == "translation" || field == "rotation" ||
+                                 field == "scale" || field == "weights")
+                              : list == "meshes" && field == "weights";
+    if (!checked) return true;
+    const std::string owner = (node ? "node " : "mesh ") + std::to_string(frames_[1].elements - 1);
+    if (d == 3 && !is_array)
+      error = "invalid glTF: " + owner + ": \"" + field + "\" is not an array of numbers";
+    else if (d == 4 && !is_number)
+      error = "invalid glTF: " + owner + ": \"" + field + "\" has a non-number at item " + std::to_string(position);
+    return error.empty();
+  }
+
   bool value() {
     if (depth_ == 0) {
       error = "malformed glTF: the JSON root is not an object";
@@ -164,10 +199,12 @@ class JsonPrecheck final : public nlohmann::json_sax<nlohmann::json> {
       error = "malformed glTF: JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels";
       return false;
     }
+    frames_.push_back(Frame{!is_object, 0, {}});
     return true;
   }
   bool close() {
     --depth_;
+    frames_.pop_back();
     return true;
   }
 
@@ -448,9 +485,7 @@ class GltfConverter {
       const std::string mesh_where = "mesh " + std::to_string(m);
       // Morph targets (POSITION deltas only): kept unless one is stored in a
       // way we do not read, then the base shape is used, as before.
-      bool morphs = false;
-      for (const tinygltf::Primitive& prim : gm.primitives)
-        morphs = morphs || !prim.targets.empty();
+      bool morphs = has_any_target(gm);
       if (morphs) {
         for (const tinygltf::Primitive& prim : gm.primitives)
           for (const auto& target : prim.targets) {
@@ -483,6 +518,9 @@ class GltfConverter {
         if (morphs && !prim.targets.empty()) append_morph_targets(mesh, prim, first_vertex, targets, where);
       }
       if (morphs && targets > 0) finish_morph_targets(mesh, gm, mesh_where);
+      else if (!gm.weights.empty() && !has_any_target(gm))
+        warn(mesh_where + " has " + std::to_string(gm.weights.size()) +
+             " default morph weights but no morph targets; ignored");
       scene_.meshes.push_back(std::move(mesh));
     }
   }
@@ -516,6 +554,12 @@ class GltfConverter {
         deltas[first_vertex + i] = d[i];
       }
     }
+  }
+
+  static bool has_any_target(const tinygltf::Mesh& gm) {
+    for (const tinygltf::Primitive& prim : gm.primitives)
+      if (!prim.targets.empty()) return true;
+    return false;
   }
 
   /// Pads the deltas of primitives without targets, takes the default

@@ -402,7 +402,8 @@ std::string glb_bytes(const std::string& path, std::string json_text, const std:
 
 void write_gltf(const Scene& scene, const std::string& path, bool binary, bool overwrite) {
   std::error_code ec;
-  if (!overwrite && fs::exists(fs::symlink_status(path, ec))) throw SceneError(path + ": already exists");
+  if (!overwrite && fs::exists(fs::symlink_status(path, ec)))
+    throw SceneError(path + ": exists (use --force to overwrite)");
   if (const std::string problem = output_path_problem(path); !problem.empty()) throw SceneError(path + ": " + problem);
 
   GltfWriter writer(scene, path);
@@ -423,7 +424,7 @@ void write_gltf(const Scene& scene, const std::string& path, bool binary, bool o
   // a failure never leaves a partial file under the real name, and never
   // writes through a link or FIFO that happens to be there.
   const OutputWrite w = write_output_file(path, {bytes}, overwrite);
-  if (w.exists) throw SceneError(path + ": already exists");
+  if (w.exists) throw SceneError(path + ": exists (use --force to overwrite)");
   if (!w.ok()) throw SceneError(path + ": " + w.problem);
 }
 

@@ -250,6 +250,46 @@ TEST_F(GltfLoader, ProjectiveMatrixAndOtherAssetVersionsAreWarnedAbout) {
   EXPECT_NE(w.find("node 0 has a matrix whose last row is not (0, 0, 0, 1)"), std::string::npos) << w;
 }
 
+// A mesh's default weights without morph targets are ignored, and said so.
+TEST_F(GltfLoader, MeshWeightsWithoutMorphTargetsAreWarnedAbout) {
+  GltfBuilder b = one_triangle();
+  b.doc["meshes"][0]["weights"] = {0.5, 0.25};
+  const Scene s = load_gltf(write_gltf(b));
+  ASSERT_EQ(s.triangles.size(), 1u);
+  ASSERT_EQ(s.report.warnings.size(), 1u);
+  EXPECT_EQ(s.report.warnings[0], "mesh 0 has 2 default morph weights but no morph targets; ignored");
+}
+
+// tinygltf reads `"rotation": "abc"` as no rotation and skips a string inside
+// a matrix (then reporting 15 numbers): the pre-pass names the node, the
+// property and the item instead.
+TEST_F(GltfLoader, NonNumbersInNodeAndMeshArraysAreNamed) {
+  const auto with = [&](const char* owner, const char* key, const json& value, const std::string& name) {
+    GltfBuilder b = one_triangle();
+    b.doc[owner][0][key] = value;
+    return write_gltf(b, name);
+  };
+  expect_error(with("nodes", "rotation", "abc", "rot.gltf"),
+               "invalid glTF: node 0: \"rotation\" is not an array of numbers");
+  expect_error(with("nodes", "scale", json{{"x", 1}}, "scale.gltf"), "node 0: \"scale\" is not an array of numbers");
+  expect_error(with("nodes", "matrix", json{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, "x", 1}, "matrix.gltf"),
+               "invalid glTF: node 0: \"matrix\" has a non-number at item 14");
+  expect_error(with("nodes", "translation", json{1, nullptr, 3}, "null.gltf"),
+               "node 0: \"translation\" has a non-number at item 1");
+  expect_error(with("nodes", "weights", json{json{1}}, "nested.gltf"),
+               "node 0: \"weights\" has a non-number at item 0");
+  expect_error(with("meshes", "weights", "w", "mesh.gltf"), "mesh 0: \"weights\" is not an array of numbers");
+  // The node is counted past nested values before it.
+  GltfBuilder c = one_triangle();
+  c.doc["nodes"][0]["extras"] = {{"list", {1, {{"rotation", "not a node's"}}, {2, 3}}}};
+  c.doc["nodes"].push_back({{"extras", {{"a", {{1, 2}, {3}}}}}, {"rotation", {0, 0, "z", 1}}});
+  expect_error(write_gltf(c, "second.gltf"), "node 1: \"rotation\" has a non-number at item 2");
+  // The same keys elsewhere are not nodes' transforms and stay tinygltf's business.
+  GltfBuilder b = one_triangle();
+  b.doc["asset"]["extras"] = {{"rotation", "abc"}, {"matrix", {"x"}}};
+  EXPECT_EQ(load_gltf(write_gltf(b, "extras.gltf")).triangles.size(), 1u);
+}
+
 TEST_F(GltfLoader, TrsAndMatrixGiveTheSameWorldTriangles) {
   const glm::vec3 t(1, 2, 3), sc(2, 2, 2);
   const glm::quat r = glm::angleAxis(glm::radians(90.0f), glm::vec3(0, 0, 1));

@@ -266,7 +266,7 @@ TEST_F(GltfWriter, RefusesToOverwriteUnlessAsked) {
     write_gltf(smaller, path("x.glb"), true);
     ADD_FAILURE() << "overwrote an existing file";
   } catch (const SceneError& e) {
-    EXPECT_EQ(std::string(e.what()), path("x.glb") + ": already exists");
+    EXPECT_EQ(std::string(e.what()), path("x.glb") + ": exists (use --force to overwrite)");
   }
   EXPECT_EQ(read_file(dir_ / "x.glb"), before);
   write_gltf(smaller, path("x.glb"), true, /*overwrite=*/true);
