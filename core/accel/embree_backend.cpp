@@ -217,6 +217,18 @@ bool within_embree_range(const glm::vec3& v) {
   return std::abs(v.x) <= kEmbreeLarge && std::abs(v.y) <= kEmbreeLarge && std::abs(v.z) <= kEmbreeLarge;
 }
 
+/// Embree's box tests take 1/d with |d| clamped to at least 1e-18 (its
+/// rcp_safe), so a direction whose every component is that small is traced
+/// with other boxes than its own and misses what it hits: measured on the
+/// teapot, rays at distance ~6 lost hits once their largest component fell
+/// to ~1e-17 (all of them from ~1e-19 on). 1e-15 keeps a margin; a zero
+/// direction is refused too (it can hit nothing).
+constexpr float kEmbreeShortest = 1e-15f;
+
+bool long_enough_for_embree(const glm::vec3& d) {
+  return std::max(std::abs(d.x), std::max(std::abs(d.y), std::abs(d.z))) >= kEmbreeShortest;
+}
+
 std::string num_text(float x) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", x);
@@ -238,7 +250,7 @@ std::string vec_text(const glm::vec3& v) {
 /// Whether Embree takes the ray (ray_problem's test, without the words).
 [[gnu::always_inline]] inline bool embree_takes(const Ray& ray) {
   return ray.tmin >= 0.0f && ray.tmax == ray.tmax && within_embree_range(ray.origin) &&
-         within_embree_range(ray.direction);
+         within_embree_range(ray.direction) && long_enough_for_embree(ray.direction);
 }
 
 }  // namespace
@@ -253,6 +265,10 @@ std::string EmbreeAccelerator::ray_problem(const Ray& ray) const {
     why = "origin " + vec_text(ray.origin) + " has a component";
   else if (!within_embree_range(ray.direction))
     why = "direction " + vec_text(ray.direction) + " has a component";
+  else if (!long_enough_for_embree(ray.direction))
+    return "cannot trace a ray whose direction " + vec_text(ray.direction) +
+           " has no component of 1e-15 or more (Embree clamps 1/d at 1e18 in its box tests and would miss what "
+           "the ray hits; the other structures trace it)";
   else
     return {};
   if (why.ends_with("component")) why += " that is NaN or beyond ±1.844e18";

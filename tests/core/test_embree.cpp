@@ -284,6 +284,8 @@ TEST(Embree, RaysItsKernelsCannotTakeAreRefusedNotTraced) {
       {Ray({0, 0, -5}, {0, 0, 1}, 0.0f, nan), "tmax is NaN"},
       {Ray({2e18f, 0, -5}, {0, 0, 1}), "origin (2e+18, 0, -5) has a component that is NaN or beyond"},
       {Ray({0, 0, -5}, {0, 0, -3e38f}), "direction (0, 0, -3e+38) has a component"},
+      {Ray({0, 0, -5}, {1e-20f, -2e-20f, 9e-16f}), "direction (1e-20, -2e-20, 9e-16) has no component of 1e-15"},
+      {Ray({0, 0, -5}, {0, 0, 0}), "direction (0, 0, 0) has no component of 1e-15"},
   };
   for (const Case& c : refused) {
     SCOPED_TRACE(c.says);
@@ -312,6 +314,35 @@ TEST(Embree, RaysItsKernelsCannotTakeAreRefusedNotTraced) {
   }
   // Our structures take every one of them.
   for (const Case& c : refused) EXPECT_EQ(bvh.ray_problem(c.ray), "");
+}
+
+// Embree clamps 1/d at 1e18 in its box tests, so a ray whose direction is
+// that short misses what it hits (measured: from a largest component of
+// ~1e-17 at distance ~6). It refuses directions below 1e-15 (above); from
+// there on it agrees with brute force, segments and tmin > 0 included.
+TEST(Embree, ShortDirectionsFrom1em15AgreeWithBruteForce) {
+  const std::vector<Triangle> tris = random_soup(3000, 11);
+  const BruteForce reference(tris);
+  const EmbreeAccelerator embree(tris);
+  int hits = 0;
+  for (const Ray& unit : random_rays(4000, 21)) {
+    const float m =
+        std::max(std::abs(unit.direction.x), std::max(std::abs(unit.direction.y), std::abs(unit.direction.z)));
+    const float s = 1e-15f / m;  // the largest component exactly at the limit (rounded up when it is not)
+    Ray r(unit.origin, unit.direction * s, unit.tmin / s, unit.tmax / s);
+    if (std::max(std::abs(r.direction.x), std::max(std::abs(r.direction.y), std::abs(r.direction.z))) < 1e-15f)
+      r.direction *= 1.0000001f;
+    ASSERT_EQ(embree.ray_problem(r), "");
+    const Hit expected = reference.closest_hit(r, {});
+    const Hit got = embree.closest_hit(r, {});
+    ASSERT_EQ(got.valid(), expected.valid()) << unit.origin.x << " " << unit.direction.x;
+    if (expected.valid()) {
+      ++hits;
+      EXPECT_TRUE(same_t(got.t, expected.t)) << got.t << " vs " << expected.t;
+    }
+    EXPECT_EQ(embree.any_hit(r, {}), reference.any_hit(r, {}));
+  }
+  EXPECT_GT(hits, 1000);
 }
 
 // Embree's build silently leaves out a triangle with a coordinate beyond
