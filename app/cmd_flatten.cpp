@@ -5,11 +5,12 @@
 // primary ray of the same view for both.
 #include <cstdio>
 #include <memory>
-#include <sstream>
 
 #include "app/cli_common.h"
 #include "core/accel/tlas/flatten_json.h"
 #include "core/accel/tlas/flatten_what_if.h"
+#include "core/accel/tlas/instance_ids.h"
+#include "core/util/one_line.h"
 
 namespace accelviz::cli {
 
@@ -24,36 +25,23 @@ struct FlattenOptions {
   bool json = false;
 };
 
-std::vector<std::uint32_t> parse_ids(const std::string& text) {
-  if (text == "all") return {};
-  std::vector<std::uint32_t> ids;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    std::size_t used = 0;
-    unsigned long v = 0;
-    try {
-      v = std::stoul(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != item.size() || item[0] == '-' || v > 0xFFFFFFFFul)
-      throw UsageError("--instances: expected instance ids like 0,2,5 or 'all', got '" + text + "'");
-    ids.push_back(static_cast<std::uint32_t>(v));
-  }
-  if (ids.empty()) throw UsageError("--instances: expected instance ids like 0,2,5 or 'all', got '" + text + "'");
-  return ids;
-}
-
 int run_flatten(const FlattenOptions& o, const GlobalOptions& global) {
   const ImageSize size = parse_size(o.size);
-  std::vector<std::uint32_t> ids = parse_ids(o.instances);
+  try {
+    check_instance_ids(o.instances);  // before the scene loads
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--") + e.what());
+  }
   Progress progress(global.quiet);
   progress.begin("loading " + o.scene);
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
   progress.end(std::to_string(scene.instances.size()) + " instances");
-  if (o.instances == "all")
-    for (std::uint32_t i = 0; i < scene.instances.size(); ++i) ids.push_back(i);
+  std::vector<std::uint32_t> ids;
+  try {
+    ids = parse_instance_ids(o.instances, scene.instances.size());
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--") + e.what());
+  }
   TlasOptions to;
   to.blas.threads = o.threads;
   to.blas.compute_epo = false;
@@ -73,8 +61,8 @@ int run_flatten(const FlattenOptions& o, const GlobalOptions& global) {
     print_json_line(j);
     return 0;
   }
-  std::printf("%s: %llu instances merged into one BLAS (%llu triangles), %dx%d primary rays\n", o.scene.c_str(),
-              static_cast<unsigned long long>(w.merged_instances), static_cast<unsigned long long>(w.merged_triangles),
+  std::printf("%s: %s merged into one BLAS (%s), %dx%d primary rays\n", o.scene.c_str(),
+              count_of(w.merged_instances, "instance").c_str(), count_of(w.merged_triangles, "triangle").c_str(),
               size.width, size.height);
   std::printf("%-10s %9s %7s %10s %10s %9s %11s %11s %11s\n", "", "instances", "blas", "sah_cost", "memory_MiB",
               "build_ms", "nodes/ray", "prims/ray", "inst/ray");
@@ -92,7 +80,9 @@ Command add_flatten_command(CLI::App& parent, const GlobalOptions& global) {
   CLI::App* sub = parent.add_subcommand(
       "flatten", "What-if: merge the listed instances into one BLAS and compare SAH, memory and measured cost per ray");
   sub->add_option("SCENE", o->scene, "Scene file (.gltf, .glb, .obj) or builtin:NAME[?key=value&...]")->required();
-  sub->add_option("--instances", o->instances, "Instance ids to merge, e.g. 0,2,5, or 'all'")->required();
+  sub->add_option("--instances", o->instances,
+                  "Instance ids to merge: ids and inclusive ranges, e.g. 0,2,5-9, or 'all'")
+      ->required();
   sub->add_option("--size", o->size, "Primary rays traced, WxH")->check(size_validator())->capture_default_str();
   sub->add_option("--camera", o->camera, "Camera spec (default: the scene's default view)");
   add_threads_option(sub, o->threads, "Build threads (0: all)");

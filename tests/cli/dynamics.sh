@@ -105,7 +105,14 @@ assert b["instances"] == a["instances"] - 2, j
 assert a["rays"] == b["rays"] == 1200 and a["hits"] == b["hits"] > 0, j
 assert a["sah_cost"] > 0 and b["sah_cost"] > 0 and a["mean_instances"] > 0, j
 print("flatten what-if ok")'
-for ids in "0,0" "x" "99999"; do
+# The ids take the GUI's syntax (core/accel/tlas/instance_ids.h): ranges, and an id listed twice
+# counts once; an empty item between commas is a typo, not a list.
+"$accelviz" -q flatten 'builtin:forest?size=2000' --instances '0-2,1, 1' --size 8x8 --json -j 1 | python3 -c '
+import json, sys
+j = json.load(sys.stdin)
+assert j["merged_instances"] == 3, j
+print("flatten ranges ok")'
+for ids in "0,,1" "0," "x" "99999" "2-1"; do
   set +e
   msg=$("$accelviz" flatten 'builtin:forest?size=2000' --instances "$ids" 2>&1)
   rc=$?

@@ -52,6 +52,17 @@ TEST(AppFlatten, InstanceIdListsParseAndFormat) {
   }
   EXPECT_NO_THROW(check_instance_ids("0-4000000000,all"));  // syntax only: nothing expanded
   EXPECT_THROW(check_instance_ids("4-2"), std::invalid_argument);
+  // Spaces beside a comma are fine; an empty item between commas is a typo.
+  EXPECT_EQ(parse_instance_ids("0 , 2,  3", 10), (std::vector<std::uint32_t>{0, 2, 3}));
+  for (const char* bad : {"0,,1", "0, ,1", ",0", "0,", "0 ,"}) {
+    try {
+      check_instance_ids(bad);
+      ADD_FAILURE() << "accepted '" << bad << "'";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(e.what()),
+                "instances: an empty item in '" + std::string(bad) + "' (expected e.g. 0,2,5-9 or all)");
+    }
+  }
 }
 
 TEST(AppFlatten, ScriptCommandsParse) {

@@ -21,22 +21,11 @@
 #include <vector>
 
 #include "core/accel/tlas/flatten_what_if.h"
+#include "core/accel/tlas/instance_ids.h"
 #include "ui/app/build_worker.h"
 #include "ui/app/latest_job_worker.h"
 
 namespace accelviz {
-
-/// "0,2,5-9" (ids and inclusive ranges, separated by commas or spaces) or
-/// "all" → sorted, distinct instance ids, each < COUNT. Throws
-/// std::invalid_argument with a one-line message naming the bad item.
-std::vector<std::uint32_t> parse_instance_ids(std::string_view text, std::size_t count);
-
-/// The syntax of an id list alone (no instance count yet): throws what
-/// parse_instance_ids would for a malformed item.
-void check_instance_ids(std::string_view text);
-
-/// IDS back as text, runs of consecutive ids as ranges ("0,2,5-9").
-std::string format_instance_ids(const std::vector<std::uint32_t>& ids);
 
 /// The spec the committed scene goes by: "SPEC [flattened N instances]".
 /// It names an in-memory scene (LoadedScene::in_memory); it cannot be loaded again.
