@@ -25,6 +25,7 @@ void render_raster(const Scene& scene, const Accelerator& accel, const Camera& c
                    float fixed_max, const QueryOptions& query, float c_trav, float c_isect, unsigned threads,
                    const std::string& out, bool force, nlohmann::json& figures) {
   const auto* bvh = dynamic_cast<const Bvh*>(&accel);
+  if (ro.box_depth_last >= 0 && ro.box_depth < 0) throw UsageError("--depth-last needs --depth (the first depth)");
   const bool want_boxes = ro.leaves || ro.box_depth >= 0;
   if (want_boxes && !bvh)
     throw UsageError("--depth/--leaves draw BVH node boxes; structure '" + accel.name() + "' has none to draw");

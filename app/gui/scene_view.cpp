@@ -97,7 +97,7 @@ void SceneView::upload_boxes(const AppState& app) {
   NodeSelection sel;
   sel.mode = v.box_mode;
   sel.depth = static_cast<std::uint32_t>(v.box_depth);
-  sel.depth_last = static_cast<std::uint32_t>(std::max(v.box_depth, v.box_depth_last));
+  sel.depth_last = static_cast<std::uint32_t>(v.box_range_last());
   sel.node = static_cast<std::uint32_t>(v.box_node);
   StructureNodes::Selection s;
   if (region) {  // the nodes the region's rays entered, instead of the view's selection

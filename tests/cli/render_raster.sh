@@ -63,4 +63,13 @@ if "$accelviz" -q render "$scene" --view raster --structure grid --depth 2 --out
   echo "FAIL: grid has no node boxes"; exit 1
 fi
 grep -q "grid" "$tmp/err"
+# A range needs its first depth, and its last depth must not be below the first.
+for opt in "--depth-last 3" "--depth 3 --depth-last 2"; do
+  # shellcheck disable=SC2086
+  if "$accelviz" -q render "$scene" --view raster $opt --out "$tmp/z.png" 2>"$tmp/err"; then
+    echo "FAIL: raster $opt was accepted"; exit 1
+  fi
+  grep -q -- "--depth" "$tmp/err" || { echo "FAIL: raster $opt message"; cat "$tmp/err"; exit 1; }
+  [ ! -e "$tmp/z.png" ] || { echo "FAIL: raster $opt wrote a picture"; exit 1; }
+done
 echo "render_raster ok"

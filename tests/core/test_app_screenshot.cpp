@@ -210,6 +210,25 @@ TEST(AppScreenshot, TheCommandsCarryTheTraversalOrderAndXray) {
   EXPECT_EQ(cmd.find(" --xray"), std::string::npos) << cmd;
 }
 
+// A depth range whose last depth is below the first (a script or settings
+// file can set one) draws the first depth alone; the replay command says
+// that range, not one the CLI would refuse.
+TEST(AppScreenshot, ADepthRangeBelowItsFirstDepthReplaysWhatWasDrawn) {
+  ScreenshotInfo info = test_info();
+  ViewSettings& v = info.config.view;
+  v.show_boxes = true;
+  v.box_mode = BoxMode::depth_range;
+  v.box_depth = 5;
+  v.box_depth_last = 2;
+  EXPECT_EQ(v.box_range_last(), 5);
+  std::string cmd = screenshot_sidecar(info, "shot.png")["reproduce"]["render_raster"];
+  EXPECT_NE(cmd.find(" --depth 5 --depth-last 5"), std::string::npos) << cmd;
+  v.box_depth_last = 7;
+  EXPECT_EQ(v.box_range_last(), 7);
+  cmd = screenshot_sidecar(info, "shot.png")["reproduce"]["render_raster"];
+  EXPECT_NE(cmd.find(" --depth 5 --depth-last 7"), std::string::npos) << cmd;
+}
+
 // Boxes the Predicted vs measured view drew (a region's entered nodes,
 // colours by visits) are said on the caption and in the side-car, and noted
 // as not replayed; a subtree's node note is not claimed for a region's boxes.

@@ -45,6 +45,9 @@ struct ViewSettings {
   BoxMode box_mode = BoxMode::depth;
   int box_depth = 3;       ///< depth mode: the depth; range mode: the first depth
   int box_depth_last = 5;  ///< range mode: the last depth (inclusive)
+  /// Range mode's last depth as drawn: a last depth set below the first one
+  /// (a script or settings file can) draws the first depth alone.
+  int box_range_last() const { return box_depth_last < box_depth ? box_depth : box_depth_last; }
   int box_node = 0;        ///< subtree mode: its root node (the "selected node")
   BoxColorBy box_color = BoxColorBy::depth;
   bool boxes_through_mesh = false;

@@ -198,7 +198,7 @@ std::string render_command(const ScreenshotInfo& info, bool raster, const std::s
           cmd += " --depth " + std::to_string(v.box_depth);
           break;
         case BoxMode::depth_range:
-          cmd += " --depth " + std::to_string(v.box_depth) + " --depth-last " + std::to_string(v.box_depth_last);
+          cmd += " --depth " + std::to_string(v.box_depth) + " --depth-last " + std::to_string(v.box_range_last());
           break;
         case BoxMode::leaves:
           cmd += " --leaves";

@@ -378,6 +378,8 @@ bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout
     case BoxMode::depth_range:
       changed |= slider_int("First depth", v.box_depth, 0, std::max(max_depth, 1));
       changed |= slider_int("Last depth", v.box_depth_last, 0, std::max(max_depth, 1));
+      if (v.box_depth_last < v.box_depth)
+        ImGui::TextDisabled("Last depth is below the first: depth %d alone is drawn", v.box_depth);
       break;
     case BoxMode::leaves:
       break;
