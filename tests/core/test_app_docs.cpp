@@ -48,6 +48,11 @@ TEST(AppDocs, EveryOptionKeyAndDefaultIsDocumented) {
     const std::string line = docs.substr(at, docs.find('\n', at) - at);
     EXPECT_NE(line.find("| `" + option_value(defaults, o.key) + "` |"), std::string::npos)
         << "the documented default of " << o.key << " is not " << option_value(defaults, o.key) << ": " << line;
+    // The values column is the text `set` and its errors give (a '|' escaped for the table).
+    std::string values;
+    for (const char ch : o.values) values += ch == '|' ? std::string("\\|") : std::string(1, ch);
+    EXPECT_EQ(line.rfind(row + " " + values + " | `", 0), 0u)
+        << "the documented values of " << o.key << " are not '" << values << "': " << line;
   }
 }
 

@@ -178,10 +178,12 @@ const std::vector<Entry>& entries() {
                    b.leaf_size_cap = static_cast<int>(*x);
                    return {};
                  }});
-    t.push_back(float_option("ctrav", "> 0", "BVH SAH cost of an inner-node visit (C_trav; also the cost metric's)", 0,
-                             1e6, true, [](AppConfig& c) -> float& { return c.structure.options.bvh.cost_traversal; }));
-    t.push_back(float_option("cisect", "> 0", "BVH SAH cost of a triangle test (C_isect; also the cost metric's)", 0,
-                             1e6, true, [](AppConfig& c) -> float& { return c.structure.options.bvh.cost_intersect; }));
+    t.push_back(float_option("ctrav", "> 0, at most 1e6",
+                             "BVH SAH cost of an inner-node visit (C_trav; also the cost metric's)", 0, 1e6, true,
+                             [](AppConfig& c) -> float& { return c.structure.options.bvh.cost_traversal; }));
+    t.push_back(float_option("cisect", "> 0, at most 1e6",
+                             "BVH SAH cost of a triangle test (C_isect; also the cost metric's)", 0, 1e6, true,
+                             [](AppConfig& c) -> float& { return c.structure.options.bvh.cost_intersect; }));
     t.push_back(
         int_option("threads", "0..256", "build threads (0: all hardware threads)", 0, 256, [](AppConfig& c) -> int& {
           // unsigned in StructureOptions; the range keeps the cast exact.
@@ -190,9 +192,9 @@ const std::vector<Entry>& entries() {
     t.push_back(bool_option("epo", "BVH: compute the EPO figure after the build",
                             [](AppConfig& c) -> bool& { return c.structure.options.bvh.compute_epo; }));
     // K-D tree (KdTreeOptions).
-    t.push_back(float_option("kd-ctrav", "> 0", "K-D tree C_trav", 0, 1e6, true,
+    t.push_back(float_option("kd-ctrav", "> 0, at most 1e6", "K-D tree C_trav", 0, 1e6, true,
                              [](AppConfig& c) -> float& { return c.structure.options.kdtree.cost_traversal; }));
-    t.push_back(float_option("kd-cisect", "> 0", "K-D tree C_isect", 0, 1e6, true,
+    t.push_back(float_option("kd-cisect", "> 0, at most 1e6", "K-D tree C_isect", 0, 1e6, true,
                              [](AppConfig& c) -> float& { return c.structure.options.kdtree.cost_intersect; }));
     t.push_back(int_option("kd-max-depth", "0..64", "K-D tree deepest leaf (0: auto, 8 + 1.3 log2 N)", 0, 64,
                            [](AppConfig& c) -> int& { return c.structure.options.kdtree.max_depth; }));
@@ -205,7 +207,7 @@ const std::vector<Entry>& entries() {
     t.push_back(bool_option("kd-mailboxing", "K-D tree: skip triangles this ray already tested",
                             [](AppConfig& c) -> bool& { return c.structure.options.kdtree.mailboxing; }));
     // Uniform grid (GridOptions).
-    t.push_back({{"grid-res", "X,Y,Z (0,0,0: auto)", "grid cells per axis"},
+    t.push_back({{"grid-res", "X,Y,Z, each 0..4096 (0,0,0: auto; zeros only all together)", "grid cells per axis"},
                  [](const AppConfig& c) {
                    const auto& r = c.structure.options.grid.resolution;
                    return std::to_string(r[0]) + "," + std::to_string(r[1]) + "," + std::to_string(r[2]);
@@ -228,8 +230,8 @@ const std::vector<Entry>& entries() {
                    c.structure.options.grid.resolution = r;
                    return {};
                  }});
-    t.push_back(float_option("grid-lambda", "> 0", "grid: automatic resolution gives about lambda*N cells", 0, 1e4,
-                             true, [](AppConfig& c) -> float& { return c.structure.options.grid.lambda; }));
+    t.push_back(float_option("grid-lambda", "> 0, at most 1e4", "grid: automatic resolution gives about lambda*N cells",
+                             0, 1e4, true, [](AppConfig& c) -> float& { return c.structure.options.grid.lambda; }));
     t.push_back(bool_option("grid-exact", "grid: reference triangles only in the cells they overlap",
                             [](AppConfig& c) -> bool& { return c.structure.options.grid.exact_overlap; }));
     t.push_back(bool_option("grid-mailboxing", "grid: skip triangles this ray already tested",
@@ -284,7 +286,7 @@ const std::vector<Entry>& entries() {
                            [](AppConfig& c) -> int& { return c.view.box_depth; }));
     t.push_back(int_option("box-depth-last", "0..64", "range: last depth (inclusive)", 0, 64,
                            [](AppConfig& c) -> int& { return c.view.box_depth_last; }));
-    t.push_back(int_option("box-node", "0..2^31", "subtree: the selected node", 0, std::numeric_limits<int>::max(),
+    t.push_back(int_option("box-node", "0..2^31-1", "subtree: the selected node", 0, std::numeric_limits<int>::max(),
                            [](AppConfig& c) -> int& { return c.view.box_node; }));
     t.push_back(enum_option<BoxColorBy>("box-color", "box colours: by depth or by share of the SAH cost",
                                         {{"depth", BoxColorBy::depth}, {"sah", BoxColorBy::sah_share}},
@@ -295,7 +297,7 @@ const std::vector<Entry>& entries() {
                                       "two-level: top-level node boxes, or every instance's BLAS boxes in world space",
                                       {{"tlas", BoxLevel::tlas}, {"blas", BoxLevel::blas}},
                                       [](AppConfig& c) -> BoxLevel& { return c.view.box_level; }));
-    t.push_back(int_option("box-instance", "-1..2^31", "two-level, blas level: only this instance's boxes (-1: all)",
+    t.push_back(int_option("box-instance", "-1..2^31-1", "two-level, blas level: only this instance's boxes (-1: all)",
                            -1, std::numeric_limits<int>::max(),
                            [](AppConfig& c) -> int& { return c.view.box_instance; }));
     t.push_back(bool_option("instance-colors", "two-level: each instance in its own colour (hashed from its id)",
