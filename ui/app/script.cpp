@@ -109,6 +109,12 @@ std::string_view command_name(ScriptCommand::Kind kind) {
   return "?";
 }
 
+std::vector<std::string_view> script_command_names() {
+  std::vector<std::string_view> names;
+  for (const NamedKind& c : kCommands) names.push_back(c.name);
+  return names;
+}
+
 std::vector<ScriptCommand> parse_script(std::string_view text, const std::string& file) {
   std::vector<ScriptCommand> out;
   // `set` values are checked against a scratch configuration that follows
@@ -133,7 +139,8 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
         std::find_if(std::begin(kCommands), std::end(kCommands), [&](const NamedKind& c) { return c.name == word; });
     if (it == std::end(kCommands)) {
       std::string valid;
-      for (const NamedKind& k : kCommands) valid += (valid.empty() ? "" : ", ") + std::string(k.name);
+      for (const std::string_view name : script_command_names())
+        valid += (valid.empty() ? "" : ", ") + std::string(name);
       fail("unknown command '" + std::string(word) + "' (valid: " + valid + ")");
     }
 

@@ -54,6 +54,8 @@ struct ScriptCommand {
 
 /// The command's name as written in scripts ("dump-ray").
 std::string_view command_name(ScriptCommand::Kind kind);
+/// Every command's name, in the order of the script language's table.
+std::vector<std::string_view> script_command_names();
 
 /// A parse or run error; what() is "FILE:LINE: message".
 class ScriptError : public std::runtime_error {
