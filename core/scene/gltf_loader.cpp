@@ -84,7 +84,9 @@ std::string hex32(std::uint32_t v) {
 // --- Step 2: SAX pre-pass over the JSON ------------------------------------
 
 /// Walks the JSON without building it: records the first syntax error, stops
-/// at absurd nesting, and collects the top-level `extensionsRequired` strings.
+/// at absurd nesting, collects the top-level `extensionsRequired` strings and
+/// type-checks what tinygltf reads loosely (negative indices and counts, the
+/// number arrays of nodes and meshes).
 class JsonPrecheck final : public nlohmann::json_sax<nlohmann::json> {
  public:
   std::vector<std::string> required;
@@ -108,23 +110,14 @@ class JsonPrecheck final : public nlohmann::json_sax<nlohmann::json> {
   bool binary(binary_t&) override { return element(false) && value(); }
   bool string(string_t& s) override {
     if (!element(false)) return false;
-    if (in_required_ && depth_ == 2) required.push_back(s);
+    if (frames_.size() == 2 && frames_[1].array && frames_[0].key == "extensionsRequired") required.push_back(s);
     return value();
   }
   bool start_object(std::size_t) override { return element(false) && open(true); }
   bool end_object() override { return close(); }
-  bool start_array(std::size_t) override {
-    const bool entering_required = depth_ == 1 && key_ == "extensionsRequired";
-    if (!element(false, true) || !open(false)) return false;
-    if (entering_required) in_required_ = true;
-    return true;
-  }
-  bool end_array() override {
-    if (depth_ == 2) in_required_ = false;
-    return close();
-  }
+  bool start_array(std::size_t) override { return element(false, true) && open(false); }
+  bool end_array() override { return close(); }
   bool key(string_t& k) override {
-    if (depth_ == 1) key_ = k;
     last_key_ = k;
     if (!frames_.empty()) frames_.back().key = k;
     return true;
@@ -187,15 +180,15 @@ class JsonPrecheck final : public nlohmann::json_sax<nlohmann::json> {
   }
 
   bool value() {
-    if (depth_ == 0) {
+    if (frames_.empty()) {
       error = "malformed glTF: the JSON root is not an object";
       return false;
     }
     return true;
   }
   bool open(bool is_object) {
-    if (depth_ == 0 && !is_object) return value();
-    if (++depth_ > kMaxJsonDepth) {
+    if (frames_.empty() && !is_object) return value();
+    if (frames_.size() + 1 > kMaxJsonDepth) {
       error = "malformed glTF: JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels";
       return false;
     }
@@ -203,14 +196,9 @@ class JsonPrecheck final : public nlohmann::json_sax<nlohmann::json> {
     return true;
   }
   bool close() {
-    --depth_;
     frames_.pop_back();
     return true;
   }
-
-  std::size_t depth_ = 0;
-  std::string key_;
-  bool in_required_ = false;
 };
 
 /// Extensions whose absence of support cannot change the geometry we trace:
