@@ -106,9 +106,10 @@ TEST(AccuracyPanel, DrawsEveryStateAndReportsRunAndCancel) {
   running.calibration = cal;
   ui.frame(st, &running, true, ImVec2(-100, -100), false);
 
-  // Find the buttons by scanning the top of the window: Run and Cancel (enabled while busy).
+  // Find the buttons by scanning the top of the window below its title bar
+  // (a click on the title's arrow would collapse it): Run and Cancel (enabled while busy).
   bool run = false, cancel = false;
-  for (int y = 90; y < 220 && !(run && cancel); y += 4)
+  for (int y = 130; y < 400 && !(run && cancel); y += 4)
     for (int x = 356; x < 700 && !(run && cancel); x += 6) {
       const panels::AccuracyAction a =
           ui.click(st, &running, true, ImVec2(static_cast<float>(x), static_cast<float>(y)));

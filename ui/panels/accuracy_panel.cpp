@@ -268,7 +268,7 @@ AccuracyAction accuracy_panel(AccuracyPanelState& st, const SweepSnapshot* snap,
                               const std::string& structure, const PanelLayout& layout) {
   AccuracyAction act;
   const float s = layout.scale;
-  if (!begin_panel("Cost of accuracy", layout, 356, 60, 560, 640, st.collapsed_at_start)) return act;
+  if (!begin_stacked_panel("Cost of accuracy", layout, 4, 560, 640, st.collapsed_at_start)) return act;
   if (st.params_for != structure) {
     st.params = default_sweep_params_text(structure);
     st.params_for = structure;

@@ -53,12 +53,7 @@ std::optional<std::pair<std::string, bool>> scene_effects_section(const SceneEff
 
 void dynamics_panel(DynamicsPlayer& player, const DynamicsSnapshot* snap, bool busy, const PanelLayout& layout) {
   const float s = layout.scale;
-  ImGui::SetNextWindowPos(ImVec2(360 * s, layout.height - 330 * s), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(520 * s, 300 * s), ImGuiCond_FirstUseEver);
-  if (!ImGui::Begin("Dynamics")) {
-    ImGui::End();
-    return;
-  }
+  if (!begin_panel("Dynamics", layout, 360, 470, 470, 300)) return;
   if (ImGui::Button(player.playing ? "Pause" : "Play")) player.playing = !player.playing;
   ImGui::SameLine();
   ImGui::SetNextItemWidth(90.0f * s);

@@ -42,7 +42,7 @@ FlattenAction flatten_panel(FlattenPanelState& state, const Scene* scene, const 
   const float s = layout.scale;
   const bool collapsed = state.collapsed_at_start;
   state.collapsed_at_start = false;
-  if (!begin_panel("Flatten what-if", layout, -460, 420, 440, 420, collapsed)) return action;
+  if (!begin_stacked_panel("Flatten what-if", layout, 7, 440, 420, collapsed)) return action;
   if (!scene) {
     ImGui::TextDisabled("no scene");
     ImGui::End();

@@ -52,7 +52,7 @@ const char* kMetricNames[] = {"nodes", "prims", "cost"};
 ABAction ab_panel(ABPanelState& st, const ABResult* r, bool busy, const std::string& error,
                   const StructureChoice& current, const PanelLayout& layout) {
   ABAction act;
-  if (!begin_panel("A/B compare", layout, 330.0f, 60.0f, 560.0f, 430.0f, true)) return act;
+  if (!begin_stacked_panel("A/B compare", layout, 0, 560.0f, 430.0f)) return act;
   if (ImGui::Button("Pin current as A")) act.pin = true;
   ImGui::SameLine();
   ImGui::BeginDisabled(!st.pinned || busy);
@@ -114,7 +114,7 @@ ABAction ab_panel(ABPanelState& st, const ABResult* r, bool busy, const std::str
 InsightAction insight_panel(InsightPanelState& st, const ViewInsight* v, const RegionTouch* region, bool busy,
                             const std::string& error, std::uint32_t selected, const PanelLayout& layout) {
   InsightAction act;
-  if (!begin_panel("Predicted vs measured", layout, 330.0f, 100.0f, 470.0f, 480.0f, true)) return act;
+  if (!begin_stacked_panel("Predicted vs measured", layout, 1, 470.0f, 480.0f)) return act;
   if (ImGui::Button(busy ? "Measuring ..." : "Measure this view")) act.refresh = true;
   if (!error.empty()) ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.4f, 1.0f), "%s", error.c_str());
   if (!v) {
@@ -261,7 +261,7 @@ InsightAction insight_panel(InsightPanelState& st, const ViewInsight* v, const R
 bool explainer_panel(ExplainerState& st, const SplitExplanation* e, std::uint32_t node, const std::string& note,
                      const PanelLayout& layout) {
   bool changed = false;
-  if (!begin_panel("SAH explainer", layout, 330.0f, 140.0f, 520.0f, 460.0f, true)) return false;
+  if (!begin_stacked_panel("SAH explainer", layout, 2, 520.0f, 460.0f)) return false;
   changed = ImGui::SliderInt("buckets B", &st.buckets, 2, 64, "%d", ImGuiSliderFlags_AlwaysClamp);
   ImGui::Combo("axis", &st.axis, "x\0y\0z\0");
   ImGui::SameLine();
@@ -431,7 +431,7 @@ std::optional<std::uint32_t> tree_panel(const StructureNodes* nodes, const std::
                                         std::uint32_t selected, bool& scroll_to_selected, const PanelLayout& layout,
                                         ColorMap map, std::uint64_t ramp_max, bool ramp_of_boxes) {
   std::optional<std::uint32_t> clicked;
-  if (!begin_panel("Tree", layout, 330.0f, 180.0f, 420.0f, 420.0f, true)) return clicked;
+  if (!begin_stacked_panel("Tree", layout, 3, 420.0f, 420.0f)) return clicked;
   if (!nodes || nodes->empty() || nodes->kind() == "grid") {
     ImGui::TextDisabled("The structure shown has no tree.");
   } else {

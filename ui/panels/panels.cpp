@@ -18,16 +18,50 @@
 namespace accelviz::panels {
 namespace {
 
-// First-use placement in a 1280×800 window: scene, structure and screenshot
-// on the left, stats and view on the right but clear of the heatmap legend
-// (the renderer draws it along the right edge), the ray inspector at the
-// bottom in between, all clear of the status line. ImGui's saved layout replaces
-// this afterwards.
+// First-use placement, designed for a 1280×800 window: scene, structure and
+// screenshot on the left, stats and view on the right but clear of the
+// heatmap legend (the renderer draws it along the right edge), the ray
+// inspector at the bottom in between, the insight windows stacked collapsed
+// at the top in between, all clear of the status line. Vertical positions and
+// heights follow the window's height; x < 0 counts from the right edge.
+// ImGui's saved layout replaces this afterwards; follow_display() keeps it in
+// the window when the window is resized.
+constexpr float kReferenceHeight = 800.0f;  ///< the window height the layout was designed for
+constexpr float kMiddleX = 356.0f;          ///< the left edge of the strip between the columns
+constexpr float kMiddleWidth = 470.0f;      ///< its width in a 1280-wide window, less a margin
+
+float vertical_factor(const PanelLayout& l) {
+  return std::clamp(l.height / (kReferenceHeight * l.scale), 0.5f, 4.0f);
+}
+
 void place(const PanelLayout& l, float x, float y, float w, float h) {
-  const float s = l.scale;
+  const float s = l.scale, f = vertical_factor(l);
   const float px = x >= 0.0f ? x * s : l.width + x * s;
-  ImGui::SetNextWindowPos(ImVec2(px, y * s), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(w * s, h * s), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowPos(ImVec2(px, y * s * f), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(w * s, h * s * f), ImGuiCond_FirstUseEver);
+}
+
+/// Called between Begin and End: when the window (the display) changed size
+/// since this panel's last frame, a panel in the right half keeps its
+/// distance to the right edge, and every panel's top and height scale with
+/// the height, so the columns stay clear of each other and of the status line.
+void follow_display(const PanelLayout& l) {
+  ImGuiStorage* st = ImGui::GetStateStorage();
+  const ImGuiID kw = ImGui::GetID("##display_w"), kh = ImGui::GetID("##display_h");
+  const float w0 = st->GetFloat(kw, 0.0f), h0 = st->GetFloat(kh, 0.0f);
+  st->SetFloat(kw, l.width);
+  st->SetFloat(kh, l.height);
+  if (w0 <= 0.0f || h0 <= 0.0f || (w0 == l.width && h0 == l.height)) return;
+  ImVec2 pos = ImGui::GetWindowPos();
+  ImVec2 size = ImGui::GetWindowSize();
+  if (pos.x + size.x * 0.5f > w0 * 0.5f) pos.x += l.width - w0;
+  const float f = l.height / h0;
+  pos.y *= f;
+  ImGui::SetWindowPos(pos);
+  if (!ImGui::IsWindowCollapsed()) {
+    size.y *= f;
+    ImGui::SetWindowSize(size);
+  }
 }
 
 std::string bytes_text(std::uint64_t b) {
@@ -501,12 +535,7 @@ std::optional<std::size_t> ray_panel(const RayInspection* ray, std::size_t step,
                                      const PanelLayout& layout) {
   std::optional<std::size_t> moved;
   // Along the bottom edge, between the left and right columns.
-  ImGui::SetNextWindowSize(ImVec2(486 * layout.scale, 260 * layout.scale), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowPos(ImVec2(356 * layout.scale, layout.height - 300 * layout.scale), ImGuiCond_FirstUseEver);
-  if (!ImGui::Begin("Ray")) {
-    ImGui::End();
-    return moved;
-  }
+  if (!begin_panel("Ray", layout, kMiddleX, 560, kMiddleWidth, 200)) return moved;
   if (!ray) {
     ImGui::TextWrapped("Click the 3D view (without dragging) to cast that pixel's ray.");
     ImGui::End();
@@ -606,9 +635,8 @@ std::optional<std::size_t> ray_panel(const RayInspection* ray, std::size_t step,
 
 bool screenshot_panel(std::string& folder, const std::string& default_folder, const std::string& last_written,
                       const PanelLayout& layout) {
-  place(layout, 8, 684, 340, 76);
   bool pressed = false;
-  if (ImGui::Begin("Screenshot")) {
+  if (begin_panel("Screenshot", layout, 8, 684, 340, 76)) {
     ImGui::SetNextItemWidth(-1.0f);
     ImGui::InputTextWithHint("##folder", default_folder.c_str(), &folder);
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("folder for screenshots (empty: %s)", default_folder.c_str());
@@ -618,8 +646,8 @@ bool screenshot_panel(std::string& folder, const std::string& default_folder, co
       ImGui::TextDisabled("%s", last_written.c_str());
       if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", last_written.c_str());
     }
+    ImGui::End();
   }
-  ImGui::End();
   return pressed;
 }
 
@@ -648,12 +676,30 @@ void help_panel(bool& open, const PanelLayout& layout) {
   ImGui::End();
 }
 
-bool begin_panel(const char* title, const PanelLayout& layout, float x, float y, float w, float h, bool collapsed) {
-  place(layout, x, y, w, h);
+namespace {
+
+bool begin_placed(const char* title, const PanelLayout& layout, bool collapsed) {
   if (collapsed) ImGui::SetNextWindowCollapsed(true, ImGuiCond_FirstUseEver);
-  if (ImGui::Begin(title)) return true;
+  const bool open = ImGui::Begin(title);
+  follow_display(layout);
+  if (open) return true;
   ImGui::End();
   return false;
+}
+
+}  // namespace
+
+bool begin_panel(const char* title, const PanelLayout& layout, float x, float y, float w, float h, bool collapsed) {
+  place(layout, x, y, w, h);
+  return begin_placed(title, layout, collapsed);
+}
+
+bool begin_stacked_panel(const char* title, const PanelLayout& layout, int slot, float w, float h, bool collapsed) {
+  const float s = layout.scale, f = vertical_factor(layout);
+  const float y = 8.0f * s * f + static_cast<float>(slot) * (ImGui::GetFrameHeight() + 4.0f * s);
+  ImGui::SetNextWindowPos(ImVec2(kMiddleX * s, y), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(std::min(w, kMiddleWidth) * s, h * s * f), ImGuiCond_FirstUseEver);
+  return begin_placed(title, layout, collapsed);
 }
 
 bool progress_cancel_row(double fraction, const char* overlay, float bar_width, CancelAt cancel_at) {

@@ -107,6 +107,12 @@ void pixel_tooltip(int x, int y, const PixelFigures& p, HeatMetric metric, bool 
 /// or clipped: it is already ended and the panel returns.
 bool begin_panel(const char* title, const PanelLayout& layout, float x, float y, float w, float h,
                  bool collapsed = false);
+/// The same for the insight windows: on first use one title bar below the
+/// other (`slot` 0, 1, ...) in the strip between the two columns, at most as
+/// wide as that strip, so that collapsed they neither overlap each other nor
+/// the columns.
+bool begin_stacked_panel(const char* title, const PanelLayout& layout, int slot, float w, float h,
+                         bool collapsed = true);
 /// A running job's row, from the cursor on: a progress bar `bar_width` wide
 /// (an ImGui item width: -1 fills the row, -w leaves w at its right) showing
 /// `fraction` and `overlay` (null: the percentage), with a Cancel button on

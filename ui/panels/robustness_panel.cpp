@@ -40,7 +40,7 @@ RobustnessAction robustness_panel(RobustnessPanelState& st, const RobustnessSnap
                                   const std::string& structure, const PanelLayout& layout) {
   RobustnessAction act;
   const float s = layout.scale;
-  if (!begin_panel("Robustness", layout, 380, 90, 620, 560, st.collapsed_at_start)) return act;
+  if (!begin_stacked_panel("Robustness", layout, 5, 620, 560, st.collapsed_at_start)) return act;
   ImGui::TextWrapped(
       "Adversarial rays (through vertices, shared edges, axis-aligned with +0/-0, grazing) traced with "
       "Moller-Trumbore vs watertight triangle tests and plain vs padded slab tests, against the "

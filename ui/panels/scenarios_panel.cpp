@@ -17,7 +17,7 @@ ScenarioAction scenarios_panel(ScenarioPanelState& st, const ScenarioFigures* fi
                                const PanelLayout& layout) {
   ScenarioAction act;
   const float s = layout.scale;
-  if (!begin_panel("Scenarios", layout, 330.0f, 20.0f, 560.0f, 420.0f, true)) return act;
+  if (!begin_stacked_panel("Scenarios", layout, 6, 560.0f, 420.0f)) return act;
   const auto& all = scenarios();
   for (int i = 0; i < static_cast<int>(all.size()); ++i) {
     if (i > 0) ImGui::SameLine();

@@ -1,0 +1,137 @@
+// The panels' first-use layout (ui/panels/panels.cpp: place, begin_panel,
+// begin_stacked_panel, follow_display) drawn headless: the real panels in a
+// 1280×800 window, then the window resized. The columns stay clear of each
+// other and of the status line, the insight windows' collapsed title bars
+// neither overlap one another nor the columns, and a resize carries the
+// right column with the right edge and scales every panel with the height.
+#include <gtest/gtest.h>
+#include <imgui.h>
+#include <imgui_internal.h>
+
+#include <string>
+#include <vector>
+
+#include "tests/gl/imgui_headless.h"
+#include "ui/panels/insight_panels.h"
+#include "ui/panels/panels.h"
+
+namespace accelviz::unity_test_layout_panel {
+namespace {
+
+struct Rect {
+  float x0, y0, x1, y1;
+};
+
+Rect rect_of(const char* title) {
+  const ImGuiWindow* w = ImGui::FindWindowByName(title);
+  EXPECT_NE(w, nullptr) << title;
+  if (!w) return {0, 0, 0, 0};
+  // A collapsed window occupies its title bar only.
+  const float h = w->Collapsed ? w->TitleBarHeight() : w->Size.y;
+  return {w->Pos.x, w->Pos.y, w->Pos.x + w->Size.x, w->Pos.y + h};
+}
+
+bool overlap(const Rect& a, const Rect& b) {
+  return a.x0 < b.x1 && b.x0 < a.x1 && a.y0 < b.y1 && b.y0 < a.y1;
+}
+
+const char* const kColumns[] = {"Scene", "Structure", "Screenshot", "Stats", "View", "Ray"};
+const char* const kStacked[] = {"A/B compare", "Predicted vs measured", "SAH explainer",
+                                "Tree",        "Cost of accuracy",      "Robustness",
+                                "Scenarios",   "Flatten what-if"};
+
+struct Ui : test::HeadlessImGuiContext {
+  Ui() : HeadlessImGuiContext(ImVec2(1600, 1000)) {}
+
+  panels::ViewInfo info;
+  ViewSettings view;
+  StructureChoice choice;
+  std::string path, folder;
+  panels::ABPanelState ab;
+  panels::InsightPanelState insight;
+  panels::ExplainerState explainer;
+  panels::ScenarioPanelState scenarios;
+  panels::AccuracyPanelState accuracy;
+  panels::RobustnessPanelState robustness;
+  panels::FlattenPanelState flatten;
+  bool cancel = false, scroll = false;
+
+  /// Every panel of the layout in a window of w × h (the display may be larger).
+  void frame(float w, float h) {
+    begin_frame(ImVec2(-100, -100), false);
+    const panels::PanelLayout l{1.0f, w, h};
+    panels::scene_panel(path, {}, nullptr, "", -1, l);
+    panels::structure_panel(choice, panels::BuildProgress{}, cancel, l);
+    panels::stats_panel(nullptr, nullptr, l);
+    panels::view_panel(view, info, l);
+    panels::ray_panel(nullptr, 0, nullptr, l);
+    panels::screenshot_panel(folder, "/tmp", "", l);
+    panels::ab_panel(ab, nullptr, false, "", choice, l);
+    panels::insight_panel(insight, nullptr, nullptr, false, "", 0, l);
+    panels::explainer_panel(explainer, nullptr, 0, "", l);
+    panels::tree_panel(nullptr, nullptr, 0, scroll, l, ColorMap::viridis, 0, false);
+    panels::scenarios_panel(scenarios, nullptr, false, "", l);
+    panels::accuracy_panel(accuracy, nullptr, false, "bvh", l);
+    panels::robustness_panel(robustness, nullptr, false, "bvh", l);
+    panels::flatten_panel(flatten, nullptr, nullptr, false, 0.0, std::nullopt, l);
+    ImGui::Render();
+  }
+
+  void expect_tidy(float w, float h) {
+    SCOPED_TRACE(std::to_string(static_cast<int>(w)) + "x" + std::to_string(static_cast<int>(h)));
+    const float status_top = h - ImGui::GetFrameHeightWithSpacing() - 4.0f;
+    std::vector<Rect> columns;
+    for (const char* c : kColumns) {
+      const Rect r = rect_of(c);
+      EXPECT_GE(r.x0, 0.0f) << c;
+      EXPECT_LE(r.x1, w) << c;
+      EXPECT_GE(r.y0, 0.0f) << c;
+      EXPECT_LE(r.y1, status_top + 0.5f) << c << " runs into the status line";
+      for (std::size_t i = 0; i < columns.size(); ++i)
+        EXPECT_FALSE(overlap(r, columns[i])) << c << " overlaps " << kColumns[i];
+      columns.push_back(r);
+    }
+    std::vector<Rect> bars;
+    for (const char* t : kStacked) {
+      const Rect r = rect_of(t);
+      for (std::size_t i = 0; i < bars.size(); ++i)
+        EXPECT_FALSE(overlap(r, bars[i])) << t << " overlaps " << kStacked[i];
+      for (std::size_t i = 0; i < columns.size(); ++i)
+        EXPECT_FALSE(overlap(r, columns[i])) << t << " overlaps " << kColumns[i];
+      bars.push_back(r);
+    }
+  }
+};
+
+TEST(PanelLayout, ColumnsAndCollapsedInsightWindowsStayApartAndFollowAResize) {
+  Ui ui;
+  ui.flatten.collapsed_at_start = true;
+  for (int i = 0; i < 3; ++i) ui.frame(1280, 800);
+  ui.expect_tidy(1280, 800);
+  const Rect stats = rect_of("Stats");
+  EXPECT_FLOAT_EQ(1280.0f - stats.x0, 438.0f);
+
+  // Larger: the right column keeps its distance to the right edge; the
+  // others keep theirs to the left; every panel scales with the height.
+  for (int i = 0; i < 3; ++i) ui.frame(1600, 1000);
+  ui.expect_tidy(1600, 1000);
+  EXPECT_FLOAT_EQ(1600.0f - rect_of("Stats").x0, 438.0f);
+  EXPECT_FLOAT_EQ(rect_of("Scene").x0, 8.0f);
+  EXPECT_NEAR(rect_of("View").y1 - rect_of("View").y0, 404.0f * 1000.0f / 800.0f, 1.0f);
+
+  // Smaller than designed for: nothing runs off the window or into the status line.
+  for (int i = 0; i < 3; ++i) ui.frame(1280, 720);
+  ui.expect_tidy(1280, 720);
+}
+
+// A window opened at another size than the design's gets the layout at its
+// own size on first use (the vertical positions and heights scaled).
+TEST(PanelLayout, FirstUseInASmallerWindowFitsIt) {
+  Ui ui;
+  ui.flatten.collapsed_at_start = true;
+  for (int i = 0; i < 3; ++i) ui.frame(1280, 720);
+  ui.expect_tidy(1280, 720);
+}
+
+}  // namespace
+}  // namespace accelviz::unity_test_layout_panel
