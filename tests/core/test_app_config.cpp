@@ -173,6 +173,18 @@ TEST(AppConfig, SameBuildIgnoresQueryAndOtherTypesOptions) {
   k2 = k1;
   k2.options.threads = 1;
   EXPECT_FALSE(same_build(k1, k2)) << "the thread count changes what the build reports";
+  // tlas builds its levels with the BVH's options: changing one rebuilds it
+  // (it did not: the GUI kept the old two-level structure), and its
+  // description and screenshots name them.
+  StructureChoice t1, t2;
+  t1.name = t2.name = "tlas";
+  EXPECT_TRUE(same_build(t1, t2));
+  t2.options.bvh.buckets = 2;
+  EXPECT_FALSE(same_build(t1, t2));
+  t2 = t1;
+  t2.options.bvh.max_leaf_size = 16;
+  EXPECT_FALSE(same_build(t1, t2));
+  EXPECT_EQ(describe_structure(t1), "tlas (splitter=binned, buckets=32, leaf=4, leaf-cap=16, ctrav=1, cisect=1)");
 }
 
 TEST(AppConfig, DescriptionsAndCaption) {

@@ -229,6 +229,28 @@ TEST(AppScreenshot, ADepthRangeBelowItsFirstDepthReplaysWhatWasDrawn) {
   EXPECT_NE(cmd.find(" --depth 5 --depth-last 7"), std::string::npos) << cmd;
 }
 
+// render --view raster draws a BVH's boxes only: for another structure the
+// replay command leaves the window's boxes out and says so (it gave
+// --depth, which the CLI refuses for them).
+TEST(AppScreenshot, BoxesOfOtherStructuresThanTheBvhAreNotedNotReplayed) {
+  ScreenshotInfo info = test_info();
+  info.config.view.show_boxes = true;
+  info.config.view.box_mode = BoxMode::depth;
+  for (const char* name : {"kdtree", "grid", "octree", "voxels", "tlas"}) {
+    SCOPED_TRACE(name);
+    info.config.structure.name = name;
+    const nlohmann::json j = screenshot_sidecar(info, "shot.png");
+    const std::string cmd = j["reproduce"]["render_raster"];
+    EXPECT_EQ(cmd.find(" --depth"), std::string::npos) << cmd;
+    EXPECT_EQ(cmd.find(" --leaves"), std::string::npos) << cmd;
+    EXPECT_NE(j["reproduce"]["notes"].dump().find("draws a BVH's node boxes only"), std::string::npos)
+        << j["reproduce"]["notes"];
+  }
+  info.config.structure.name = "bvh";
+  const std::string cmd = screenshot_sidecar(info, "shot.png")["reproduce"]["render_raster"];
+  EXPECT_NE(cmd.find(" --depth 3"), std::string::npos) << cmd;
+}
+
 // Boxes the Predicted vs measured view drew (a region's entered nodes,
 // colours by visits) are said on the caption and in the side-car, and noted
 // as not replayed; a subtree's node note is not claimed for a region's boxes.

@@ -409,7 +409,8 @@ std::vector<std::pair<std::string, std::string>> option_values(const AppConfig& 
 }
 
 std::vector<std::string_view> structure_option_keys(std::string_view name) {
-  if (name == "bvh") return {"splitter", "buckets", "leaf", "leaf-cap", "ctrav", "cisect"};
+  // tlas builds its BLASes and its TLAS with the BVH's options (core/accel/factory.cpp).
+  if (name == "bvh" || name == "tlas") return {"splitter", "buckets", "leaf", "leaf-cap", "ctrav", "cisect"};
   if (name == "kdtree")
     return {"kd-ctrav", "kd-cisect", "kd-max-depth", "kd-leaf", "kd-empty-bonus", "kd-perfect-splits", "kd-mailboxing"};
   if (name == "grid") return {"grid-res", "grid-lambda", "grid-exact", "grid-mailboxing"};

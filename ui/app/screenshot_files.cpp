@@ -182,7 +182,7 @@ std::string render_command(const ScreenshotInfo& info, bool raster, const std::s
   if (notes) {
     const AppConfig defaults;
     for (std::string_view key : structure_option_keys(s.name)) {
-      if (s.name == "bvh" || s.name == "embree") break;
+      if (s.name == "bvh" || s.name == "tlas" || s.name == "embree") break;  // render takes these
       if (option_value(c, key) != option_value(defaults, key))
         notes->push_back(std::string(key) + "=" + option_value(c, key) +
                          " is not a command-line option of render (it builds " + s.name +
@@ -192,7 +192,13 @@ std::string render_command(const ScreenshotInfo& info, bool raster, const std::s
   if (raster) {
     cmd += " --view raster";
     const ViewSettings& v = c.view;
-    if (v.show_boxes) {
+    if (v.show_boxes && s.name != "bvh") {
+      // render --view raster draws a BVH's node boxes only (it refuses
+      // --depth/--leaves for other structures).
+      if (notes)
+        notes->push_back("raster: the command line draws a BVH's node boxes only; the window's " + s.name +
+                         " boxes are left out");
+    } else if (v.show_boxes) {
       switch (v.box_mode) {
         case BoxMode::depth:
           cmd += " --depth " + std::to_string(v.box_depth);
