@@ -16,11 +16,6 @@ namespace {
 
 const glm::u8vec3 kWhite{255, 255, 255}, kAxis{40, 40, 40}, kGrid{225, 225, 225}, kText{20, 20, 20};
 
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
 void put(RgbImage& img, int x, int y, glm::u8vec3 c) {
   if (x >= 0 && y >= 0 && x < img.width && y < img.height) img.set(x, y, c);
 }
@@ -40,7 +35,7 @@ void line(RgbImage& img, int x0, int y0, int x1, int y1, glm::u8vec3 c) {
 }
 
 void text(RgbImage& img, int x, int y, const std::string& s, glm::u8vec3 c, int scale = 1) {
-  draw_text(img, x, y, lower(s), c, scale);
+  draw_text(img, x, y, s, c, scale);
 }
 
 /// Axis range with a margin; log axes work in log10 space.
@@ -148,7 +143,7 @@ RgbImage draw_chart(const ChartOptions& opts, const std::vector<ChartSeries>& se
       const int x = px(static_cast<double>(i));
       line(img, x, top, x, bottom, kGrid);
       line(img, x, bottom, x, bottom + 4, kAxis);
-      text(img, x - text_width(lower(opts.x_categories[i]), 1) / 2, bottom + 8, opts.x_categories[i], kText);
+      text(img, x - text_width(opts.x_categories[i], 1) / 2, bottom + 8, opts.x_categories[i], kText);
     }
   } else {
     for (double t : axis_ticks(ax)) {
@@ -166,7 +161,7 @@ RgbImage draw_chart(const ChartOptions& opts, const std::vector<ChartSeries>& se
   // ---- titles ----
   if (!opts.title.empty()) text(img, left, 10, opts.title, kText, 2);
   if (!opts.x_label.empty())
-    text(img, (left + right) / 2 - text_width(lower(opts.x_label), 1) / 2, bottom + 24, opts.x_label, kText);
+    text(img, (left + right) / 2 - text_width(opts.x_label, 1) / 2, bottom + 24, opts.x_label, kText);
   if (!opts.y_label.empty()) text(img, 4, top - 12, opts.y_label, kText);
 
   // ---- data ----
@@ -198,7 +193,7 @@ RgbImage draw_chart(const ChartOptions& opts, const std::vector<ChartSeries>& se
   int ly = top + 4;
   for (const ChartSeries& s : series) {
     if (s.name.empty()) continue;
-    const int w = text_width(lower(s.name), 1);
+    const int w = text_width(s.name, 1);
     const int x = right - w - 16;
     for (int dy = -2; dy <= 2; ++dy)
       for (int dx = 0; dx < 8; ++dx) put(img, x + dx, ly + 3 + dy, s.color);

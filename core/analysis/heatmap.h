@@ -161,8 +161,9 @@ glm::u8vec3 heatmap_color(HeatMetric metric, float value, float scale_max, const
 /// below or to the right of the W×H picture. The shaded metric gets no legend.
 RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts);
 
-/// Tiny built-in 5×7 bitmap font (digits, lowercase letters, M and a few
-/// signs), drawn at an integer scale; unknown characters draw as blanks.
+/// Tiny built-in 5×7 bitmap font (digits, letters, punctuation; descenders
+/// take two rows below the 7), drawn at an integer scale; unknown characters
+/// draw as blanks.
 int text_width(std::string_view text, int scale);
 void draw_text(RgbImage& img, int x, int y, std::string_view text, glm::u8vec3 color, int scale);
 

@@ -114,8 +114,10 @@ TEST(AppScreenshot, CaptionStripUnderTheFrame) {
     for (int x = 0; x < 200; ++x) (out.at(x, y).x > 150 ? bright : dark)++;
   EXPECT_GT(bright, 50);
   EXPECT_GT(dark, bright);
-  // Upper-case letters (absent from the font) are lower-cased, not dropped.
-  EXPECT_EQ(add_caption(frame, "BVH").pixels, add_caption(frame, "bvh").pixels);
+  // Capitals and the signs a caption uses are drawn as themselves.
+  EXPECT_NE(add_caption(frame, "BVH").pixels, add_caption(frame, "bvh").pixels);
+  EXPECT_NE(add_caption(frame, "a;b").pixels, add_caption(frame, "a b").pixels);
+  EXPECT_NE(add_caption(frame, "region's").pixels, add_caption(frame, "region s").pixels);
 }
 
 TEST(AppScreenshot, LongCaptionsWrapInsteadOfBeingCut) {

@@ -238,9 +238,26 @@ TEST(Heatmap, BitmapTextDrawsKnownGlyphsOnly) {
   EXPECT_EQ(img.at(1, 6), glm::u8vec3(255));
   EXPECT_EQ(img.at(0, 0), glm::u8vec3(0));
   RgbImage blank(40, 10, {0, 0, 0});
-  draw_text(blank, 0, 0, "  ~", {255, 255, 255}, 1);
+  draw_text(blank, 0, 0, "  \t\x7f", {255, 255, 255}, 1);
   EXPECT_EQ(blank.pixels, RgbImage(40, 10, {0, 0, 0}).pixels);
   EXPECT_EQ(text_width("12", 2), 22);
+  // Capitals, the signs captions use, and descenders below the 7 rows.
+  const auto lit = [](const char* text) {
+    RgbImage img(8, 12, {0, 0, 0});
+    draw_text(img, 0, 0, text, {255, 255, 255}, 1);
+    int n = 0, below = 0;
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x)
+        if (img.at(x, y).x == 255) {
+          ++n;
+          below += y >= 7;
+        }
+    return std::pair{n, below};
+  };
+  for (const char* c : {"A", "B", "H", "S", "V", "Z", ";", "'", "%", "_", "?", "!", "[", "<", "#", "&"})
+    EXPECT_GT(lit(c).first, 0) << c << " draws nothing";
+  for (const char* c : {"g", "j", "p", "q", "y", ";", ","}) EXPECT_GT(lit(c).second, 0) << c << " has no descender";
+  for (const char* c : {"a", "o", "x", "B", "9"}) EXPECT_EQ(lit(c).second, 0) << c << " runs below the baseline";
 }
 
 // ---- the batch tracer under the heatmap (core/query/batch) ----

@@ -135,13 +135,10 @@ std::vector<std::string> wrap_caption(const std::string& text, int max_chars, in
 RgbImage add_caption(const RgbImage& frame, const std::string& caption) {
   const int scale = frame.width >= 1000 ? 2 : 1;
   const int pad = 4 * scale;
-  // The legend font has lower-case letters only (and M); everything else
-  // it lacks draws as a blank, so lower-case the caption first.
-  std::string text;
-  for (char c : caption) text += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string& text = caption;
   const int max_chars = std::max(0, (frame.width - 2 * pad) / (6 * scale));
   const std::vector<std::string> lines = wrap_caption(text, max_chars, kCaptionMaxLines);
-  const int line_height = 10 * scale;  // 7 rows of glyph, 3 of spacing
+  const int line_height = 10 * scale;  // 7 rows of glyph and 2 of descender, 1 of spacing
   const int strip = pad + std::max<int>(1, static_cast<int>(lines.size())) * line_height - 3 * scale + pad;
   RgbImage out(frame.width, frame.height + strip, glm::u8vec3(28, 30, 34));
   std::copy(frame.pixels.begin(), frame.pixels.end(), out.pixels.begin());
