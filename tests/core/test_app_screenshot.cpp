@@ -165,7 +165,7 @@ TEST(AppScreenshot, SideCarSaysHowToReproduceThePicture) {
   EXPECT_EQ(j["heatmap"]["range"][1], 39.0);
   EXPECT_EQ(j["options"].size(), option_table().size());
   EXPECT_EQ(j["ray_pixel"][0], 32);
-  EXPECT_EQ(j["caption"], screenshot_caption(info.config));
+  EXPECT_EQ(j["caption"], screenshot_caption(info.config) + ", ray of pixel 32,24");
   EXPECT_EQ(j["boxes"]["drawn"], 0);
 
   const std::string cmd = j["reproduce"]["render_heatmap"];
@@ -253,6 +253,28 @@ TEST(AppScreenshot, BoxesOfOtherStructuresThanTheBvhAreNotedNotReplayed) {
   EXPECT_NE(cmd.find(" --depth 3"), std::string::npos) << cmd;
 }
 
+// A ray replay stopped before its end is brought back by the side-car's
+// script (`step N` after the click), said on the caption, and noted for the
+// raster command (which draws the whole traversal).
+TEST(AppScreenshot, ARayReplayStepIsReplayedAndSaid) {
+  ScreenshotInfo info = test_info();
+  info.config.view.show_ray_path = true;
+  info.ray_steps = 10;
+  nlohmann::json j = screenshot_sidecar(info, "shot.png");
+  std::string script = j["reproduce"]["script"].dump();
+  EXPECT_EQ(script.find("\"step "), std::string::npos) << script;  // the whole traversal: no step
+  EXPECT_NE(screenshot_caption(info).find(", ray of pixel 32,24"), std::string::npos) << screenshot_caption(info);
+  EXPECT_EQ(screenshot_caption(info).find(" at step"), std::string::npos) << screenshot_caption(info);
+  info.ray_step = 3;
+  j = screenshot_sidecar(info, "shot.png");
+  script = j["reproduce"]["script"].dump();
+  EXPECT_NE(script.find("\"click 32 24\",\"step 3\",\"screenshot "), std::string::npos) << script;
+  EXPECT_NE(screenshot_caption(info).find(", ray of pixel 32,24 at step 3 of 10"), std::string::npos)
+      << screenshot_caption(info);
+  EXPECT_NE(j["reproduce"]["notes"].dump().find("replay at step 3 of 10"), std::string::npos)
+      << j["reproduce"]["notes"];
+}
+
 // Boxes the Predicted vs measured view drew (a region's entered nodes,
 // colours by visits) are said on the caption and in the side-car, and noted
 // as not replayed; a subtree's node note is not claimed for a region's boxes.
@@ -278,7 +300,7 @@ TEST(AppScreenshot, AThinnedBoxOverlayIsSaidOnThePictureAndInTheSideCar) {
   ScreenshotInfo info = test_info();
   info.boxes_drawn = 200000;
   info.boxes_matched = 288291;
-  EXPECT_EQ(screenshot_caption(info), screenshot_caption(info.config) + ", boxes 200000 of 288291");
+  EXPECT_EQ(screenshot_caption(info), screenshot_caption(info.config) + ", boxes 200000 of 288291, ray of pixel 32,24");
   const nlohmann::json j = screenshot_sidecar(info, "shot.png");
   EXPECT_EQ(j["caption"], screenshot_caption(info));
   EXPECT_EQ(j["boxes"]["drawn"], 200000);
@@ -290,7 +312,7 @@ TEST(AppScreenshot, AThinnedBoxOverlayIsSaidOnThePictureAndInTheSideCar) {
             "draws all");
   // All drawn: nothing added.
   info.boxes_drawn = info.boxes_matched = 5000;
-  EXPECT_EQ(screenshot_caption(info), screenshot_caption(info.config));
+  EXPECT_EQ(screenshot_caption(info), screenshot_caption(info.config) + ", ray of pixel 32,24");
   EXPECT_TRUE(screenshot_sidecar(info, "shot.png")["reproduce"]["notes"].empty());
 }
 

@@ -419,7 +419,11 @@ ScreenshotInfo AppState::screenshot_info(float scale_min, float scale_max) const
   }
   info.scale_min = scale_min;
   info.scale_max = scale_max;
-  if (inspection_) info.ray_pixel = std::make_pair(inspection_->x, inspection_->y);
+  if (inspection_) {
+    info.ray_pixel = std::make_pair(inspection_->x, inspection_->y);
+    info.ray_steps = inspection_->trace.steps.size();
+    if (replay_step_ + 1 < info.ray_steps) info.ray_step = replay_step_;
+  }
   return info;
 }
 

@@ -220,8 +220,13 @@ std::string render_command(const ScreenshotInfo& info, bool raster, const std::s
     if (v.show_wireframe) cmd += " --wireframe";
     if (v.heatmap == HeatmapDisplay::blend) cmd += " --blend " + format_number(v.opacity);
     if (v.heatmap == HeatmapDisplay::full_screen) cmd += " --blend 1";
-    if (info.ray_pixel && v.show_ray_path)
+    if (info.ray_pixel && v.show_ray_path) {
       cmd += " --ray-pixel " + std::to_string(info.ray_pixel->first) + "," + std::to_string(info.ray_pixel->second);
+      if (notes && info.ray_step)
+        notes->push_back("raster: --ray-pixel draws the whole traversal; the window showed its replay at step " +
+                         std::to_string(*info.ray_step) + " of " + std::to_string(info.ray_steps) +
+                         " (the script's `step` brings that back)");
+    }
   }
   return cmd + " --out " + shell_quote(out);
 }
@@ -235,6 +240,10 @@ std::string screenshot_caption(const ScreenshotInfo& info) {
   else if (!info.box_node_note.empty())
     s += ", boxes of " + info.box_node_note;
   if (info.boxes_by_visits) s += ", coloured by visits";
+  if (info.ray_pixel && info.config.view.show_ray_path) {
+    s += ", ray of pixel " + std::to_string(info.ray_pixel->first) + "," + std::to_string(info.ray_pixel->second);
+    if (info.ray_step) s += " at step " + std::to_string(*info.ray_step) + " of " + std::to_string(info.ray_steps);
+  }
   return s;
 }
 
@@ -266,6 +275,7 @@ nlohmann::json screenshot_sidecar(const ScreenshotInfo& info, const fs::path& pn
   script.push_back("wait");
   if (info.ray_pixel)
     script.push_back("click " + std::to_string(info.ray_pixel->first) + " " + std::to_string(info.ray_pixel->second));
+  if (info.ray_pixel && info.ray_step) script.push_back("step " + std::to_string(*info.ray_step));
   script.push_back("screenshot " + stem + "-replay.png");
   script.push_back("quit");
 

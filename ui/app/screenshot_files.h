@@ -44,6 +44,10 @@ struct ScreenshotInfo {
   float scale_min = 0.0f;  ///< the heatmap range actually drawn
   float scale_max = 1.0f;
   std::optional<std::pair<int, int>> ray_pixel;  ///< the inspected pixel, when a ray is shown
+  /// The ray's replay when it stops before the traversal's end: the step
+  /// shown (0-based) and the steps in all.
+  std::optional<std::size_t> ray_step;
+  std::size_t ray_steps = 0;
   /// The node-box overlay as drawn: boxes drawn and boxes the selection
   /// names (more when the window cut the list and thinned it; 0 and 0
   /// without boxes).
