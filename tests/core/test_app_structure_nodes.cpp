@@ -130,6 +130,16 @@ TEST(AppStructureNodes, GridCellsAreTheGridsOwn) {
   const auto cells = t.select({BoxMode::leaves, 0, 0, 0}, 1u << 30);
   EXPECT_EQ(cells.matched,
             static_cast<std::uint64_t>(grid.build_stats().node_count - grid.build_stats().extra.at("empty_cells")));
+  // Depths: 0 the bounds, 1 the cells, none deeper (a range past 1 held every
+  // cell, and depth 3 nothing, while its maximum depth is 1).
+  EXPECT_EQ(t.max_depth(), 1u);
+  const auto matched = [&](NodeSelection s) { return t.select(s, 1u << 30).matched; };
+  EXPECT_EQ(matched({BoxMode::depth, 1, 1, 0}), cells.matched);
+  EXPECT_EQ(matched({BoxMode::depth_range, 0, 1, 0}), cells.matched + 1);
+  EXPECT_EQ(matched({BoxMode::depth_range, 1, 5, 0}), cells.matched);
+  EXPECT_EQ(matched({BoxMode::depth_range, 0, 0, 0}), 1u);
+  EXPECT_EQ(matched({BoxMode::depth_range, 3, 5, 0}), 0u);
+  EXPECT_EQ(matched({BoxMode::depth, 3, 3, 0}), 0u);
 }
 
 // The View panel's line for a node id: what the id names in the structure

@@ -301,16 +301,17 @@ template <class F>
 void StructureNodes::for_each_selected(const NodeSelection& sel, F&& add) const {
   if (grid_) {
     const auto& g = *grid_;
-    if (sel.mode == BoxMode::depth && sel.depth == 0) {
-      add({g.bounds, 0, 0, false, 1.0f});
-      return;
-    }
     if (sel.mode == BoxMode::subtree) {
       if (const auto b = box(sel.node)) add({*b, sel.node, 1, true, 0.0f});
       return;
     }
-    if (sel.mode == BoxMode::depth_range && sel.depth == 0) add({g.bounds, 0, 0, false, 1.0f});
-    if (sel.mode == BoxMode::depth && sel.depth > 1) return;
+    // Depth 0: the grid's bounds; depth 1: its occupied cells (the leaves).
+    const bool range = sel.mode == BoxMode::depth_range;
+    const bool bounds = (sel.mode == BoxMode::depth || range) && sel.depth == 0;
+    const bool cells = sel.mode == BoxMode::leaves || (sel.mode == BoxMode::depth && sel.depth == 1) ||
+                       (range && sel.depth <= 1 && sel.depth_last >= 1);
+    if (bounds) add({g.bounds, 0, 0, false, 1.0f});
+    if (!cells) return;
     double total = 0.0;
     for (std::uint32_t c : g.counts) total += c;
     for (std::uint32_t c = 0; c < g.counts.size(); ++c)

@@ -445,6 +445,9 @@ bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout
       ImGui::TextDisabled("%" PRIu64 " of %" PRIu64 " boxes drawn (list cut)", info.boxes_drawn, info.boxes_matched);
     else
       ImGui::TextDisabled("%" PRIu64 " boxes drawn", info.boxes_drawn);
+    const bool by_depth = v.box_mode == BoxMode::depth || v.box_mode == BoxMode::depth_range;
+    if (by_depth && info.boxes_matched == 0 && v.box_depth > max_depth)
+      ImGui::TextDisabled("no node at depth %d: the deepest is %d", v.box_depth, max_depth);
   }
 
   section("Heatmap");
