@@ -624,6 +624,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       return Status::done;
     case K::set:
       fail_if(app_.set_option(c.arg, c.value));
+      if (c.arg == "box-node") insight_.box_node_set_again(app_);
       return Status::done;
     case K::camera:
       // After `open`, the camera applies to the new scene: wait for it

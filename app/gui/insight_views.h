@@ -42,6 +42,12 @@ class InsightViews {
   /// selected) while another build was shown, which one: node ids are per
   /// build. "" outside subtree mode.
   std::string box_node_note(const AppState& app) const;
+  /// The subtree node id was set again (a script's `set box-node`), perhaps
+  /// to the same number: it now belongs to the build shown.
+  void box_node_set_again(const AppState& app) {
+    box_node_seen_ = -1;
+    track_box_node(app);
+  }
 
  private:
   /// Selects node `id` of the structure shown (the Boxes view's subtree mode),

@@ -703,23 +703,27 @@ TEST_F(GuiScript, AClicksSelectionFollowsTheStructureShown) {
 
 // A node id typed into the subtree mode says what it names in the structure
 // shown, and, once another build is shown, that it was set in an earlier one
-// (node ids are per build) until a new id is set.
+// (node ids are per build) until an id is set again (the same one too).
 TEST_F(GuiScript, ATypedNodeIdSaysWhatItNamesAndWhichBuildItWasSetIn) {
   const RunResult r =
       run(std::string("open ") + kTeapot + "\nsize 320 240\ncamera " + kCamera +
           "\nset box-mode subtree\nset box-node 5\nwait\ndump-stats " + path("bvh.json").string() +
           "\nstructure grid\nwait\ndump-stats " + path("grid.json").string() + "\nscreenshot " +
-          path("grid-shot.png").string() + "\nset box-node 7\nwait\ndump-stats " + path("grid7.json").string() +
+          path("grid-shot.png").string() + "\nset box-node 5\nwait\ndump-stats " + path("grid5.json").string() +
+          "\nset box-node 7\nwait\ndump-stats " + path("grid7.json").string() +
           "\nset box-node 2000000000\nwait\ndump-stats " + path("past.json").string() + "\nquit\n");
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string bvh = read_json(path("bvh.json"))["boxes"]["node_note"];
   const std::string grid = read_json(path("grid.json"))["boxes"]["node_note"];
+  const std::string grid5 = read_json(path("grid5.json"))["boxes"]["node_note"];
   const std::string grid7 = read_json(path("grid7.json"))["boxes"]["node_note"];
   const std::string past = read_json(path("past.json"))["boxes"]["node_note"];
   EXPECT_EQ(bvh.rfind("node 5: ", 0), 0u) << bvh;
   EXPECT_EQ(bvh.find("earlier build"), std::string::npos) << bvh;
   EXPECT_EQ(grid.rfind("cell 5 (x ", 0), 0u) << grid;
   EXPECT_NE(grid.find("; the id was set in an earlier build (bvh"), std::string::npos) << grid;
+  EXPECT_EQ(grid5.rfind("cell 5 (x ", 0), 0u) << grid5;
+  EXPECT_EQ(grid5.find("earlier build"), std::string::npos) << "the same id set again names this build: " << grid5;
   EXPECT_EQ(grid7.rfind("cell 7 (x ", 0), 0u) << grid7;
   EXPECT_EQ(grid7.find("earlier build"), std::string::npos) << grid7;
   EXPECT_EQ(past.rfind("no cell 2000000000: this grid has cells 0-", 0), 0u) << past;

@@ -321,6 +321,9 @@ void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const Pa
   const BuildStats& b = built->accel->build_stats();
   ImGui::Text("%s", built->accel->name().c_str());
   if (ImGui::BeginTable("build", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV)) {
+    // The names as wide as the longest (the extras' keys are long), the values the rest.
+    ImGui::TableSetupColumn("name", ImGuiTableColumnFlags_WidthFixed);
+    ImGui::TableSetupColumn("value", ImGuiTableColumnFlags_WidthStretch);
     row("build ms", "%.2f", b.build_ms);
     row("wall ms", "%.2f", built->wall_ms);
     row("nodes", "%" PRIu64, b.node_count);
@@ -330,8 +333,15 @@ void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const Pa
     row("memory", "%s", bytes_text(b.memory_bytes).c_str());
     row("SAH cost", "%.4g", b.sah_cost);
     if (const auto it = b.extra.find("epo"); it != b.extra.end()) row("EPO", "%.4g", it->second);
-    for (const auto& [k, v] : b.extra)
-      if (k != "epo") row(k.c_str(), "%.6g", v);
+    for (const auto& [k, v] : b.extra) {
+      if (k == "epo") continue;
+      if (k.starts_with("memory_") && v >= 0.0 && v < 1.8e19)
+        row(k.c_str(), "%s", bytes_text(static_cast<std::uint64_t>(v)).c_str());
+      else if (v == std::floor(v) && std::abs(v) < 1e15)
+        row(k.c_str(), "%.0f", v);  // counts: 192320, not 1.9232e+05
+      else
+        row(k.c_str(), "%.6g", v);
+    }
     ImGui::EndTable();
   }
   section("Current view");
@@ -340,6 +350,8 @@ void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const Pa
   } else {
     const HeatmapSummary& s = view->summary;
     if (ImGui::BeginTable("view", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV)) {
+      ImGui::TableSetupColumn("name", ImGuiTableColumnFlags_WidthFixed);
+      ImGui::TableSetupColumn("value", ImGuiTableColumnFlags_WidthStretch);
       row("pixels", "%d x %d%s", view->image.width, view->image.height,
           view->complete ? "" : (" (1 in " + std::to_string(view->stride * view->stride) + ")").c_str());
       row("nodes / pixel", "mean %.2f, max %u", s.mean_nodes, s.max_nodes);
@@ -382,10 +394,14 @@ bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout
   const bool two_level = info.node_kind == "tlas";
   if (two_level) {  // which level's boxes, and per-instance colours
     int level = static_cast<int>(v.box_level);
-    if (combo("Level", level, {"top (TLAS nodes, instance boxes)", "bottom (each instance's BLAS)"})) {
+    if (combo("Level", level, {"top (TLAS)", "bottom (BLASes)"})) {
       v.box_level = static_cast<BoxLevel>(level);
       changed = true;
     }
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip(
+          "top: the TLAS nodes, each instance's world box as their leaves; bottom: every instance's BLAS nodes "
+          "carried to world space");
     if (v.box_level == BoxLevel::blas) {
       int inst = v.box_instance;
       if (ImGui::InputInt("Instance", &inst)) {
@@ -394,7 +410,9 @@ bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout
             static_cast<int>(std::min<std::uint64_t>(info.instances > 0 ? info.instances - 1 : 0, 0x7FFFFFFF)));
         changed = true;
       }
+      ImGui::PushTextWrapPos(0.0f);
       ImGui::TextDisabled("-1: every instance (whole instances up to the box limit)");
+      ImGui::PopTextWrapPos();
     }
     changed |= checkbox("Instance colours", v.instance_colors, "each instance's triangles and boxes in its own colour");
   }
@@ -425,7 +443,9 @@ bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout
             static_cast<int>(std::min<std::uint64_t>(info.node_count > 0 ? info.node_count - 1 : 0, 0x7FFFFFFF)));
         changed = true;
       }
+      ImGui::PushTextWrapPos(0.0f);
       ImGui::TextDisabled("F frames it; the Ray panel's node ids work here");
+      ImGui::PopTextWrapPos();
       if (!info.box_node_note.empty()) {
         ImGui::PushTextWrapPos(0.0f);
         ImGui::TextDisabled("%s", info.box_node_note.c_str());
@@ -548,15 +568,17 @@ std::optional<std::size_t> ray_panel(const RayInspection* ray, std::size_t step,
               ray->structure.c_str());
   ImGui::Text("origin    %.5g, %.5g, %.5g", ray->ray.origin.x, ray->ray.origin.y, ray->ray.origin.z);
   ImGui::Text("direction %.5g, %.5g, %.5g", ray->ray.direction.x, ray->ray.direction.y, ray->ray.direction.z);
-  if (ray->hit.valid())
+  if (!ray->hit.valid())
+    ImGui::TextUnformatted("miss");
+  else if (ray->structure == "voxels")  // its hits are voxels: an index into the voxel list, no barycentrics
+    ImGui::Text("hit voxel %u at t = %.6g", ray->hit.prim, ray->hit.t);
+  else
     ImGui::Text("hit prim %u at t = %.6g, barycentrics u = %.4f, v = %.4f", ray->hit.prim, ray->hit.t, ray->hit.u,
                 ray->hit.v);
-  else
-    ImGui::TextUnformatted("miss");
   const RayStats& s = ray->stats;
-  ImGui::Text("nodes %u, box tests %u, prim tests %u, culled %u, missed %u, repeated %u, empty cells %u",
-              s.nodes_visited, s.box_tests, s.prim_tests, s.nodes_culled, s.nodes_missed, s.repeated_prim_tests,
-              s.empty_cells);
+  ImGui::Text("nodes %u, box tests %u, prim tests %u", s.nodes_visited, s.box_tests, s.prim_tests);
+  ImGui::Text("culled %u, missed %u, repeated %u, empty cells %u", s.nodes_culled, s.nodes_missed,
+              s.repeated_prim_tests, s.empty_cells);
   for (const ShadowRay& sh : ray->shadows)
     ImGui::Text("shadow ray to light %zu%s%s: %s (nodes %u, prim tests %u)", sh.light, sh.light_name.empty() ? "" : " ",
                 sh.light_name.c_str(), sh.occluded ? "occluded" : "lit", sh.stats.nodes_visited, sh.stats.prim_tests);
