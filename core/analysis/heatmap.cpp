@@ -46,6 +46,10 @@ std::string_view metric_name(HeatMetric m) {
   return "nodes";
 }
 
+std::string_view metric_short_label(HeatMetric m) {
+  return m == HeatMetric::depth ? "distance" : metric_name(m);
+}
+
 std::string_view metric_label(HeatMetric m) {
   switch (m) {
     case HeatMetric::nodes:
@@ -443,6 +447,31 @@ std::string format_tick(double v) {
   return buf;
 }
 
+std::vector<double> legend_ticks(double lo, double hi, bool whole) {
+  if (!(hi > lo) || !std::isfinite(lo) || !std::isfinite(hi)) return {lo};
+  // The round step nearest a quarter of the range (by ratio).
+  const double raw = (hi - lo) / 4.0;
+  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
+  double step = mag;
+  for (const double m : {1.0, 2.0, 2.5, 5.0, 10.0}) {
+    if (whole && m == 2.5) continue;  // 2.5 nodes is no count
+    if (std::abs(std::log(m * mag / raw)) < std::abs(std::log(step / raw))) step = m * mag;
+  }
+  if (whole) step = std::max(1.0, std::round(step));
+  std::vector<double> ticks{lo};
+  for (double k = std::floor(lo / step) + 1.0;; k += 1.0) {
+    const double v = k * step;
+    if (v > hi - 0.3 * step) break;
+    if (v > lo) ticks.push_back(v);
+  }
+  ticks.push_back(hi);
+  return ticks;
+}
+
+bool metric_counts(HeatMetric m) {
+  return m == HeatMetric::nodes || m == HeatMetric::prims || m == HeatMetric::instances;
+}
+
 // ---- colour mapping and legend ---------------------------------------------------
 
 RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
@@ -453,17 +482,20 @@ RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
   // Legend geometry, in multiples of the glyph scale so it grows with the image.
   const int s = std::max(w, h) >= 480 ? 2 : 1;
   const int pad = 4 * s, glyph_h = kGlyphH * s, bar = 10 * s, tick = 3 * s;
-  constexpr int kTicks = 5;
-  std::string labels[kTicks];
+  const std::vector<double> ticks = legend_ticks(0.0, scale_max, metric_counts(image.metric));
+  std::vector<std::string> labels;
   int widest = 0;
-  for (int k = 0; k < kTicks; ++k) {
-    labels[k] = format_tick(static_cast<double>(scale_max) * k / (kTicks - 1));
-    widest = std::max(widest, text_width(labels[k], s));
+  for (const double v : ticks) {
+    labels.push_back(format_tick(v));
+    widest = std::max(widest, text_width(labels.back(), s));
   }
+  // Where tick k sits along the bar: its value's fraction of the range.
+  const auto at = [&](std::size_t k) { return scale_max > 0.0f ? ticks[k] / static_cast<double>(scale_max) : 0.0; };
   int extra_w = 0, extra_h = 0;
   if (legend == LegendPlacement::bottom) extra_h = pad + glyph_h + pad + bar + tick + s + glyph_h + pad;
   if (legend == LegendPlacement::right)
-    extra_w = std::max(pad + bar + tick + 3 * s + widest + pad, text_width(metric_name(image.metric), s) + 2 * pad);
+    extra_w =
+        std::max(pad + bar + tick + 3 * s + widest + pad, text_width(metric_short_label(image.metric), s) + 2 * pad);
 
   const glm::u8vec3 panel(24, 24, 24), ink(235, 235, 235);
   RgbImage out;  // every pixel written below: the heatmap's rows on all threads, then the legend's
@@ -505,8 +537,8 @@ RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
       const float t = static_cast<float>(x - xl) / static_cast<float>(xr - xl);
       fill_rect(out, x, bar_y, 1, bar, to_rgb8(colormap(opts.map, t)));
     }
-    for (int k = 0; k < kTicks; ++k) {
-      const int x = xl + static_cast<int>(std::lround(static_cast<double>(xr - xl) * k / (kTicks - 1)));
+    for (std::size_t k = 0; k < ticks.size(); ++k) {
+      const int x = xl + static_cast<int>(std::lround(static_cast<double>(xr - xl) * at(k)));
       fill_rect(out, x - (s - 1) / 2, bar_y + bar, s, tick, ink);
       const int lw = text_width(labels[k], s);
       const int lx = std::clamp(x - lw / 2, 0, std::max(0, out.width - lw));
@@ -514,15 +546,15 @@ RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
     }
   } else if (legend == LegendPlacement::right) {
     const int x0 = w + pad;
-    draw_text(out, x0, pad, metric_name(image.metric), ink, s);
+    draw_text(out, x0, pad, metric_short_label(image.metric), ink, s);
     const int yt = pad + glyph_h + pad + glyph_h / 2;
     const int yb = std::max(yt + 1, h - 1 - pad - glyph_h / 2);
     for (int y = yt; y <= yb; ++y) {
       const float t = static_cast<float>(yb - y) / static_cast<float>(yb - yt);  // max at the top
       fill_rect(out, x0, y, bar, 1, to_rgb8(colormap(opts.map, t)));
     }
-    for (int k = 0; k < kTicks; ++k) {
-      const int y = yb - static_cast<int>(std::lround(static_cast<double>(yb - yt) * k / (kTicks - 1)));
+    for (std::size_t k = 0; k < ticks.size(); ++k) {
+      const int y = yb - static_cast<int>(std::lround(static_cast<double>(yb - yt) * at(k)));
       fill_rect(out, x0 + bar, y - (s - 1) / 2, tick, s, ink);
       // A gap after the tick so that it does not read as a minus sign.
       draw_text(out, x0 + bar + tick + 3 * s, std::clamp(y - glyph_h / 2, 0, std::max(0, out.height - glyph_h)),

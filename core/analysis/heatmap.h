@@ -30,6 +30,9 @@ enum class HeatMetric {
 
 std::string_view metric_name(HeatMetric m);   ///< "nodes", "prims", ...
 std::string_view metric_label(HeatMetric m);  ///< legend title, e.g. "nodes visited per ray"
+/// A narrow legend's title: the name, but "distance" for `depth` (the hit's
+/// t, not a tree depth).
+std::string_view metric_short_label(HeatMetric m);
 std::optional<HeatMetric> parse_metric(std::string_view name);
 /// Whether the metric needs per-ray counters (a slower, instrumented pass).
 bool metric_needs_stats(HeatMetric m);
@@ -169,6 +172,17 @@ void draw_text(RgbImage& img, int x, int y, std::string_view text, glm::u8vec3 c
 
 /// A legend number: "0", "12", "0.25", "1.5k", "2.3M", "1e-05".
 std::string format_tick(double v);
+
+/// The values a legend over [lo, hi] marks: lo, hi, and between them the
+/// multiples of a round step (1, 2 or 5 times a power of ten) that make about
+/// four intervals, leaving out one within 0.3 of a step of hi (their labels
+/// would touch). With `whole` (counts per ray) the step is a whole number, so
+/// no tick reads 22.2 nodes. Ascending; {lo} alone when hi <= lo.
+std::vector<double> legend_ticks(double lo, double hi, bool whole);
+
+/// Whether the metric counts whole things per ray (nodes, primitive tests,
+/// instances), so that its legend marks whole numbers.
+bool metric_counts(HeatMetric m);
 
 /// "" when `path` names a PNG file (its name ends in .png, in any case), else
 /// "<path>: a PNG file's name must end in .png". write_png refuses other

@@ -228,6 +228,19 @@ TEST(Heatmap, TickFormatting) {
   EXPECT_EQ(format_tick(15300.0), "15.3k");
   EXPECT_EQ(format_tick(2.3e6), "2.3M");
   EXPECT_EQ(format_tick(1e-5), "1e-05");
+  // Legend ticks: whole numbers for counts (nodes 0..89 read 22.2 and 44.5),
+  // round steps otherwise, both ends always, none crowding the top.
+  using V = std::vector<double>;
+  EXPECT_EQ(legend_ticks(0, 89, true), (V{0, 20, 40, 60, 80, 89}));
+  EXPECT_EQ(legend_ticks(0, 200, true), (V{0, 50, 100, 150, 200}));
+  EXPECT_EQ(legend_ticks(0, 3, true), (V{0, 1, 2, 3}));
+  EXPECT_EQ(legend_ticks(0, 1, true), (V{0, 1}));
+  EXPECT_EQ(legend_ticks(0, 7.18, false), (V{0, 2, 4, 6, 7.18}));
+  EXPECT_EQ(legend_ticks(0, 1, false), (V{0, 0.25, 0.5, 0.75, 1}));
+  EXPECT_EQ(legend_ticks(0, 41, true), (V{0, 10, 20, 30, 41})) << "40 is within half a step of 41";
+  EXPECT_EQ(legend_ticks(10, 90, true), (V{10, 20, 40, 60, 80, 90}));
+  EXPECT_EQ(legend_ticks(5, 5, true), (V{5}));
+  for (const double v : legend_ticks(0, 1234567, true)) EXPECT_EQ(v, std::floor(v));
 }
 
 TEST(Heatmap, BitmapTextDrawsKnownGlyphsOnly) {

@@ -36,19 +36,18 @@ void add_rect(std::vector<OverlayVertex>& out, float x0, float y0, float x1, flo
 
 }  // namespace
 
-LegendLayout layout_legend(int width, int height, const glm::vec2& range, std::string_view title) {
+LegendLayout layout_legend(int width, int height, const glm::vec2& range, std::string_view title, bool whole) {
   LegendLayout L;
-  // Proportions (glyph scale, padding, bar width, five ticks) follow core's
+  // Proportions (glyph scale, padding, bar width) and ticks (legend_ticks) follow core's
   // CPU legend (colorize), so both read alike.
   const int s = std::max(width, height) >= 480 ? 2 : 1;
   const int pad = 4 * s, glyph_h = kGlyphH * s, bar_w = 10 * s, tick = 3 * s;
-  constexpr int kTicks = 5;
   L.scale = s;
 
+  const std::vector<double> ticks = legend_ticks(range.x, range.y, whole);
   std::vector<std::string> numbers;
   int widest = 0;
-  for (int k = 0; k < kTicks; ++k) {
-    const double v = range.x + (static_cast<double>(range.y) - range.x) * k / (kTicks - 1);
+  for (const double v : ticks) {
     numbers.push_back(format_tick(v));
     widest = std::max(widest, text_width(numbers.back(), s));
   }
@@ -64,11 +63,13 @@ LegendLayout layout_legend(int width, int height, const glm::vec2& range, std::s
   const int bar_top = L.panel.y0 + header;
   L.bar = {bar_x0, bar_top, bar_x0 + bar_w, bar_top + bar_len};
   L.labels.push_back({std::string(title), L.panel.x0 + pad, L.panel.y0 + pad});
-  for (int k = 0; k < kTicks; ++k) {
-    // Tick k sits on the row of value k/4 of the range: the bottom row is the
+  const double span = static_cast<double>(range.y) - range.x;
+  for (std::size_t k = 0; k < ticks.size(); ++k) {
+    // Tick k sits on the row of its value in the range: the bottom row is the
     // low end. Ticks stick out on the bar's left: on the right, next to the
     // numbers, they would read as minus signs.
-    const int y = L.bar.y1 - 1 - (bar_len - 1) * k / (kTicks - 1);
+    const double f = span > 0.0 ? (ticks[k] - range.x) / span : 0.0;
+    const int y = L.bar.y1 - 1 - static_cast<int>(std::lround((bar_len - 1) * f));
     L.ticks.push_back({L.bar.x0 - tick, y, L.bar.x0, y + s});
     L.labels.push_back({numbers[k], L.bar.x1 + pad, y - glyph_h / 2});
   }

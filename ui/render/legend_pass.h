@@ -36,7 +36,7 @@ struct LegendLayout {
 };
 
 /// Lays out a legend for `range` (low, high) in a width × height viewport.
-LegendLayout layout_legend(int width, int height, const glm::vec2& range, std::string_view title);
+LegendLayout layout_legend(int width, int height, const glm::vec2& range, std::string_view title, bool whole = false);
 
 class LegendPass {
  public:

@@ -114,8 +114,8 @@ LegendLayout Renderer::legend_layout(const RenderView& view, int width, int heig
       heatmap_.metric() == HeatMetric::shaded) {
     return {};
   }
-  const std::string title = h.title.empty() ? std::string(metric_name(heatmap_.metric())) : h.title;
-  return layout_legend(width, height, heatmap_range(h), title);
+  const std::string title = h.title.empty() ? std::string(metric_short_label(heatmap_.metric())) : h.title;
+  return layout_legend(width, height, heatmap_range(h), title, metric_counts(heatmap_.metric()));
 }
 
 void Renderer::render(const RenderView& view, int width, int height) {
