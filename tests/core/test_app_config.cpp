@@ -203,6 +203,10 @@ TEST(AppConfig, DescriptionsAndCaption) {
   const std::string cap = screenshot_caption(c);
   for (const char* part : {"grid (", "watertight", "unordered", "heatmap cost inferno scale 0,50", "blend 0.6"})
     EXPECT_NE(cap.find(part), std::string::npos) << part << " missing from: " << cap;
+  // The shaded metric is grey shading: no colour map or scale to name.
+  ASSERT_EQ(apply_option(c, "metric", "shaded"), "");
+  EXPECT_NE(screenshot_caption(c).find(", heatmap shaded blend 0.6"), std::string::npos) << screenshot_caption(c);
+  EXPECT_EQ(screenshot_caption(c).find("inferno"), std::string::npos) << screenshot_caption(c);
   ASSERT_EQ(apply_option(c, "heatmap", "off"), "");
   EXPECT_EQ(screenshot_caption(c).find("heatmap"), std::string::npos);
 }

@@ -13,6 +13,7 @@
 
 #include "core/accel/factory.h"
 #include "core/scene/load.h"
+#include "core/util/one_line.h"
 #include "ui/app/shortcuts.h"
 
 namespace accelviz::panels {
@@ -163,8 +164,10 @@ SceneAction scene_panel(std::string& path_field, const std::vector<std::string>&
   if (scene) {
     ImGui::Separator();
     ImGui::Text("%s triangles", triangle_count_text(*scene).c_str());
-    ImGui::Text("%zu meshes, %zu instances", scene->meshes.size(), scene->instances.size());
-    ImGui::Text("%zu lights, %zu cameras", scene->lights.size(), scene->cameras.size());
+    ImGui::Text("%s, %s", count_of(scene->meshes.size(), "mesh").c_str(),
+                count_of(scene->instances.size(), "instance").c_str());
+    ImGui::Text("%s, %s", count_of(scene->lights.size(), "light").c_str(),
+                count_of(scene->cameras.size(), "camera").c_str());
     if (scene->report.dropped_nonfinite || scene->report.degenerate)
       ImGui::Text("%" PRIu64 " dropped (non-finite), %" PRIu64 " degenerate", scene->report.dropped_nonfinite,
                   scene->report.degenerate);
@@ -482,9 +485,15 @@ bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout
     changed = true;
   }
   int metric = static_cast<int>(v.metric);
-  if (combo("Metric", metric, {"nodes visited", "primitive tests", "cost", "shaded", "depth", "instances visited"})) {
+  if (combo("Metric", metric,
+            {"nodes visited", "primitive tests", "cost", "shaded", "hit distance", "instances visited"})) {
     v.metric = static_cast<HeatMetric>(metric);
     changed = true;
+  }
+  if (v.metric == HeatMetric::instances && info.node_kind != "tlas") {
+    ImGui::PushTextWrapPos(0.0f);
+    ImGui::TextDisabled("only a two-level structure (tlas) enters instances: this one shows 0 everywhere");
+    ImGui::PopTextWrapPos();
   }
   int device = v.heatmap_gpu ? 1 : 0;
   if (combo("Trace on", device, {"CPU", "GPU"})) {
