@@ -623,6 +623,9 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       fail_if(app_.set_option("structure", c.arg));
       return Status::done;
     case K::set:
+      // A node id names a node of one build: it waits for the build on its
+      // way (a `structure` just before) and is that build's.
+      if (c.arg == "box-node" && !app_.settled()) return Status::again;
       fail_if(app_.set_option(c.arg, c.value));
       if (c.arg == "box-node") insight_.box_node_set_again(app_);
       return Status::done;

@@ -42,8 +42,9 @@ class InsightViews {
   /// selected) while another build was shown, which one: node ids are per
   /// build. "" outside subtree mode.
   std::string box_node_note(const AppState& app) const;
-  /// The subtree node id was set again (a script's `set box-node`), perhaps
-  /// to the same number: it now belongs to the build shown.
+  /// The subtree node id was set again (a script's `set box-node`, which
+  /// waits for a build on its way), perhaps to the same number: it belongs
+  /// to the build shown.
   void box_node_set_again(const AppState& app) {
     box_node_seen_ = -1;
     track_box_node(app);

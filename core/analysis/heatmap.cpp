@@ -397,7 +397,7 @@ constexpr Glyph kFont[] = {
     {'z', {0b00000, 0b00000, 0b11111, 0b00010, 0b00100, 0b01000, 0b11111}},
 };
 
-constexpr int kGlyphW = 5, kGlyphH = 7, kGlyphRows = 9, kAdvance = 6;  // kGlyphH: above the baseline
+constexpr int kGlyphW = kFontGlyphW, kGlyphH = kFontGlyphH, kGlyphRows = kFontGlyphRows, kAdvance = kFontAdvance;
 
 const Glyph* find_glyph(char c) {
   for (const Glyph& g : kFont)

@@ -166,7 +166,10 @@ RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts);
 
 /// Tiny built-in 5×7 bitmap font (digits, letters, punctuation; descenders
 /// take two rows below the 7), drawn at an integer scale; unknown characters
-/// draw as blanks.
+/// draw as blanks. Its geometry in font pixels: kFontGlyphW columns,
+/// kFontGlyphH rows above the baseline, kFontGlyphRows in all, kFontAdvance
+/// from one character to the next.
+inline constexpr int kFontGlyphW = 5, kFontGlyphH = 7, kFontGlyphRows = 9, kFontAdvance = 6;
 int text_width(std::string_view text, int scale);
 void draw_text(RgbImage& img, int x, int y, std::string_view text, glm::u8vec3 color, int scale);
 

@@ -711,13 +711,18 @@ TEST_F(GuiScript, ATypedNodeIdSaysWhatItNamesAndWhichBuildItWasSetIn) {
           "\nstructure grid\nwait\ndump-stats " + path("grid.json").string() + "\nscreenshot " +
           path("grid-shot.png").string() + "\nset box-node 5\nwait\ndump-stats " + path("grid5.json").string() +
           "\nset box-node 7\nwait\ndump-stats " + path("grid7.json").string() +
-          "\nset box-node 2000000000\nwait\ndump-stats " + path("past.json").string() + "\nquit\n");
+          "\nset box-node 2000000000\nwait\ndump-stats " + path("past.json").string() +
+          // Set again right after a switch, before the new build is shown: it is that build's.
+          "\nstructure kdtree\nset box-node 5\nwait\ndump-stats " + path("kd.json").string() + "\nquit\n");
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string bvh = read_json(path("bvh.json"))["boxes"]["node_note"];
   const std::string grid = read_json(path("grid.json"))["boxes"]["node_note"];
   const std::string grid5 = read_json(path("grid5.json"))["boxes"]["node_note"];
   const std::string grid7 = read_json(path("grid7.json"))["boxes"]["node_note"];
   const std::string past = read_json(path("past.json"))["boxes"]["node_note"];
+  const std::string kd = read_json(path("kd.json"))["boxes"]["node_note"];
+  EXPECT_EQ(kd.rfind("node 5: ", 0), 0u) << kd;
+  EXPECT_EQ(kd.find("earlier build"), std::string::npos) << kd;
   EXPECT_EQ(bvh.rfind("node 5: ", 0), 0u) << bvh;
   EXPECT_EQ(bvh.find("earlier build"), std::string::npos) << bvh;
   EXPECT_EQ(grid.rfind("cell 5 (x ", 0), 0u) << grid;

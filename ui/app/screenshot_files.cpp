@@ -191,8 +191,8 @@ std::string render_command(const ScreenshotInfo& info, bool raster, const std::s
     const ViewSettings& v = c.view;
     if (v.show_boxes && s.name != "bvh") {
       // render --view raster draws a BVH's node boxes only (it refuses
-      // --depth/--leaves for other structures).
-      if (notes)
+      // --depth/--leaves for other structures); say so when boxes were drawn.
+      if (notes && info.boxes_drawn > 0)
         notes->push_back("raster: the command line draws a BVH's node boxes only; the window's " + s.name +
                          " boxes are left out");
     } else if (v.show_boxes) {

@@ -1,6 +1,7 @@
 #include "ui/panels/panels.h"
 
 #include <imgui.h>
+#include <imgui_internal.h>  // ImGuiWindow::SizeFull: the size a resize asked for this frame
 #include <imgui_stdlib.h>
 
 #include <algorithm>
@@ -42,27 +43,41 @@ void place(const PanelLayout& l, float x, float y, float w, float h) {
   ImGui::SetNextWindowSize(ImVec2(w * s, h * s * f), ImGuiCond_FirstUseEver);
 }
 
+/// The top of stacked insight window `slot`: title bars one below the other
+/// (their spacing does not scale, so bars placed at any window height line up).
+float stacked_y(const PanelLayout& l, int slot) {
+  return 8.0f * l.scale * vertical_factor(l) + static_cast<float>(slot) * (ImGui::GetFrameHeight() + 4.0f * l.scale);
+}
+
 /// Called between Begin and End: when the window (the display) changed size
 /// since this panel's last frame, a panel in the right half keeps its
 /// distance to the right edge, and every panel's top and height scale with
-/// the height, so the columns stay clear of each other and of the status line.
-void follow_display(const PanelLayout& l) {
+/// the height, so the columns stay clear of each other and of the status line;
+/// a stacked insight window (`slot` >= 0) goes back to its place in the stack.
+void follow_display(const PanelLayout& l, int slot) {
   ImGuiStorage* st = ImGui::GetStateStorage();
   const ImGuiID kw = ImGui::GetID("##display_w"), kh = ImGui::GetID("##display_h");
+  const ImGuiID kx = ImGui::GetID("##pos_x"), ky = ImGui::GetID("##pos_y");
   const float w0 = st->GetFloat(kw, 0.0f), h0 = st->GetFloat(kh, 0.0f);
-  st->SetFloat(kw, l.width);
-  st->SetFloat(kh, l.height);
-  if (w0 <= 0.0f || h0 <= 0.0f || (w0 == l.width && h0 == l.height)) return;
-  ImVec2 pos = ImGui::GetWindowPos();
-  ImVec2 size = ImGui::GetWindowSize();
-  if (pos.x + size.x * 0.5f > w0 * 0.5f) pos.x += l.width - w0;
-  const float f = l.height / h0;
-  pos.y *= f;
-  ImGui::SetWindowPos(pos);
-  if (!ImGui::IsWindowCollapsed()) {
+  ImGuiWindow* w = ImGui::GetCurrentWindow();
+  if (w0 > 0.0f && h0 > 0.0f && (w0 != l.width || h0 != l.height)) {
+    // Where it was in the last frame: ImGui has already pulled a window the
+    // smaller display would hide back into it (pos.y = height - 19), which
+    // scaled would land on the panel above. SizeFull, not GetWindowSize(): a
+    // size set in the frame before (two resizes in a row) shows there already.
+    ImVec2 pos(st->GetFloat(kx, w->Pos.x), st->GetFloat(ky, w->Pos.y));
+    ImVec2 size = w->SizeFull;
+    if (pos.x + size.x * 0.5f > w0 * 0.5f) pos.x += l.width - w0;
+    const float f = l.height / h0;
+    pos.y = slot >= 0 ? stacked_y(l, slot) : pos.y * f;
+    ImGui::SetWindowPos(pos);
     size.y *= f;
     ImGui::SetWindowSize(size);
   }
+  st->SetFloat(kw, l.width);
+  st->SetFloat(kh, l.height);
+  st->SetFloat(kx, w->Pos.x);
+  st->SetFloat(ky, w->Pos.y);
 }
 
 std::string bytes_text(std::uint64_t b) {
@@ -84,10 +99,12 @@ void row(const char* name, const char* fmt, ...) {
   ImGui::TableSetColumnIndex(0);
   ImGui::TextUnformatted(name);
   ImGui::TableSetColumnIndex(1);
+  ImGui::PushTextWrapPos(0.0f);  // a long value wraps in its column instead of being cut
   va_list args;
   va_start(args, fmt);
   ImGui::TextV(fmt, args);
   va_end(args);
+  ImGui::PopTextWrapPos();
 }
 
 // A combo over a fixed list of names; returns true when the index changed.
@@ -338,7 +355,7 @@ void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const Pa
     if (const auto it = b.extra.find("epo"); it != b.extra.end()) row("EPO", "%.4g", it->second);
     for (const auto& [k, v] : b.extra) {
       if (k == "epo") continue;
-      if (k.starts_with("memory_") && v >= 0.0 && v < 1.8e19)
+      if ((k.starts_with("memory_") || k.ends_with("_bytes")) && v >= 0.0 && v < 1.8e19)
         row(k.c_str(), "%s", bytes_text(static_cast<std::uint64_t>(v)).c_str());
       else if (v == std::floor(v) && std::abs(v) < 1e15)
         row(k.c_str(), "%.0f", v);  // counts: 192320, not 1.9232e+05
@@ -582,8 +599,8 @@ std::optional<std::size_t> ray_panel(const RayInspection* ray, std::size_t step,
   else if (ray->structure == "voxels")  // its hits are voxels: an index into the voxel list, no barycentrics
     ImGui::Text("hit voxel %u at t = %.6g", ray->hit.prim, ray->hit.t);
   else
-    ImGui::Text("hit prim %u at t = %.6g, barycentrics u = %.4f, v = %.4f", ray->hit.prim, ray->hit.t, ray->hit.u,
-                ray->hit.v);
+    ImGui::TextWrapped("hit prim %u at t = %.6g, barycentrics u = %.4f, v = %.4f", ray->hit.prim, ray->hit.t,
+                       ray->hit.u, ray->hit.v);
   const RayStats& s = ray->stats;
   ImGui::Text("nodes %u, box tests %u, prim tests %u", s.nodes_visited, s.box_tests, s.prim_tests);
   ImGui::Text("culled %u, missed %u, repeated %u, empty cells %u", s.nodes_culled, s.nodes_missed,
@@ -712,10 +729,10 @@ void help_panel(bool& open, const PanelLayout& layout) {
 
 namespace {
 
-bool begin_placed(const char* title, const PanelLayout& layout, bool collapsed) {
+bool begin_placed(const char* title, const PanelLayout& layout, bool collapsed, int slot = -1) {
   if (collapsed) ImGui::SetNextWindowCollapsed(true, ImGuiCond_FirstUseEver);
   const bool open = ImGui::Begin(title);
-  follow_display(layout);
+  follow_display(layout, slot);
   if (open) return true;
   ImGui::End();
   return false;
@@ -730,10 +747,9 @@ bool begin_panel(const char* title, const PanelLayout& layout, float x, float y,
 
 bool begin_stacked_panel(const char* title, const PanelLayout& layout, int slot, float w, float h, bool collapsed) {
   const float s = layout.scale, f = vertical_factor(layout);
-  const float y = 8.0f * s * f + static_cast<float>(slot) * (ImGui::GetFrameHeight() + 4.0f * s);
-  ImGui::SetNextWindowPos(ImVec2(kMiddleX * s, y), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowPos(ImVec2(kMiddleX * s, stacked_y(layout, slot)), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(std::min(w, kMiddleWidth) * s, h * s * f), ImGuiCond_FirstUseEver);
-  return begin_placed(title, layout, collapsed);
+  return begin_placed(title, layout, collapsed, slot);
 }
 
 bool progress_cancel_row(double fraction, const char* overlay, float bar_width, CancelAt cancel_at) {

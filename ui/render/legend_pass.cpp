@@ -9,10 +9,11 @@
 namespace accelviz {
 namespace {
 
-// The font's geometry, as core/analysis/heatmap.h documents it: 5×7 glyphs.
-constexpr int kGlyphW = 5, kGlyphH = 7;
-// Atlas: printable ASCII 32..126 in one row of 6×8 cells.
-constexpr int kFirstChar = 32, kLastChar = 126, kCellW = 6, kCellH = 8;
+// The font's geometry (core/analysis/heatmap.h): 5×7 glyphs above the
+// baseline, 9 rows with the descenders.
+constexpr int kGlyphW = kFontGlyphW, kGlyphH = kFontGlyphH, kGlyphRows = kFontGlyphRows;
+// Atlas: printable ASCII 32..126 in one row of 6×10 cells.
+constexpr int kFirstChar = 32, kLastChar = 126, kCellW = kFontAdvance, kCellH = kGlyphRows + 1;
 constexpr int kAtlasW = (kLastChar - kFirstChar + 1) * kCellW;
 
 struct OverlayVertex {
@@ -126,8 +127,8 @@ void LegendPass::draw(const ShaderProgram& program, const LegendLayout& L, GLuin
       const int c = (ch >= kFirstChar && ch <= kLastChar) ? ch : ' ';
       const float u0 = static_cast<float>((c - kFirstChar) * kCellW) / kAtlasW;
       const float u1 = static_cast<float>((c - kFirstChar) * kCellW + kGlyphW) / kAtlasW;
-      const float v1 = static_cast<float>(kGlyphH) / kCellH;
-      add_rect(v, x, label.y, x + kGlyphW * s, label.y + kGlyphH * s, {u0, 0.0f}, {u1, v1}, kInk, 2.0f);
+      const float v1 = static_cast<float>(kGlyphRows) / kCellH;
+      add_rect(v, x, label.y, x + kGlyphW * s, label.y + kGlyphRows * s, {u0, 0.0f}, {u1, v1}, kInk, 2.0f);
       x += kCellW * s;
     }
   }
