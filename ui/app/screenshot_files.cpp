@@ -135,11 +135,11 @@ std::vector<std::string> wrap_caption(const std::string& text, int max_chars, in
 RgbImage add_caption(const RgbImage& frame, const std::string& caption) {
   const int scale = frame.width >= 1000 ? 2 : 1;
   const int pad = 4 * scale;
-  const std::string& text = caption;
-  const int max_chars = std::max(0, (frame.width - 2 * pad) / (6 * scale));
-  const std::vector<std::string> lines = wrap_caption(text, max_chars, kCaptionMaxLines);
-  const int line_height = 10 * scale;  // 7 rows of glyph and 2 of descender, 1 of spacing
-  const int strip = pad + std::max<int>(1, static_cast<int>(lines.size())) * line_height - 3 * scale + pad;
+  const int max_chars = std::max(0, (frame.width - 2 * pad) / (kFontAdvance * scale));
+  const std::vector<std::string> lines = wrap_caption(caption, max_chars, kCaptionMaxLines);
+  const int line_height = (kFontGlyphRows + 1) * scale;  // 7 rows of glyph and 2 of descender, 1 of spacing
+  // The last line without its spacing row, then the padding.
+  const int strip = pad + std::max<int>(1, static_cast<int>(lines.size())) * line_height - scale + pad;
   RgbImage out(frame.width, frame.height + strip, glm::u8vec3(28, 30, 34));
   std::copy(frame.pixels.begin(), frame.pixels.end(), out.pixels.begin());
   for (std::size_t i = 0; i < lines.size(); ++i)
