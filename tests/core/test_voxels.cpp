@@ -214,6 +214,16 @@ TEST(Voxels, FullBlocksCollapse) {
   const Voxels v4(s, VoxelOptions{4});
   EXPECT_GT(v4.build_stats().extra.at("full_blocks"), 0.0);
   EXPECT_EQ(v4.to_dense().bits, voxelize_dense(s, v4.domain()).bits);
+  // Leaves are the full octants: the full root is one leaf at depth 0; at
+  // level 4 the collapsed blocks sit above the voxels' depth 4.
+  EXPECT_EQ(v.build_stats().leaf_count, 1u);
+  EXPECT_EQ(v.build_stats().avg_leaf_depth, 0.0);
+  EXPECT_GT(v4.build_stats().avg_leaf_depth, 0.0);
+  EXPECT_LT(v4.build_stats().avg_leaf_depth, 4.0);
+  // Without collapsed blocks every leaf is a voxel, at the level.
+  const Voxels thin(flat_wall(), VoxelOptions{5});
+  ASSERT_EQ(thin.build_stats().extra.at("full_blocks"), 0.0);
+  EXPECT_DOUBLE_EQ(thin.build_stats().avg_leaf_depth, 5.0);
 }
 
 TEST(Voxels, HitIsTheEntryFaceOfTheFirstOccupiedVoxel) {

@@ -2,14 +2,15 @@
 // keeping the triangles that overlap it, down to single voxels; bottom-up
 // on the way back, octants that came back all full collapse into their
 // parent, and only octants that are neither empty nor full get a node.
-#include "core/accel/voxels/voxels.h"
-#include "core/util/timing.h"
-
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+
+#include "core/accel/voxels/voxels.h"
+#include "core/util/timing.h"
 
 namespace accelviz {
 
@@ -75,6 +76,8 @@ class VoxelBuilder {
         n.full |= static_cast<std::uint8_t>(1u << o);
         ++full_octants_;
         if (half > 1) ++full_blocks_;
+        // Its depth: the root (size = resolution) is at 0, a voxel at the level.
+        full_depth_sum_ += static_cast<double>(d_.level - std::countr_zero(half));
       } else {
         nodes_.push_back(kids[o].node);
       }
@@ -84,6 +87,7 @@ class VoxelBuilder {
   }
 
   std::uint64_t occupied_ = 0, full_octants_ = 0, full_blocks_ = 0;
+  double full_depth_sum_ = 0.0;  ///< the depths of the full octants, summed
 
  private:
   void report(std::uint32_t size) {
@@ -134,7 +138,9 @@ Voxels::Voxels(std::span<const Triangle> triangles, const VoxelOptions& opts, co
   stats_.node_count = nodes_.size();
   stats_.leaf_count = builder.full_octants_ + (root_ == Root::full ? 1 : 0);
   stats_.max_depth = static_cast<std::uint32_t>(domain_.level);
-  stats_.avg_leaf_depth = 0.0;
+  // Leaves are the full octants (a full root is one leaf at depth 0).
+  stats_.avg_leaf_depth =
+      stats_.leaf_count > 0 ? builder.full_depth_sum_ / static_cast<double>(stats_.leaf_count) : 0.0;
   stats_.memory_bytes = nodes_.size() * sizeof(VoxelNode);
   stats_.extra["occupied_voxels"] = static_cast<double>(occupied_);
   stats_.extra["dense_bytes"] = dense_bytes;
