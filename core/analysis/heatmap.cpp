@@ -79,6 +79,10 @@ bool metric_needs_stats(HeatMetric m) {
   return m == HeatMetric::nodes || m == HeatMetric::prims || m == HeatMetric::cost || m == HeatMetric::instances;
 }
 
+bool metric_counts(HeatMetric m) {
+  return metric_needs_stats(m) && m != HeatMetric::cost;  // cost weighs its counts with C_trav and C_isect
+}
+
 float metric_value(HeatMetric m, const Ray& ray, const Hit& hit, const RayStats& stats, float c_trav, float c_isect) {
   constexpr float kNoValue = std::numeric_limits<float>::quiet_NaN();
   switch (m) {
@@ -466,10 +470,6 @@ std::vector<double> legend_ticks(double lo, double hi, bool whole) {
   }
   ticks.push_back(hi);
   return ticks;
-}
-
-bool metric_counts(HeatMetric m) {
-  return m == HeatMetric::nodes || m == HeatMetric::prims || m == HeatMetric::instances;
 }
 
 // ---- colour mapping and legend ---------------------------------------------------
