@@ -465,12 +465,10 @@ std::string screenshot_caption(const AppConfig& config) {
   else if (config.structure.query.back_to_front)
     s += ", back-to-front";
   if (config.structure.query.xray) s += ", x-ray";
-  if (config.view.heatmap != HeatmapDisplay::off && config.view.metric == HeatMetric::shaded) {
-    s += ", heatmap shaded";  // grey shading: no colour map, no scale
-    if (config.view.heatmap == HeatmapDisplay::blend) s += " blend " + option_value(config, "opacity");
-  } else if (config.view.heatmap != HeatmapDisplay::off) {
-    s += ", heatmap " + std::string(metric_name(config.view.metric)) + " " +
-         std::string(colormap_name(config.view.colormap)) + " scale " + option_value(config, "scale");
+  if (config.view.heatmap != HeatmapDisplay::off) {
+    s += ", heatmap " + std::string(metric_name(config.view.metric));
+    if (config.view.metric != HeatMetric::shaded)  // grey shading: no colour map, no scale
+      s += " " + std::string(colormap_name(config.view.colormap)) + " scale " + option_value(config, "scale");
     if (config.view.heatmap == HeatmapDisplay::blend) s += " blend " + option_value(config, "opacity");
   }
   return s;
