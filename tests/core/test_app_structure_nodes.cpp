@@ -133,6 +133,7 @@ TEST(AppStructureNodes, GridCellsAreTheGridsOwn) {
   // Depths: 0 the bounds, 1 the cells, none deeper (a range past 1 held every
   // cell, and depth 3 nothing, while its maximum depth is 1).
   EXPECT_EQ(t.max_depth(), 1u);
+  EXPECT_EQ(grid.build_stats().max_depth, t.max_depth());  // the Stats panel's figure (it said 0)
   const auto matched = [&](NodeSelection s) { return t.select(s, 1u << 30).matched; };
   EXPECT_EQ(matched({BoxMode::depth, 1, 1, 0}), cells.matched);
   EXPECT_EQ(matched({BoxMode::depth_range, 0, 1, 0}), cells.matched + 1);

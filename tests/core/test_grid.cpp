@@ -311,12 +311,16 @@ TEST(Grid, EmptyOneAndDegenerateInputs) {
   EXPECT_FALSE(none.closest_hit(Ray({0, 0, -1}, {0, 0, 1}), {}).valid());
   EXPECT_FALSE(none.any_hit(Ray({0, 0, -1}, {0, 0, 1}), {}));
   EXPECT_EQ(none.build_stats().node_count, 0u);
+  EXPECT_EQ(none.build_stats().max_depth, 0u);
 
   const Scene one{{{-1, -1, 2}, {1, -1, 2}, {0, 1, 2}}};
   const Grid g1(one);
   const Hit h = g1.closest_hit(Ray({0, 0, 0}, {0, 0, 1}), {});
   ASSERT_TRUE(h.valid());
   EXPECT_FLOAT_EQ(h.t, 2.0f);
+  // The cells lie one level below the bounds (depth 0), as the box views draw them.
+  EXPECT_EQ(g1.build_stats().max_depth, 1u);
+  EXPECT_EQ(g1.build_stats().avg_leaf_depth, 1.0);
 
   Rng rng{10};
   Scene same;  // all centroids equal

@@ -162,7 +162,10 @@ Grid::Grid(std::span<const Triangle> triangles, const GridOptions& opts, const P
   stats_.build_ms = ms_since(t_start);
   stats_.node_count = ncells;
   stats_.leaf_count = ncells;
-  stats_.max_depth = 0;
+  // The cells are the grid's leaves, one level below its bounds (the box
+  // views draw the bounds at depth 0 and the cells at depth 1).
+  stats_.max_depth = ncells > 0 ? 1 : 0;
+  stats_.avg_leaf_depth = ncells > 0 ? 1.0 : 0.0;
   stats_.memory_bytes = (cell_start_.size() + refs_.size()) * sizeof(std::uint32_t);
   stats_.extra["cells"] = static_cast<double>(ncells);
   stats_.extra["empty_cells"] = static_cast<double>(empty);
