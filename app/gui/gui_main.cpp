@@ -353,6 +353,9 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
   const glm::vec2 range = view_->heatmap_range(app_);
   vi.range_min = range.x;
   vi.range_max = range.y;
+  const ValueRange values = view_->heatmap_values();
+  vi.value_min = values.min;
+  vi.value_max = values.max;
   vi.heatmap_on_gpu = app_.heatmap_on_gpu();
   vi.gpu_note = app_.gpu_heatmap_note();
   const auto gpu_trace = app_.gpu_heatmap_progress();

@@ -121,8 +121,11 @@ void InsightViews::draw_labels(const AppState& app, const ViewInsight& v, const 
     if (!p) continue;
     const ImVec2 at(p->x * sx, p->y * sy);
     const ImVec2 size = ImGui::CalcTextSize(l.text.c_str());
-    dl->AddRectFilled(ImVec2(at.x - 2.0f, at.y - size.y - 2.0f), ImVec2(at.x + size.x + 2.0f, at.y),
-                      l.selected ? IM_COL32(150, 60, 20, 220) : IM_COL32(20, 20, 20, 200), 3.0f);
+    const ImVec2 lo(at.x - 2.0f, at.y - size.y - 2.0f), hi(at.x + size.x + 2.0f, at.y + 2.5f);
+    // A label under a panel would show faintly through its translucent background.
+    if (panels::covered_by_window(lo.x, lo.y, hi.x, hi.y)) continue;
+    dl->AddRectFilled(lo, ImVec2(hi.x, at.y), l.selected ? IM_COL32(150, 60, 20, 220) : IM_COL32(20, 20, 20, 200),
+                      3.0f);
     dl->AddText(ImVec2(at.x, at.y - size.y - 1.0f), IM_COL32(255, 255, 255, 255), l.text.c_str());
     dl->AddCircleFilled(at, 2.5f, IM_COL32(255, 255, 255, 255));
   }

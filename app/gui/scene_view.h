@@ -40,6 +40,8 @@ class SceneView {
   Renderer& renderer() { return renderer_; }
   /// The heatmap range the legend shows under the current settings.
   glm::vec2 heatmap_range(const AppState& app) const;
+  /// The heatmap image's smallest and largest value.
+  ValueRange heatmap_values() const { return renderer_.heatmap_values(); }
   /// Whether a heatmap image has been uploaded.
   bool has_heatmap() const { return has_heatmap_; }
 

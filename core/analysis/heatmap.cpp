@@ -270,23 +270,39 @@ std::optional<LegendPlacement> parse_legend_placement(std::string_view name) {
   return std::nullopt;
 }
 
-float heatmap_scale_max(const MetricImage& image, float fixed_max) {
-  if (fixed_max > 0.0f && std::isfinite(fixed_max)) return fixed_max;
-  // Blocks on all threads, then the largest of their maxima (the same
+ValueRange metric_value_range(const MetricImage& image) {
+  // Blocks on all threads, then the extremes of their extremes (the same
   // whatever the order).
   constexpr std::size_t kBlock = 16384;
-  std::vector<float> block_max((image.values.size() + kBlock - 1) / kBlock, 0.0f);
-  parallel_for(block_max.size(), 0, 4, [&](std::size_t b0, std::size_t b1, unsigned) {
+  constexpr float inf = std::numeric_limits<float>::infinity();
+  std::vector<ValueRange> block((image.values.size() + kBlock - 1) / kBlock, ValueRange{inf, -inf});
+  parallel_for(block.size(), 0, 4, [&](std::size_t b0, std::size_t b1, unsigned) {
     for (std::size_t b = b0; b < b1; ++b) {
-      float m = 0.0f;
+      ValueRange r{inf, -inf};
       for (std::size_t i = b * kBlock; i < std::min(image.values.size(), (b + 1) * kBlock); ++i)
-        if (std::isfinite(image.values[i])) m = std::max(m, image.values[i]);
-      block_max[b] = m;
+        if (std::isfinite(image.values[i])) {
+          r.min = std::min(r.min, image.values[i]);
+          r.max = std::max(r.max, image.values[i]);
+        }
+      block[b] = r;
     }
   });
-  float max = 0.0f;
-  for (float m : block_max) max = std::max(max, m);
-  return max > 0.0f ? max : 1.0f;
+  ValueRange all{inf, -inf};
+  for (const ValueRange& r : block) {
+    all.min = std::min(all.min, r.min);
+    all.max = std::max(all.max, r.max);
+  }
+  return all.min <= all.max ? all : ValueRange{};
+}
+
+float heatmap_scale_max(const ValueRange& values, float fixed_max) {
+  if (fixed_max > 0.0f && std::isfinite(fixed_max)) return fixed_max;
+  return values.max > 0.0f ? values.max : 1.0f;
+}
+
+float heatmap_scale_max(const MetricImage& image, float fixed_max) {
+  if (fixed_max > 0.0f && std::isfinite(fixed_max)) return fixed_max;
+  return heatmap_scale_max(metric_value_range(image), fixed_max);
 }
 
 glm::u8vec3 heatmap_color(HeatMetric metric, float value, float scale_max, const ColorizeOptions& opts) {
@@ -451,6 +467,13 @@ std::string format_tick(double v) {
   return buf;
 }
 
+std::vector<std::string> legend_labels(const std::vector<double>& ticks, bool above_top) {
+  std::vector<std::string> labels;
+  for (const double v : ticks) labels.push_back(format_tick(v));
+  if (above_top && !labels.empty()) labels.back() += '+';
+  return labels;
+}
+
 std::vector<double> legend_ticks(double lo, double hi, bool whole) {
   if (!(hi > lo) || !std::isfinite(lo) || !std::isfinite(hi)) return {lo};
   // The round step nearest a quarter of the range (by ratio).
@@ -483,12 +506,12 @@ RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
   const int s = std::max(w, h) >= 480 ? 2 : 1;
   const int pad = 4 * s, glyph_h = kGlyphH * s, bar = 10 * s, tick = 3 * s;
   const std::vector<double> ticks = legend_ticks(0.0, scale_max, metric_counts(image.metric));
-  std::vector<std::string> labels;
+  // A fixed top with values above it: its number says so ("20+").
+  const bool above_top =
+      opts.max > 0.0f && legend != LegendPlacement::none && metric_value_range(image).max > scale_max;
+  const std::vector<std::string> labels = legend_labels(ticks, above_top);
   int widest = 0;
-  for (const double v : ticks) {
-    labels.push_back(format_tick(v));
-    widest = std::max(widest, text_width(labels.back(), s));
-  }
+  for (const std::string& l : labels) widest = std::max(widest, text_width(l, s));
   // Where tick k sits along the bar: its value's fraction of the range.
   const auto at = [&](std::size_t k) { return scale_max > 0.0f ? ticks[k] / static_cast<double>(scale_max) : 0.0; };
   int extra_w = 0, extra_h = 0;

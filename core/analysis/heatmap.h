@@ -151,9 +151,17 @@ struct ColorizeOptions {
   glm::vec3 background{0.3f, 0.3f, 0.3f};  ///< pixels without a value (and the shaded metric's misses)
 };
 
+/// The smallest and largest finite value of `image` (both 0 when it has none).
+struct ValueRange {
+  float min = 0.0f, max = 0.0f;
+};
+ValueRange metric_value_range(const MetricImage& image);
+
 /// Top of the colour scale for `image`: `fixed_max` when > 0, else the image's
 /// maximum; never 0 (an all-zero image uses 1) so the scale stays defined.
 float heatmap_scale_max(const MetricImage& image, float fixed_max);
+/// The same from the image's value range (metric_value_range).
+float heatmap_scale_max(const ValueRange& values, float fixed_max);
 
 /// Colour of one metric value under the options (what a pixel of the heatmap
 /// area gets); background for NaN; the shaded metric is drawn in grey.
@@ -182,6 +190,11 @@ std::string format_tick(double v);
 /// would touch). With `whole` (counts per ray) the step is a whole number, so
 /// no tick reads 22.2 nodes. Ascending; {lo} alone when hi <= lo.
 std::vector<double> legend_ticks(double lo, double hi, bool whole);
+
+/// The numbers a legend writes at `ticks` (format_tick), the top one with a
+/// "+" when `above_top`: the image has values above the scale's top, drawn
+/// in its top colour (a locked or fixed scale).
+std::vector<std::string> legend_labels(const std::vector<double>& ticks, bool above_top);
 
 /// Whether the metric counts whole things per ray (nodes, primitive tests,
 /// instances), so that its legend marks whole numbers.

@@ -241,6 +241,69 @@ TEST(Heatmap, TickFormatting) {
   EXPECT_EQ(legend_ticks(10, 90, true), (V{10, 20, 40, 60, 80, 90}));
   EXPECT_EQ(legend_ticks(5, 5, true), (V{5}));
   for (const double v : legend_ticks(0, 1234567, true)) EXPECT_EQ(v, std::floor(v));
+  // Values above a locked or fixed top: its number says so.
+  using S = std::vector<std::string>;
+  EXPECT_EQ(legend_labels(V{0, 10, 20}, false), (S{"0", "10", "20"}));
+  EXPECT_EQ(legend_labels(V{0, 10, 20}, true), (S{"0", "10", "20+"}));
+  EXPECT_EQ(legend_labels(V{}, true), S{});
+}
+
+TEST(Heatmap, ValueRangeSkipsMissingValues) {
+  MetricImage img;
+  img.width = 4;
+  img.height = 1;
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  img.values = {nan, 3.5f, 0.25f, inf};
+  const ValueRange r = metric_value_range(img);
+  EXPECT_EQ(r.min, 0.25f);
+  EXPECT_EQ(r.max, 3.5f);
+  img.values = {nan, nan, nan, nan};  // nothing: 0 .. 0, and the automatic top is 1
+  EXPECT_EQ(metric_value_range(img).min, 0.0f);
+  EXPECT_EQ(metric_value_range(img).max, 0.0f);
+  EXPECT_EQ(heatmap_scale_max(img, 0.0f), 1.0f);
+  // Large images go through blocks on all threads: the extremes anywhere.
+  img.width = 300;
+  img.height = 200;
+  img.values.assign(60000, 5.0f);
+  img.values[17] = 2.0f;
+  img.values[59999] = 9.0f;
+  EXPECT_EQ(metric_value_range(img).min, 2.0f);
+  EXPECT_EQ(metric_value_range(img).max, 9.0f);
+}
+
+// A fixed top below the image's largest value: the legend's top number reads
+// "10+". Against the same picture clamped to 10 (the same colours, no value
+// above the top) only the legend's top number differs.
+TEST(Heatmap, FixedMaxBelowTheValuesMarksTheTopNumber) {
+  MetricImage img;
+  img.width = 64;
+  img.height = 48;
+  img.metric = HeatMetric::nodes;
+  for (int i = 0; i < 64 * 48; ++i) img.values.push_back(static_cast<float>(i % 21));  // 0..20
+  MetricImage clamped = img;
+  for (float& v : clamped.values) v = std::min(v, 10.0f);
+  for (const LegendPlacement where : {LegendPlacement::right, LegendPlacement::bottom}) {
+    ColorizeOptions o;
+    o.max = 10.0f;
+    o.legend = where;
+    const RgbImage a = colorize(img, o), b = colorize(clamped, o);
+    // The picture is the same (values above the top take its colour)...
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) ASSERT_EQ(a.at(x, y), b.at(x, y)) << x << "," << y;
+    // ...the legend is not: a wider right legend (the '+'), or ink where the clamped one has none.
+    int differ = a.width != b.width || a.height != b.height ? 1000 : 0;
+    if (differ == 0)
+      for (int y = 0; y < a.height; ++y)
+        for (int x = 0; x < a.width; ++x) differ += a.at(x, y) != b.at(x, y);
+    EXPECT_GT(differ, 3) << "no '+' drawn";
+  }
+  // A fixed top at the largest value leaves nothing above it: the picture and
+  // the right legend (whose title does not name the fixed top) equal the
+  // automatic scale's.
+  ColorizeOptions fixed, automatic;
+  fixed.legend = automatic.legend = LegendPlacement::right;
+  fixed.max = 20.0f;
+  EXPECT_TRUE(colorize(img, fixed).pixels == colorize(img, automatic).pixels);
 }
 
 TEST(Heatmap, BitmapTextDrawsKnownGlyphsOnly) {

@@ -144,7 +144,17 @@ TEST_F(Heatmap, LegendGradientAndNumbersFollowTheRange) {
   EXPECT_EQ(legend.labels[0].text, "nodes");
   EXPECT_EQ(legend.labels[1].text, format_tick(0.0));
   EXPECT_EQ(legend.labels[3].text, format_tick(100.0));
-  EXPECT_EQ(legend.labels[5].text, format_tick(200.0));
+  EXPECT_EQ(legend.labels[5].text, format_tick(200.0));  // the ramp's values are all below 200
+  {
+    // A locked top below the ramp's largest value (162.15): its number says so.
+    RenderView narrow = view;
+    narrow.heatmap.range_max = 100.0f;
+    ASSERT_GT(image_max(values), 100.0f);
+    EXPECT_EQ(renderer_->legend_layout(narrow, kWidth, kHeight).labels.back().text, format_tick(100.0) + "+");
+    narrow.heatmap.auto_scale = true;  // the image's own top: never a sign
+    const std::string top = renderer_->legend_layout(narrow, kWidth, kHeight).labels.back().text;
+    EXPECT_NE(top.back(), '+') << top;
+  }
 
   const Rgba8Image img = draw(view);
   const auto& bar = legend.bar;

@@ -159,5 +159,43 @@ TEST(PanelLayout, FirstUseInASmallerWindowFitsIt) {
   ui.expect_tidy(1280, 720);
 }
 
+// What the 3D view draws behind the windows (hot-node labels) is left out
+// where a window covers it: an open window by its whole rectangle, a
+// collapsed one by its title bar, a window not drawn this frame by last
+// frame's place, and no longer once it is closed.
+TEST(PanelLayout, CoveredByWindowFollowsOpenCollapsedAndClosedWindows) {
+  test::HeadlessImGuiContext ctx(ImVec2(800, 600));
+  const auto window = [](const char* title, ImVec2 pos, bool collapsed) {
+    ImGui::SetNextWindowPos(pos, ImGuiCond_Always);
+    ImGui::SetNextWindowSize(ImVec2(200, 300), ImGuiCond_Always);
+    ImGui::SetNextWindowCollapsed(collapsed, ImGuiCond_Always);
+    ImGui::Begin(title);
+    ImGui::End();
+  };
+  const auto covered = [](float x, float y) { return panels::covered_by_window(x, y, x + 20, y + 10); };
+  for (int i = 0; i < 2; ++i) {
+    ctx.begin_frame(ImVec2(-100, -100), false);
+    window("Open", ImVec2(100, 100), false);
+    window("Folded", ImVec2(500, 100), true);
+    EXPECT_TRUE(covered(150, 350));   // inside Open
+    EXPECT_TRUE(covered(90, 95));     // overlaps Open's corner
+    EXPECT_FALSE(covered(350, 200));  // between the two
+    EXPECT_TRUE(covered(550, 102));   // Folded's title bar
+    EXPECT_FALSE(covered(550, 200));  // below Folded's title bar: its body is not drawn
+    ImGui::Render();
+  }
+  // The next frame, before the windows are begun: last frame's places.
+  ctx.begin_frame(ImVec2(-100, -100), false);
+  EXPECT_TRUE(covered(150, 350));
+  EXPECT_TRUE(covered(550, 102));
+  window("Folded", ImVec2(500, 100), true);
+  ImGui::Render();
+  // Open was not drawn in that frame: it is closed now.
+  ctx.begin_frame(ImVec2(-100, -100), false);
+  EXPECT_FALSE(covered(150, 350));
+  EXPECT_TRUE(covered(550, 102));
+  ImGui::Render();
+}
+
 }  // namespace
 }  // namespace accelviz::unity_test_layout_panel

@@ -13,12 +13,16 @@
 #include <thread>
 
 #include "core/accel/factory.h"
+#include "core/analysis/heatmap.h"
 #include "core/scene/load.h"
 #include "core/util/one_line.h"
 #include "ui/app/shortcuts.h"
 
 namespace accelviz::panels {
 namespace {
+
+/// A note that something is not as it looks (amber; errors are red).
+const ImVec4 kWarnColour(1.0f, 0.78f, 0.35f, 1.0f);
 
 // First-use placement, designed for a 1280×800 window: scene, structure and
 // screenshot on the left, stats and view on the right but clear of the
@@ -563,6 +567,18 @@ bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout
       v.scale_max = r[1];
       changed = true;
     }
+    // Values outside a locked range take its end colours: say how far they go.
+    const bool above = info.value_max > info.range_max, below = info.value_min < info.range_min;
+    if (v.heatmap != HeatmapDisplay::off && (above || below)) {
+      ImGui::PushTextWrapPos(0.0f);
+      if (above)
+        ImGui::TextColored(kWarnColour, "values up to %.4g lie above the range: drawn in its top colour (legend: %s+)",
+                           info.value_max, format_tick(info.range_max).c_str());
+      if (below)
+        ImGui::TextColored(kWarnColour, "values down to %.4g lie below the range: drawn in its bottom colour",
+                           info.value_min);
+      ImGui::PopTextWrapPos();
+    }
   } else {
     ImGui::TextDisabled("range %.4g .. %.4g (auto)", info.range_min, info.range_max);
   }
@@ -743,6 +759,21 @@ bool begin_placed(const char* title, const PanelLayout& layout, bool collapsed, 
 bool begin_panel(const char* title, const PanelLayout& layout, float x, float y, float w, float h, bool collapsed) {
   place(layout, x, y, w, h);
   return begin_placed(title, layout, collapsed);
+}
+
+bool covered_by_window(float x0, float y0, float x1, float y1) {
+  const ImGuiContext* g = ImGui::GetCurrentContext();
+  if (!g) return false;
+  for (const ImGuiWindow* w : g->Windows) {
+    // Windows begun this frame are Active; the others keep last frame's state in WasActive.
+    const bool shown = w->BeginCount > 0 ? w->Active : w->WasActive;
+    if (!shown || w->Hidden || w->IsFallbackWindow ||
+        (w->Flags & (ImGuiWindowFlags_ChildWindow | ImGuiWindowFlags_Tooltip)))
+      continue;
+    const ImRect r = w->Rect();
+    if (x0 < r.Max.x && r.Min.x < x1 && y0 < r.Max.y && r.Min.y < y1) return true;
+  }
+  return false;
 }
 
 bool begin_stacked_panel(const char* title, const PanelLayout& layout, int slot, float w, float h, bool collapsed) {

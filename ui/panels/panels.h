@@ -68,6 +68,7 @@ struct ViewInfo {
   std::uint32_t blas_max_depth = 0;          ///< tlas: the deepest BLAS node (the blas level's depth range)
   std::uint64_t instances = 0;               ///< tlas: instances (the blas level's instance choice)
   float range_min = 0.0f, range_max = 1.0f;  ///< the heatmap range in use
+  float value_min = 0.0f, value_max = 0.0f;  ///< the heatmap image's smallest and largest value
   bool heatmap_on_gpu = false;               ///< the heatmap shown was traced on the GPU
   std::string gpu_note;                      ///< why "Trace on: GPU" fell back to the CPU ("" when it did not)
   int gpu_rows_done = -1;                    ///< the GPU trace in progress: rows done (-1: none running)
@@ -113,6 +114,11 @@ bool begin_panel(const char* title, const PanelLayout& layout, float x, float y,
 /// the columns.
 bool begin_stacked_panel(const char* title, const PanelLayout& layout, int slot, float w, float h,
                          bool collapsed = true);
+/// True when the screen rectangle (x0, y0)-(x1, y1) (ImGui's units) overlaps a
+/// top-level window drawn this frame, or last frame for one not yet drawn
+/// in this one (a collapsed window by its title bar): what is drawn behind
+/// the windows there would show through their translucent background.
+bool covered_by_window(float x0, float y0, float x1, float y1);
 /// A running job's row, from the cursor on: a progress bar `bar_width` wide
 /// (an ImGui item width: -1 fills the row, -w leaves w at its right) showing
 /// `fraction` and `overlay` (null: the percentage), with a Cancel button on

@@ -69,7 +69,7 @@ void HeatmapPass::upload(const MetricImage& image) {
   width_ = image.width;
   height_ = image.height;
   metric_ = image.metric;
-  auto_max_ = heatmap_scale_max(image, 0.0f);
+  values_range_ = metric_value_range(image);
   check_gl_errors("heatmap upload");
 }
 

@@ -31,7 +31,10 @@ class HeatmapPass {
   HeatMetric metric() const { return metric_; }
   /// Top of the automatic scale: the image's maximum, 1 for an all-zero
   /// image (core's heatmap_scale_max, so GL and CPU heatmaps agree).
-  float auto_max() const { return auto_max_; }
+  float auto_max() const { return heatmap_scale_max(values_range_, 0.0f); }
+  /// The image's smallest and largest value (a locked range may leave some
+  /// outside: they are drawn in its end colours).
+  ValueRange value_range() const { return values_range_; }
 
   /// Replaces the colour map: exactly 256 entries (throws std::invalid_argument otherwise).
   void set_lut(std::span<const glm::vec3> lut);
@@ -50,7 +53,7 @@ class HeatmapPass {
   int width_ = 0;
   int height_ = 0;
   HeatMetric metric_ = HeatMetric::nodes;
-  float auto_max_ = 1.0f;
+  ValueRange values_range_;
 };
 
 }  // namespace accelviz

@@ -37,7 +37,8 @@ void add_rect(std::vector<OverlayVertex>& out, float x0, float y0, float x1, flo
 
 }  // namespace
 
-LegendLayout layout_legend(int width, int height, const glm::vec2& range, std::string_view title, bool whole) {
+LegendLayout layout_legend(int width, int height, const glm::vec2& range, std::string_view title, bool whole,
+                           bool above_top) {
   LegendLayout L;
   // Proportions (glyph scale, padding, bar width) and ticks (legend_ticks) follow core's
   // CPU legend (colorize), so both read alike.
@@ -46,12 +47,9 @@ LegendLayout layout_legend(int width, int height, const glm::vec2& range, std::s
   L.scale = s;
 
   const std::vector<double> ticks = legend_ticks(range.x, range.y, whole);
-  std::vector<std::string> numbers;
+  const std::vector<std::string> numbers = legend_labels(ticks, above_top);
   int widest = 0;
-  for (const double v : ticks) {
-    numbers.push_back(format_tick(v));
-    widest = std::max(widest, text_width(numbers.back(), s));
-  }
+  for (const std::string& n : numbers) widest = std::max(widest, text_width(n, s));
   const int panel_w = std::max(pad + tick + bar_w + pad + widest + pad, text_width(title, s) + 2 * pad);
   const int header = pad + glyph_h + pad + glyph_h / 2;  // title, then half a glyph so the top number fits
   const int footer = glyph_h / 2 + pad;

@@ -35,8 +35,11 @@ struct LegendLayout {
   std::vector<Label> labels;  ///< title first, then the tick numbers from low to high
 };
 
-/// Lays out a legend for `range` (low, high) in a width × height viewport.
-LegendLayout layout_legend(int width, int height, const glm::vec2& range, std::string_view title, bool whole = false);
+/// Lays out a legend for `range` (low, high) in a width × height viewport;
+/// `above_top`: the image has values above the range, and the top number
+/// says so ("20+", core's legend_labels).
+LegendLayout layout_legend(int width, int height, const glm::vec2& range, std::string_view title, bool whole = false,
+                           bool above_top = false);
 
 class LegendPass {
  public:

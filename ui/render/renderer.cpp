@@ -115,7 +115,9 @@ LegendLayout Renderer::legend_layout(const RenderView& view, int width, int heig
     return {};
   }
   const std::string title = h.title.empty() ? std::string(metric_short_label(heatmap_.metric())) : h.title;
-  return layout_legend(width, height, heatmap_range(h), title, metric_counts(heatmap_.metric()));
+  const glm::vec2 range = heatmap_range(h);
+  return layout_legend(width, height, range, title, metric_counts(heatmap_.metric()),
+                       heatmap_.value_range().max > range.y);
 }
 
 void Renderer::render(const RenderView& view, int width, int height) {

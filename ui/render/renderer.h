@@ -74,6 +74,8 @@ class Renderer {
   Aabb content_bounds() const;
   /// The value range the heatmap and its legend use under `view`.
   glm::vec2 heatmap_range(const HeatmapView& view) const;
+  /// The heatmap image's smallest and largest value (outside a locked range, some are clamped).
+  ValueRange heatmap_values() const { return heatmap_.value_range(); }
   /// Where the legend is drawn for `view` at this size (visible = false when none).
   LegendLayout legend_layout(const RenderView& view, int width, int height) const;
 
