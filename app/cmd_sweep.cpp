@@ -175,7 +175,8 @@ nlohmann::json result_json(const SweepResult& r, double budget) {
       {"nodes", r.nodes},
       {"leaves", r.leaves},
       {"max_depth", r.max_depth},
-      {"sah_cost", r.sah_cost},
+      {"sah_cost", r.sah_cost > 0 ? nlohmann::json(r.sah_cost) : nlohmann::json(nullptr)},
+      {"build_of", r.build_of.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.build_of)},
       {"epo", r.epo >= 0 ? nlohmann::json(r.epo) : nlohmann::json(nullptr)},
       {"rays_per_s", r.rays_per_s},
       {"rays_per_s_runs", r.rays_per_s_runs},
@@ -244,20 +245,24 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
   config.threads = o.threads;
   config.ray_budget = o.ray_budget;
   std::vector<SweepResult> results;
+  results.reserve(settings.size());
   for (std::size_t i = 0; i < settings.size(); ++i) {
     progress.begin("setting " + std::to_string(i + 1) + "/" + std::to_string(settings.size()) + ": " +
                    setting_label(settings[i]));
-    results.push_back(measure_sweep_setting(scene.triangles, rays, probes, config, settings[i]));
+    // A setting that differs from an earlier one only in the triangle test builds the same tree: its build is
+    // not measured again (a second measurement would report the noise as a cost).
+    const auto same = earlier_same_build(settings, i);
+    results.push_back(
+        measure_sweep_setting(scene.triangles, rays, probes, config, settings[i], same ? &results[*same] : nullptr));
     char buf[96];
     std::snprintf(buf, sizeof buf, "build %.1f ms, %.3g rays/s", results.back().build_ms, results.back().rays_per_s);
     progress.end(buf);
   }
 
   // ---- analysis ----
-  std::vector<Point2> pts;
-  for (const SweepResult& r : results) pts.push_back({r.build_ms, r.trace_ms(o.ray_budget)});
-  const std::vector<std::size_t> front = pareto_front(pts);
-  const double budgets[] = {1e6, 1e9, o.ray_budget};
+  const std::vector<std::size_t> front = pareto_front(sweep_points(results, o.ray_budget));
+  std::vector<double> budgets{1e6, 1e9};
+  if (o.ray_budget != 1e6 && o.ray_budget != 1e9) budgets.push_back(o.ray_budget);
 
   // ---- files ----
   prepare_output_dir(o.out, "sweep", o.force);
@@ -288,7 +293,15 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
   j["best_for_budget"] = nlohmann::json::array();
   for (double b : budgets) {
     const SweepResult& r = results[best_for_budget(results, b)];
-    j["best_for_budget"].push_back({{"rays", b}, {"setting", setting_label(r.setting)}, {"total_ms", r.total_ms(b)}});
+    nlohmann::json e = {{"rays", b}, {"setting", setting_label(r.setting)}, {"total_ms", r.total_ms(b)}};
+    if (!probes.empty()) {
+      e["edge_leaks"] = r.edges.misses;
+      const auto clean = best_without_leaks(results, b);
+      e["best_without_leaks"] = clean ? nlohmann::json{{"setting", setting_label(results[*clean].setting)},
+                                                       {"total_ms", results[*clean].total_ms(b)}}
+                                      : nlohmann::json(nullptr);
+    }
+    j["best_for_budget"].push_back(e);
   }
   write_output_text(dir / "sweep.json", j.dump(2) + "\n");
 
@@ -315,8 +328,10 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
   if (!probes.empty()) std::printf(" %12s %12s", "edge leaks", "rays hit 2x");
   std::printf("\n");
   for (const SweepResult& r : results) {
-    std::printf("%-32s %10.2f %10s %8.3f %10.2f %10.2f %12.3f %12.2f", setting_label(r.setting).c_str(), r.build_ms,
-                format_bytes(r.memory_bytes).c_str(), r.sah_cost, r.nodes_per_ray, r.prims_per_ray, r.rays_per_s / 1e6,
+    char sah[32] = "n/a";  // grids and voxels report no SAH cost
+    if (r.sah_cost > 0) std::snprintf(sah, sizeof sah, "%.3f", r.sah_cost);
+    std::printf("%-32s %10.2f %10s %8s %10.2f %10.2f %12.3f %12.2f", setting_label(r.setting).c_str(), r.build_ms,
+                format_bytes(r.memory_bytes).c_str(), sah, r.nodes_per_ray, r.prims_per_ray, r.rays_per_s / 1e6,
                 r.total_ms(o.ray_budget));
     if (!probes.empty())
       std::printf(" %5llu/%llu", static_cast<unsigned long long>(r.edges.misses),
@@ -324,13 +339,34 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
     if (!probes.empty()) std::printf(" %12llu", static_cast<unsigned long long>(r.ray_double_hits));
     std::printf("\n");
   }
-  std::printf("\nPareto-optimal (build ms, trace ms for %g rays):\n", o.ray_budget);
-  for (std::size_t i : front)
-    std::printf("  %-32s build %.2f ms, trace %.2f ms\n", setting_label(results[i].setting).c_str(),
-                results[i].build_ms, results[i].trace_ms(o.ray_budget));
+  for (const SweepResult& r : results)
+    if (!r.build_of.empty()) {
+      std::printf(
+          "settings that differ only in the triangle test share one tree: its build figures are measured "
+          "once (e.g. %s: those of %s)\n",
+          setting_label(r.setting).c_str(), r.build_of.c_str());
+      break;
+    }
+  std::printf("\nPareto-optimal (build ms, trace ms for %g rays%s):\n", o.ray_budget,
+              probes.empty() ? "" : ", edge leaks");
+  for (std::size_t i : front) {
+    std::printf("  %-32s build %.2f ms, trace %.2f ms", setting_label(results[i].setting).c_str(), results[i].build_ms,
+                results[i].trace_ms(o.ray_budget));
+    if (!probes.empty()) std::printf(", %llu leaks", static_cast<unsigned long long>(results[i].edges.misses));
+    std::printf("\n");
+  }
   for (double b : {1e6, 1e9}) {
     const SweepResult& r = results[best_for_budget(results, b)];
-    std::printf("best for %g rays: %s (total %.1f ms)\n", b, setting_label(r.setting).c_str(), r.total_ms(b));
+    std::printf("best for %g rays: %s (total %.1f ms)", b, setting_label(r.setting).c_str(), r.total_ms(b));
+    // The fastest setting may leak through shared edges: name the fastest that does not.
+    if (!probes.empty() && r.edges.misses > 0) {
+      std::printf("; it leaks through %llu of %llu shared-edge probes", static_cast<unsigned long long>(r.edges.misses),
+                  static_cast<unsigned long long>(r.edges.probes));
+      if (const auto clean = best_without_leaks(results, b))
+        std::printf("; without leaks: %s (total %.1f ms)", setting_label(results[*clean].setting).c_str(),
+                    results[*clean].total_ms(b));
+    }
+    std::printf("\n");
   }
   std::printf("wrote %s: sweep.csv, sweep.json and %zu charts\n", absolute_path(o.out).c_str(), charts.size());
   return 0;

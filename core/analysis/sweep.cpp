@@ -78,6 +78,23 @@ const std::vector<std::string>& sweep_param_names(std::string_view structure) {
   return it == names.end() ? only_triangle : it->second;
 }
 
+bool sweep_param_is_query(std::string_view name) {
+  return name == "triangle";
+}
+
+std::optional<std::size_t> earlier_same_build(std::span<const SweepSetting> settings, std::size_t i) {
+  const auto build_part = [](const SweepSetting& s) {
+    SweepSetting b;
+    for (const auto& kv : s)
+      if (!sweep_param_is_query(kv.first)) b.push_back(kv);
+    return b;
+  };
+  const SweepSetting mine = build_part(settings[i]);
+  for (std::size_t j = 0; j < i; ++j)
+    if (build_part(settings[j]) == mine) return j;
+  return std::nullopt;
+}
+
 SweepParam parse_sweep_param(std::string_view text) {
   const std::size_t eq = text.find('=');
   if (eq == std::string_view::npos || eq == 0)
@@ -336,7 +353,7 @@ std::uint64_t count_ray_double_hits(std::span<const Triangle> triangles,
 TimedStructure time_structure(
     const std::function<std::unique_ptr<Accelerator>(const ProgressCallback& progress)>& build,
     std::span<const Ray> rays, const QueryOptions& query, unsigned threads, int warmup, int repeat,
-    const std::function<bool()>& keep_going) {
+    const std::function<bool()>& keep_going, bool time_builds) {
   const auto check = [&] {
     if (keep_going && !keep_going()) throw BuildCancelled();
   };
@@ -352,11 +369,11 @@ TimedStructure time_structure(
     check();
     if (!rays.empty()) trace_closest(*t.accel, rays, t.hits, query, n_threads);
   }
-  for (int k = 0; k < std::max(1, repeat); ++k) {
+  for (int k = 0; k < (time_builds ? std::max(1, repeat) : t.accel ? 0 : 1); ++k) {
     t.accel.reset();
     check();
     t.accel = build(progress);
-    t.build_ms_runs.push_back(t.accel->build_stats().build_ms);
+    if (time_builds) t.build_ms_runs.push_back(t.accel->build_stats().build_ms);
   }
   if (rays.empty()) return t;
   for (int k = 0; k < std::max(1, repeat); ++k) {
@@ -430,7 +447,7 @@ CalibrationReport compare_calibrated_bvh(std::span<const Triangle> triangles, st
 
 SweepResult measure_sweep_setting(std::span<const Triangle> triangles, std::span<const Ray> rays,
                                   std::span<const EdgeProbe> probes, const SweepConfig& config,
-                                  const SweepSetting& setting) {
+                                  const SweepSetting& setting, const SweepResult* same_build) {
   SweepResult r;
   r.setting = setting;
   StructureOptions so = config.base;
@@ -441,16 +458,28 @@ SweepResult measure_sweep_setting(std::span<const Triangle> triangles, std::span
   r.triangle_test = q.triangle_test == TriangleTest::watertight ? "watertight" : "fast";
   TimedStructure t = time_structure(
       [&](const ProgressCallback& progress) { return build_accelerator(config.structure, triangles, so, progress); },
-      rays, q, config.threads, config.warmup, config.repeat, config.keep_going);
-  r.build_ms_runs = std::move(t.build_ms_runs);
-  r.build_ms = median(r.build_ms_runs);
-  const BuildStats& bs = t.accel->build_stats();
-  r.memory_bytes = bs.memory_bytes;
-  r.nodes = bs.node_count;
-  r.leaves = bs.leaf_count;
-  r.max_depth = bs.max_depth;
-  r.sah_cost = bs.sah_cost;
-  if (const auto it = bs.extra.find("epo"); it != bs.extra.end()) r.epo = it->second;
+      rays, q, config.threads, config.warmup, config.repeat, config.keep_going, same_build == nullptr);
+  if (same_build) {
+    r.build_of = same_build->build_of.empty() ? setting_label(same_build->setting) : same_build->build_of;
+    r.build_ms_runs = same_build->build_ms_runs;
+    r.build_ms = same_build->build_ms;
+    r.memory_bytes = same_build->memory_bytes;
+    r.nodes = same_build->nodes;
+    r.leaves = same_build->leaves;
+    r.max_depth = same_build->max_depth;
+    r.sah_cost = same_build->sah_cost;
+    r.epo = same_build->epo;
+  } else {
+    r.build_ms_runs = std::move(t.build_ms_runs);
+    r.build_ms = median(r.build_ms_runs);
+    const BuildStats& bs = t.accel->build_stats();
+    r.memory_bytes = bs.memory_bytes;
+    r.nodes = bs.node_count;
+    r.leaves = bs.leaf_count;
+    r.max_depth = bs.max_depth;
+    r.sah_cost = bs.sah_cost;
+    if (const auto it = bs.extra.find("epo"); it != bs.extra.end()) r.epo = it->second;
+  }
 
   if (!rays.empty()) {
     r.rays_per_s_runs = std::move(t.rays_per_s_runs);
@@ -473,23 +502,27 @@ std::vector<SweepResult> run_sweep(std::span<const Triangle> triangles, std::spa
   out.reserve(settings.size());
   for (std::size_t i = 0; i < settings.size(); ++i) {
     if (progress && !progress(i, settings.size(), setting_label(settings[i]))) throw BuildCancelled();
-    out.push_back(measure_sweep_setting(triangles, rays, probes, config, settings[i]));
+    const auto same = earlier_same_build(settings, i);
+    out.push_back(measure_sweep_setting(triangles, rays, probes, config, settings[i], same ? &out[*same] : nullptr));
   }
   return out;
 }
 
 // ---- analysis ------------------------------------------------------------------------
 
-std::vector<std::size_t> pareto_front(std::span<const Point2> points) {
+std::vector<std::size_t> pareto_front(std::span<const ParetoPoint> points) {
+  const auto finite = [](const ParetoPoint& p) {
+    return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+  };
   std::vector<std::size_t> front;
   for (std::size_t i = 0; i < points.size(); ++i) {
-    const Point2& p = points[i];
-    if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
+    const ParetoPoint& p = points[i];
+    if (!finite(p)) continue;
     bool dominated = false;
     for (std::size_t j = 0; j < points.size() && !dominated; ++j) {
-      const Point2& o = points[j];
-      if (j == i || !std::isfinite(o.x) || !std::isfinite(o.y)) continue;
-      dominated = o.x <= p.x && o.y <= p.y && (o.x < p.x || o.y < p.y);
+      const ParetoPoint& o = points[j];
+      if (j == i || !finite(o)) continue;
+      dominated = o.x <= p.x && o.y <= p.y && o.z <= p.z && (o.x < p.x || o.y < p.y || o.z < p.z);
     }
     if (!dominated) front.push_back(i);
   }
@@ -499,11 +532,28 @@ std::vector<std::size_t> pareto_front(std::span<const Point2> points) {
   return front;
 }
 
+std::vector<ParetoPoint> sweep_points(std::span<const SweepResult> results, double rays) {
+  std::vector<ParetoPoint> p;
+  p.reserve(results.size());
+  for (const SweepResult& r : results)
+    p.push_back({r.build_ms, r.trace_ms(rays), r.edges.probes > 0 ? static_cast<double>(r.edges.misses) : 0.0});
+  return p;
+}
+
 std::size_t best_for_budget(std::span<const SweepResult> results, double rays) {
   if (results.empty()) throw std::invalid_argument("best_for_budget: no results");
   std::size_t best = 0;
   for (std::size_t i = 1; i < results.size(); ++i)
     if (results[i].total_ms(rays) < results[best].total_ms(rays)) best = i;
+  return best;
+}
+
+std::optional<std::size_t> best_without_leaks(std::span<const SweepResult> results, double rays) {
+  std::optional<std::size_t> best;
+  for (std::size_t i = 0; i < results.size(); ++i)
+    if (results[i].edges.probes > 0 && results[i].edges.misses == 0 &&
+        (!best || results[i].total_ms(rays) < results[*best].total_ms(rays)))
+      best = i;
   return best;
 }
 
@@ -516,15 +566,17 @@ std::string sweep_csv(std::span<const SweepResult> results, double ray_budget) {
   for (const std::string& p : params) os << p << ',';
   os << "label,triangle_test,build_ms,memory_bytes,nodes,leaves,max_depth,sah_cost,epo,nodes_per_ray,"
         "prims_per_ray,hit_fraction,rays_per_s,ray_budget,trace_ms_budget,total_ms_budget,edge_probes,"
-        "edge_misses,edge_double_hits,ray_double_hits\n";
+        "edge_misses,edge_double_hits,ray_double_hits,build_of\n";
   for (const SweepResult& r : results) {
     for (const auto& [k, v] : r.setting) os << v << ',';
     os << '"' << setting_label(r.setting) << "\"," << r.triangle_test << ',' << r.build_ms << ',' << r.memory_bytes
-       << ',' << r.nodes << ',' << r.leaves << ',' << r.max_depth << ',' << r.sah_cost << ',';
+       << ',' << r.nodes << ',' << r.leaves << ',' << r.max_depth << ',';
+    if (r.sah_cost > 0) os << r.sah_cost;  // empty: the structure reports none (grid, voxels)
+    os << ',';
     if (r.epo >= 0) os << r.epo;
     os << ',' << r.nodes_per_ray << ',' << r.prims_per_ray << ',' << r.hit_fraction << ',' << r.rays_per_s << ','
        << ray_budget << ',' << r.trace_ms(ray_budget) << ',' << r.total_ms(ray_budget) << ',' << r.edges.probes << ','
-       << r.edges.misses << ',' << r.edges.double_hits << ',' << r.ray_double_hits << '\n';
+       << r.edges.misses << ',' << r.edges.double_hits << ',' << r.ray_double_hits << ",\"" << r.build_of << "\"\n";
   }
   return os.str();
 }

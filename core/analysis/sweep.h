@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -46,6 +47,14 @@ SweepParam parse_sweep_param(std::string_view text);
 /// Throws std::invalid_argument naming the unknown parameter or bad value,
 /// and for a parameter given twice or an empty list.
 std::vector<SweepSetting> expand_sweep(std::string_view structure, std::span<const SweepParam> params);
+
+/// Whether parameter `name` sets a query option only (the triangle test):
+/// settings that differ only in such parameters build the same structure.
+bool sweep_param_is_query(std::string_view name);
+
+/// The first setting before settings[i] that builds the same structure
+/// (equal but for query parameters), if any.
+std::optional<std::size_t> earlier_same_build(std::span<const SweepSetting> settings, std::size_t i);
 
 /// Writes one setting into the structure and query options. Throws
 /// std::invalid_argument for an unknown name or a bad value (same messages).
@@ -132,6 +141,10 @@ struct SweepResult {
   /// on both sides (counted twice by any-hit or counting queries).
   std::uint64_t ray_double_hits = 0;
   std::string triangle_test;    ///< "watertight" or "fast"
+  /// Set when the build figures (build_ms*, memory, nodes, leaves, depth,
+  /// SAH, EPO) are those of an earlier setting that builds the same tree
+  /// (earlier_same_build): its label. Empty when measured here.
+  std::string build_of;
 
   /// Trace time of `rays` rays at the measured rate, in ms.
   double trace_ms(double rays) const { return rays_per_s > 0 ? rays / rays_per_s * 1e3 : 0.0; }
@@ -157,10 +170,12 @@ struct TimedStructure {
 /// `build(progress)` builds one tree, calling `progress` as builders do
 /// (false cancels). `keep_going` (empty: never cancel) is asked between
 /// builds and passes and during builds; false throws BuildCancelled.
+/// `time_builds` false: no timed builds (build_ms_runs stays empty); the
+/// tree of the last warm-up round is kept (one untimed build without one).
 TimedStructure time_structure(
     const std::function<std::unique_ptr<Accelerator>(const ProgressCallback& progress)>& build,
     std::span<const Ray> rays, const QueryOptions& query, unsigned threads, int warmup, int repeat,
-    const std::function<bool()>& keep_going);
+    const std::function<bool()>& keep_going, bool time_builds = true);
 
 /// BVH built with the default constants (1, 1) and with the calibrated ones
 /// (1, C_isect of the query's triangle test), judged by the same yardstick.
@@ -190,29 +205,42 @@ CalibrationReport compare_calibrated_bvh(std::span<const Triangle> triangles, st
 using SweepProgress = std::function<bool(std::size_t index, std::size_t count, const std::string& label)>;
 
 /// Measures one setting over `rays` (and `probes` when non-empty).
+/// `same_build`: the result of an earlier setting that builds the same tree
+/// (earlier_same_build): its build figures are taken, not measured again
+/// (a second measurement of one tree would report its noise as a cost).
 SweepResult measure_sweep_setting(std::span<const Triangle> triangles, std::span<const Ray> rays,
                                   std::span<const EdgeProbe> probes, const SweepConfig& config,
-                                  const SweepSetting& setting);
+                                  const SweepSetting& setting, const SweepResult* same_build = nullptr);
 
-/// Every setting in order.
+/// Every setting in order (settings that build the same tree share its build figures).
 std::vector<SweepResult> run_sweep(std::span<const Triangle> triangles, std::span<const Ray> rays,
                                    std::span<const EdgeProbe> probes, const SweepConfig& config,
                                    std::span<const SweepSetting> settings, const SweepProgress& progress = {});
 
 // ---- analysis ------------------------------------------------------------------------
 
-struct Point2 {
-  double x = 0, y = 0;
+/// A setting's costs, all to be minimised: x build ms, y trace ms, and z a
+/// third cost (the shared-edge leaks, where they were measured; else 0).
+struct ParetoPoint {
+  double x = 0, y = 0, z = 0;
 };
 
-/// Indices of the points no other point dominates when minimising both
-/// coordinates (q dominates p when q.x <= p.x, q.y <= p.y and one is strictly
-/// smaller), sorted by x then y. Equal points are all kept. Non-finite points
-/// are never on the front.
-std::vector<std::size_t> pareto_front(std::span<const Point2> points);
+/// Indices of the points no other point dominates when minimising every
+/// coordinate (q dominates p when q is nowhere larger and somewhere
+/// smaller), sorted by x then y. Equal points are all kept. Non-finite
+/// points are never on the front.
+std::vector<std::size_t> pareto_front(std::span<const ParetoPoint> points);
+
+/// The results as points: build ms, trace ms for `rays` rays, and the edge
+/// leaks (probe misses) when the triangle test was swept, so that an
+/// accurate setting stays on the front beside a faster one that leaks.
+std::vector<ParetoPoint> sweep_points(std::span<const SweepResult> results, double rays);
 
 /// Index of the result with the smallest total_ms(rays); results must not be empty.
 std::size_t best_for_budget(std::span<const SweepResult> results, double rays);
+/// The same among the results whose shared-edge probes found no leak; none
+/// when no probe was made or every result leaks.
+std::optional<std::size_t> best_without_leaks(std::span<const SweepResult> results, double rays);
 
 /// CSV with a header row: the swept parameters as columns, then the figures.
 std::string sweep_csv(std::span<const SweepResult> results, double ray_budget);

@@ -30,6 +30,12 @@ for r in rows:
     assert float(r["build_ms"]) > 0 and float(r["rays_per_s"]) > 0 and float(r["sah_cost"]) > 0, r
     assert int(r["edge_probes"]) == 300, r
     assert int(r["edge_misses"]) <= int(r["edge_probes"]), r
+# The triangle test is a query option: one tree per bucket count, built and timed once.
+by = {(r["buckets"], r["triangle"]): r for r in rows}
+for b in ("2", "8", "exact"):
+    w, f = by[(b, "watertight")], by[(b, "fast")]
+    assert w["build_of"] == "" and f["build_of"] == w["label"], (w, f)
+    assert f["build_ms"] == w["build_ms"] and f["memory_bytes"] == w["memory_bytes"], (w, f)
 j = json.load(open(os.path.join(out, "sweep.json")))
 for k in ("cpu_model", "hardware_threads", "threads_used", "date", "command_line"):
     assert k in j["machine"], k
@@ -38,6 +44,9 @@ assert j["warmup"] == 1 and j["repeat"] == 1, (j["warmup"], j["repeat"])
 assert "sweep" in j["machine"]["command_line"]
 assert len(j["results"]) == 6 and len(j["pareto_front"]) >= 1
 assert {b["rays"] for b in j["best_for_budget"]} >= {1e6, 1e9}, j["best_for_budget"]
+assert len(j["best_for_budget"]) == 2, j["best_for_budget"]  # the default budget 1e6 is listed once
+for b in j["best_for_budget"]:
+    assert "edge_leaks" in b and "best_without_leaks" in b, b  # edges were probed
 for png in glob.glob(os.path.join(out, "*.png")):
     data = open(png, "rb").read()
     assert data[:8] == b"\x89PNG\r\n\x1a\n", png
@@ -51,6 +60,17 @@ for png in glob.glob(os.path.join(out, "*.png")):
             idat += data[pos + 8:pos + 8 + n]
         pos += 12 + n
     assert len(zlib.decompress(idat)) == h * (1 + 3 * w), png
+PY
+
+# Grids report no SAH cost: n/a in the table, null in the JSON, empty in the CSV.
+"$bin" -q sweep 'builtin:soup?size=200' -s grid --param lambda=1,2 --size 8x8 --repeat 1 --threads 1 \
+  --out "$tmp/g" > "$tmp/g.txt"
+grep -q " n/a " "$tmp/g.txt" || fail "grid SAH not n/a: $(cat "$tmp/g.txt")"
+python3 - "$tmp/g" <<'PY'
+import csv, json, os, sys
+j = json.load(open(os.path.join(sys.argv[1], "sweep.json")))
+assert all(r["sah_cost"] is None for r in j["results"]), j["results"]
+assert all(r["sah_cost"] == "" for r in csv.DictReader(open(os.path.join(sys.argv[1], "sweep.csv"))))
 PY
 
 # A directory that holds sweep files is refused without --force, accepted with it.

@@ -118,7 +118,7 @@ TEST(SweepSeries, OneLinePerCombinationOfTheOtherParameters) {
   EXPECT_EQ(by_leaf[2].result, (std::vector<std::size_t>{2, 5}));
   EXPECT_EQ(by_leaf[2].value_index, (std::vector<int>{0, 1}));
 
-  const std::vector<Point2> pts = build_vs_trace_points(res, 1e6);
+  const std::vector<ParetoPoint> pts = sweep_points(res, 1e6);
   EXPECT_EQ(pts.size(), res.size());
 }
 

@@ -83,11 +83,39 @@ TEST(SweepParams, AppliesToTheRightOptions) {
 TEST(Pareto, HandMadePointSet) {
   // Front: (1,9) (2,5) (2,5) (4,3) (7,1). Dominated: (3,6) by (2,5); (5,3)
   // by (4,3) (same y, larger x); (8,8); (7,2) by (7,1). NaN never on the front.
-  const std::vector<Point2> pts{{3, 6}, {1, 9}, {2, 5}, {5, 3}, {4, 3}, {8, 8}, {7, 1}, {7, 2}, {2, 5}, {NAN, 0}};
+  const std::vector<ParetoPoint> pts{{3, 6}, {1, 9}, {2, 5}, {5, 3}, {4, 3}, {8, 8}, {7, 1}, {7, 2}, {2, 5}, {NAN, 0}};
   const std::vector<std::size_t> front = pareto_front(pts);
   EXPECT_EQ(front, (std::vector<std::size_t>{1, 2, 8, 4, 6}));
-  EXPECT_TRUE(pareto_front(std::vector<Point2>{}).empty());
-  EXPECT_EQ(pareto_front(std::vector<Point2>{{1, 1}}), (std::vector<std::size_t>{0}));
+  EXPECT_TRUE(pareto_front(std::vector<ParetoPoint>{}).empty());
+  EXPECT_EQ(pareto_front(std::vector<ParetoPoint>{{1, 1}}), (std::vector<std::size_t>{0}));
+}
+
+// The third cost (edge leaks): a slower setting that does not leak stays on
+// the front beside a faster one that does (the audit found sweep's front and
+// "best" naming only triangle=fast, which leaked through 413 of 3,336 probes).
+TEST(Pareto, LeaksKeepTheAccurateSettingOnTheFront) {
+  SweepResult fast, watertight, slow_leaky;
+  fast.setting = {{"triangle", "fast"}};
+  fast.build_ms = 2;
+  fast.rays_per_s = 2e6;
+  fast.edges = {100, 7, 0};
+  watertight.setting = {{"triangle", "watertight"}};
+  watertight.build_ms = 2;
+  watertight.rays_per_s = 1.5e6;
+  watertight.edges = {100, 0, 0};
+  slow_leaky = fast;  // slower than fast and leaks as much: dominated
+  slow_leaky.rays_per_s = 1e6;
+  std::vector<SweepResult> r{fast, watertight, slow_leaky};
+  EXPECT_EQ(pareto_front(sweep_points(r, 1e6)), (std::vector<std::size_t>{0, 1}));
+  // Without the leaks (not measured), watertight is dominated by fast.
+  std::vector<SweepResult> unmeasured = r;
+  for (SweepResult& x : unmeasured) x.edges = {};
+  EXPECT_EQ(pareto_front(sweep_points(unmeasured, 1e6)), (std::vector<std::size_t>{0}));
+  EXPECT_EQ(best_for_budget(r, 1e6), 0u);
+  EXPECT_EQ(best_without_leaks(r, 1e6), std::optional<std::size_t>(1));
+  EXPECT_EQ(best_without_leaks(unmeasured, 1e6), std::nullopt);  // no probe made: nothing to say
+  r[1].edges.misses = 1;
+  EXPECT_EQ(best_without_leaks(std::vector<SweepResult>{r[0], r[1]}, 1e6), std::nullopt);  // every one leaks
 }
 
 TEST(Pareto, BestForBudgetTradesBuildAgainstTrace) {
@@ -330,6 +358,57 @@ TEST(Sweep, WarmupRoundsRunUntimed) {
   // Two more builds and two more passes, each asked about at least once.
   EXPECT_GE(asked_by[2], asked_by[0] + 4);
   EXPECT_EQ(SweepConfig{}.warmup, 1);
+}
+
+TEST(SweepParams, SettingsDifferingOnlyInTheTriangleTestShareABuild) {
+  const std::vector<SweepParam> params{{"triangle", {"watertight", "fast"}}, {"buckets", {"4", "8"}}};
+  const std::vector<SweepSetting> s = expand_sweep("bvh", params);  // wt/4, wt/8, fast/4, fast/8
+  ASSERT_EQ(s.size(), 4u);
+  EXPECT_EQ(earlier_same_build(s, 0), std::nullopt);
+  EXPECT_EQ(earlier_same_build(s, 1), std::nullopt);
+  EXPECT_EQ(earlier_same_build(s, 2), std::optional<std::size_t>(0));
+  EXPECT_EQ(earlier_same_build(s, 3), std::optional<std::size_t>(1));
+  EXPECT_TRUE(sweep_param_is_query("triangle"));
+  EXPECT_FALSE(sweep_param_is_query("buckets"));
+}
+
+// The audit: sweeping `triangle` rebuilt the same grid and reported 6.25 ms
+// against 2.26 ms for it. Now the second setting takes the first's build
+// figures, and is not built again for timing.
+TEST(Sweep, TheSameTreeIsBuiltAndTimedOnce) {
+  const Scene scene = load_scene("builtin:teapot?size=800");
+  const std::vector<Ray> rays = small_primary(scene, 24, 18);
+  const std::vector<SweepParam> params{{"lambda", {"1", "4"}}, {"triangle", {"watertight", "fast"}}};
+  const std::vector<SweepSetting> settings = expand_sweep("grid", params);
+  SweepConfig cfg;
+  cfg.structure = "grid";
+  cfg.repeat = 3;
+  cfg.warmup = 1;
+  cfg.threads = 1;
+  const std::vector<SweepResult> res = run_sweep(scene.triangles, rays, {}, cfg, settings);
+  ASSERT_EQ(res.size(), 4u);
+  for (std::size_t i : {1u, 3u}) {
+    SCOPED_TRACE(i);
+    EXPECT_EQ(res[i].build_of, setting_label(res[i - 1].setting));
+    EXPECT_EQ(res[i].build_ms_runs, res[i - 1].build_ms_runs);
+    EXPECT_EQ(res[i].build_ms, res[i - 1].build_ms);
+    EXPECT_EQ(res[i].memory_bytes, res[i - 1].memory_bytes);
+    EXPECT_EQ(res[i].triangle_test, "fast");
+    EXPECT_GT(res[i].rays_per_s, 0.0);  // traced with its own test
+  }
+  EXPECT_TRUE(res[0].build_of.empty());
+  EXPECT_NE(res[0].memory_bytes, res[2].memory_bytes);  // lambda 1 and 4: two trees
+  // A shared build costs no timed builds: warm-up's tree is traced.
+  std::size_t asked_shared = 0, asked_own = 0;
+  for (bool shared : {false, true}) {
+    std::size_t& asked = shared ? asked_shared : asked_own;
+    cfg.keep_going = [&asked] {
+      ++asked;
+      return true;
+    };
+    (void)measure_sweep_setting(scene.triangles, rays, {}, cfg, settings[1], shared ? &res[0] : nullptr);
+  }
+  EXPECT_LE(asked_shared + 3, asked_own) << "three timed builds left out";
 }
 
 TEST(Sweep, OtherStructuresSweepTheirOwnParameters) {

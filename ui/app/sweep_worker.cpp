@@ -48,13 +48,6 @@ std::string apply_sweep_point(StructureChoice& choice, std::string_view structur
   return {};
 }
 
-std::vector<Point2> build_vs_trace_points(std::span<const SweepResult> results, double rays) {
-  std::vector<Point2> p;
-  p.reserve(results.size());
-  for (const SweepResult& r : results) p.push_back({r.build_ms, r.trace_ms(rays)});
-  return p;
-}
-
 const char* sweep_figure_name(SweepFigure f) {
   switch (f) {
     case SweepFigure::sah_cost:
@@ -163,11 +156,14 @@ std::shared_ptr<const SweepSnapshot> run_sweep_request(
     cfg.repeat = r.repeat;
     cfg.threads = r.threads;
     cfg.keep_going = keep_going;
-    for (const SweepSetting& s : snap->settings) {
+    for (std::size_t i = 0; i < snap->settings.size(); ++i) {
       if (keep_going && !keep_going()) throw BuildCancelled();
+      const SweepSetting& s = snap->settings[i];
       snap->stage = r.structure + " " + setting_label(s);
       emit();
-      snap->results.push_back(measure_sweep_setting(tris, rays, probes, cfg, s));
+      const auto same = earlier_same_build(snap->settings, i);
+      SweepResult m = measure_sweep_setting(tris, rays, probes, cfg, s, same ? &snap->results[*same] : nullptr);
+      snap->results.push_back(std::move(m));
     }
     if (r.calibrate) {
       snap->stage = "calibrating";

@@ -36,9 +36,6 @@ std::string default_sweep_params_text(std::string_view structure);
 /// `choice` is unchanged on error.
 std::string apply_sweep_point(StructureChoice& choice, std::string_view structure, const SweepSetting& setting);
 
-/// (build ms, trace ms for `rays` rays) of every result: the Pareto chart's points.
-std::vector<Point2> build_vs_trace_points(std::span<const SweepResult> results, double rays);
-
 /// The swept figures the panel can chart against a parameter.
 enum class SweepFigure { sah_cost, rays_per_s, nodes_per_ray, prims_per_ray, build_ms, total_ms, memory, edge_misses };
 inline constexpr int kSweepFigureCount = 8;

@@ -128,10 +128,10 @@ void result_tooltip(const SweepResult& r, double budget) {
 
 // Build time vs trace time for the budget; returns the clicked result index or -1.
 int pareto_chart(const std::vector<SweepResult>& res, double budget, std::size_t best) {
-  const std::vector<Point2> pts = build_vs_trace_points(res, budget);
+  const std::vector<ParetoPoint> pts = sweep_points(res, budget);
   const std::vector<std::size_t> front = pareto_front(pts);
   double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
-  for (const Point2& p : pts)
+  for (const ParetoPoint& p : pts)
     x0 = std::min(x0, p.x), x1 = std::max(x1, p.x), y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
   pad_range(x0, x1, true);
   pad_range(y0, y1, true);
@@ -140,7 +140,7 @@ int pareto_chart(const std::vector<SweepResult>& res, double budget, std::size_t
   const Plot plot = begin_plot("##pareto", 220.0f, x0, x1, y0, y1, "build ms (median)", ylabel);
   ImDrawList* dl = ImGui::GetWindowDrawList();
   std::vector<ImVec2> screen;
-  for (const Point2& p : pts) screen.push_back(plot.map(p.x, p.y));
+  for (const ParetoPoint& p : pts) screen.push_back(plot.map(p.x, p.y));
   for (std::size_t k = 1; k < front.size(); ++k) dl->AddLine(screen[front[k - 1]], screen[front[k]], kFront, 2.0f);
   const bool label_all = res.size() <= 10;
   for (std::size_t i = 0; i < res.size(); ++i) {
@@ -327,8 +327,22 @@ AccuracyAction accuracy_panel(AccuracyPanelState& st, const SweepSnapshot* snap,
     ImGui::SameLine();
     ImGui::TextColored(ImVec4(0.3f, 0.86f, 0.43f, 1.0f), "best: %s (%.3g ms)", setting_label(res[best].setting).c_str(),
                        res[best].total_ms(st.ray_budget));
+    // The fastest may leak through shared edges: name the fastest that does not.
+    if (res[best].edges.probes > 0 && res[best].edges.misses > 0) {
+      char clean_text[160] = "";
+      if (const auto clean = best_without_leaks(res, st.ray_budget))
+        std::snprintf(clean_text, sizeof clean_text, "; without leaks: %s (%.3g ms)",
+                      setting_label(res[*clean].setting).c_str(), res[*clean].total_ms(st.ray_budget));
+      ImGui::PushTextWrapPos(0.0f);
+      ImGui::TextColored(ImVec4(1.0f, 0.78f, 0.35f, 1.0f), "it leaks through %llu of %llu shared-edge probes%s",
+                         static_cast<unsigned long long>(res[best].edges.misses),
+                         static_cast<unsigned long long>(res[best].edges.probes), clean_text);
+      ImGui::PopTextWrapPos();
+    }
 
-    if (ImGui::CollapsingHeader("Build time vs trace time (Pareto front in red)", ImGuiTreeNodeFlags_DefaultOpen)) {
+    if (ImGui::CollapsingHeader(snap->probes ? "Build time vs trace time (Pareto front in red: build, trace and leaks)"
+                                             : "Build time vs trace time (Pareto front in red)",
+                                ImGuiTreeNodeFlags_DefaultOpen)) {
       const int c = pareto_chart(res, st.ray_budget, best);
       if (c >= 0) clicked = c;
     }
