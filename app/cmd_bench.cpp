@@ -23,6 +23,7 @@
 #include "core/query/batch.h"
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
+#include "core/scene/effects.h"
 #include "core/util/parallel.h"
 
 namespace accelviz::cli {
@@ -263,10 +264,8 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
     progress.end();
     if (want_diffuse) sets.push_back({"diffuse", diffuse_rays(scene.triangles, sets[0].rays, hits, o.seed)});
     if (want_shadow) {
-      std::vector<Light> lights = scene.lights;
-      if (lights.empty()) {
-        // Benchmark-only stand-in, reported in the output.
-        lights.push_back(synthetic_bench_light(scene.bounds()));
+      const std::vector<Light> lights = shadow_lights(scene, true);
+      if (scene.lights.empty()) {  // a stand-in, reported in the output
         synthetic_light = true;
         synthetic_position = lights[0].position;
       }

@@ -1,15 +1,15 @@
 // accelviz rays SCENE --kind primary|diffuse|shadow --out FILE.rays: writes
 // one of the benchmark's ray sets as a ray file, for `trace`, for other
 // renderers, and for tests.
-#include "app/cli_common.h"
+#include <cstdio>
+#include <memory>
 
+#include "app/cli_common.h"
 #include "core/query/batch.h"
 #include "core/query/camera.h"
 #include "core/query/ray_file.h"
 #include "core/query/ray_sets.h"
-
-#include <cstdio>
-#include <memory>
+#include "core/scene/effects.h"
 
 namespace accelviz::cli {
 
@@ -57,9 +57,8 @@ int run_rays(const RaysOptions& o, const GlobalOptions& global) {
       rays = diffuse_rays(scene.triangles, rays, hits, o.seed);
       j["seed"] = o.seed;
     } else {
-      std::vector<Light> lights = scene.lights;
-      if (lights.empty()) {
-        lights.push_back(synthetic_bench_light(scene.bounds()));
+      const std::vector<Light> lights = shadow_lights(scene, true);
+      if (scene.lights.empty()) {
         const glm::vec3 p = lights[0].position;
         if (!global.quiet)
           std::fprintf(stderr, "accelviz: %s has no lights: shadow rays aim at a synthetic point light at (%g, %g, %g)\n",

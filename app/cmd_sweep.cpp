@@ -2,14 +2,6 @@
 // in time. Thin over core/analysis/sweep.h: parse, load, make the ray set,
 // run the sweep, then write sweep.csv, sweep.json and the charts, and print
 // the Pareto-optimal settings and the best setting for a few ray budgets.
-#include "app/cli_common.h"
-
-#include "core/analysis/chart.h"
-#include "core/analysis/sweep.h"
-#include "core/query/camera.h"
-#include "core/util/huge_page_allocator.h"
-#include "core/util/parallel.h"
-
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -18,6 +10,14 @@
 #include <iostream>
 #include <map>
 #include <thread>
+
+#include "app/cli_common.h"
+#include "core/analysis/chart.h"
+#include "core/analysis/sweep.h"
+#include "core/query/camera.h"
+#include "core/scene/effects.h"
+#include "core/util/huge_page_allocator.h"
+#include "core/util/parallel.h"
 
 namespace accelviz::cli {
 
@@ -221,9 +221,9 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
 
   progress.begin(std::string("making ") + o.rays + " rays");
   const Camera camera = camera_for(o.camera, scene, size);
-  bool synthetic_light = false;
+  bool synthetic = false;  // shadow rays to synthetic_light(): the scene has no lights
   const std::vector<Ray> rays =
-      sweep_ray_set(scene, camera, size.width, size.height, kind, o.seed, o.threads, &synthetic_light);
+      sweep_ray_set(scene, camera, size.width, size.height, kind, o.seed, o.threads, &synthetic);
   progress.end(std::to_string(rays.size()) + " rays");
 
   // Shared-edge probes only when the triangle test is swept: they need an edge map of the whole mesh.
@@ -280,7 +280,7 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
   j["triangles"] = scene.triangles.size();
   j["structure"] = o.structure;
   j["rays"] = {{"kind", o.rays}, {"count", rays.size()}, {"size", {size.width, size.height}}, {"seed", o.seed}};
-  if (kind == RayKind::shadow) j["rays"]["synthetic_light"] = synthetic_light;
+  if (kind == RayKind::shadow) j["rays"]["synthetic_light"] = synthetic;
   j["repeat"] = o.repeat;
   j["warmup"] = o.warmup;
   j["ray_budget"] = o.ray_budget;
@@ -323,6 +323,10 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
   std::printf("scene %s: %zu triangles; %s, %zu %s rays; %u threads; medians of %d; ray budget %g\n", o.scene.c_str(),
               scene.triangles.size(), o.structure.c_str(), rays.size(), o.rays.c_str(), threads, o.repeat,
               o.ray_budget);
+  if (kind == RayKind::shadow && synthetic) {
+    const glm::vec3 p = synthetic_light(scene.bounds()).position;
+    std::printf("the scene has no lights: shadow rays aim at a synthetic point light at (%g, %g, %g)\n", p.x, p.y, p.z);
+  }
   std::printf("%-32s %10s %10s %8s %10s %10s %12s %12s", "setting", "build ms", "memory", "SAH", "nodes/ray",
               "prims/ray", "Mrays/s", "total ms");
   if (!probes.empty()) std::printf(" %12s %12s", "edge leaks", "rays hit 2x");

@@ -65,6 +65,7 @@
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
 #include "core/scene/animation.h"
+#include "core/scene/effects.h"
 #include "core/scene/load.h"
 #include "core/util/timing.h"
 #ifdef ACCELVIZ_GBENCH_HEATMAP
@@ -91,7 +92,7 @@ struct Fixture {
     std::vector<Hit> hits(rays[0].size());
     trace_closest(bvh, rays[0], hits, QueryOptions{}, 0u);
     rays[1] = diffuse_rays(scene.triangles, rays[0], hits, 1);
-    const Light light = synthetic_bench_light(scene.bounds());
+    const Light light = synthetic_light(scene.bounds());
     rays[2] = shadow_rays(scene.triangles, rays[0], hits, std::span<const Light>(&light, 1));
     // Radially outward in the primary rays' directions from 1.5 diagonals
     // off the centre, beyond the bounds' circumsphere (half a diagonal):

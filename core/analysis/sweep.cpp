@@ -15,6 +15,7 @@
 #include "core/accel/bvh/bvh.h"
 #include "core/analysis/sah.h"
 #include "core/query/batch.h"
+#include "core/scene/effects.h"
 #include "core/util/parallel.h"
 #include "core/util/random.h"
 #include "core/util/timing.h"
@@ -597,12 +598,8 @@ std::vector<Ray> sweep_ray_set(const Scene& scene, const Camera& camera, int wid
   std::vector<Hit> hits(primary.size());
   trace_closest(bvh, primary, hits, QueryOptions{}, resolve_threads(threads));
   if (kind == RayKind::diffuse) return diffuse_rays(scene.triangles, primary, hits, seed);
-  std::vector<Light> lights = scene.lights;
-  if (lights.empty()) {
-    lights.push_back(synthetic_bench_light(scene.bounds()));
-    if (synthetic_light) *synthetic_light = true;
-  }
-  return shadow_rays(scene.triangles, primary, hits, lights);
+  if (synthetic_light) *synthetic_light = scene.lights.empty();
+  return shadow_rays(scene.triangles, primary, hits, shadow_lights(scene, true));
 }
 
 }  // namespace accelviz

@@ -252,7 +252,7 @@ namespace accelviz {
 /// The ray set a sweep traces, made as the benchmark makes it: primary rays
 /// of `camera` (W×H); for diffuse and shadow, one closest-hit pass of a
 /// default BVH finds the primary hits they start from (shadow rays aim at the
-/// scene's lights, or at synthetic_bench_light when it has none, reported in
+/// scene's lights, or at synthetic_light when it has none, reported in
 /// `synthetic_light`).
 std::vector<Ray> sweep_ray_set(const Scene& scene, const Camera& camera, int width, int height, RayKind kind,
                                std::uint64_t seed, unsigned threads, bool* synthetic_light = nullptr);

@@ -135,19 +135,4 @@ std::vector<Ray> shadow_rays(std::span<const Triangle> triangles, std::span<cons
   return rays;
 }
 
-Light synthetic_bench_light(const Aabb& bounds) {
-  Light light;
-  light.name = "synthetic benchmark light";
-  light.kind = Light::Kind::point;
-  if (bounds.is_empty()) {
-    light.position = glm::vec3(0.0f, 10.0f, 0.0f);
-    return light;
-  }
-  float radius = 0.5f * glm::length(bounds.extent());
-  if (!(radius > 0.0f)) radius = 1.0f;
-  const glm::vec3 side = glm::normalize(glm::vec3(1.0f, 0.0f, 1.4f));
-  light.position = bounds.center() + glm::vec3(0.0f, radius, 0.0f) + 0.5f * radius * side;
-  return light;
-}
-
 }  // namespace accelviz

@@ -43,9 +43,4 @@ std::vector<Ray> diffuse_rays(std::span<const Triangle> triangles, std::span<con
 std::vector<Ray> shadow_rays(std::span<const Triangle> triangles, std::span<const Ray> primary,
                              std::span<const Hit> hits, std::span<const Light> lights);
 
-/// A point light above the scene for scenes that have none, used by the
-/// benchmark's shadow rays only (and reported as such): above the box centre
-/// by its bounding radius, shifted towards the default camera side.
-Light synthetic_bench_light(const Aabb& bounds);
-
 }  // namespace accelviz

@@ -111,15 +111,22 @@ bool shadow_rays_wanted(const Scene& scene, const EffectForces& forces) {
 std::vector<Light> shadow_lights(const Scene& scene, bool wanted) {
   if (!wanted) return {};
   if (!scene.lights.empty()) return scene.lights;
-  const Aabb b = scene.bounds();
-  Light l;
-  l.name = "synthetic";
-  l.kind = Light::Kind::point;
-  if (!b.is_empty()) {
-    const glm::vec3 e = b.extent();
-    l.position = b.center() + glm::vec3(0.0f, 2.0f * std::max({e.x, e.y, e.z}), 0.0f);
+  return {synthetic_light(scene.bounds())};
+}
+
+Light synthetic_light(const Aabb& bounds) {
+  Light light;
+  light.name = "synthetic";
+  light.kind = Light::Kind::point;
+  if (bounds.is_empty()) {
+    light.position = glm::vec3(0.0f, 10.0f, 0.0f);
+    return light;
   }
-  return {l};
+  float radius = 0.5f * glm::length(bounds.extent());
+  if (!(radius > 0.0f)) radius = 1.0f;
+  const glm::vec3 side = glm::normalize(glm::vec3(1.0f, 0.0f, 1.4f));
+  light.position = bounds.center() + glm::vec3(0.0f, radius, 0.0f) + 0.5f * radius * side;
+  return light;
 }
 
 Ray shadow_ray(const Ray& primary, const Hit& h, const Light& l) {

@@ -57,10 +57,15 @@ std::string effects_text(const SceneEffects& effects);
 /// them on (what decide_effects() says, without the rest of its work).
 bool shadow_rays_wanted(const Scene& scene, const EffectForces& forces);
 
-/// The lights shadow rays aim at: the scene's own, or, when shadow rays are
-/// forced on a scene without lights, one synthetic point light named
-/// "synthetic" above the scene: at the bounds' centre raised by twice the
-/// box's largest extent along +y. Empty when WANTED is false.
+/// The point light shadow rays aim at in a scene without lights, wherever
+/// they are asked for (forced in the app; the shadow rays of `bench`, `rays`,
+/// `sweep` and the benchmarks): named "synthetic", above the box centre by
+/// the box's bounding radius and half that towards the default camera's
+/// side (+x, +z); at (0, 10, 0) for an empty box.
+Light synthetic_light(const Aabb& bounds);
+
+/// The lights shadow rays aim at: the scene's own, or, in a scene without
+/// lights, synthetic_light(its bounds). Empty when WANTED is false.
 std::vector<Light> shadow_lights(const Scene& scene, bool wanted);
 
 /// The shadow (any-hit) ray from PRIMARY's hit H toward L: starts a little

@@ -73,6 +73,13 @@ assert all(r["sah_cost"] is None for r in j["results"]), j["results"]
 assert all(r["sah_cost"] == "" for r in csv.DictReader(open(os.path.join(sys.argv[1], "sweep.csv"))))
 PY
 
+# Shadow rays in a scene without lights aim at the synthetic light, and stdout says where.
+printf 'v -1 -1 0\nv 1 -1 0\nv 0 1 0\nv 0 0 -1\nf 1 2 3\nf 1 2 4\nf 2 3 4\nf 3 1 4\n' > "$tmp/unlit.obj"
+"$bin" -q sweep "$tmp/unlit.obj" --rays shadow --param leaf=1 --size 16x12 --repeat 1 --threads 1 \
+  --out "$tmp/sh" > "$tmp/sh.txt"
+grep -q "no lights: shadow rays aim at a synthetic point light at (" "$tmp/sh.txt" ||
+  fail "synthetic light not said: $(cat "$tmp/sh.txt")"
+
 # A directory that holds sweep files is refused without --force, accepted with it.
 if "$bin" -q sweep 'builtin:soup?size=200' --param leaf=1,4 --size 8x8 --repeat 1 --out "$out" 2> "$tmp/err.txt"; then
   fail "overwrote a sweep directory without --force"

@@ -9,6 +9,7 @@
 #include "core/query/batch.h"
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
+#include "core/scene/effects.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_camera {
@@ -280,7 +281,7 @@ TEST(RaySets, ShadowRaysGoToLightsInFrontOfTheSurface) {
     }
   }
   EXPECT_GT(to_below, 0u);
-  const Light synthetic = synthetic_bench_light(Aabb{{-5, 0, -5}, {5, 6, 5}});
+  const Light synthetic = synthetic_light(Aabb{{-5, 0, -5}, {5, 6, 5}});
   EXPECT_GT(synthetic.position.y, 6.0f);
 }
 }  // namespace unity_test_camera

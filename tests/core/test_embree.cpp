@@ -16,6 +16,7 @@
 #include "core/query/batch.h"
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
+#include "core/scene/effects.h"
 #include "core/scene/load.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
@@ -170,7 +171,7 @@ TEST(EmbreeOracle, SharedMeshesClosestAndAnyHitAgreeWithTheBvh) {
     std::vector<Hit> primary_hits(rays.size());
     trace_closest(bvh, rays, primary_hits, {}, 0u);
     const std::vector<Ray> bounces = diffuse_rays(tris, rays, primary_hits, 7);
-    const Light light[] = {synthetic_bench_light(box)};
+    const Light light[] = {synthetic_light(box)};
     const std::vector<Ray> shadows = shadow_rays(tris, rays, primary_hits, light);
     rays.insert(rays.end(), bounces.begin(), bounces.end());
     rays.insert(rays.end(), shadows.begin(), shadows.end());
