@@ -269,3 +269,46 @@ TEST(AppBuildWorker, ReopeningTheSameSceneReloadsIt) {
   EXPECT_EQ(app.settings().last_scene, "scene");
 }
 }  // namespace unity_test_app_build_worker
+
+namespace unity_test_app_build_worker {
+namespace {
+// The promise "simulate only the effects a scene calls for": a scene that
+// instances a mesh more than once opens as the two-level structure (the
+// effects list says "two-level on" for it); a scene without instancing then
+// goes back to the structure the app left; a structure the user picks is kept.
+TEST(AppBuildWorker, AnOpenedScenesInstancingChoosesTheLevel) {
+  AppSettings settings;
+  settings.config.structure.name = "kdtree";
+  AppState app(settings);
+  const auto shown = [&](const std::string& spec, const std::string& name) {
+    return pump(app, [&] {
+      return app.settled() && app.current() && app.current()->scene->spec == spec && app.current()->choice.name == name;
+    });
+  };
+  const std::string forest = "builtin:forest?size=400", teapot = "builtin:teapot?size=300";
+  app.open_scene(forest);
+  ASSERT_TRUE(shown(forest, "tlas"));
+  EXPECT_EQ(app.config().structure.name, "tlas");
+  EXPECT_NE(app.message().find("two-level structure (tlas) instead of kdtree"), std::string::npos) << app.message();
+  app.open_scene(teapot);
+  ASSERT_TRUE(shown(teapot, "kdtree"));
+  EXPECT_EQ(app.config().structure.name, "kdtree");
+  EXPECT_NE(app.message().find("back to kdtree from tlas"), std::string::npos) << app.message();
+  // A structure change by the user is not undone, and builds once.
+  app.open_scene(forest);
+  ASSERT_TRUE(shown(forest, "tlas"));
+  ASSERT_EQ(app.set_option("structure", "grid"), "");
+  ASSERT_TRUE(shown(forest, "grid"));
+  for (int i = 0; i < 20; ++i) app.update(64, 48);
+  EXPECT_EQ(app.current()->choice.name, "grid");
+  // tlas picked by the user on a scene without instancing stays tlas when such a scene opens again.
+  app.open_scene(teapot);
+  ASSERT_TRUE(shown(teapot, "grid"));
+  ASSERT_EQ(app.set_option("structure", "tlas"), "");
+  ASSERT_TRUE(shown(teapot, "tlas"));
+  app.open_scene(teapot);
+  ASSERT_TRUE(pump(app, [&] { return app.settled() && !app.loading_scene(); }));
+  EXPECT_EQ(app.current()->choice.name, "tlas");
+}
+}  // namespace
+}  // namespace unity_test_app_build_worker

@@ -24,6 +24,7 @@ void AppState::open_scene(const std::string& spec) {
   wanted_scene_ = spec;
   reload_ = true;
   scene_loading_ = true;
+  follow_effects_ = true;
   set_message("loading " + spec);
 }
 
@@ -105,8 +106,14 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
   const StructureChoice& wanted = config().structure;
   if (!wanted_scene_.empty() &&
       (reload_ || wanted_scene_ != requested_scene_ || !requested_ || !same_build(*requested_, wanted))) {
+    // A structure the user chose (not the app for an instanced scene) is kept from then on.
+    if (requested_ && requested_->name != wanted.name) left_for_tlas_.clear();
     BuildRequest r{wanted_scene_, wanted, reload_, {}};
     if (preloaded_ && preloaded_->spec == wanted_scene_) r.preloaded = preloaded_;
+    r.follow_effects = follow_effects_;
+    r.forces = config().effects;
+    if (wanted.name == "tlas") r.single_level = left_for_tlas_;
+    follow_effects_ = false;
     preloaded_.reset();
     request_id_ = builds_.request(std::move(r));
     if (scene_loading_) scene_request_id_ = request_id_;
@@ -122,6 +129,16 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
     if (o.id != request_id_) continue;
     if (o.result == BuildOutcome::Result::built) {
       const bool new_scene = !rest_ || rest_->scene != o.built->scene;
+      // The scene's effects chose the level (BuildRequest::follow_effects): the choice follows.
+      std::string switched;
+      if (!o.switched_from.empty()) {
+        settings_.config.structure.name = o.built->choice.name;
+        if (requested_) requested_->name = o.built->choice.name;
+        left_for_tlas_ = o.built->choice.name == "tlas" ? o.switched_from : std::string();
+        switched = o.built->choice.name == "tlas"
+                       ? "; " + o.switch_reason + ": two-level structure (tlas) instead of " + o.switched_from
+                       : "; no mesh instanced twice: back to " + o.built->choice.name + " from tlas";
+      }
       current_ = std::move(o.built);
       rest_ = current_;
       u.structure_changed = true;
@@ -140,7 +157,7 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
           m += ", " + std::to_string(scene.report.warnings.size()) +
                " loader warning(s): " + scene.report.warnings.front();
         if (!camera_.framing_problem.empty()) m += "; " + camera_.framing_problem;
-        set_message(m);
+        set_message(m + switched);
       } else {
         set_message("built " + describe_structure(current_->choice) + " in " +
                     std::to_string(static_cast<long long>(std::lround(current_->wall_ms))) + " ms");

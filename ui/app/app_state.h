@@ -171,6 +171,11 @@ class AppState {
   std::string wanted_scene_;
   bool reload_ = false;
   bool scene_loading_ = false;
+  bool follow_effects_ = false;  ///< the next request loads a scene the user opened: its effects choose the level
+  /// The single-level structure the app left when an opened scene's
+  /// instancing chose `tlas`; a scene without instancing goes back to it.
+  /// "" once the user chooses a structure.
+  std::string left_for_tlas_;
   std::shared_ptr<const LoadedScene> preloaded_;  ///< open_loaded_scene's scene, until requested
   std::uint64_t scene_request_id_ = 0;            ///< the build request that loads the wanted scene
   std::string requested_scene_;                   ///< of the last build request

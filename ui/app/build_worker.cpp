@@ -92,6 +92,7 @@ void BuildWorker::set_stage(std::string s) {
 BuildOutcome BuildWorker::execute(std::uint64_t id, const BuildRequest& r) {
   BuildOutcome out;
   out.id = id;
+  std::string building = r.structure.name;  // the structure built (the scene's effects may choose another)
   try {
     std::shared_ptr<const LoadedScene> scene = scene_;
     if (r.preloaded) {
@@ -119,13 +120,26 @@ BuildOutcome BuildWorker::execute(std::uint64_t id, const BuildRequest& r) {
       scene_ = scene;
     }
     if (cancelled(id)) throw BuildCancelled();
-    set_stage("building " + r.structure.name);
+    StructureChoice wanted = r.structure;
+    if (r.follow_effects) {
+      const Effect two_level = decide_effects(scene->scene, r.forces).two_level;
+      const std::string level = two_level.on                                       ? std::string("tlas")
+                                : wanted.name == "tlas" && !r.single_level.empty() ? r.single_level
+                                                                                   : wanted.name;
+      if (level != wanted.name) {
+        out.switched_from = wanted.name;
+        out.switch_reason = two_level.reason;
+        wanted.name = level;
+      }
+    }
+    building = wanted.name;
+    set_stage("building " + wanted.name);
     const auto t0 = std::chrono::steady_clock::now();
     const ProgressCallback progress = [this, id](double f) {
       fraction_ = std::clamp(f, 0.0, 1.0);
       return !cancelled(id);
     };
-    StructureChoice choice = r.structure;
+    StructureChoice choice = wanted;
     choice.options.scene = &scene->scene;  // "tlas": two levels from the scene's instances (used during the build only)
     std::shared_ptr<const Accelerator> accel = build_(scene->scene.triangles, choice, progress);
     if (cancelled(id)) throw BuildCancelled();
@@ -134,7 +148,7 @@ BuildOutcome BuildWorker::execute(std::uint64_t id, const BuildRequest& r) {
     built->nodes = StructureNodes::of(*accel);
     built->scene = std::move(scene);
     built->accel = std::move(accel);
-    built->choice = r.structure;
+    built->choice = wanted;
     built->wall_ms = ms_since(t0);
     out.result = BuildOutcome::Result::built;
     out.built = std::move(built);
@@ -142,10 +156,10 @@ BuildOutcome BuildWorker::execute(std::uint64_t id, const BuildRequest& r) {
     out.result = BuildOutcome::Result::cancelled;
   } catch (const std::bad_alloc&) {
     out.result = BuildOutcome::Result::failed;
-    out.error = "out of memory while building " + r.structure.name;
+    out.error = "out of memory while building " + building;
   } catch (const std::exception& e) {
     out.result = BuildOutcome::Result::failed;
-    out.error = r.structure.name + ": " + joined_line(e.what());
+    out.error = building + ": " + joined_line(e.what());
   }
   return out;
 }

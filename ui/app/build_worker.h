@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/accel/accel.h"
+#include "core/scene/effects.h"
 #include "core/scene/scene.h"
 #include "ui/app/app_config.h"
 #include "ui/app/latest_job_worker.h"
@@ -49,6 +50,14 @@ struct BuildRequest {
   bool reload = false;  ///< load the scene again even if it is the current one (File > Open of the same file)
   /// When set, this scene (spec == `scene`) is used instead of loading one.
   std::shared_ptr<const LoadedScene> preloaded;
+  /// A scene opened by the user: its effects (decide_effects with `forces`)
+  /// choose the level. A scene that instances a mesh more than once is built
+  /// as `tlas` whatever `structure` names; one that does not, while
+  /// `structure` is `tlas` and `single_level` names a structure (the one the
+  /// app left for an instanced scene), is built as `single_level`.
+  bool follow_effects = false;
+  EffectForces forces;
+  std::string single_level;
 };
 
 struct BuildOutcome {
@@ -58,6 +67,10 @@ struct BuildOutcome {
   std::shared_ptr<const BuiltStructure> built;  ///< when built
   std::string error;                            ///< when failed: one line
   bool scene_error = false;                     ///< the failure was loading the scene
+  /// The structure the request named when the scene's effects chose another
+  /// (BuildRequest::follow_effects; built->choice names the one built); "" otherwise.
+  std::string switched_from;
+  std::string switch_reason;  ///< the two-level effect's reason, when switched
 };
 
 class BuildWorker {
