@@ -120,4 +120,15 @@ for ids in "0,,1" "0," "x" "99999" "2-1"; do
   [ $rc -eq 2 ] || { echo "FAIL: flatten --instances $ids: exit $rc, expected 2"; exit 1; }
   grep -q -- "--instances" <<<"$msg" || { echo "FAIL: message should name --instances: $msg"; exit 1; }
 done
+# refit's motion is its own: it says so, for a static scene and for an animated one alike.
+"$accelviz" -q refit 'builtin:teapot?size=300' --frames 1 --size 16x12 -j 1 --out "$tmp/refit1" > "$tmp/refit1.txt"
+grep -q "motion: synthetic vertex motion (the scene itself is static)" "$tmp/refit1.txt" ||
+  { echo "FAIL: refit on a static scene: $(cat "$tmp/refit1.txt")"; exit 1; }
+"$accelviz" -q refit 'builtin:dynamic?size=1200' --frames 1 --size 16x12 -j 1 --out "$tmp/refit2" > "$tmp/refit2.txt"
+grep -q "the scene's own .* animation(s) are not played here" "$tmp/refit2.txt" ||
+  { echo "FAIL: refit on an animated scene: $(cat "$tmp/refit2.txt")"; exit 1; }
+python3 -c '
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["motion"] == "synthetic" and j["scene_animations"] > 0, j' "$tmp/refit2/refit.json"
 echo "dynamics cli ok"
