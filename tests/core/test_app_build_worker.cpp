@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "core/accel/brute_force.h"
+#include "core/accel/tlas/tlas.h"
 #include "core/query/camera.h"
 #include "ui/app/app_state.h"
 
@@ -306,6 +307,13 @@ TEST(AppBuildWorker, AnOpenedScenesInstancingChoosesTheLevel) {
   ASSERT_TRUE(shown(teapot, "grid"));
   ASSERT_EQ(app.set_option("structure", "tlas"), "");
   ASSERT_TRUE(shown(teapot, "tlas"));
+  // Allowed, and said: the scene calls for one level.
+  const auto* tlas = dynamic_cast<const Tlas*>(app.current()->accel.get());
+  ASSERT_NE(tlas, nullptr);
+  EXPECT_NE(app.message().find("no mesh is instanced twice (two-level off): tlas holds its " +
+                               std::to_string(tlas->instances().size()) + " instance(s)"),
+            std::string::npos)
+      << app.message();
   app.open_scene(teapot);
   ASSERT_TRUE(pump(app, [&] { return app.settled() && !app.loading_scene(); }));
   EXPECT_EQ(app.current()->choice.name, "tlas");

@@ -143,6 +143,10 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
       rest_ = current_;
       u.structure_changed = true;
       const Scene& scene = current_->scene->scene;
+      // tlas over a scene that instances nothing twice: allowed (to see what a level costs), said.
+      if (current_->choice.name == "tlas" && !decide_effects(scene, config().effects).two_level.on)
+        switched += "; no mesh is instanced twice (two-level off): tlas holds its " +
+                    std::to_string(std::max<std::size_t>(1, scene.instances.size())) + " instance(s)";
       if (new_scene) {
         u.scene_changed = true;
         camera_ = ViewCamera::scene_default(scene, aspect_of(view_w_, view_h_));
@@ -160,7 +164,7 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
         set_message(m + switched);
       } else {
         set_message("built " + describe_structure(current_->choice) + " in " +
-                    std::to_string(static_cast<long long>(std::lround(current_->wall_ms))) + " ms");
+                    std::to_string(static_cast<long long>(std::lround(current_->wall_ms))) + " ms" + switched);
         recast();
       }
     } else if (o.result == BuildOutcome::Result::failed) {
