@@ -63,22 +63,50 @@ struct Entry {
   Setter set;
 };
 
-Entry int_option(std::string_view key, std::string_view values, std::string_view help, long long lo, long long hi,
+// OptionInfo holds views: texts made for the table live as long as it (built
+// once, by entries()' static initialisation).
+std::string_view kept(std::string text) {
+  static std::deque<std::string> texts;
+  return texts.emplace_back(std::move(text));
+}
+
+// An integer bound as the values texts write it: "256", "1000000", "2^31-1".
+std::string int_bound_text(long long v) {
+  return v == std::numeric_limits<int>::max() ? "2^31-1" : std::to_string(v);
+}
+
+// A float bound: "0", "0.5", "1000", "1e6".
+std::string bound_text(double v) {
+  if (v >= 1e4 && v == std::floor(v)) {
+    const int e = static_cast<int>(std::lround(std::log10(v)));
+    if (std::pow(10.0, e) == v) return "1e" + std::to_string(e);
+  }
+  return format_number(v);
+}
+
+// What an option accepts, from its bounds (so the help texts, the docs and
+// the errors cannot drift from the check).
+std::string range_text(double lo, double hi, bool lo_open) {
+  return lo_open ? "> " + bound_text(lo) + ", at most " + bound_text(hi) : bound_text(lo) + ".." + bound_text(hi);
+}
+
+Entry int_option(std::string_view key, std::string_view help, long long lo, long long hi,
                  std::function<int&(AppConfig&)> field) {
+  const std::string_view values = kept(int_bound_text(lo) + ".." + int_bound_text(hi));
   return {{key, values, help},
           [field](const AppConfig& c) { return std::to_string(field(const_cast<AppConfig&>(c))); },
-          [field, lo, hi](AppConfig& c, std::string_view v) -> std::string {
+          [field, lo, hi, values](AppConfig& c, std::string_view v) -> std::string {
             const auto x = to_int(v);
-            if (!x || *x < lo || *x > hi)
-              return "expected an integer in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " + quoted(v);
+            if (!x || *x < lo || *x > hi) return "expected an integer in " + std::string(values) + ", got " + quoted(v);
             field(c) = static_cast<int>(*x);
             return {};
           }};
 }
 
 // `lo_open`: the lower bound itself is refused (costs must be > 0).
-Entry float_option(std::string_view key, std::string_view values, std::string_view help, double lo, double hi,
-                   bool lo_open, std::function<float&(AppConfig&)> field) {
+Entry float_option(std::string_view key, std::string_view help, double lo, double hi, bool lo_open,
+                   std::function<float&(AppConfig&)> field) {
+  const std::string_view values = kept(range_text(lo, hi, lo_open));
   return {{key, values, help},
           [field](const AppConfig& c) { return format_number(field(const_cast<AppConfig&>(c))); },
           [field, lo, hi, lo_open, values](AppConfig& c, std::string_view v) -> std::string {
@@ -106,15 +134,12 @@ Entry bool_option(std::string_view key, std::string_view help, std::function<boo
 template <typename T>
 Entry enum_option(std::string_view key, std::string_view help, std::vector<std::pair<std::string_view, T>> names,
                   std::function<T&(AppConfig&)> field) {
-  // OptionInfo holds views: the joined names live as long as the table
-  // (built once, by entries()' static initialisation).
-  static std::deque<std::string> joined;
   std::string j;
   for (const auto& [n, t] : names) {
     if (!j.empty()) j += '|';
     j += n;
   }
-  const std::string_view values = joined.emplace_back(std::move(j));
+  const std::string_view values = kept(std::move(j));
   return {{key, values, help},
           [field, names](const AppConfig& c) {
             const T v = field(const_cast<AppConfig&>(c));
@@ -136,7 +161,9 @@ const std::vector<Entry>& entries() {
   static const std::vector<Entry> table = [] {
     std::vector<Entry> t;
     // Structure type.
-    t.push_back({{"structure", "brute|brute-bbox|bvh|kdtree|grid|octree|voxels|tlas|embree", "structure to build"},
+    std::string names;
+    for (const std::string& n : structure_names()) names += (names.empty() ? "" : "|") + n;
+    t.push_back({{"structure", kept(std::move(names)), "structure to build"},
                  [](const AppConfig& c) { return c.structure.name; },
                  [](AppConfig& c, std::string_view v) -> std::string {
                    const auto& names = structure_names();
@@ -153,7 +180,7 @@ const std::vector<Entry>& entries() {
                                   {"median", BvhSplitter::median},
                                   {"lbvh", BvhSplitter::lbvh}},
                                  [](AppConfig& c) -> BvhSplitter& { return c.structure.options.bvh.splitter; }));
-    t.push_back(int_option("buckets", "2..256", "BVH binned SAH buckets", 2, 256,
+    t.push_back(int_option("buckets", "BVH binned SAH buckets", 2, 256,
                            [](AppConfig& c) -> int& { return c.structure.options.bvh.buckets; }));
     // Raising the cap along with the leaf size keeps the pair valid, as the
     // command line's --leaf does.
@@ -178,30 +205,27 @@ const std::vector<Entry>& entries() {
                    b.leaf_size_cap = static_cast<int>(*x);
                    return {};
                  }});
-    t.push_back(float_option("ctrav", "> 0, at most 1e6",
-                             "BVH SAH cost of an inner-node visit (C_trav; also the cost metric's)", 0, 1e6, true,
-                             [](AppConfig& c) -> float& { return c.structure.options.bvh.cost_traversal; }));
-    t.push_back(float_option("cisect", "> 0, at most 1e6",
-                             "BVH SAH cost of a triangle test (C_isect; also the cost metric's)", 0, 1e6, true,
-                             [](AppConfig& c) -> float& { return c.structure.options.bvh.cost_intersect; }));
-    t.push_back(
-        int_option("threads", "0..256", "build threads (0: all hardware threads)", 0, 256, [](AppConfig& c) -> int& {
-          // unsigned in StructureOptions; the range keeps the cast exact.
-          return reinterpret_cast<int&>(c.structure.options.threads);
-        }));
+    t.push_back(float_option("ctrav", "BVH SAH cost of an inner-node visit (C_trav; also the cost metric's)", 0, 1e6,
+                             true, [](AppConfig& c) -> float& { return c.structure.options.bvh.cost_traversal; }));
+    t.push_back(float_option("cisect", "BVH SAH cost of a triangle test (C_isect; also the cost metric's)", 0, 1e6,
+                             true, [](AppConfig& c) -> float& { return c.structure.options.bvh.cost_intersect; }));
+    t.push_back(int_option("threads", "build threads (0: all hardware threads)", 0, 256, [](AppConfig& c) -> int& {
+      // unsigned in StructureOptions; the range keeps the cast exact.
+      return reinterpret_cast<int&>(c.structure.options.threads);
+    }));
     t.push_back(bool_option("epo", "BVH: compute the EPO figure after the build",
                             [](AppConfig& c) -> bool& { return c.structure.options.bvh.compute_epo; }));
     // K-D tree (KdTreeOptions).
-    t.push_back(float_option("kd-ctrav", "> 0, at most 1e6", "K-D tree C_trav", 0, 1e6, true,
+    t.push_back(float_option("kd-ctrav", "K-D tree C_trav", 0, 1e6, true,
                              [](AppConfig& c) -> float& { return c.structure.options.kdtree.cost_traversal; }));
-    t.push_back(float_option("kd-cisect", "> 0, at most 1e6", "K-D tree C_isect", 0, 1e6, true,
+    t.push_back(float_option("kd-cisect", "K-D tree C_isect", 0, 1e6, true,
                              [](AppConfig& c) -> float& { return c.structure.options.kdtree.cost_intersect; }));
-    t.push_back(int_option("kd-max-depth", "0..64", "K-D tree deepest leaf (0: auto, 8 + 1.3 log2 N)", 0, 64,
+    t.push_back(int_option("kd-max-depth", "K-D tree deepest leaf (0: auto, 8 + 1.3 log2 N)", 0, 64,
                            [](AppConfig& c) -> int& { return c.structure.options.kdtree.max_depth; }));
-    t.push_back(int_option("kd-leaf", "1..1000000", "K-D tree: nodes with at most this many triangles are leaves", 1,
-                           1000000, [](AppConfig& c) -> int& { return c.structure.options.kdtree.max_leaf_size; }));
-    t.push_back(float_option("kd-empty-bonus", "0..1", "K-D tree SAH discount for a split with an empty side", 0, 1,
-                             false, [](AppConfig& c) -> float& { return c.structure.options.kdtree.empty_bonus; }));
+    t.push_back(int_option("kd-leaf", "K-D tree: nodes with at most this many triangles are leaves", 1, 1000000,
+                           [](AppConfig& c) -> int& { return c.structure.options.kdtree.max_leaf_size; }));
+    t.push_back(float_option("kd-empty-bonus", "K-D tree SAH discount for a split with an empty side", 0, 1, false,
+                             [](AppConfig& c) -> float& { return c.structure.options.kdtree.empty_bonus; }));
     t.push_back(bool_option("kd-perfect-splits", "K-D tree: clip triangles to the node box (Havran 2000)",
                             [](AppConfig& c) -> bool& { return c.structure.options.kdtree.perfect_splits; }));
     t.push_back(bool_option("kd-mailboxing", "K-D tree: skip triangles this ray already tested",
@@ -230,23 +254,23 @@ const std::vector<Entry>& entries() {
                    c.structure.options.grid.resolution = r;
                    return {};
                  }});
-    t.push_back(float_option("grid-lambda", "> 0, at most 1e4", "grid: automatic resolution gives about lambda*N cells",
-                             0, 1e4, true, [](AppConfig& c) -> float& { return c.structure.options.grid.lambda; }));
+    t.push_back(float_option("grid-lambda", "grid: automatic resolution gives about lambda*N cells", 0, 1e4, true,
+                             [](AppConfig& c) -> float& { return c.structure.options.grid.lambda; }));
     t.push_back(bool_option("grid-exact", "grid: reference triangles only in the cells they overlap",
                             [](AppConfig& c) -> bool& { return c.structure.options.grid.exact_overlap; }));
     t.push_back(bool_option("grid-mailboxing", "grid: skip triangles this ray already tested",
                             [](AppConfig& c) -> bool& { return c.structure.options.grid.mailboxing; }));
     // Octree (OctreeOptions).
-    t.push_back(int_option("octree-depth", "0..16", "octree deepest cell", 0, kOctreeMaxDepth,
+    t.push_back(int_option("octree-depth", "octree deepest cell", 0, kOctreeMaxDepth,
                            [](AppConfig& c) -> int& { return c.structure.options.octree.max_depth; }));
-    t.push_back(int_option("octree-leaf", "1..1000000", "octree: cells with more triangles are split", 1, 1000000,
+    t.push_back(int_option("octree-leaf", "octree: cells with more triangles are split", 1, 1000000,
                            [](AppConfig& c) -> int& { return c.structure.options.octree.max_leaf_size; }));
     t.push_back(bool_option("octree-mailboxing", "octree: skip triangles this ray already tested",
                             [](AppConfig& c) -> bool& { return c.structure.options.octree.mailboxing; }));
     t.push_back(bool_option("octree-cost-termination", "octree: stop splitting where the SAH rates it no cheaper",
                             [](AppConfig& c) -> bool& { return c.structure.options.octree.cost_termination; }));
     // Voxels (VoxelOptions).
-    t.push_back(int_option("voxel-level", "0..10", "voxels per axis = 2^level", 0, kVoxelMaxLevel,
+    t.push_back(int_option("voxel-level", "voxels per axis = 2^level", 0, kVoxelMaxLevel,
                            [](AppConfig& c) -> int& { return c.structure.options.voxels.level; }));
     // Embree (EmbreeOptions).
     t.push_back(enum_option<EmbreeQuality>(
@@ -282,11 +306,11 @@ const std::vector<Entry>& entries() {
                                       {"leaves", BoxMode::leaves},
                                       {"subtree", BoxMode::subtree}},
                                      [](AppConfig& c) -> BoxMode& { return c.view.box_mode; }));
-    t.push_back(int_option("box-depth", "0..64", "depth of the boxes (range: first depth)", 0, 64,
+    t.push_back(int_option("box-depth", "depth of the boxes (range: first depth)", 0, 64,
                            [](AppConfig& c) -> int& { return c.view.box_depth; }));
-    t.push_back(int_option("box-depth-last", "0..64", "range: last depth (inclusive)", 0, 64,
+    t.push_back(int_option("box-depth-last", "range: last depth (inclusive)", 0, 64,
                            [](AppConfig& c) -> int& { return c.view.box_depth_last; }));
-    t.push_back(int_option("box-node", "0..2^31-1", "subtree: the selected node", 0, std::numeric_limits<int>::max(),
+    t.push_back(int_option("box-node", "subtree: the selected node", 0, std::numeric_limits<int>::max(),
                            [](AppConfig& c) -> int& { return c.view.box_node; }));
     t.push_back(enum_option<BoxColorBy>("box-color", "box colours: by depth or by share of the SAH cost",
                                         {{"depth", BoxColorBy::depth}, {"sah", BoxColorBy::sah_share}},
@@ -297,9 +321,8 @@ const std::vector<Entry>& entries() {
                                       "two-level: top-level node boxes, or every instance's BLAS boxes in world space",
                                       {{"tlas", BoxLevel::tlas}, {"blas", BoxLevel::blas}},
                                       [](AppConfig& c) -> BoxLevel& { return c.view.box_level; }));
-    t.push_back(int_option("box-instance", "-1..2^31-1", "two-level, blas level: only this instance's boxes (-1: all)",
-                           -1, std::numeric_limits<int>::max(),
-                           [](AppConfig& c) -> int& { return c.view.box_instance; }));
+    t.push_back(int_option("box-instance", "two-level, blas level: only this instance's boxes (-1: all)", -1,
+                           std::numeric_limits<int>::max(), [](AppConfig& c) -> int& { return c.view.box_instance; }));
     t.push_back(bool_option("instance-colors", "two-level: each instance in its own colour (hashed from its id)",
                             [](AppConfig& c) -> bool& { return c.view.instance_colors; }));
     t.push_back(enum_option<HeatmapDisplay>(
@@ -317,14 +340,14 @@ const std::vector<Entry>& entries() {
     t.push_back(bool_option("heatmap-gpu",
                             "trace the heatmap on the GPU (compute shader, BVH only; otherwise on the CPU)",
                             [](AppConfig& c) -> bool& { return c.view.heatmap_gpu; }));
-    t.push_back(float_option("heatmap-gpu-ms", "0..1000",
+    t.push_back(float_option("heatmap-gpu-ms",
                              "GPU heatmap: ms of tracing per frame, in row bands (0: one 8-row band a frame)", 0, 1000,
                              false, [](AppConfig& c) -> float& { return c.view.heatmap_gpu_ms; }));
     t.push_back(enum_option<ColorMap>(
         "colormap", "heatmap colour map",
         {{"viridis", ColorMap::viridis}, {"inferno", ColorMap::inferno}, {"turbo", ColorMap::turbo}},
         [](AppConfig& c) -> ColorMap& { return c.view.colormap; }));
-    t.push_back(float_option("opacity", "0..1", "blend: heatmap opacity", 0, 1, false,
+    t.push_back(float_option("opacity", "blend: heatmap opacity", 0, 1, false,
                              [](AppConfig& c) -> float& { return c.view.opacity; }));
     t.push_back({{"scale", "auto|MIN,MAX", "heatmap range: the image's [0, max] or locked"},
                  [](const AppConfig& c) {
