@@ -34,10 +34,6 @@ void line(RgbImage& img, int x0, int y0, int x1, int y1, glm::u8vec3 c) {
   }
 }
 
-void text(RgbImage& img, int x, int y, const std::string& s, glm::u8vec3 c, int scale = 1) {
-  draw_text(img, x, y, s, c, scale);
-}
-
 /// Axis range with a margin; log axes work in log10 space.
 struct Axis {
   double lo = 0, hi = 1;
@@ -136,14 +132,14 @@ RgbImage draw_chart(const ChartOptions& opts, const std::vector<ChartSeries>& se
     line(img, left, y, right, y, kGrid);
     line(img, left - 4, y, left, y, kAxis);
     const std::string s = format_tick(t);
-    text(img, left - 7 - text_width(s, 1), y - 3, s, kText);
+    draw_text(img, left - 7 - text_width(s, 1), y - 3, s, kText, 1);
   }
   if (categorical) {
     for (std::size_t i = 0; i < opts.x_categories.size(); ++i) {
       const int x = px(static_cast<double>(i));
       line(img, x, top, x, bottom, kGrid);
       line(img, x, bottom, x, bottom + 4, kAxis);
-      text(img, x - text_width(opts.x_categories[i], 1) / 2, bottom + 8, opts.x_categories[i], kText);
+      draw_text(img, x - text_width(opts.x_categories[i], 1) / 2, bottom + 8, opts.x_categories[i], kText, 1);
     }
   } else {
     for (double t : axis_ticks(ax)) {
@@ -152,17 +148,17 @@ RgbImage draw_chart(const ChartOptions& opts, const std::vector<ChartSeries>& se
       line(img, x, top, x, bottom, kGrid);
       line(img, x, bottom, x, bottom + 4, kAxis);
       const std::string s = format_tick(t);
-      text(img, x - text_width(s, 1) / 2, bottom + 8, s, kText);
+      draw_text(img, x - text_width(s, 1) / 2, bottom + 8, s, kText, 1);
     }
   }
   line(img, left, top, left, bottom, kAxis);
   line(img, left, bottom, right, bottom, kAxis);
 
   // ---- titles ----
-  if (!opts.title.empty()) text(img, left, 10, opts.title, kText, 2);
+  if (!opts.title.empty()) draw_text(img, left, 10, opts.title, kText, 2);
   if (!opts.x_label.empty())
-    text(img, (left + right) / 2 - text_width(opts.x_label, 1) / 2, bottom + 24, opts.x_label, kText);
-  if (!opts.y_label.empty()) text(img, 4, top - 12, opts.y_label, kText);
+    draw_text(img, (left + right) / 2 - text_width(opts.x_label, 1) / 2, bottom + 24, opts.x_label, kText, 1);
+  if (!opts.y_label.empty()) draw_text(img, 4, top - 12, opts.y_label, kText, 1);
 
   // ---- data ----
   for (const ChartSeries& s : series) {
@@ -185,7 +181,8 @@ RgbImage draw_chart(const ChartOptions& opts, const std::vector<ChartSeries>& se
       if (s.points)
         for (int dy = -s.marker; dy <= s.marker; ++dy)
           for (int dx = -s.marker; dx <= s.marker; ++dx) put(img, x + dx, y + dy, s.color);
-      if (i < s.labels.size() && !s.labels[i].empty()) text(img, x + s.marker + 3, y - s.marker - 8, s.labels[i], s.color);
+      if (i < s.labels.size() && !s.labels[i].empty())
+        draw_text(img, x + s.marker + 3, y - s.marker - 8, s.labels[i], s.color, 1);
     }
   }
 
@@ -197,7 +194,7 @@ RgbImage draw_chart(const ChartOptions& opts, const std::vector<ChartSeries>& se
     const int x = right - w - 16;
     for (int dy = -2; dy <= 2; ++dy)
       for (int dx = 0; dx < 8; ++dx) put(img, x + dx, ly + 3 + dy, s.color);
-    text(img, x + 12, ly, s.name, kText);
+    draw_text(img, x + 12, ly, s.name, kText, 1);
     ly += 12;
   }
   return img;
