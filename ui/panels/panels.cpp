@@ -17,6 +17,7 @@
 #include "core/scene/load.h"
 #include "core/util/one_line.h"
 #include "ui/app/shortcuts.h"
+#include "ui/render/overlays.h"
 
 namespace accelviz::panels {
 namespace {
@@ -131,6 +132,23 @@ bool float_positive(const char* label, float& v, float speed, const char* help) 
 void section(const char* label) {
   ImGui::Separator();
   ImGui::TextDisabled("%s", label);
+}
+
+// The key to the ray replay's box colours in the 3D view: a ramp from the
+// first box entered to the current step's (RayPathStyle's colours).
+void visit_fade_key() {
+  const RayPathStyle style;
+  const auto col = [](const glm::vec4& c) { return ImGui::ColorConvertFloat4ToU32(ImVec4(c.x, c.y, c.z, 1.0f)); };
+  ImGui::TextDisabled("boxes entered: first");
+  ImGui::SameLine();
+  const float w = 90.0f * ImGui::GetFontSize() / 13.0f, h = ImGui::GetTextLineHeight();
+  const ImVec2 p = ImGui::GetCursorScreenPos();
+  ImGui::GetWindowDrawList()->AddRectFilledMultiColor(p, ImVec2(p.x + w, p.y + h), col(style.first_visit),
+                                                      col(style.last_visit), col(style.last_visit),
+                                                      col(style.first_visit));
+  ImGui::Dummy(ImVec2(w, h));
+  ImGui::SameLine();
+  ImGui::TextDisabled("this step's");
 }
 
 bool checkbox(const char* label, bool& v, const char* help = nullptr) {
@@ -600,30 +618,44 @@ std::optional<std::size_t> ray_panel(const RayInspection* ray, std::size_t step,
                                      const PanelLayout& layout) {
   std::optional<std::size_t> moved;
   // Along the bottom edge, between the left and right columns.
-  if (!begin_panel("Ray", layout, kMiddleX, 560, kMiddleWidth, 200)) return moved;
+  if (!begin_panel("Ray", layout, kMiddleX, 530, kMiddleWidth, 230)) return moved;
   if (!ray) {
     ImGui::TextWrapped("Click the 3D view (without dragging) to cast that pixel's ray.");
     ImGui::End();
     return moved;
   }
-  ImGui::Text("pixel %d, %d of %d x %d   structure %s", ray->x, ray->y, ray->width, ray->height,
-              ray->structure.c_str());
-  ImGui::Text("origin    %.5g, %.5g, %.5g", ray->ray.origin.x, ray->ray.origin.y, ray->ray.origin.z);
-  ImGui::Text("direction %.5g, %.5g, %.5g", ray->ray.direction.x, ray->ray.direction.y, ray->ray.direction.z);
-  if (!ray->hit.valid())
-    ImGui::TextUnformatted("miss");
-  else if (ray->structure == "voxels")  // its hits are voxels: an index into the voxel list, no barycentrics
-    ImGui::Text("hit voxel %u at t = %.6g", ray->hit.prim, ray->hit.t);
-  else
-    ImGui::TextWrapped("hit prim %u at t = %.6g, barycentrics u = %.4f, v = %.4f", ray->hit.prim, ray->hit.t,
-                       ray->hit.u, ray->hit.v);
+  // The summary first (pixel, hit, counters); the rest folded, so that the
+  // traversal list stays in view in a short window.
   const RayStats& s = ray->stats;
-  ImGui::Text("nodes %u, box tests %u, prim tests %u", s.nodes_visited, s.box_tests, s.prim_tests);
-  ImGui::Text("culled %u, missed %u, repeated %u, empty cells %u", s.nodes_culled, s.nodes_missed,
-              s.repeated_prim_tests, s.empty_cells);
-  for (const ShadowRay& sh : ray->shadows)
-    ImGui::Text("shadow ray to light %zu%s%s: %s (nodes %u, prim tests %u)", sh.light, sh.light_name.empty() ? "" : " ",
-                sh.light_name.c_str(), sh.occluded ? "occluded" : "lit", sh.stats.nodes_visited, sh.stats.prim_tests);
+  if (!ray->hit.valid())
+    ImGui::Text("pixel %d, %d (%s): miss", ray->x, ray->y, ray->structure.c_str());
+  else if (ray->structure == "voxels")  // its hits are voxels: an index into the voxel list, no barycentrics
+    ImGui::Text("pixel %d, %d (%s): hit voxel %u at t = %.6g", ray->x, ray->y, ray->structure.c_str(), ray->hit.prim,
+                ray->hit.t);
+  else
+    ImGui::TextWrapped("pixel %d, %d (%s): hit prim %u at t = %.6g", ray->x, ray->y, ray->structure.c_str(),
+                       ray->hit.prim, ray->hit.t);
+  std::size_t occluded = 0;
+  for (const ShadowRay& sh : ray->shadows) occluded += sh.occluded;
+  if (ray->shadows.empty())
+    ImGui::Text("nodes %u, box tests %u, prim tests %u", s.nodes_visited, s.box_tests, s.prim_tests);
+  else
+    ImGui::TextWrapped("nodes %u, box tests %u, prim tests %u; shadow rays: %zu lit, %zu occluded", s.nodes_visited,
+                       s.box_tests, s.prim_tests, ray->shadows.size() - occluded, occluded);
+  if (ImGui::TreeNode("Details")) {
+    ImGui::Text("pixel %d, %d of %d x %d", ray->x, ray->y, ray->width, ray->height);
+    ImGui::Text("origin    %.5g, %.5g, %.5g", ray->ray.origin.x, ray->ray.origin.y, ray->ray.origin.z);
+    ImGui::Text("direction %.5g, %.5g, %.5g", ray->ray.direction.x, ray->ray.direction.y, ray->ray.direction.z);
+    if (ray->hit.valid() && ray->structure != "voxels")
+      ImGui::Text("barycentrics u = %.4f, v = %.4f", ray->hit.u, ray->hit.v);
+    ImGui::Text("culled %u, missed %u, repeated %u, empty cells %u", s.nodes_culled, s.nodes_missed,
+                s.repeated_prim_tests, s.empty_cells);
+    for (const ShadowRay& sh : ray->shadows)
+      ImGui::Text("shadow ray to light %zu%s%s: %s (nodes %u, prim tests %u)", sh.light,
+                  sh.light_name.empty() ? "" : " ", sh.light_name.c_str(), sh.occluded ? "occluded" : "lit",
+                  sh.stats.nodes_visited, sh.stats.prim_tests);
+    ImGui::TreePop();
+  }
 
   const auto& steps = ray->trace.steps;
   if (steps.empty()) {
@@ -631,7 +663,11 @@ std::optional<std::size_t> ray_panel(const RayInspection* ray, std::size_t step,
     ImGui::End();
     return moved;
   }
-  section("Traversal");
+  // The section's rule, its name and the key to the 3D boxes' colours on one line.
+  ImGui::Separator();
+  ImGui::TextDisabled("Traversal");
+  ImGui::SameLine(0.0f, 2.0f * ImGui::GetFontSize());
+  visit_fade_key();
   const std::size_t last = steps.size() - 1;
   if (ImGui::ArrowButton("##first", ImGuiDir_Left)) moved = 0;
   ImGui::SameLine();
@@ -643,7 +679,11 @@ std::optional<std::size_t> ray_panel(const RayInspection* ray, std::size_t step,
   ImGui::SameLine();
   int s_i = static_cast<int>(step);
   ImGui::SetNextItemWidth(-1.0f);
-  if (ImGui::SliderInt("##step", &s_i, 0, static_cast<int>(last), "step %d")) moved = static_cast<std::size_t>(s_i);
+  // The slider names the step's event, so the replay reads without the list below.
+  char format[96];
+  const VisitStep& now = steps[std::min(step, last)];
+  std::snprintf(format, sizeof format, "step %%d of %zu: %s %u", last, step_kind_name(now.kind), now.id);
+  if (ImGui::SliderInt("##step", &s_i, 0, static_cast<int>(last), format)) moved = static_cast<std::size_t>(s_i);
 
   if (ImGui::BeginTable("steps", 5,
                         ImGuiTableFlags_ScrollY | ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV |

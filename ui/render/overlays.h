@@ -41,8 +41,9 @@ struct RayPathStyle {
   glm::vec4 hit_marker{1.0f, 0.15f, 0.15f, 1.0f};  ///< the point at the hit
   glm::vec4 normal{0.3f, 0.7f, 1.0f, 1.0f};        ///< the normal line at the hit
   glm::vec4 highlight{1.0f, 0.45f, 0.1f, 1.0f};    ///< highlighted primitives
-  glm::vec4 first_visit{0.3f, 1.0f, 0.4f, 1.0f};   ///< first visited box...
-  glm::vec4 last_visit{1.0f, 0.3f, 0.8f, 1.0f};    ///< ...fading to the last
+  // Saturated and dark enough to read on the white mesh and the dark background alike.
+  glm::vec4 first_visit{0.1f, 0.4f, 1.0f, 1.0f};   ///< first visited box (blue)...
+  glm::vec4 last_visit{0.9f, 0.1f, 0.8f, 1.0f};    ///< ...fading to the last (magenta: the current step's)
   float marker_px = 7.0f;                          ///< hit marker size in pixels
 };
 
