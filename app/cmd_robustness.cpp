@@ -4,8 +4,10 @@
 // grazing) traced with Moller-Trumbore vs watertight triangle tests and plain
 // vs padded slab tests (and a structure's own traversal with both triangle
 // tests); per variant the misses, double hits and wrong hits against the
-// double-precision reference, and the time each costs. Always exit 0 after a
-// run: the figures are the result (the fast variants are expected to fail).
+// double-precision reference, and the time each costs. Exit 0 after a run:
+// the figures are the result (the fast variants are expected to fail); 1 when
+// the structure named refused the scene or some rays (Embree's limits), after
+// the figures of what ran.
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -55,6 +57,19 @@ int run_robustness(const RobustnessOptions& o, const GlobalOptions& global) {
     throw UsageError(std::string("--structure ") + o.structure + ": " + e.what());
   }
   progress.end(std::to_string(static_cast<long long>(r.reference_ms)) + " ms reference");
+  // The structure named refused the scene or rays (Embree's limits): the lab's
+  // own variants are reported, the structure's on the rays it took, and the
+  // run exits 1, as a refusal does in verify and bench.
+  const bool refused = !r.structure_refused.empty() || r.structure_rays_refused > 0;
+  std::string refusal;
+  if (!r.structure_refused.empty()) {
+    refusal = o.structure + ": not checked: " +
+              (r.structure_refused.starts_with("embree: ") ? r.structure_refused.substr(8) : r.structure_refused);
+  } else if (r.structure_rays_refused > 0) {
+    refusal = o.structure + ": " + std::to_string(r.structure_rays_refused) + " of " + std::to_string(r.rays) +
+              " rays not traced (the first, ray " + std::to_string(r.structure_first_refused_ray) + ": " +
+              r.structure_refused_ray_reason + ")";
+  }
 
   if (o.json) {
     nlohmann::json variants = nlohmann::json::array();
@@ -69,6 +84,7 @@ int run_robustness(const RobustnessOptions& o, const GlobalOptions& global) {
            {"triangle_test", v.triangle_test == TriangleTest::watertight ? "watertight" : "moller-trumbore"},
            {"slab", v.own_structure ? "structure" : (v.padded_slab ? "padded" : "plain")},
            {"misses", v.misses},
+           {"not_traced", v.not_traced},
            {"double_hits", v.double_hits},
            {"wrong", v.wrong},
            {"misses_by_family", miss_f},
@@ -85,8 +101,9 @@ int run_robustness(const RobustnessOptions& o, const GlobalOptions& global) {
                      {"seed", o.seed},
                      {"reference_hits", r.reference_hits},
                      {"reference_ms", r.reference_ms},
-                     {"variants", variants}});
-    return 0;
+                     {"variants", variants},
+                     {"not_checked", refused ? nlohmann::json(refusal) : nlohmann::json(nullptr)}});
+    return refused ? 1 : 0;
   }
   std::cout << "robustness: " << o.scene << " triangles=" << r.triangles << " rays=" << r.rays << " (vertex "
             << r.rays_by_family[0] << ", edge " << r.rays_by_family[1] << ", axis " << r.rays_by_family[2]
@@ -101,8 +118,9 @@ int run_robustness(const RobustnessOptions& o, const GlobalOptions& global) {
                   static_cast<unsigned long long>(v.wrong), v.ms, v.mrays_per_s);
     std::cout << line;
   }
+  if (refused) std::cout << refusal << "\n";
   std::cout.flush();
-  return 0;
+  return refused ? 1 : 0;
 }
 
 Command add_robustness_command(CLI::App& parent, const GlobalOptions& global) {

@@ -228,10 +228,27 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
   const Bvh bvh(triangles, bo);
   const std::vector<Triangle> leaf_tris = bvh.copy_leaf_triangles();  // the lab's traversals index leaf positions
   std::unique_ptr<Accelerator> own;
+  std::vector<std::uint8_t> own_refuses;  // per ray: the structure cannot take it (Embree's limits)
   if (!opts.structure.empty()) {
     StructureOptions so;
     so.threads = opts.threads;
-    own = build_accelerator(opts.structure, triangles, so);
+    try {
+      own = build_accelerator(opts.structure, triangles, so);
+    } catch (const std::runtime_error& e) {
+      if (opts.structure != "embree") throw;
+      res.structure_refused = e.what();  // a scene Embree cannot hold: the lab's own variants still run
+    }
+    if (own) {
+      own_refuses.assign(res.rays, 0);
+      for (std::size_t i = 0; i < res.rays; ++i)
+        if (std::string why = own->ray_problem(res.lab_rays[i].ray); !why.empty()) {
+          own_refuses[i] = 1;
+          if (res.structure_rays_refused++ == 0) {
+            res.structure_first_refused_ray = i;
+            res.structure_refused_ray_reason = std::move(why);
+          }
+        }
+    }
   }
   check();
 
@@ -290,7 +307,7 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
     for (std::size_t i = 0; i < res.rays; ++i) {
       const Ray& ray = res.lab_rays[i].ray;
       if (s.own) {
-        hits[i] = own->closest_hit(ray, q);
+        if (!own_refuses[i]) hits[i] = own->closest_hit(ray, q);
       } else {
         const WatertightRay wr(ray.direction);
         hits[i] = s.padded ? lab_closest<true>(bvh, leaf_tris, ray, s.test, wr)
@@ -299,9 +316,15 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
       if ((i & 4095) == 4095) check();
     }
     v.ms = ms_since(t0);
-    v.mrays_per_s = v.ms > 0.0 ? static_cast<double>(res.rays) / (v.ms * 1e3) : 0.0;
+    const std::size_t traced = s.own ? res.rays - res.structure_rays_refused : res.rays;
+    v.mrays_per_s = v.ms > 0.0 ? static_cast<double>(traced) / (v.ms * 1e3) : 0.0;
     // Classification (not timed).
     for (std::size_t i = 0; i < res.rays; ++i) {
+      if (s.own && own_refuses[i]) {
+        ++v.not_traced;
+        v.per_ray[i] = 4;
+        continue;
+      }
       const LabRay& lr = res.lab_rays[i];
       const ReferenceHit& rh = ref[i];
       const Hit& h = hits[i];

@@ -65,11 +65,12 @@ struct LabVariant {
   std::uint64_t misses = 0;
   std::uint64_t double_hits = 0;
   std::uint64_t wrong = 0;
+  std::uint64_t not_traced = 0;  ///< rays the structure refuses (Embree's limits): neither traced nor classified
   std::uint64_t misses_by_family[kLabFamilies] = {};
   std::uint64_t double_hits_by_family[kLabFamilies] = {};
   double ms = 0.0;  ///< closest-hit tracing of every ray, one thread
   double mrays_per_s = 0.0;
-  /// Per ray: 0 ok, 1 miss, 2 double hit, 3 wrong (miss wins over double hit).
+  /// Per ray: 0 ok, 1 miss, 2 double hit, 3 wrong (miss wins over double hit), 4 not traced.
   std::vector<std::uint8_t> per_ray;
 };
 
@@ -81,10 +82,19 @@ struct LabResult {
   std::vector<LabRay> lab_rays;
   std::vector<LabVariant> variants;
   double reference_ms = 0.0;
+  /// The structure's build refused the scene (Embree: a vertex beyond its
+  /// range): its words, and no variant of it; the lab's own variants still run.
+  std::string structure_refused;
+  /// Rays the structure refuses (Accelerator::ray_problem, Embree's limits):
+  /// how many, the first and why. Its variants trace the others.
+  std::uint64_t structure_rays_refused = 0;
+  std::size_t structure_first_refused_ray = 0;
+  std::string structure_refused_ray_reason;
 };
 
-/// Runs the lab. Throws std::invalid_argument for an unknown or voxel
-/// structure, BuildCancelled when `keep_going` returns false (checked between
+/// Runs the lab. A structure that refuses the scene or rays (Embree) does not
+/// stop it: see LabResult::structure_refused. Throws std::invalid_argument for
+/// an unknown or voxel structure, BuildCancelled when `keep_going` returns false (checked between
 /// stages and every few thousand rays).
 LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptions& opts,
                              const std::function<bool()>& keep_going = {});

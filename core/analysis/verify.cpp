@@ -31,10 +31,14 @@ std::vector<VerifyStructure> parse_verify_structures(const std::string& list, un
     if (!item.empty()) names.push_back(item);
   if (names.empty()) throw std::invalid_argument("--structure: empty list");
   std::vector<VerifyStructure> out;
-  auto add = [&](const std::string& label, const std::string& factory, BvhSplitter splitter = BvhSplitter::binned_sah) {
-    for (const VerifyStructure& s : out)
-      if (s.label == label) return;
-    VerifyStructure s{label, factory, {}};
+  auto add = [&](const std::string& label, const std::string& factory, BvhSplitter splitter = BvhSplitter::binned_sah,
+                 bool named = false) {
+    for (VerifyStructure& s : out)
+      if (s.label == label) {
+        s.named = s.named || named;
+        return;
+      }
+    VerifyStructure s{label, factory, {}, named};
     s.options.threads = threads;
     s.options.bvh.splitter = splitter;
     out.push_back(std::move(s));
@@ -57,9 +61,10 @@ std::vector<VerifyStructure> parse_verify_structures(const std::string& list, un
       add_bvh(n);
     } else if (n == "brute" || n == "brute-bbox" || n == "kdtree" || n == "grid" || n == "octree" || n == "embree") {
       if (n == "embree" && !kHaveEmbree) throw std::invalid_argument("--structure embree: this build has no Embree backend");
-      add(n, n);
+      add(n, n, BvhSplitter::binned_sah, /*named=*/true);
     } else if (n == "tlas") {
-      add("tlas", "tlas");  // two levels from the scene's instances when verify_structures gets the scene
+      add("tlas", "tlas", BvhSplitter::binned_sah,
+          /*named=*/true);  // two levels from the scene's instances when verify_structures gets the scene
     } else if (n == "voxels") {
       throw std::invalid_argument("--structure voxels: voxel hits are voxels, not triangles; it cannot be verified against triangles");
     } else {
@@ -73,6 +78,11 @@ std::vector<VerifyStructure> parse_verify_structures(const std::string& list, un
 }
 
 namespace {
+
+std::string without_prefix(std::string text, std::string_view prefix) {
+  if (text.starts_with(prefix)) text.erase(0, prefix.size());
+  return text;
+}
 
 // One independent stream per ray index, so the rays do not depend on the
 // order they are generated in.
@@ -197,12 +207,35 @@ VerifyResult verify_structures(std::span<const Triangle> triangles, std::span<co
   for (const VerifyStructure& s : structures) {
     StructureOptions so = s.options;
     so.scene = scene;  // "tlas": the scene's own instances (hits use the flattened ids the reference uses)
-    const std::unique_ptr<Accelerator> accel = build_accelerator(s.factory_name, triangles, so);
+    std::unique_ptr<Accelerator> accel;
+    try {
+      accel = build_accelerator(s.factory_name, triangles, so);
+    } catch (const std::runtime_error& e) {
+      // Embree refuses a scene it cannot hold (a vertex beyond ±1.844e18):
+      // the other structures are still checked.
+      if (s.factory_name != "embree") throw;
+      res.not_checked.push_back({s.label, s.named, true, rays.size(), 0, without_prefix(e.what(), "embree: ")});
+      continue;
+    }
+    // Rays the structure cannot take (Embree's limits) are left out of its
+    // check, counted and the first named; every other ray is checked.
+    std::vector<std::uint8_t> refused(rays.size(), 0);
+    VerifyNotChecked skipped{s.label, s.named, false, 0, 0, {}};
+    for (std::size_t i = 0; i < rays.size(); ++i)
+      if (std::string problem = accel->ray_problem(rays[i]); !problem.empty()) {
+        refused[i] = 1;
+        if (skipped.rays++ == 0) {
+          skipped.first_ray = i;
+          skipped.reason = std::move(problem);
+        }
+      }
+    if (skipped.rays > 0) res.not_checked.push_back(skipped);
     const unsigned nt = resolve_threads(threads);
     std::vector<VerifyCounts> per_thread(nt);
     parallel_for(rays.size(), threads, 256, [&](std::size_t b, std::size_t e, unsigned ti) {
       VerifyCounts& c = per_thread[ti];
       for (std::size_t i = b; i < e; ++i) {
+        if (refused[i]) continue;
         const Hit h = accel->closest_hit(rays[i], q);
         const Verdict vc = classify_closest(triangles, rays[i], ref[i], h);
         const Verdict va = classify_any(ref[i], accel->any_hit(rays[i], q));

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "core/accel/accel.h"
+#include "core/accel/embree_backend.h"
 #include "core/analysis/robustness_lab.h"
 #include "core/scene/load.h"
 #include "tests/core/spatial_test_scenes.h"
@@ -106,6 +107,41 @@ TEST(RobustnessLab, FastTriangleTestLeaksOrDoubleCountsWhereWatertightDoesNot) {
   EXPECT_EQ(wt.name, "watertight + padded slab");
   EXPECT_GT(mt.misses + mt.double_hits, wt.misses + wt.double_hits);
   EXPECT_EQ(wt.wrong, 0u);
+}
+
+// Embree refuses a scene with a vertex beyond ±1.844e18 and rays from
+// origins beyond that bound: the lab's own variants still run (the lab used
+// to stop at the refusal), the structure's variants trace the rays it takes.
+TEST(RobustnessLab, AStructureThatRefusesTheSceneOrRaysLeavesTheLabRunning) {
+  if (!kHaveEmbree) GTEST_SKIP() << "no Embree in this build";
+  LabOptions o;
+  o.rays = 400;
+  o.threads = 1;
+  o.structure = "embree";
+  {
+    const auto huge = test_scenes::subdivided_cube(glm::vec3(-2e18f), 4e18f, 3);
+    const LabResult r = run_robustness_lab(huge, o);
+    EXPECT_NE(r.structure_refused.find("beyond ±1.844e18"), std::string::npos) << r.structure_refused;
+    ASSERT_EQ(r.variants.size(), 4u);
+    for (const LabVariant& v : r.variants) EXPECT_FALSE(v.own_structure) << v.name;
+    EXPECT_EQ(r.variants[3].misses, 0u);
+  }
+  {
+    // Vertices within Embree's range, but the lab's origins lie up to 1.5
+    // scene radii out: beyond it.
+    const auto big = test_scenes::subdivided_cube(glm::vec3(-1e18f), 2e18f, 3);
+    const LabResult r = run_robustness_lab(big, o);
+    EXPECT_TRUE(r.structure_refused.empty()) << r.structure_refused;
+    EXPECT_GT(r.structure_rays_refused, 0u);
+    EXPECT_LT(r.structure_rays_refused, r.rays);
+    EXPECT_NE(r.structure_refused_ray_reason.find("origin"), std::string::npos) << r.structure_refused_ray_reason;
+    ASSERT_GT(r.variants.size(), 4u);
+    for (const LabVariant& v : r.variants) {
+      SCOPED_TRACE(v.name);
+      EXPECT_EQ(v.not_traced, v.own_structure ? r.structure_rays_refused : 0u);
+      EXPECT_EQ(count_status(v, 4), v.not_traced);
+    }
+  }
 }
 
 TEST(RobustnessLab, BadStructureAndCancel) {
