@@ -164,6 +164,27 @@ TEST(Verify, StructureListParsing) {
   }
 }
 
+// The rays are made in the scene's own size: a closed cube of 1e-20 gets as
+// few near ties (decisions within rounding) as one of 1. With a floor of 1e-6
+// on the size, the tiny cube's rays came from 1e14 sizes away and lost their
+// aim: 43% of its checks were near ties against 4% at scale 1.
+TEST(Verify, ATinySceneIsProbedAsAUnitSceneIs) {
+  const auto structures = parse_verify_structures("bvh-binned", 2);
+  const auto share_of_near_ties = [&](float half, std::uint64_t* reference_hits) {
+    const auto tris = test_scenes::subdivided_cube(glm::vec3(-half), 2.0f * half, 4);
+    const std::vector<Ray> rays = verify_rays(tris, 6000, 1);
+    const VerifyResult r = verify_structures(tris, rays, structures, 2);
+    EXPECT_TRUE(r.ok()) << half;
+    *reference_hits = r.reference_hits;
+    return static_cast<double>(r.total.near_ties) / (2.0 * static_cast<double>(rays.size()));  // closest + any
+  };
+  std::uint64_t unit_hits = 0, tiny_hits = 0;
+  const double unit = share_of_near_ties(1.0f, &unit_hits), tiny = share_of_near_ties(1e-20f, &tiny_hits);
+  EXPECT_GT(unit, 0.0);
+  EXPECT_LT(tiny, 2.0 * unit + 0.01) << "unit " << unit << ", tiny " << tiny;
+  EXPECT_NEAR(static_cast<double>(tiny_hits), static_cast<double>(unit_hits), 0.05 * 6000);
+}
+
 // Embree refuses a scene with a vertex beyond ±1.844e18 and rays it cannot
 // take (here: directions without a component of 1e-15): the other structures
 // are still checked on every ray, Embree on the rays it takes, and the
