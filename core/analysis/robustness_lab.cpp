@@ -249,15 +249,22 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
   bo.threads = opts.threads;
   const Bvh bvh(triangles, bo);
   const std::vector<Triangle> leaf_tris = bvh.copy_leaf_triangles();  // the lab's traversals index leaf positions
-  std::unique_ptr<Accelerator> own;
+  // The structure's own traversal; Embree ignores our triangle test, so it is
+  // built twice instead: its default mode and its robust mode.
+  const bool embree = opts.structure == "embree";
+  std::unique_ptr<Accelerator> own, own_robust;
   std::vector<std::uint8_t> own_refuses;  // per ray: the structure cannot take it (Embree's limits)
   if (!opts.structure.empty()) {
     StructureOptions so;
     so.threads = opts.threads;
     try {
       own = build_accelerator(opts.structure, triangles, so);
+      if (embree) {
+        so.embree.robust = true;
+        own_robust = build_accelerator(opts.structure, triangles, so);
+      }
     } catch (const std::runtime_error& e) {
-      if (opts.structure != "embree") throw;
+      if (!embree) throw;
       res.structure_refused = e.what();  // a scene Embree cannot hold: the lab's own variants still run
     }
     if (own) {
@@ -302,6 +309,8 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
     TriangleTest test;
     bool padded;
     bool own;
+    const Accelerator* accel = nullptr;  ///< own: the structure traced
+    const char* embree_mode = nullptr;   ///< Embree's rows: "default" or "robust" (our triangle test does not apply)
   };
   std::vector<Spec> specs = {
       {"moller-trumbore + plain slab", TriangleTest::moller_trumbore, false, false},
@@ -309,9 +318,12 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
       {"watertight + plain slab", TriangleTest::watertight, false, false},
       {"watertight + padded slab", TriangleTest::watertight, true, false},
   };
-  if (own) {
-    specs.push_back({opts.structure + " (moller-trumbore)", TriangleTest::moller_trumbore, true, true});
-    specs.push_back({opts.structure + " (watertight)", TriangleTest::watertight, true, true});
+  if (own && embree) {
+    specs.push_back({"embree (default mode)", TriangleTest::moller_trumbore, true, true, own.get(), "default"});
+    specs.push_back({"embree (robust mode)", TriangleTest::watertight, true, true, own_robust.get(), "robust"});
+  } else if (own) {
+    specs.push_back({opts.structure + " (moller-trumbore)", TriangleTest::moller_trumbore, true, true, own.get()});
+    specs.push_back({opts.structure + " (watertight)", TriangleTest::watertight, true, true, own.get()});
   }
 
   for (const Spec& s : specs) {
@@ -320,6 +332,10 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
     v.triangle_test = s.test;
     v.padded_slab = s.padded;
     v.own_structure = s.own;
+    if (s.embree_mode) {
+      v.embree_mode = s.embree_mode;
+      v.double_hits_counted = false;
+    }
     v.per_ray.assign(res.rays, 0);
     std::vector<Hit> hits(res.rays);
     QueryOptions q;
@@ -329,7 +345,7 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
     for (std::size_t i = 0; i < res.rays; ++i) {
       const Ray& ray = res.lab_rays[i].ray;
       if (s.own) {
-        if (!own_refuses[i]) hits[i] = own->closest_hit(ray, q);
+        if (!own_refuses[i]) hits[i] = s.accel->closest_hit(ray, q);
       } else {
         const WatertightRay wr(ray.direction);
         hits[i] = s.padded ? lab_closest<true>(bvh, leaf_tris, ray, s.test, wr)
@@ -368,7 +384,7 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
         ++v.wrong;
         v.per_ray[i] = 3;
       }
-      if (rh.valid() && ref_count[i] == 1) {
+      if (v.double_hits_counted && rh.valid() && ref_count[i] == 1) {
         const WatertightRay wr(lr.ray.direction);
         const float t0f = static_cast<float>(rh.t - rh.t_tolerance), t1f = static_cast<float>(rh.t + rh.t_tolerance);
         const int n = s.padded ? lab_count<true>(bvh, leaf_tris, lr.ray, s.test, wr, t0f, t1f)
