@@ -109,7 +109,7 @@ std::vector<QueryFigures> measure_in_turns(const std::vector<const Accelerator*>
     for (std::size_t i = 0; i < f.size(); ++i) f[i].*field = m[i];
     progress.end();
   };
-  const std::string threads = std::to_string(all) + " threads";
+  const std::string threads = all > 1 ? count_of(all, "thread") : "all threads (1)";
   figure("closest hit, 1 thread", &QueryFigures::closest_1t,
          [&](std::size_t i) { trace_closest(*accels[i], rays, hits, q, 1u); });
   figure("closest hit, " + threads, &QueryFigures::closest_nt,
@@ -268,7 +268,7 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
 
   progress.begin("loading " + o.scene);
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
-  progress.end(std::to_string(scene.triangles.size()) + " triangles");
+  progress.end(count_of(scene.triangles.size(), "triangle"));
   StructureOptions so = o.structure_opts.to_options(o.threads, /*compute_epo=*/!o.no_epo);
   so.scene = &scene;  // "tlas" builds its two levels from the scene's meshes and instances
 
@@ -491,16 +491,22 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   }
 
   // ---- text ----
+  // The columns: one thread, and the run's --threads (all hardware threads by
+  // default). With one thread in all, the second pair is a second one-thread
+  // measurement: "all=1T", so that no two headers read alike.
+  const std::string nt = all > 1 ? std::to_string(all) + "T" : "all=1T";
+  const std::string closest_nt = "closest " + nt, any_nt = "any " + nt;
   const std::string warm = o.warmup > 0 ? " after " + std::to_string(o.warmup) + " untimed" : "";
   const std::string embree_isa = so.embree.isa == EmbreeIsa::automatic
                                      ? std::string()
                                      : ", its " + std::string(embree_isa_name(so.embree.isa)) + " kernels";
-  std::printf("scene %s: %zu triangles; %u threads; medians of %d runs%s; %s triangle test%s%s\n", o.scene.c_str(),
-              scene.triangles.size(), all, o.repeat, warm.c_str(), o.triangle_test.c_str(),
+  std::printf("scene %s: %s; %s; medians of %s%s; %s triangle test%s%s\n", o.scene.c_str(),
+              count_of(scene.triangles.size(), "triangle").c_str(), count_of(all, "thread").c_str(),
+              count_of(static_cast<std::size_t>(o.repeat), "run").c_str(), warm.c_str(), o.triangle_test.c_str(),
               kHaveEmbree ? (so.embree.robust ? "; Embree robust" : "; Embree default (not robust)") : "",
               kHaveEmbree ? embree_isa.c_str() : "");
   for (const RaySet& set : sets)
-    std::printf("  %-8s %zu rays%s\n", set.name.c_str(), set.rays.size(),
+    std::printf("  %-8s %s%s\n", set.name.c_str(), count_of(set.rays.size(), "ray").c_str(),
                 set.name == "shadow" && synthetic_light ? " (to a synthetic light: the scene has none)" : "");
   for (const StructureResult& r : results) {
     std::printf("\n%s\n", r.name.c_str());
@@ -521,11 +527,10 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
       std::printf("  Embree rtcBuildBVH binary tree: SAH %.3f (ours/embree %.3f), build %.1f ms, %llu leaves\n",
                   r.embree_bvh->sah_cost, ratio(r.stats.sah_cost, r.embree_bvh->sah_cost), r.embree_bvh->build_ms,
                   static_cast<unsigned long long>(r.embree_bvh->leaf_count));
-    const std::string closest_nt = "closest " + std::to_string(all) + "T", any_nt = "any " + std::to_string(all) + "T";
-    std::printf("  %-8s %12s %12s %12s %12s %10s %10s\n", "Mrays/s", "closest 1T", closest_nt.c_str(), "any 1T",
+    std::printf("  %-8s %15s %15s %15s %15s %10s %10s\n", "Mrays/s", "closest 1T", closest_nt.c_str(), "any 1T",
                 any_nt.c_str(), "nodes/ray", "prims/ray");
     for (const auto& [set, f] : r.queries) {
-      std::printf("  %-8s %12.2f %12.2f %12.2f %12.2f", set.c_str(), f.closest_1t, f.closest_nt, f.any_1t, f.any_nt);
+      std::printf("  %-8s %15.2f %15.2f %15.2f %15.2f", set.c_str(), f.closest_1t, f.closest_nt, f.any_1t, f.any_nt);
       if (has_counters) {
         std::printf(" %10.1f %10.1f\n", f.closest_nodes, f.closest_prims);
       } else {
@@ -550,9 +555,9 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
         const QueryFigures* theirs = figures_on(*embree, r.queries[k].first);
         if (!theirs) continue;  // Embree refused a ray of this set
         const QueryFigures& b = *theirs;
-        std::printf("    %-8s closest 1T %.2f, closest %uT %.2f, any 1T %.2f, any %uT %.2f\n",
-                    r.queries[k].first.c_str(), ratio(a.closest_1t, b.closest_1t), all,
-                    ratio(a.closest_nt, b.closest_nt), ratio(a.any_1t, b.any_1t), all, ratio(a.any_nt, b.any_nt));
+        std::printf("    %-8s closest 1T %.2f, %s %.2f, any 1T %.2f, %s %.2f\n", r.queries[k].first.c_str(),
+                    ratio(a.closest_1t, b.closest_1t), closest_nt.c_str(), ratio(a.closest_nt, b.closest_nt),
+                    ratio(a.any_1t, b.any_1t), any_nt.c_str(), ratio(a.any_nt, b.any_nt));
         if (a.packets && b.packets)
           std::printf("    %-8s packets of 8, 1T: closest %.2f, any %.2f\n", r.queries[k].first.c_str(),
                       ratio(a.closest_packet_1t, b.closest_packet_1t), ratio(a.any_packet_1t, b.any_packet_1t));

@@ -41,7 +41,7 @@ int run_robustness(const RobustnessOptions& o, const GlobalOptions& global) {
   Progress progress(global.quiet);
   progress.begin("loading " + o.scene);
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
-  progress.end(std::to_string(scene.triangles.size()) + " triangles");
+  progress.end(count_of(scene.triangles.size(), "triangle"));
   if (scene.triangles.empty()) throw UsageError(o.scene + ": no triangles to aim adversarial rays at");
 
   LabOptions lo;
@@ -49,7 +49,7 @@ int run_robustness(const RobustnessOptions& o, const GlobalOptions& global) {
   lo.seed = o.seed;
   lo.structure = o.structure;
   lo.threads = o.threads;
-  progress.begin("robustness lab, " + std::to_string(o.rays) + " rays");
+  progress.begin("robustness lab, " + count_of(o.rays, "ray"));
   LabResult r;
   try {
     r = run_robustness_lab(scene.triangles, lo);

@@ -35,13 +35,13 @@ int run_verify(const VerifyOptions& o, const GlobalOptions& global) {
   Progress progress(global.quiet);
   progress.begin("loading " + o.scene);
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
-  progress.end(std::to_string(scene.triangles.size()) + " triangles");
+  progress.end(count_of(scene.triangles.size(), "triangle"));
   if (scene.triangles.empty() && !scene.instances.empty())
     throw std::runtime_error(o.scene +
                              ": instanced and too large to flatten; verify needs the flattened triangles for its "
                              "brute-force reference");
 
-  progress.begin("verifying " + std::to_string(structures.size()) + " structures");
+  progress.begin("verifying " + count_of(structures.size(), "structure"));
   std::vector<Ray> rays;
   try {
     rays = verify_rays(scene.triangles, o.rays, o.seed);
