@@ -202,7 +202,7 @@ Scene load_scene_noting_warnings(const std::string& spec, bool quiet) {
 Scene load_scene_with_progress(const std::string& spec, bool quiet, Progress& progress) {
   progress.begin("loading " + spec);
   Scene scene = load_scene_noting_warnings(spec, quiet);
-  progress.end(std::to_string(scene.triangles.size()) + " triangles");
+  progress.end(count_of(scene.triangles.size(), "triangle"));
   return scene;
 }
 

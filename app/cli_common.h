@@ -14,6 +14,7 @@
 #include "core/geometry/triangle.h"
 #include "core/scene/scene.h"
 #include "core/util/image_size.h"
+#include "core/util/one_line.h"  // count_of: "1 thread", "2 threads"
 #include "core/util/timing.h"
 
 namespace accelviz::cli {

@@ -34,7 +34,7 @@ int run_animate(const AnimateOptions& o, const GlobalOptions& global) {
   Progress progress(global.quiet);
   progress.begin("loading " + o.scene);
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
-  progress.end(std::to_string(scene.instances.size()) + " instances");
+  progress.end(count_of(scene.instances.size(), "instance"));
   const SceneEffects fx = decide_effects(scene);
   if (!fx.per_frame_updates.on) {
     std::fprintf(stderr, "accelviz: %s: %s; each frame costs nothing\n", o.scene.c_str(),
@@ -51,8 +51,8 @@ int run_animate(const AnimateOptions& o, const GlobalOptions& global) {
   ao.rebuild_ratio = o.rebuild_ratio;
   SceneAnimator animator(scene, tlas, ao);
   if (!o.json) {
-    std::printf("%s: %zu instances, %zu BLAS, two-level %.1f MiB (flattened estimate %.1f MiB), build %.1f ms\n",
-                o.scene.c_str(), tlas.instances().size(), tlas.blas_count(),
+    std::printf("%s: %s, %zu BLAS, two-level %.1f MiB (flattened estimate %.1f MiB), build %.1f ms\n", o.scene.c_str(),
+                count_of(tlas.instances().size(), "instance").c_str(), tlas.blas_count(),
                 static_cast<double>(tlas.memory_two_level()) / 1048576.0,
                 static_cast<double>(tlas.memory_flattened_estimate()) / 1048576.0, tlas.build_stats().build_ms);
     std::printf("%5s %8s %7s %6s %8s %9s %9s %10s %10s %10s %9s\n", "frame", "time", "moved", "refits", "rebuilds",

@@ -62,6 +62,9 @@ struct QueryFigures {
 
 struct StructureResult {
   std::string name;
+  std::string refused;  ///< why the structure was not built (Embree refused the scene); empty when it was
+  /// Ray sets the structure refused a ray of (Embree's limits), with the first ray and why; not measured.
+  std::vector<std::pair<std::string, std::string>> refused_sets;
   std::vector<double> build_ms;
   BuildStats stats;                            ///< of the last build
   std::optional<EmbreeBvhFigures> embree_bvh;  ///< bvh only: Embree's binary rtcBuildBVH on the same input
@@ -93,9 +96,9 @@ std::vector<double> timed_medians_in_turns(std::size_t structures, int warmup, i
 
 /// Throughput of every structure on one ray set, the structures in turns
 /// (timed_medians_in_turns) for each of the four figures.
-std::vector<QueryFigures> measure_in_turns(const std::vector<std::unique_ptr<Accelerator>>& accels,
-                                           const std::vector<Ray>& rays, const QueryOptions& q, unsigned all,
-                                           int warmup, int repeat, Progress& progress, const std::string& label) {
+std::vector<QueryFigures> measure_in_turns(const std::vector<const Accelerator*>& accels, const std::vector<Ray>& rays,
+                                           const QueryOptions& q, unsigned all, int warmup, int repeat,
+                                           Progress& progress, const std::string& label) {
   std::vector<QueryFigures> f(accels.size());
   const std::size_t n = rays.size();
   if (n == 0) return f;
@@ -107,7 +110,7 @@ std::vector<QueryFigures> measure_in_turns(const std::vector<std::unique_ptr<Acc
     for (std::size_t i = 0; i < f.size(); ++i) f[i].*field = m[i];
     progress.end();
   };
-  const std::string threads = std::to_string(all) + " threads";
+  const std::string threads = all > 1 ? count_of(all, "thread") : "all threads (1)";
   figure("closest hit, 1 thread", &QueryFigures::closest_1t,
          [&](std::size_t i) { trace_closest(*accels[i], rays, hits, q, 1u); });
   figure("closest hit, " + threads, &QueryFigures::closest_nt,
@@ -122,7 +125,7 @@ std::vector<QueryFigures> measure_in_turns(const std::vector<std::unique_ptr<Acc
   std::vector<std::size_t> index;
   for (std::size_t i = 0; i < accels.size(); ++i)
     if (accels[i]->has_packets()) {
-      with_packets.push_back(accels[i].get());
+      with_packets.push_back(accels[i]);
       index.push_back(i);
       f[i].packets = true;
     }
@@ -213,6 +216,27 @@ std::vector<std::string> bench_structure_names() {
   return names;
 }
 
+/// "ray I: why" for the first ray of `rays` that `accel` cannot take (Embree's
+/// limits, Accelerator::ray_problem); empty when it takes every ray.
+std::string first_refused_ray(const Accelerator& accel, const std::vector<Ray>& rays) {
+  for (std::size_t i = 0; i < rays.size(); ++i)
+    if (const std::string problem = accel.ray_problem(rays[i]); !problem.empty())
+      return "ray " + std::to_string(i) + ": " + problem;
+  return {};
+}
+
+/// Embree refuses scenes it cannot hold (a vertex beyond its range, its
+/// build leaves such triangles out): that is a refusal of the structure, not
+/// an error of the run.
+bool refuses_scenes(const std::string& name) {
+  return name == "embree" || name.starts_with("embree-");
+}
+
+std::string without_embree_prefix(std::string text) {
+  if (text.starts_with("embree: ")) text.erase(0, 8);
+  return text;
+}
+
 std::unique_ptr<Accelerator> build_bench_structure(const std::string& name, std::span<const Triangle> tris,
                                                    const StructureOptions& so, const ProgressCallback& cb) {
   if (name.starts_with("embree-")) {
@@ -224,6 +248,9 @@ std::unique_ptr<Accelerator> build_bench_structure(const std::string& name, std:
 }
 
 int run_bench(BenchOptions o, const GlobalOptions& global) {
+  // A structure named in --structure that refuses the scene or rays makes the
+  // run exit 1 (after the others are measured); the default list's Embree does not.
+  const bool named_by_user = !o.structures.empty();
   if (o.structures.empty())
     o.structures = kHaveEmbree ? std::vector<std::string>{"bvh", "embree"} : std::vector<std::string>{"bvh"};
   if (o.repeat < 1) throw UsageError("--repeat must be at least 1");
@@ -242,11 +269,11 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
 
   progress.begin("loading " + o.scene);
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
-  progress.end(std::to_string(scene.triangles.size()) + " triangles");
+  progress.end(count_of(scene.triangles.size(), "triangle"));
   StructureOptions so = o.structure_opts.to_options(o.threads, /*compute_epo=*/!o.no_epo);
   so.scene = &scene;  // "tlas" builds its two levels from the scene's meshes and instances
 
-  // ---- ray sets, from the first structure's primary hits ----
+  // ---- ray sets, from the primary hits of the first structure that takes the scene and the primary rays ----
   const Camera camera = camera_for(o.camera, scene, size);
   std::vector<RaySet> sets;
   sets.push_back({"primary", primary_rays(camera, size.width, size.height)});
@@ -255,10 +282,29 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   const bool want_diffuse = o.rays == "all" || o.rays == "diffuse";
   const bool want_shadow = o.rays == "all" || o.rays == "shadow";
   if (want_diffuse || want_shadow) {
-    progress.begin("primary hits for the secondary rays (" + o.structures.front() + ")");
     StructureOptions quick = so;
     quick.bvh.compute_epo = false;
-    const std::unique_ptr<Accelerator> ref = build_bench_structure(o.structures.front(), scene.triangles, quick, {});
+    std::unique_ptr<Accelerator> ref;
+    std::string first_refusal;
+    for (const std::string& name : o.structures) {
+      progress.begin("primary hits for the secondary rays (" + name + ")");
+      try {
+        ref = build_bench_structure(name, scene.triangles, quick, {});
+      } catch (const std::runtime_error& e) {
+        if (!refuses_scenes(name)) throw;
+        if (first_refusal.empty()) first_refusal = e.what();
+        progress.end("refused");
+        continue;
+      }
+      if (const std::string refused = first_refused_ray(*ref, sets[0].rays); !refused.empty()) {
+        if (first_refusal.empty()) first_refusal = name + ": primary rays: " + refused;
+        ref.reset();
+        progress.end("refused");
+        continue;
+      }
+      break;
+    }
+    if (!ref) throw std::runtime_error(first_refusal);  // no structure takes the scene and its primary rays
     std::vector<Hit> hits(sets[0].rays.size());
     trace_closest(*ref, sets[0].rays, hits, q, all);
     progress.end();
@@ -287,16 +333,28 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
     for (std::size_t i = 0; i < count; ++i) {
       const std::string& name = o.structures[i];
       results[i].name = name;
+      if (!results[i].refused.empty()) continue;
       const std::string round = k < 0 ? "warm-up " + std::to_string(k + o.warmup + 1) + "/" + std::to_string(o.warmup)
                                       : std::to_string(k + 1) + "/" + std::to_string(o.repeat);
       progress.begin("building " + name + " (" + round + ")");
       accels[i].reset();  // never two copies of one structure in memory
-      accels[i] = build_bench_structure(name, scene.triangles, so, progress.callback());
+      try {
+        accels[i] = build_bench_structure(name, scene.triangles, so, progress.callback());
+      } catch (const std::runtime_error& e) {
+        if (!refuses_scenes(name)) throw;
+        results[i].refused = without_embree_prefix(e.what());  // the others are still measured
+        progress.end("refused");
+        continue;
+      }
       if (k >= 0) results[i].build_ms.push_back(accels[i]->build_stats().build_ms);
       progress.end(std::to_string(static_cast<long long>(accels[i]->build_stats().build_ms)) + " ms");
     }
+  bool any_built = false;
+  for (const StructureResult& r : results) any_built = any_built || r.refused.empty();
+  if (!any_built) throw std::runtime_error("embree: " + results.front().refused);
   for (std::size_t i = 0; i < count; ++i) {
     StructureResult& r = results[i];
+    if (!r.refused.empty()) continue;
     r.stats = accels[i]->build_stats();
 #ifdef ACCELVIZ_HAVE_EMBREE
     if (r.name == "bvh" && !scene.triangles.empty()) {
@@ -309,19 +367,42 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   }
 
   // ---- queries: per ray set and figure, the structures in turns ----
+  // A structure that refuses a ray of a set (Embree's limits) is not measured
+  // on that set: the others' figures stay on the same rays.
   for (const RaySet& set : sets) {
-    std::vector<QueryFigures> f = measure_in_turns(accels, set.rays, q, all, o.warmup, o.repeat, progress, set.name);
+    std::vector<const Accelerator*> taking;
+    std::vector<std::size_t> index;
     for (std::size_t i = 0; i < count; ++i) {
+      if (!accels[i]) continue;
+      if (std::string refused = first_refused_ray(*accels[i], set.rays); !refused.empty()) {
+        results[i].refused_sets.push_back({set.name, std::move(refused)});
+        continue;
+      }
+      taking.push_back(accels[i].get());
+      index.push_back(i);
+    }
+    std::vector<QueryFigures> f = measure_in_turns(taking, set.rays, q, all, o.warmup, o.repeat, progress, set.name);
+    for (std::size_t k = 0; k < index.size(); ++k) {
+      const std::size_t i = index[k];
       progress.begin(o.structures[i] + " " + set.name + ": counting pass");
-      count_per_ray(*accels[i], set.rays, q, all, f[i]);
+      count_per_ray(*accels[i], set.rays, q, all, f[k]);
       progress.end();
-      results[i].queries.push_back({set.name, f[i]});
+      results[i].queries.push_back({set.name, f[k]});
     }
   }
+  bool refusals = false;
+  for (const StructureResult& r : results) refusals = refusals || !r.refused.empty() || !r.refused_sets.empty();
+  const int exit_code = refusals && named_by_user ? 1 : 0;
 
   const StructureResult* embree = nullptr;
   for (const StructureResult& r : results)
-    if (r.name == "embree") embree = &r;
+    if (r.name == "embree" && r.refused.empty()) embree = &r;
+  /// The figures of `r` on the set named `set`, or null when it was not measured there.
+  const auto figures_on = [](const StructureResult& r, const std::string& set) -> const QueryFigures* {
+    for (const auto& [name, f] : r.queries)
+      if (name == set) return &f;
+    return nullptr;
+  };
 
   // ---- JSON ----
   nlohmann::json j;
@@ -346,7 +427,14 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
     if (set.name == "diffuse") j["ray_sets"]["diffuse"]["seed"] = o.seed;
   }
   j["structures"] = nlohmann::json::array();
+  j["not_measured"] = nlohmann::json::array();
   for (const StructureResult& r : results) {
+    if (!r.refused.empty()) j["not_measured"].push_back({{"structure", r.name}, {"reason", r.refused}});
+    for (const auto& [set, why] : r.refused_sets)
+      j["not_measured"].push_back({{"structure", r.name}, {"ray_set", set}, {"reason", why}});
+  }
+  for (const StructureResult& r : results) {
+    if (!r.refused.empty()) continue;
     nlohmann::json s;
     s["name"] = r.name;
     s["build"] = {
@@ -375,13 +463,15 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   if (embree) {
     j["ratios_vs_embree"] = nlohmann::json::object();
     for (const StructureResult& r : results) {
-      if (&r == embree) continue;
+      if (&r == embree || !r.refused.empty()) continue;
       nlohmann::json rr = {{"build_ms", ratio(median(r.build_ms), median(embree->build_ms))},
                            {"memory_bytes", ratio(static_cast<double>(r.stats.memory_bytes),
                                                   static_cast<double>(embree->stats.memory_bytes))}};
       for (std::size_t k = 0; k < r.queries.size(); ++k) {
         const QueryFigures& a = r.queries[k].second;
-        const QueryFigures& b = embree->queries[k].second;
+        const QueryFigures* theirs = figures_on(*embree, r.queries[k].first);
+        if (!theirs) continue;  // Embree refused a ray of this set
+        const QueryFigures& b = *theirs;
         rr[r.queries[k].first] = {{"closest_mrays_1t", ratio(a.closest_1t, b.closest_1t)},
                                   {"closest_mrays_nt", ratio(a.closest_nt, b.closest_nt)},
                                   {"any_mrays_1t", ratio(a.any_1t, b.any_1t)},
@@ -396,23 +486,33 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   }
   if (o.json) {
     std::cout << j.dump(2) << std::endl;
-    return 0;
+    return exit_code;
   }
 
   // ---- text ----
+  // The columns: one thread, and the run's --threads (all hardware threads by
+  // default). With one thread in all, the second pair is a second one-thread
+  // measurement: "all=1T", so that no two headers read alike.
+  const std::string nt = all > 1 ? std::to_string(all) + "T" : "all=1T";
+  const std::string closest_nt = "closest " + nt, any_nt = "any " + nt;
   const std::string warm = o.warmup > 0 ? " after " + std::to_string(o.warmup) + " untimed" : "";
   const std::string embree_isa = so.embree.isa == EmbreeIsa::automatic
                                      ? std::string()
                                      : ", its " + std::string(embree_isa_name(so.embree.isa)) + " kernels";
-  std::printf("scene %s: %zu triangles; %u threads; medians of %d runs%s; %s triangle test%s%s\n", o.scene.c_str(),
-              scene.triangles.size(), all, o.repeat, warm.c_str(), o.triangle_test.c_str(),
+  std::printf("scene %s: %s; %s; medians of %s%s; %s triangle test%s%s\n", o.scene.c_str(),
+              count_of(scene.triangles.size(), "triangle").c_str(), count_of(all, "thread").c_str(),
+              count_of(static_cast<std::size_t>(o.repeat), "run").c_str(), warm.c_str(), o.triangle_test.c_str(),
               kHaveEmbree ? (so.embree.robust ? "; Embree robust" : "; Embree default (not robust)") : "",
               kHaveEmbree ? embree_isa.c_str() : "");
   for (const RaySet& set : sets)
-    std::printf("  %-8s %zu rays%s\n", set.name.c_str(), set.rays.size(),
+    std::printf("  %-8s %s%s\n", set.name.c_str(), count_of(set.rays.size(), "ray").c_str(),
                 set.name == "shadow" && synthetic_light ? " (to a synthetic light: the scene has none)" : "");
   for (const StructureResult& r : results) {
     std::printf("\n%s\n", r.name.c_str());
+    if (!r.refused.empty()) {
+      std::printf("  not measured: %s\n", r.refused.c_str());
+      continue;
+    }
     const bool has_counters = !r.name.starts_with("embree");  // Embree exposes neither its tree nor per-ray counters
     std::printf("  build %.1f ms", median(r.build_ms));
     if (r.stats.node_count > 0)
@@ -426,17 +526,17 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
       std::printf("  Embree rtcBuildBVH binary tree: SAH %.3f (ours/embree %.3f), build %.1f ms, %llu leaves\n",
                   r.embree_bvh->sah_cost, ratio(r.stats.sah_cost, r.embree_bvh->sah_cost), r.embree_bvh->build_ms,
                   static_cast<unsigned long long>(r.embree_bvh->leaf_count));
-    const std::string closest_nt = "closest " + std::to_string(all) + "T", any_nt = "any " + std::to_string(all) + "T";
-    std::printf("  %-8s %12s %12s %12s %12s %10s %10s\n", "Mrays/s", "closest 1T", closest_nt.c_str(), "any 1T",
+    std::printf("  %-8s %15s %15s %15s %15s %10s %10s\n", "Mrays/s", "closest 1T", closest_nt.c_str(), "any 1T",
                 any_nt.c_str(), "nodes/ray", "prims/ray");
     for (const auto& [set, f] : r.queries) {
-      std::printf("  %-8s %12.2f %12.2f %12.2f %12.2f", set.c_str(), f.closest_1t, f.closest_nt, f.any_1t, f.any_nt);
+      std::printf("  %-8s %15.2f %15.2f %15.2f %15.2f", set.c_str(), f.closest_1t, f.closest_nt, f.any_1t, f.any_nt);
       if (has_counters) {
         std::printf(" %10.1f %10.1f\n", f.closest_nodes, f.closest_prims);
       } else {
         std::printf(" %10s %10s\n", "n/a", "n/a");
       }
     }
+    for (const auto& [set, why] : r.refused_sets) std::printf("  %-8s not measured: %s\n", set.c_str(), why.c_str());
     for (const auto& [set, f] : r.queries)
       if (f.packets)
         std::printf("  %-8s packets of 8, 1T: closest %.2f, any %.2f Mrays/s\n", set.c_str(), f.closest_packet_1t,
@@ -445,23 +545,25 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   if (embree) {
     std::printf("\nratios ours/embree (build and memory: lower is better; Mrays/s: higher is better)\n");
     for (const StructureResult& r : results) {
-      if (&r == embree) continue;
+      if (&r == embree || !r.refused.empty()) continue;
       std::printf("  %s: build %.2f, memory %.2f\n", r.name.c_str(),
                   ratio(median(r.build_ms), median(embree->build_ms)),
                   ratio(static_cast<double>(r.stats.memory_bytes), static_cast<double>(embree->stats.memory_bytes)));
       for (std::size_t k = 0; k < r.queries.size(); ++k) {
         const QueryFigures& a = r.queries[k].second;
-        const QueryFigures& b = embree->queries[k].second;
-        std::printf("    %-8s closest 1T %.2f, closest %uT %.2f, any 1T %.2f, any %uT %.2f\n",
-                    r.queries[k].first.c_str(), ratio(a.closest_1t, b.closest_1t), all,
-                    ratio(a.closest_nt, b.closest_nt), ratio(a.any_1t, b.any_1t), all, ratio(a.any_nt, b.any_nt));
+        const QueryFigures* theirs = figures_on(*embree, r.queries[k].first);
+        if (!theirs) continue;  // Embree refused a ray of this set
+        const QueryFigures& b = *theirs;
+        std::printf("    %-8s closest 1T %.2f, %s %.2f, any 1T %.2f, %s %.2f\n", r.queries[k].first.c_str(),
+                    ratio(a.closest_1t, b.closest_1t), closest_nt.c_str(), ratio(a.closest_nt, b.closest_nt),
+                    ratio(a.any_1t, b.any_1t), any_nt.c_str(), ratio(a.any_nt, b.any_nt));
         if (a.packets && b.packets)
           std::printf("    %-8s packets of 8, 1T: closest %.2f, any %.2f\n", r.queries[k].first.c_str(),
                       ratio(a.closest_packet_1t, b.closest_packet_1t), ratio(a.any_packet_1t, b.any_packet_1t));
       }
     }
   }
-  return 0;
+  return exit_code;
 }
 
 }  // namespace

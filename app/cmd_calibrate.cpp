@@ -61,7 +61,7 @@ int run_calibrate(const CalibrateCliOptions& o, const GlobalOptions& global) {
     progress.begin("loading " + o.scene);
     const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
     require_flattened(scene, o.scene, "calibrate --scene");
-    progress.end(std::to_string(scene.triangles.size()) + " triangles");
+    progress.end(count_of(scene.triangles.size(), "triangle"));
     const std::vector<Ray> rays = primary_rays(camera_for("", scene, size), size.width, size.height);
     progress.begin("BVH with the default and the calibrated constants");
     report = compare_calibrated_bvh(scene.triangles, rays, c, q, o.threads, o.repeat);
@@ -82,10 +82,12 @@ int run_calibrate(const CalibrateCliOptions& o, const GlobalOptions& global) {
   std::printf("ray-triangle, watertight    %7.2f ns  (C_isect/C_trav = %.3f)\n", c.ns_triangle_watertight,
               c.c_isect_watertight());
   std::printf("ray-triangle, fast (M-T)    %7.2f ns  (C_isect/C_trav = %.3f)\n", c.ns_triangle_fast, c.c_isect_fast());
-  std::printf("C_trav = 1 is one inner-node visit = two box tests; medians of %d loops, one thread\n", o.repeat);
+  std::printf("C_trav = 1 is one inner-node visit = two box tests; medians of %s, one thread\n",
+              count_of(static_cast<std::size_t>(o.repeat), "loop").c_str());
   if (!o.scene.empty()) {
-    std::printf("\n%s, %zu primary rays, %s test:\n", o.scene.c_str(),
-                static_cast<std::size_t>(size.width) * size.height, o.triangle_test.c_str());
+    std::printf("\n%s, %s, %s test:\n", o.scene.c_str(),
+                count_of(static_cast<std::size_t>(size.width) * size.height, "primary ray").c_str(),
+                o.triangle_test.c_str());
     std::printf("  %-28s %10s %14s %10s %10s %10s\n", "constants", "build ms", "SAH (calib.)", "Mrays/s", "nodes/ray",
                 "prims/ray");
     const CalibratedTree &def = report.with_default, &cal = report.with_calibrated;

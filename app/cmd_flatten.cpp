@@ -35,7 +35,7 @@ int run_flatten(const FlattenOptions& o, const GlobalOptions& global) {
   Progress progress(global.quiet);
   progress.begin("loading " + o.scene);
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
-  progress.end(std::to_string(scene.instances.size()) + " instances");
+  progress.end(count_of(scene.instances.size(), "instance"));
   std::vector<std::uint32_t> ids;
   try {
     ids = parse_instance_ids(o.instances, scene.instances.size());

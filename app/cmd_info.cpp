@@ -1,4 +1,5 @@
 // accelviz info SCENE [--json]: what the loader found, dropped and noticed.
+#include <charconv>
 #include <cstdio>
 #include <memory>
 
@@ -17,6 +18,13 @@ struct InfoOptions {
 
 nlohmann::json vec_json(const glm::vec3& v) {
   return {v.x, v.y, v.z};
+}
+
+/// The shortest decimal that reads back as `x` (std::to_chars): distinct floats print distinct.
+std::string shortest_float(float x) {
+  char buf[32];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, x);
+  return ec == std::errc() ? std::string(buf, end) : std::to_string(x);
 }
 
 int run_info(const InfoOptions& o, const GlobalOptions& global) {
@@ -67,9 +75,12 @@ int run_info(const InfoOptions& o, const GlobalOptions& global) {
   if (empty) {
     std::printf("bounds         (empty)\n");
   } else {
-    const glm::vec3 e = b.extent();
-    std::printf("bounds         (%g, %g, %g) .. (%g, %g, %g), extent (%g, %g, %g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x,
-                b.hi.y, b.hi.z, e.x, e.y, e.z);
+    // Each float in its shortest form that reads back as the same float (%g's
+    // six digits printed a 2-wide box at 1e7 as (1e+07, ...) .. (1e+07, ...)).
+    const auto v = [](const glm::vec3& p) {
+      return "(" + shortest_float(p.x) + ", " + shortest_float(p.y) + ", " + shortest_float(p.z) + ")";
+    };
+    std::printf("bounds         %s .. %s, extent %s\n", v(b.lo).c_str(), v(b.hi).c_str(), v(b.extent()).c_str());
   }
   std::printf("dropped        %llu non-finite triangle(s)\n",
               static_cast<unsigned long long>(scene.report.dropped_nonfinite));

@@ -35,7 +35,7 @@ int run_rays(const RaysOptions& o, const GlobalOptions& global) {
 
   progress.begin("loading " + o.scene);
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
-  progress.end(std::to_string(scene.triangles.size()) + " triangles");
+  progress.end(count_of(scene.triangles.size(), "triangle"));
 
   const Camera camera =
       camera_for(o.camera, scene, size);

@@ -181,7 +181,15 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
         {"yfov_deg", camera.yfov * 180.0 / 3.14159265358979}}},
   };
   note_instanced_triangles(figures, *accel);
-  if (metric_needs_stats(metric)) figures["instrumented"] = true;  // render_ms includes counting
+  // render_ms includes counting for the counter metrics; Embree keeps no
+  // per-ray counters (its nodes/prims/cost images are all 0), so nothing was counted.
+  const bool counters = o.structure != "embree";
+  figures["per_ray_counters"] = counters;
+  if (metric_needs_stats(metric)) {
+    figures["instrumented"] = counters;
+    if (!counters && !global.quiet)
+      std::cerr << "accelviz: embree keeps no per-ray counters: its " << o.metric << " image is all 0\n";
+  }
   figures["device"] = o.device;
   for (const auto& [key, value] : gpu_figures.items()) figures[key] = value;
   return colorize(img, co);

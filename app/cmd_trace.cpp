@@ -30,7 +30,7 @@ int run_trace(const TraceOptions& o, const GlobalOptions& global) {
 
   progress.begin("reading " + o.rays);
   const std::vector<Ray> rays = read_rays(o.rays);
-  progress.end(std::to_string(rays.size()) + " rays");
+  progress.end(count_of(rays.size(), "ray"));
 
   const Scene scene = load_scene_with_progress(o.scene, global.quiet, progress);
   const std::unique_ptr<Accelerator> accel =

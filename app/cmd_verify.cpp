@@ -1,7 +1,9 @@
 // accelviz verify SCENE --rays N --structure all|LIST [--seed S] [--threads T] [--json]:
 // traces random, adversarial and camera rays on every structure (closest and
 // any hit) and compares with the double-precision reference. Prints one
-// summary line; exit 1 when any disagreement is not explained by rounding.
+// summary line (after a line per structure that refused the scene or rays);
+// exit 1 when any disagreement is not explained by rounding, or when a
+// structure named by itself (not through "all") refused.
 #include "app/cli_common.h"
 
 #include "core/analysis/verify.h"
@@ -33,13 +35,13 @@ int run_verify(const VerifyOptions& o, const GlobalOptions& global) {
   Progress progress(global.quiet);
   progress.begin("loading " + o.scene);
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
-  progress.end(std::to_string(scene.triangles.size()) + " triangles");
+  progress.end(count_of(scene.triangles.size(), "triangle"));
   if (scene.triangles.empty() && !scene.instances.empty())
     throw std::runtime_error(o.scene +
                              ": instanced and too large to flatten; verify needs the flattened triangles for its "
                              "brute-force reference");
 
-  progress.begin("verifying " + std::to_string(structures.size()) + " structures");
+  progress.begin("verifying " + count_of(structures.size(), "structure"));
   std::vector<Ray> rays;
   try {
     rays = verify_rays(scene.triangles, o.rays, o.seed);
@@ -54,12 +56,26 @@ int run_verify(const VerifyOptions& o, const GlobalOptions& global) {
     for (const std::string& ex : r.examples) std::cerr << "verify: " << ex << "\n";
 
   const VerifyCounts& t = r.total;
+  // A refusal is no disagreement: with "all" the structure is reported as not
+  // (wholly) checked and the verdict is the others'; a structure named by
+  // itself that refuses makes the run fail (exit 1), as its refusal does in
+  // render, bench and trace.
+  const bool ok = r.ok() && !r.named_refused();
   if (o.json) {
     nlohmann::json per = nlohmann::json::object();
     for (const auto& [label, c] : r.per_structure)
-      per[label] = {{"mismatched_prim", c.mismatched_prim}, {"t_beyond_tolerance", c.t_beyond_tolerance},
-                    {"anyhit_disagree", c.anyhit_disagree}, {"near_ties", c.near_ties},
-                    {"build_ms", c.build_ms},                {"ok", c.ok()}};
+      per[label] = {{"rays", c.rays},
+                    {"mismatched_prim", c.mismatched_prim},
+                    {"t_beyond_tolerance", c.t_beyond_tolerance},
+                    {"anyhit_disagree", c.anyhit_disagree},
+                    {"near_ties", c.near_ties},
+                    {"build_ms", c.build_ms},
+                    {"ok", c.ok()}};
+    nlohmann::json not_checked = nlohmann::json::object();
+    for (const VerifyNotChecked& n : r.not_checked) {
+      not_checked[n.label] = {{"rays", n.rays}, {"scene_refused", n.scene_refused}, {"reason", n.reason}};
+      if (!n.scene_refused) not_checked[n.label]["first_ray"] = n.first_ray;
+    }
     print_json_line({{"scene", o.scene},
                      {"triangles", scene.triangles.size()},
                      {"rays", r.rays},
@@ -67,20 +83,28 @@ int run_verify(const VerifyOptions& o, const GlobalOptions& global) {
                      {"threads", resolve_threads(o.threads)},
                      {"reference_hits", r.reference_hits},
                      {"structures", per},
+                     {"not_checked", not_checked},
                      {"mismatched_prim", t.mismatched_prim},
                      {"t_beyond_tolerance", t.t_beyond_tolerance},
                      {"anyhit_disagree", t.anyhit_disagree},
                      {"near_ties", t.near_ties},
                      {"reference_ms", r.reference_ms},
                      {"total_ms", r.total_ms},
-                     {"ok", r.ok()}});
+                     {"ok", ok}});
   } else {
+    for (const VerifyNotChecked& n : r.not_checked) {
+      if (n.scene_refused)
+        std::cout << n.label << ": not checked: " << n.reason << "\n";
+      else
+        std::cout << n.label << ": " << n.rays << " of " << r.rays << " rays not checked (the first, ray "
+                  << n.first_ray << ": " << n.reason << ")\n";
+    }
     std::cout << "verify: " << o.scene << " rays=" << r.rays << " structures=" << r.per_structure.size()
               << " mismatched_prim=" << t.mismatched_prim << " t_beyond_tolerance=" << t.t_beyond_tolerance
               << " anyhit_disagree=" << t.anyhit_disagree << " near_ties=" << t.near_ties << " -> "
-              << (r.ok() ? "OK" : "FAIL") << std::endl;
+              << (ok ? "OK" : "FAIL") << std::endl;
   }
-  return r.ok() ? 0 : 1;
+  return ok ? 0 : 1;
 }
 
 Command add_verify_command(CLI::App& parent, const GlobalOptions& global) {

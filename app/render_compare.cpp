@@ -113,6 +113,32 @@ QueryOptions query_of(const CompareSide& side) {
   return q;
 }
 
+nlohmann::json describe_side(const CompareSide& side, HeatMetric metric) {
+  const std::string& st = side.structure;
+  const bool bvh_options = st == "bvh" || st == "tlas";  // tlas: both levels use the BVH's options
+  nlohmann::json d = {{"structure", st}};
+  if (st != "embree" && st != "voxels") d["triangle_test"] = side.triangle_test;  // Embree: its own test
+  if (bvh_options) {
+    d["splitter"] = side.structure_opts.splitter;
+    if (side.structure_opts.splitter == "binned") d["buckets"] = side.structure_opts.buckets;
+    d["leaf"] = side.structure_opts.leaf;
+    d["leaf_cap"] = side.structure_opts.leaf_cap;
+  }
+  // The SAH's costs, and the cost metric's weights whatever the structure.
+  if (bvh_options || metric == HeatMetric::cost) {
+    d["ctrav"] = side.structure_opts.ctrav;
+    d["cisect"] = side.structure_opts.cisect;
+  }
+  if (bvh_options || st == "kdtree" || st == "octree") d["order"] = side.order;  // child order of their traversal
+  if (bvh_options) d["xray"] = side.xray;
+  if (st == "embree") {
+    d["embree_quality"] = side.structure_opts.embree_quality;
+    d["embree_robust"] = side.structure_opts.embree_robust;
+  }
+  d["per_ray_counters"] = st != "embree";  // Embree keeps none: its counter images are all 0
+  return d;
+}
+
 HeatmapOptions heatmap_options_of(const CompareSide& side, HeatMetric metric, const ImageSize& size, unsigned threads) {
   return {.metric = metric,
           .width = size.width,
@@ -152,17 +178,17 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
     double total = 0.0;
     for (const float v : images[s].values)
       if (std::isfinite(v)) total += v;
-    sides[s == 0 ? "a" : "b"] = {{"structure", c.structure},
-                                 {"splitter", c.structure_opts.splitter},
-                                 {"buckets", c.structure_opts.buckets},
-                                 {"leaf", c.structure_opts.leaf},
-                                 {"order", c.order},
-                                 {"xray", c.xray},
-                                 {"build_ms", accel->build_stats().build_ms},
-                                 {"sah_cost", accel->build_stats().sah_cost},
-                                 {"mean", fig.mean},
-                                 {"max", fig.max},
-                                 {"total", total}};
+    if (c.structure == "embree" && !global.quiet)
+      std::cerr << "accelviz: " << tag << ": embree keeps no per-ray counters: its " << job.metric
+                << " image is all 0\n";
+    nlohmann::json d = describe_side(c, metric);
+    d["build_ms"] = accel->build_stats().build_ms;
+    d["sah_cost"] = c.structure == "embree" ? nlohmann::json(nullptr)  // Embree does not expose its tree
+                                            : nlohmann::json(accel->build_stats().sah_cost);
+    d["mean"] = fig.mean;
+    d["max"] = fig.max;
+    d["total"] = total;
+    sides[s == 0 ? "a" : "b"] = d;
   }
   ABFigures ab;
   const MetricImage diff = difference_image(images[0], images[1], &ab);
@@ -184,7 +210,8 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
   figures["total_a"] = ab.total_a;
   figures["total_b"] = ab.total_b;
   figures["total_diff"] = ab.total_b - ab.total_a;
-  figures["ratio_b_over_a"] = ab.total_a > 0.0 ? ab.total_b / ab.total_a : 0.0;
+  // No ratio of a total of 0 (Embree's, which keeps no counters, or an empty view): null, not 0.
+  figures["ratio_b_over_a"] = ab.total_a > 0.0 ? nlohmann::json(ab.total_b / ab.total_a) : nlohmann::json(nullptr);
   figures["max_abs_diff"] = ab.max_abs_diff;
   figures["pixels_b_cheaper"] = ab.b_cheaper;
   figures["pixels_b_dearer"] = ab.b_dearer;

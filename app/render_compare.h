@@ -31,6 +31,14 @@ struct ComparePaths {
 };
 ComparePaths compare_paths(const std::string& out);
 
+/// A side's options as the JSON names them: the structure and every option
+/// that can differ between the sides and applies to it (triangle_test but
+/// for Embree; splitter, buckets (binned), leaf, leaf_cap, xray for bvh and
+/// tlas; order for those and kdtree, octree; ctrav, cisect for bvh, tlas and
+/// the cost metric; embree_quality, embree_robust for Embree), and
+/// per_ray_counters (false for Embree: its counter images are all 0).
+nlohmann::json describe_side(const CompareSide& side, HeatMetric metric);
+
 /// QueryOptions of a side (order, x-ray, triangle test).
 QueryOptions query_of(const CompareSide& side);
 

@@ -34,6 +34,14 @@ using Clock = std::chrono::steady_clock;
 
 using Rng = SplitMix64;  // core/util/random.h
 
+/// The power of two at or below `s` (> 0, finite): unit directions scaled by
+/// it keep their aim exactly (nothing rounds) and get t on the scene's scale.
+float power_of_two_at_or_below(float s) {
+  int e = 0;
+  std::frexp(s, &e);
+  return std::ldexp(1.0f, e - 1);
+}
+
 glm::vec3 vertex_of(const Triangle& t, std::size_t i) {
   return i == 0 ? t.v0 : i == 1 ? t.v1 : t.v2;
 }
@@ -156,7 +164,16 @@ std::vector<LabRay> lab_rays(std::span<const Triangle> triangles, std::size_t co
   Aabb b;
   for (const Triangle& t : triangles) b.extend(t.bounds());
   const glm::vec3 centre = b.center();
-  const float radius = std::max(glm::length(b.extent()), 1e-6f);
+  // Scale-invariant: the scene's own diagonal (in double: no underflow at
+  // 1e-20 nor overflow at 1e20), 1 only for a point or a diagonal beyond the
+  // float range. (A floor of 1e-6 put the origins of a 1e-20 scene 1e14 scene
+  // sizes away, where the rays aimed at a vertex or an edge lost their aim.)
+  float radius = static_cast<float>(glm::length(glm::dvec3(b.extent())));
+  if (!(radius > 0.0f) || !std::isfinite(radius)) radius = 1.0f;
+  // Unit directions (axis, grazing) scaled to the scene, as the aimed rays
+  // are (t = 1 at their target): the reference's t tolerances, 1e-6·max(1, t),
+  // then mean the same at every scale.
+  const float unit = power_of_two_at_or_below(radius);
   for (std::size_t i = 0; i < count; ++i) {
     Rng r{seed * 0x2545F4914F6CDD1Dull + i};
     const auto family = static_cast<LabFamily>(i % kLabFamilies);
@@ -185,7 +202,7 @@ std::vector<LabRay> lab_rays(std::span<const Triangle> triangles, std::size_t co
         const glm::vec3 target = r.uniform() < 0.5f ? a : a + 0.5f * (c - a);
         const float sign = (r.next() & 1) ? 1.0f : -1.0f;
         d = glm::vec3(0.0f);
-        d[axis] = sign;
+        d[axis] = sign * unit;
         for (int k = 0; k < 3; ++k)
           if (k != axis) d[k] = (r.next() & 1) ? -0.0f : 0.0f;
         o = target;
@@ -195,16 +212,21 @@ std::vector<LabRay> lab_rays(std::span<const Triangle> triangles, std::size_t co
       case LabFamily::grazing: {
         const float u = r.uniform(), v = r.uniform() * (1.0f - u);
         const glm::vec3 p = t->v0 + u * (t->v1 - t->v0) + v * (t->v2 - t->v0);
-        const glm::vec3 n = triangle_normal(*t);
+        const glm::vec3 n = triangle_normal(*t);  // unit, redone in double where float under/overflows
         glm::vec3 in_plane = glm::cross(n, r.unit_vector());
-        if (!(glm::length(in_plane) > 0.0f)) in_plane = t->v1 - t->v0;
-        in_plane = glm::normalize(in_plane);
+        if (glm::length(in_plane) > 0.0f)
+          in_plane = glm::normalize(in_plane);
+        else  // in double: the edge of a 1e-20 triangle normalises too
+          in_plane = glm::vec3(glm::normalize(glm::dvec3(t->v1) - glm::dvec3(t->v0)));
         o = p - in_plane * radius;
-        d = in_plane;
+        d = in_plane * unit;
         break;
       }
     }
-    if (!(glm::length(d) > 0.0f) || !std::isfinite(glm::length(d))) d = glm::vec3(0.0f, 0.0f, 1.0f);
+    // (Components, not the length: |d|² underflows at 1e-23 and overflows at 1e19.)
+    if (!std::isfinite(d.x) || !std::isfinite(d.y) || !std::isfinite(d.z) ||
+        (d.x == 0.0f && d.y == 0.0f && d.z == 0.0f))
+      d = glm::vec3(0.0f, 0.0f, unit);
     out.push_back({Ray(o, d), family});
   }
   return out;
@@ -227,21 +249,45 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
   bo.threads = opts.threads;
   const Bvh bvh(triangles, bo);
   const std::vector<Triangle> leaf_tris = bvh.copy_leaf_triangles();  // the lab's traversals index leaf positions
-  std::unique_ptr<Accelerator> own;
+  // The structure's own traversal; Embree ignores our triangle test, so it is
+  // built twice instead: its default mode and its robust mode.
+  const bool embree = opts.structure == "embree";
+  std::unique_ptr<Accelerator> own, own_robust;
+  std::vector<std::uint8_t> own_refuses;  // per ray: the structure cannot take it (Embree's limits)
   if (!opts.structure.empty()) {
     StructureOptions so;
     so.threads = opts.threads;
-    own = build_accelerator(opts.structure, triangles, so);
+    try {
+      own = build_accelerator(opts.structure, triangles, so);
+      if (embree) {
+        so.embree.robust = true;
+        own_robust = build_accelerator(opts.structure, triangles, so);
+      }
+    } catch (const std::runtime_error& e) {
+      if (!embree) throw;
+      res.structure_refused = e.what();  // a scene Embree cannot hold: the lab's own variants still run
+    }
+    if (own) {
+      own_refuses.assign(res.rays, 0);
+      for (std::size_t i = 0; i < res.rays; ++i)
+        if (std::string why = own->ray_problem(res.lab_rays[i].ray); !why.empty()) {
+          own_refuses[i] = 1;
+          if (res.structure_rays_refused++ == 0) {
+            res.structure_first_refused_ray = i;
+            res.structure_refused_ray_reason = std::move(why);
+          }
+        }
+    }
   }
   check();
 
   // Reference: candidates from leaves widened by a hair of the scene's size.
   Aabb b;
   for (const Triangle& t : triangles) b.extend(t.bounds());
-  const float pad =
-      b.is_empty() ? 0.0f
-                   : 1e-5f * std::max({glm::length(b.extent()), std::fabs(b.lo.x), std::fabs(b.lo.y), std::fabs(b.lo.z),
-                                       std::fabs(b.hi.x), std::fabs(b.hi.y), std::fabs(b.hi.z)});
+  const float pad = b.is_empty() ? 0.0f
+                                 : 1e-5f * std::max({static_cast<float>(glm::length(glm::dvec3(b.extent()))),
+                                                     std::fabs(b.lo.x), std::fabs(b.lo.y), std::fabs(b.lo.z),
+                                                     std::fabs(b.hi.x), std::fabs(b.hi.y), std::fabs(b.hi.z)});
   std::vector<ReferenceHit> ref(res.rays);
   std::vector<int> ref_count(res.rays, 0);
   const auto t_ref = Clock::now();
@@ -263,6 +309,8 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
     TriangleTest test;
     bool padded;
     bool own;
+    const Accelerator* accel = nullptr;  ///< own: the structure traced
+    const char* embree_mode = nullptr;   ///< Embree's rows: "default" or "robust" (our triangle test does not apply)
   };
   std::vector<Spec> specs = {
       {"moller-trumbore + plain slab", TriangleTest::moller_trumbore, false, false},
@@ -270,9 +318,12 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
       {"watertight + plain slab", TriangleTest::watertight, false, false},
       {"watertight + padded slab", TriangleTest::watertight, true, false},
   };
-  if (own) {
-    specs.push_back({opts.structure + " (moller-trumbore)", TriangleTest::moller_trumbore, true, true});
-    specs.push_back({opts.structure + " (watertight)", TriangleTest::watertight, true, true});
+  if (own && embree) {
+    specs.push_back({"embree (default mode)", TriangleTest::moller_trumbore, true, true, own.get(), "default"});
+    specs.push_back({"embree (robust mode)", TriangleTest::watertight, true, true, own_robust.get(), "robust"});
+  } else if (own) {
+    specs.push_back({opts.structure + " (moller-trumbore)", TriangleTest::moller_trumbore, true, true, own.get()});
+    specs.push_back({opts.structure + " (watertight)", TriangleTest::watertight, true, true, own.get()});
   }
 
   for (const Spec& s : specs) {
@@ -281,6 +332,10 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
     v.triangle_test = s.test;
     v.padded_slab = s.padded;
     v.own_structure = s.own;
+    if (s.embree_mode) {
+      v.embree_mode = s.embree_mode;
+      v.double_hits_counted = false;
+    }
     v.per_ray.assign(res.rays, 0);
     std::vector<Hit> hits(res.rays);
     QueryOptions q;
@@ -290,7 +345,7 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
     for (std::size_t i = 0; i < res.rays; ++i) {
       const Ray& ray = res.lab_rays[i].ray;
       if (s.own) {
-        hits[i] = own->closest_hit(ray, q);
+        if (!own_refuses[i]) hits[i] = s.accel->closest_hit(ray, q);
       } else {
         const WatertightRay wr(ray.direction);
         hits[i] = s.padded ? lab_closest<true>(bvh, leaf_tris, ray, s.test, wr)
@@ -299,9 +354,15 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
       if ((i & 4095) == 4095) check();
     }
     v.ms = ms_since(t0);
-    v.mrays_per_s = v.ms > 0.0 ? static_cast<double>(res.rays) / (v.ms * 1e3) : 0.0;
+    const std::size_t traced = s.own ? res.rays - res.structure_rays_refused : res.rays;
+    v.mrays_per_s = v.ms > 0.0 ? static_cast<double>(traced) / (v.ms * 1e3) : 0.0;
     // Classification (not timed).
     for (std::size_t i = 0; i < res.rays; ++i) {
+      if (s.own && own_refuses[i]) {
+        ++v.not_traced;
+        v.per_ray[i] = 4;
+        continue;
+      }
       const LabRay& lr = res.lab_rays[i];
       const ReferenceHit& rh = ref[i];
       const Hit& h = hits[i];
@@ -323,7 +384,7 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
         ++v.wrong;
         v.per_ray[i] = 3;
       }
-      if (rh.valid() && ref_count[i] == 1) {
+      if (v.double_hits_counted && rh.valid() && ref_count[i] == 1) {
         const WatertightRay wr(lr.ray.direction);
         const float t0f = static_cast<float>(rh.t - rh.t_tolerance), t1f = static_cast<float>(rh.t + rh.t_tolerance);
         const int n = s.padded ? lab_count<true>(bvh, leaf_tris, lr.ray, s.test, wr, t0f, t1f)

@@ -9,7 +9,8 @@
 // each variant costs. The four combinations run one and the same BVH
 // traversal (over the nodes of a Bvh built with default options) so that only
 // the tests differ; optionally a structure's own traversal is timed and
-// checked too, with both triangle tests (its slab test is its own).
+// checked too, with both triangle tests (its slab test is its own); Embree,
+// which ignores our triangle test, in its default and its robust mode.
 //
 // Per ray and variant:
 //   miss        the variant finds nothing at the reference's closest surface
@@ -52,7 +53,7 @@ std::vector<LabRay> lab_rays(std::span<const Triangle> triangles, std::size_t co
 struct LabOptions {
   std::size_t rays = 20000;
   std::uint64_t seed = 1;
-  std::string structure;  ///< "" or a factory name (not voxels): also time its own traversal
+  std::string structure;  ///< "" or a factory name (not voxels): also time its own traversal (embree: both modes)
   unsigned threads = 0;   ///< 0: all hardware threads (timing runs on one thread)
 };
 
@@ -62,14 +63,22 @@ struct LabVariant {
   TriangleTest triangle_test = TriangleTest::watertight;
   bool padded_slab = true;
   bool own_structure = false;  ///< a structure's own traversal (double hits come from the lab BVH)
+  /// Embree's rows: "default" or "robust" (RTC_SCENE_FLAG_ROBUST), its own
+  /// modes; Embree ignores our triangle test, so triangle_test does not apply.
+  /// Empty for every other variant.
+  std::string embree_mode;
+  /// False for Embree's rows: it reports one hit per ray, and the lab BVH's
+  /// count with our triangle test would say nothing about Embree.
+  bool double_hits_counted = true;
   std::uint64_t misses = 0;
   std::uint64_t double_hits = 0;
   std::uint64_t wrong = 0;
+  std::uint64_t not_traced = 0;  ///< rays the structure refuses (Embree's limits): neither traced nor classified
   std::uint64_t misses_by_family[kLabFamilies] = {};
   std::uint64_t double_hits_by_family[kLabFamilies] = {};
   double ms = 0.0;  ///< closest-hit tracing of every ray, one thread
   double mrays_per_s = 0.0;
-  /// Per ray: 0 ok, 1 miss, 2 double hit, 3 wrong (miss wins over double hit).
+  /// Per ray: 0 ok, 1 miss, 2 double hit, 3 wrong (miss wins over double hit), 4 not traced.
   std::vector<std::uint8_t> per_ray;
 };
 
@@ -81,10 +90,19 @@ struct LabResult {
   std::vector<LabRay> lab_rays;
   std::vector<LabVariant> variants;
   double reference_ms = 0.0;
+  /// The structure's build refused the scene (Embree: a vertex beyond its
+  /// range): its words, and no variant of it; the lab's own variants still run.
+  std::string structure_refused;
+  /// Rays the structure refuses (Accelerator::ray_problem, Embree's limits):
+  /// how many, the first and why. Its variants trace the others.
+  std::uint64_t structure_rays_refused = 0;
+  std::size_t structure_first_refused_ray = 0;
+  std::string structure_refused_ray_reason;
 };
 
-/// Runs the lab. Throws std::invalid_argument for an unknown or voxel
-/// structure, BuildCancelled when `keep_going` returns false (checked between
+/// Runs the lab. A structure that refuses the scene or rays (Embree) does not
+/// stop it: see LabResult::structure_refused. Throws std::invalid_argument for
+/// an unknown or voxel structure, BuildCancelled when `keep_going` returns false (checked between
 /// stages and every few thousand rays).
 LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptions& opts,
                              const std::function<bool()>& keep_going = {});

@@ -31,10 +31,14 @@ std::vector<VerifyStructure> parse_verify_structures(const std::string& list, un
     if (!item.empty()) names.push_back(item);
   if (names.empty()) throw std::invalid_argument("--structure: empty list");
   std::vector<VerifyStructure> out;
-  auto add = [&](const std::string& label, const std::string& factory, BvhSplitter splitter = BvhSplitter::binned_sah) {
-    for (const VerifyStructure& s : out)
-      if (s.label == label) return;
-    VerifyStructure s{label, factory, {}};
+  auto add = [&](const std::string& label, const std::string& factory, BvhSplitter splitter = BvhSplitter::binned_sah,
+                 bool named = false) {
+    for (VerifyStructure& s : out)
+      if (s.label == label) {
+        s.named = s.named || named;
+        return;
+      }
+    VerifyStructure s{label, factory, {}, named};
     s.options.threads = threads;
     s.options.bvh.splitter = splitter;
     out.push_back(std::move(s));
@@ -57,9 +61,10 @@ std::vector<VerifyStructure> parse_verify_structures(const std::string& list, un
       add_bvh(n);
     } else if (n == "brute" || n == "brute-bbox" || n == "kdtree" || n == "grid" || n == "octree" || n == "embree") {
       if (n == "embree" && !kHaveEmbree) throw std::invalid_argument("--structure embree: this build has no Embree backend");
-      add(n, n);
+      add(n, n, BvhSplitter::binned_sah, /*named=*/true);
     } else if (n == "tlas") {
-      add("tlas", "tlas");  // two levels from the scene's instances when verify_structures gets the scene
+      add("tlas", "tlas", BvhSplitter::binned_sah,
+          /*named=*/true);  // two levels from the scene's instances when verify_structures gets the scene
     } else if (n == "voxels") {
       throw std::invalid_argument("--structure voxels: voxel hits are voxels, not triangles; it cannot be verified against triangles");
     } else {
@@ -74,12 +79,32 @@ std::vector<VerifyStructure> parse_verify_structures(const std::string& list, un
 
 namespace {
 
+std::string without_prefix(std::string text, std::string_view prefix) {
+  if (text.starts_with(prefix)) text.erase(0, prefix.size());
+  return text;
+}
+
 // One independent stream per ray index, so the rays do not depend on the
 // order they are generated in.
 using Rng = SplitMix64;  // core/util/random.h
 
 glm::vec3 in_box(Rng& r, const glm::vec3& lo, const glm::vec3& hi) {
   return {r.uniform(lo.x, hi.x), r.uniform(lo.y, hi.y), r.uniform(lo.z, hi.z)};  // braces: x, y, z in order
+}
+
+/// The power of two at or below `s` (> 0, finite). A unit direction scaled
+/// by it is aimed exactly as before (scaling by a power of two rounds
+/// nothing) while its t is on the scene's scale, as for the rays aimed at a
+/// point (t = 1 there): tolerances of the form 1e-6·max(1, t) then mean the
+/// same at every scale.
+float power_of_two_at_or_below(float s) {
+  int e = 0;
+  std::frexp(s, &e);
+  return std::ldexp(1.0f, e - 1);
+}
+
+bool usable_direction(const glm::vec3& d) {
+  return std::isfinite(d.x) && std::isfinite(d.y) && std::isfinite(d.z) && (d.x != 0.0f || d.y != 0.0f || d.z != 0.0f);
 }
 
 Aabb scene_bounds(std::span<const Triangle> tris) {
@@ -95,8 +120,16 @@ std::vector<Ray> verify_rays(std::span<const Triangle> triangles, std::size_t co
   std::vector<Ray> rays;
   rays.reserve(count);
   const Aabb b = scene_bounds(triangles);
-  const glm::vec3 ext = glm::max(b.hi - b.lo, glm::vec3(1e-6f));
-  const float radius = glm::length(ext);
+  // Scale-invariant: everything is measured in the scene's own size (its
+  // largest extent; 1 only for a point or an extent beyond the float range),
+  // so a scene of 1e-20 is probed as a scene of 1 is. (A floor of 1e-6 put the
+  // origins of a 1e-20 scene 1e14 scene sizes away, where rays aimed at a
+  // vertex or an edge lost their aim when rounded to float.)
+  float size = std::max({b.hi.x - b.lo.x, b.hi.y - b.lo.y, b.hi.z - b.lo.z});
+  if (!(size > 0.0f) || !std::isfinite(size)) size = 1.0f;
+  const glm::vec3 ext = glm::max(b.hi - b.lo, glm::vec3(1e-6f * size));   // a flat scene keeps some depth
+  const float radius = static_cast<float>(glm::length(glm::dvec3(ext)));  // in double: no underflow or overflow
+  const float unit = power_of_two_at_or_below(std::isfinite(radius) ? radius : size);
   const glm::vec3 centre = (b.lo + b.hi) * 0.5f;
   const glm::vec3 wide_lo = b.lo - 0.5f * ext, wide_hi = b.hi + 0.5f * ext;
   const Camera cam = frame_bounds(b, 1.0f);
@@ -114,7 +147,7 @@ std::vector<Ray> verify_rays(std::span<const Triangle> triangles, std::size_t co
       // from outside aimed into the bounds.
       if (r.uniform() < 0.5) {
         o = in_box(r, wide_lo, wide_hi);
-        d = r.unit_vector();
+        d = r.unit_vector() * unit;
       } else {
         o = outside_point(r);
         d = in_box(r, b.lo, b.hi) - o;
@@ -141,7 +174,7 @@ std::vector<Ray> verify_rays(std::span<const Triangle> triangles, std::size_t co
         const float sign = r.uniform() < 0.5 ? 1.0f : -1.0f;
         d = glm::vec3(r.uniform() < 0.5 ? 0.0f : -0.0f, r.uniform() < 0.5 ? 0.0f : -0.0f,
                       r.uniform() < 0.5 ? 0.0f : -0.0f);
-        d[axis] = sign;
+        d[axis] = sign * unit;
         o = target;
         o[axis] = sign > 0 ? wide_lo[axis] : wide_hi[axis];
       } else if (sub < 0.85) {
@@ -158,16 +191,16 @@ std::vector<Ray> verify_rays(std::span<const Triangle> triangles, std::size_t co
         const int axis = static_cast<int>(r.below(3));
         const int which = static_cast<int>(r.below(3));
         o[axis] = which == 0 ? b.lo[axis] : which == 1 ? b.hi[axis] : centre[axis];
-        d = r.unit_vector();
+        d = r.unit_vector() * unit;
         if (r.uniform() < 0.3) d[axis] = 0.0f;  // in the plane
       }
     } else {
       o = cam.position;
       const Ray cr = camera_ray(cam, static_cast<float>(r.uniform()), static_cast<float>(r.uniform()), 1.0f);
       o = cr.origin;
-      d = cr.direction;
+      d = cr.direction * unit;
     }
-    if (!(glm::length(d) > 0.0f) || !std::isfinite(d.x + d.y + d.z)) d = glm::vec3(0.0f, 0.0f, 1.0f);
+    if (!usable_direction(d)) d = glm::vec3(0.0f, 0.0f, unit);
     rays.emplace_back(o, d);
   }
   return rays;
@@ -197,12 +230,36 @@ VerifyResult verify_structures(std::span<const Triangle> triangles, std::span<co
   for (const VerifyStructure& s : structures) {
     StructureOptions so = s.options;
     so.scene = scene;  // "tlas": the scene's own instances (hits use the flattened ids the reference uses)
-    const std::unique_ptr<Accelerator> accel = build_accelerator(s.factory_name, triangles, so);
+    std::unique_ptr<Accelerator> accel;
+    try {
+      accel = build_accelerator(s.factory_name, triangles, so);
+    } catch (const std::runtime_error& e) {
+      // Embree refuses a scene it cannot hold (a vertex beyond ±1.844e18):
+      // the other structures are still checked.
+      if (s.factory_name != "embree") throw;
+      res.not_checked.push_back({s.label, s.named, true, rays.size(), 0, without_prefix(e.what(), "embree: ")});
+      continue;
+    }
+    // Rays the structure cannot take (Embree's limits) are left out of its
+    // check, counted and the first named; every other ray is checked.
+    std::vector<std::uint8_t> refused(rays.size(), 0);
+    VerifyNotChecked skipped{s.label, s.named, false, 0, 0, {}};
+    for (std::size_t i = 0; i < rays.size(); ++i)
+      if (std::string problem = accel->ray_problem(rays[i]); !problem.empty()) {
+        refused[i] = 1;
+        if (skipped.rays++ == 0) {
+          skipped.first_ray = i;
+          skipped.reason = std::move(problem);
+        }
+      }
+    if (skipped.rays > 0) res.not_checked.push_back(skipped);
+    if (skipped.rays == rays.size() && !rays.empty()) continue;  // no ray to check it on: not among the checked
     const unsigned nt = resolve_threads(threads);
     std::vector<VerifyCounts> per_thread(nt);
     parallel_for(rays.size(), threads, 256, [&](std::size_t b, std::size_t e, unsigned ti) {
       VerifyCounts& c = per_thread[ti];
       for (std::size_t i = b; i < e; ++i) {
+        if (refused[i]) continue;
         const Hit h = accel->closest_hit(rays[i], q);
         const Verdict vc = classify_closest(triangles, rays[i], ref[i], h);
         const Verdict va = classify_any(ref[i], accel->any_hit(rays[i], q));

@@ -17,6 +17,9 @@ struct VerifyStructure {
   std::string label;  ///< as printed: "brute", "bvh-binned", "kdtree", ...
   std::string factory_name;
   StructureOptions options;
+  /// Named in the list by itself ("embree"), not brought in by "all": the
+  /// command treats a refusal of such a structure as an error (exit 1).
+  bool named = false;
 };
 
 /// "all" or a comma list of brute, brute-bbox, bvh (every splitter),
@@ -48,6 +51,18 @@ struct VerifyCounts {
   VerifyCounts& operator+=(const VerifyCounts& o);
 };
 
+/// A structure that refused the scene or some rays (Embree's limits, see
+/// EmbreeAccelerator::ray_problem): it is checked on the rays it takes, or
+/// not at all when it refused the scene.
+struct VerifyNotChecked {
+  std::string label;
+  bool named = false;           ///< VerifyStructure::named
+  bool scene_refused = false;   ///< the build refused the scene: no ray was checked
+  std::uint64_t rays = 0;       ///< rays not checked (every ray when scene_refused)
+  std::uint64_t first_ray = 0;  ///< the first ray refused (when !scene_refused)
+  std::string reason;           ///< the structure's words, without its "embree: " prefix
+};
+
 struct VerifyResult {
   std::uint64_t rays = 0;
   std::uint64_t reference_hits = 0;
@@ -57,8 +72,17 @@ struct VerifyResult {
   double total_ms = 0.0;
   /// A few failing rays (structure, ray index, what) for the report.
   std::vector<std::string> examples;
+  /// Structures that refused the scene or some rays, in the list's order.
+  std::vector<VerifyNotChecked> not_checked;
 
+  /// No disagreement on any ray checked (a refusal is not a disagreement).
   bool ok() const { return total.ok(); }
+  /// A structure named by itself refused the scene or a ray.
+  bool named_refused() const {
+    for (const VerifyNotChecked& n : not_checked)
+      if (n.named) return true;
+    return false;
+  }
 };
 
 /// Traces `rays` on every structure in closest and any-hit mode and compares
@@ -67,7 +91,10 @@ struct VerifyResult {
 /// from the scene's meshes and instances and is compared with the brute force
 /// over the flattened triangles; without it, "tlas" is one instance over
 /// `triangles`. Throws std::invalid_argument when `scene`'s triangles are not
-/// `triangles`.
+/// `triangles`. A structure whose build refuses the scene (Embree: a vertex
+/// beyond its range) or that refuses rays (Accelerator::ray_problem) does not
+/// stop the others: it is checked on the rays it takes and listed in
+/// `not_checked`.
 VerifyResult verify_structures(std::span<const Triangle> triangles, std::span<const Ray> rays,
                                const std::vector<VerifyStructure>& structures, unsigned threads,
                                const Scene* scene = nullptr);

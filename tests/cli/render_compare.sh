@@ -31,6 +31,47 @@ assert j["total_a"] != j["total_b"], "A and B rendered the same"
 print("compare ok:", j["total_a"], j["total_b"])
 PY
 
+# Each side names every option that can differ (here the triangle test) and
+# only the options that apply to its structure.
+out=$("$accelviz" -q render "$scene" --size 24x18 --out "$tmp/tt.png" --compare 'triangle-test=fast')
+python3 - "$(sed -n 4p <<<"$out")" <<'PY'
+import json, sys
+j = json.loads(sys.argv[1])
+a, b = j["a"], j["b"]
+assert a["triangle_test"] == "watertight" and b["triangle_test"] == "fast", j
+for side in (a, b):
+    for k in ("structure", "splitter", "buckets", "leaf", "leaf_cap", "ctrav", "cisect", "order", "xray"):
+        assert k in side, (k, side)
+    assert "embree_quality" not in side and side["per_ray_counters"] is True, side
+assert {k: v for k, v in a.items() if k != "triangle_test"}.keys() == {k: v for k, v in b.items() if k != "triangle_test"}.keys()
+print("descriptions ok")
+PY
+out=$("$accelviz" -q render "$scene" --size 24x18 --out "$tmp/kd.png" -s kdtree --compare 'leaf-cap=8 structure=bvh')
+python3 - "$(sed -n 4p <<<"$out")" <<'PY'
+import json, sys
+j = json.loads(sys.argv[1])
+a, b = j["a"], j["b"]
+assert a["structure"] == "kdtree" and not any(k in a for k in ("splitter", "buckets", "leaf_cap", "xray", "ctrav")), a
+assert a["order"] == "front-to-back" and a["triangle_test"] == "watertight", a
+assert b["structure"] == "bvh" and b["leaf_cap"] == 8, b
+print("kdtree side ok")
+PY
+if [[ "$("$accelviz" render --help)" == *",tlas,embree}"* ]]; then  # a build with Embree
+  # Embree: its options only, no counters (every total 0), and no ratio of 0/0.
+  out=$("$accelviz" -q render "$scene" --size 24x18 --out "$tmp/em.png" -s embree --compare 'embree-quality=high')
+  python3 - "$(sed -n 4p <<<"$out")" <<'PY'
+import json, sys
+j = json.loads(sys.argv[1])
+a, b = j["a"], j["b"]
+assert a["embree_quality"] == "medium" and b["embree_quality"] == "high", j
+for side in (a, b):
+    assert not any(k in side for k in ("splitter", "buckets", "leaf", "leaf_cap", "triangle_test", "order", "xray")), side
+    assert side["per_ray_counters"] is False and side["total"] == 0 and side["sah_cost"] is None, side
+assert j["total_a"] == 0 and j["ratio_b_over_a"] is None, j
+print("embree sides ok")
+PY
+fi
+
 # Child order: back-to-front enters more nodes than front-to-back over the view (a few pixels may
 # gain when their closest hit lies in the farther child's box).
 out=$("$accelviz" -q render "$scene" --size 40x30 --out "$tmp/order.png" --compare 'order=back-to-front')

@@ -36,6 +36,27 @@ assert fast["misses"] + fast["double_hits"] > robust["misses"] + robust["double_
 print("json ok:", {v["name"]: (v["misses"], v["double_hits"], v["wrong"]) for v in j["variants"]})
 PY
 
+# -s embree: Embree ignores our triangle test, so its rows are its own two
+# modes, named so in the text and the JSON, with no double-hit count.
+if [[ "$("$accelviz" render --help)" == *",tlas,embree}"* ]]; then  # a build with Embree
+  out=$("$accelviz" --quiet robustness "$scene" --rays 400 -j 1 --structure embree)
+  echo "$out"
+  for v in 'embree \(default mode\)' 'embree \(robust mode\)'; do
+    grep -Eq "^$v +[0-9]+ +n/a +[0-9]+ +[0-9.]+ +[0-9.]+$" <<<"$out" || { echo "missing row: $v" >&2; exit 1; }
+  done
+  ! grep -q 'embree (watertight)\|embree (moller-trumbore)' <<<"$out" || { echo "Embree rows named after our tests" >&2; exit 1; }
+  "$accelviz" --quiet robustness "$scene" --rays 400 -j 1 --structure embree --json | python3 -c '
+import json, sys
+j = json.load(sys.stdin)
+rows = {v["name"]: v for v in j["variants"]}
+for mode in ("default", "robust"):
+    v = rows["embree (%s mode)" % mode]
+    assert v["triangle_test"] == "embree-" + mode and v["embree_mode"] == mode, v
+    assert v["double_hits"] is None and v["slab"] == "structure", v
+assert rows["watertight + padded slab"]["embree_mode"] is None
+print("embree rows ok")'
+fi
+
 # Usage errors: exit 2, the first line names the parameter (CLI11 adds a
 # "Run with --help" line to range errors).
 for args in "--structure voxels" "--structure nope" "--rays 2"; do

@@ -5,6 +5,7 @@
 #include "core/accel/brute_force.h"
 #include "core/accel/reference.h"
 #include "core/analysis/verify.h"
+#include "tests/core/spatial_test_scenes.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_reference {
@@ -154,6 +155,84 @@ TEST(Verify, StructureListParsing) {
   ASSERT_EQ(tl.size(), 2u);
   EXPECT_EQ(tl[0].factory_name, "tlas");
   for (const auto& s : all) EXPECT_NE(s.factory_name, "tlas");
+  // A structure named by itself is marked so (its refusal is the run's error); "all" names none.
+  for (const auto& s : all) EXPECT_FALSE(s.named) << s.label;
+  for (const auto& s : parse_verify_structures("brute,tlas", 1)) EXPECT_TRUE(s.named || s.label == "brute") << s.label;
+  if (kHaveEmbree) {
+    const auto e = parse_verify_structures("all,embree", 1);
+    for (const auto& s : e) EXPECT_EQ(s.named, s.label == "embree") << s.label;
+  }
+}
+
+// The rays are made in the scene's own size: a closed cube of 1e-20 gets as
+// few near ties (decisions within rounding) as one of 1. With a floor of 1e-6
+// on the size, the tiny cube's rays came from 1e14 sizes away and lost their
+// aim: 43% of its checks were near ties against 4% at scale 1.
+TEST(Verify, ATinySceneIsProbedAsAUnitSceneIs) {
+  const auto structures = parse_verify_structures("bvh-binned", 2);
+  const auto share_of_near_ties = [&](float half, std::uint64_t* reference_hits) {
+    const auto tris = test_scenes::subdivided_cube(glm::vec3(-half), 2.0f * half, 4);
+    const std::vector<Ray> rays = verify_rays(tris, 6000, 1);
+    const VerifyResult r = verify_structures(tris, rays, structures, 2);
+    EXPECT_TRUE(r.ok()) << half;
+    *reference_hits = r.reference_hits;
+    return static_cast<double>(r.total.near_ties) / (2.0 * static_cast<double>(rays.size()));  // closest + any
+  };
+  std::uint64_t unit_hits = 0, tiny_hits = 0;
+  const double unit = share_of_near_ties(1.0f, &unit_hits), tiny = share_of_near_ties(1e-20f, &tiny_hits);
+  EXPECT_GT(unit, 0.0);
+  EXPECT_LT(tiny, 2.0 * unit + 0.01) << "unit " << unit << ", tiny " << tiny;
+  EXPECT_NEAR(static_cast<double>(tiny_hits), static_cast<double>(unit_hits), 0.05 * 6000);
+}
+
+// Embree refuses a scene with a vertex beyond ±1.844e18 and rays it cannot
+// take (here: directions without a component of 1e-15): the other structures
+// are still checked on every ray, Embree on the rays it takes, and the
+// refusal is listed, not a disagreement (verify used to stop at the first).
+TEST(Verify, AnEmbreeRefusalLeavesTheOtherStructuresChecked) {
+  if (!kHaveEmbree) GTEST_SKIP() << "no Embree in this build";
+  const auto structures = parse_verify_structures("brute,bvh-binned,embree", 1);
+  {
+    const auto huge = test_scenes::subdivided_cube(glm::vec3(-2e18f), 4e18f, 3);
+    const std::vector<Ray> rays = verify_rays(huge, 600, 5);
+    const VerifyResult r = verify_structures(huge, rays, structures, 1);
+    ASSERT_EQ(r.per_structure.size(), 2u);
+    for (const auto& [label, c] : r.per_structure) {
+      EXPECT_NE(label, "embree");
+      EXPECT_EQ(c.rays, rays.size()) << label;
+      EXPECT_TRUE(c.ok()) << label;
+    }
+    ASSERT_EQ(r.not_checked.size(), 1u);
+    EXPECT_EQ(r.not_checked[0].label, "embree");
+    EXPECT_TRUE(r.not_checked[0].scene_refused);
+    EXPECT_TRUE(r.not_checked[0].named);
+    EXPECT_EQ(r.not_checked[0].rays, rays.size());
+    EXPECT_NE(r.not_checked[0].reason.find("beyond ±1.844e18"), std::string::npos) << r.not_checked[0].reason;
+    EXPECT_TRUE(r.ok());
+    EXPECT_TRUE(r.named_refused());
+  }
+  {
+    const auto cube = test_scenes::subdivided_cube(glm::vec3(0.0f), 1.0f, 3);
+    std::vector<Ray> rays = verify_rays(cube, 400, 9);
+    std::size_t short_rays = 0;
+    for (std::size_t i = 0; i < rays.size(); i += 3, ++short_rays)
+      rays[i] = Ray(rays[i].origin, glm::normalize(rays[i].direction) * 1e-20f);
+    const VerifyResult r = verify_structures(cube, rays, parse_verify_structures("all", 1), 1);
+    ASSERT_EQ(r.not_checked.size(), 1u);
+    const VerifyNotChecked& n = r.not_checked[0];
+    EXPECT_EQ(n.label, "embree");
+    EXPECT_FALSE(n.scene_refused);
+    EXPECT_FALSE(n.named);
+    EXPECT_EQ(n.rays, short_rays);
+    EXPECT_EQ(n.first_ray, 0u);
+    EXPECT_NE(n.reason.find("no component of 1e-15"), std::string::npos) << n.reason;
+    EXPECT_EQ(r.per_structure.size(), parse_verify_structures("all", 1).size());
+    for (const auto& [label, c] : r.per_structure) {
+      EXPECT_EQ(c.rays, label == "embree" ? rays.size() - short_rays : rays.size()) << label;
+      EXPECT_TRUE(c.ok()) << label;
+    }
+    EXPECT_FALSE(r.named_refused());
+  }
 }
 
 TEST(Verify, RaysAreDeterministic) {

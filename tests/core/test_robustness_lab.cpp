@@ -5,6 +5,8 @@
 #include <stdexcept>
 
 #include "core/accel/accel.h"
+#include "core/accel/embree_backend.h"
+#include "core/accel/reference.h"
 #include "core/analysis/robustness_lab.h"
 #include "core/scene/load.h"
 #include "tests/core/spatial_test_scenes.h"
@@ -106,6 +108,109 @@ TEST(RobustnessLab, FastTriangleTestLeaksOrDoubleCountsWhereWatertightDoesNot) {
   EXPECT_EQ(wt.name, "watertight + padded slab");
   EXPECT_GT(mt.misses + mt.double_hits, wt.misses + wt.double_hits);
   EXPECT_EQ(wt.wrong, 0u);
+}
+
+// The generator measures everything in the scene's own size: a closed cube
+// of 1e-20 or 1e15 is probed as adversarially as one of 1 (a floor of 1e-6 on
+// the size put the origins of the tiny cube 1e14 sizes away, where the rays
+// aimed at its vertices and edges lost their aim: Moller-Trumbore passed it
+// with 0 misses). Moller-Trumbore leaks at least as often there as at scale
+// 1 (at 1e-20 its float products underflow, at 1e15 they overflow); the
+// watertight test with padded boxes leaves no hole at any scale; and the
+// lab's reference (the double test over padded leaves) equals the brute
+// force in double at every scale.
+TEST(RobustnessLab, TinyAndHugeScenesAreProbedAsAdversariallyAsAUnitScene) {
+  LabOptions o;
+  o.rays = 4000;
+  o.threads = 2;
+  const auto cube_of = [](float half) { return test_scenes::subdivided_cube(glm::vec3(-half), 2.0f * half, 4); };
+  const auto unit_tris = cube_of(1.0f);
+  const LabResult unit = run_robustness_lab(unit_tris, o);
+  const std::uint64_t unit_mt_misses = unit.variants[0].misses;  // moller-trumbore + plain slab
+  ASSERT_GT(unit_mt_misses, 0u);
+  for (const float half : {1e-20f, 1e15f}) {
+    SCOPED_TRACE(half);
+    const auto tris = cube_of(half);
+    const LabResult r = run_robustness_lab(tris, o);
+    ASSERT_EQ(r.variants.size(), 4u);
+    EXPECT_GE(r.variants[0].misses, unit_mt_misses) << "moller-trumbore + plain slab";
+    EXPECT_GE(r.variants[1].misses, unit.variants[1].misses) << "moller-trumbore + padded slab";
+    EXPECT_EQ(r.variants[3].misses, 0u) << "watertight + padded slab";
+    for (const LabVariant& v : r.variants) EXPECT_EQ(v.wrong, 0u) << v.name;
+    // The rays hit the cube as often as at scale 1 (the tiny cube's grazing
+    // rays missed it: 3,000 of 4,000 hit), and the reference is exact.
+    EXPECT_NEAR(static_cast<double>(r.reference_hits), static_cast<double>(unit.reference_hits), 0.02 * o.rays);
+    const ReferenceTracer brute(tris);
+    std::uint64_t brute_hits = 0;
+    for (const LabRay& lr : r.lab_rays) brute_hits += brute.closest_hit(lr.ray).valid();
+    EXPECT_EQ(brute_hits, r.reference_hits);
+  }
+}
+
+// Embree refuses a scene with a vertex beyond ±1.844e18 and rays from
+// origins beyond that bound: the lab's own variants still run (the lab used
+// to stop at the refusal), the structure's variants trace the rays it takes.
+TEST(RobustnessLab, AStructureThatRefusesTheSceneOrRaysLeavesTheLabRunning) {
+  if (!kHaveEmbree) GTEST_SKIP() << "no Embree in this build";
+  LabOptions o;
+  o.rays = 400;
+  o.threads = 1;
+  o.structure = "embree";
+  {
+    const auto huge = test_scenes::subdivided_cube(glm::vec3(-2e18f), 4e18f, 3);
+    const LabResult r = run_robustness_lab(huge, o);
+    EXPECT_NE(r.structure_refused.find("beyond ±1.844e18"), std::string::npos) << r.structure_refused;
+    ASSERT_EQ(r.variants.size(), 4u);
+    for (const LabVariant& v : r.variants) EXPECT_FALSE(v.own_structure) << v.name;
+    EXPECT_EQ(r.variants[3].misses, 0u);
+  }
+  {
+    // Vertices within Embree's range, but the lab's origins lie up to 1.5
+    // scene radii out: beyond it.
+    const auto big = test_scenes::subdivided_cube(glm::vec3(-1e18f), 2e18f, 3);
+    const LabResult r = run_robustness_lab(big, o);
+    EXPECT_TRUE(r.structure_refused.empty()) << r.structure_refused;
+    EXPECT_GT(r.structure_rays_refused, 0u);
+    EXPECT_LT(r.structure_rays_refused, r.rays);
+    EXPECT_NE(r.structure_refused_ray_reason.find("origin"), std::string::npos) << r.structure_refused_ray_reason;
+    ASSERT_GT(r.variants.size(), 4u);
+    for (const LabVariant& v : r.variants) {
+      SCOPED_TRACE(v.name);
+      EXPECT_EQ(v.not_traced, v.own_structure ? r.structure_rays_refused : 0u);
+      EXPECT_EQ(count_status(v, 4), v.not_traced);
+    }
+  }
+}
+
+// Embree ignores our triangle test: its two rows are its own two modes,
+// default and robust (RTC_SCENE_FLAG_ROBUST), not "moller-trumbore" and
+// "watertight" rows that both traced its default mode (95 misses each on
+// this cube). Its robust mode leaves no hole in a closed mesh; it reports
+// one hit per ray, so double hits are not counted for it.
+TEST(RobustnessLab, EmbreeRowsAreItsDefaultAndRobustModes) {
+  if (!kHaveEmbree) GTEST_SKIP() << "no Embree in this build";
+  LabOptions o;
+  o.rays = 4000;
+  o.threads = 1;
+  o.structure = "embree";
+  const LabResult r = run_robustness_lab(test_scenes::subdivided_cube(glm::vec3(-1.0f), 2.0f, 4), o);
+  ASSERT_EQ(r.variants.size(), 6u);
+  const LabVariant &fast = r.variants[4], &robust = r.variants[5];
+  EXPECT_EQ(fast.name, "embree (default mode)");
+  EXPECT_EQ(fast.embree_mode, "default");
+  EXPECT_EQ(robust.name, "embree (robust mode)");
+  EXPECT_EQ(robust.embree_mode, "robust");
+  for (const LabVariant* v : {&fast, &robust}) {
+    EXPECT_TRUE(v->own_structure);
+    EXPECT_FALSE(v->double_hits_counted);
+    EXPECT_EQ(v->double_hits, 0u);
+    EXPECT_EQ(v->wrong, 0u);
+  }
+  EXPECT_EQ(robust.misses, 0u) << "Embree's robust mode is watertight on a closed mesh";
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_TRUE(r.variants[k].embree_mode.empty());
+    EXPECT_TRUE(r.variants[k].double_hits_counted);
+  }
 }
 
 TEST(RobustnessLab, BadStructureAndCancel) {
