@@ -192,6 +192,13 @@ RTCBuildQuality to_rtc(EmbreeQuality q) {
 
 // ---- the accelerator ---------------------------------------------------------------
 
+/// How far the scene reaches, for the overflow check of Embree's float
+/// triangle test (products_fit_embree).
+struct EmbreeReach {
+  double coordinate = 0.0;  ///< the largest |vertex component|
+  double edge = 0.0;        ///< the largest |component| of a triangle edge
+};
+
 struct EmbreeAccelerator::Impl {
   Impl(unsigned threads, EmbreeIsa isa) : device(threads, isa) {}
   ~Impl() {
@@ -204,6 +211,7 @@ struct EmbreeAccelerator::Impl {
   // end keeps the last vertex's load inside our allocation.
   std::vector<float> vertices;         ///< 3 per triangle corner, plus one padding vertex
   std::vector<std::uint32_t> indices;  ///< 0, 1, 2, ...: triangle i uses corners 3i..3i+2
+  EmbreeReach reach;
 };
 
 namespace {
@@ -229,6 +237,27 @@ bool long_enough_for_embree(const glm::vec3& d) {
   return std::max(std::abs(d.x), std::max(std::abs(d.y), std::abs(d.z))) >= kEmbreeShortest;
 }
 
+/// Embree's triangle tests work in float on C = v0 - o, the edges, their
+/// cross product and the direction D (default mode: T = Ng·C, U = (C×D)·e2,
+/// den = Ng·D; robust mode alike, on sums of two vertices), so a triple
+/// product beyond FLT_MAX becomes inf and the hit is lost: measured on a
+/// 4×4-per-face cube of half-size s with `verify -s brute,embree` (rays of
+/// the scene's size), agreement up to s = 1e12 and 1854 of 5000 rays
+/// mismatched at 1e13. With x, y, z the largest |component| of three
+/// vectors, a component of x×y is at most 2xy and a dot product with z at
+/// most 3 of those: 6xyz, 12xyz with the robust mode's sums. Refused when
+/// 12 times the largest of |C|·|e|², |C|·|e|·|D| and |e|²·|D| (largest
+/// components) passes 3e38 (FLT_MAX is 3.4e38).
+constexpr double kEmbreeProductLimit = 3e38 / 12.0;
+
+bool products_fit_embree(const Ray& ray, const EmbreeReach& reach) {
+  const auto largest = [](const glm::vec3& v) {
+    return static_cast<double>(std::max(std::abs(v.x), std::max(std::abs(v.y), std::abs(v.z))));
+  };
+  const double c = largest(ray.origin) + reach.coordinate, d = largest(ray.direction), e = reach.edge;
+  return c * e * e <= kEmbreeProductLimit && c * e * d <= kEmbreeProductLimit && e * e * d <= kEmbreeProductLimit;
+}
+
 std::string num_text(float x) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", x);
@@ -248,9 +277,9 @@ std::string vec_text(const glm::vec3& v) {
 }
 
 /// Whether Embree takes the ray (ray_problem's test, without the words).
-[[gnu::always_inline]] inline bool embree_takes(const Ray& ray) {
+[[gnu::always_inline]] inline bool embree_takes(const Ray& ray, const EmbreeReach& reach) {
   return ray.tmin >= 0.0f && ray.tmax == ray.tmax && within_embree_range(ray.origin) &&
-         within_embree_range(ray.direction) && long_enough_for_embree(ray.direction);
+         within_embree_range(ray.direction) && long_enough_for_embree(ray.direction) && products_fit_embree(ray, reach);
 }
 
 }  // namespace
@@ -269,6 +298,12 @@ std::string EmbreeAccelerator::ray_problem(const Ray& ray) const {
     return "cannot trace a ray whose direction " + vec_text(ray.direction) +
            " has no component of 1e-15 or more (Embree clamps 1/d at 1e18 in its box tests and would miss what "
            "the ray hits; the other structures trace it)";
+  else if (!products_fit_embree(ray, impl_->reach))
+    return "cannot trace a ray from " + vec_text(ray.origin) + " along " + vec_text(ray.direction) +
+           " in this scene (vertex coordinates up to " + num_text(static_cast<float>(impl_->reach.coordinate)) +
+           ", edge components up to " + num_text(static_cast<float>(impl_->reach.edge)) +
+           "): Embree's float triangle test would overflow (products like |v0 - o|·|e1|·|e2| near FLT_MAX) and miss "
+           "what the ray hits; the other structures trace it";
   else
     return {};
   if (why.ends_with("component")) why += " that is NaN or beyond ±1.844e18";
@@ -279,18 +314,28 @@ std::string EmbreeAccelerator::ray_problem(const Ray& ray) const {
 
 EmbreeAccelerator::EmbreeAccelerator(std::span<const Triangle> triangles, const EmbreeOptions& opts)
     : impl_(std::make_unique<Impl>(opts.threads, opts.isa)) {
-  const auto t0 = Clock::now();
+  // Our checks first, outside Embree's build time.
   const std::size_t n = triangles.size();
   std::size_t out_of_range = 0, first_out = 0;
-  for (std::size_t i = 0; i < n; ++i)
-    if (!within_embree_range(triangles[i].v0) || !within_embree_range(triangles[i].v1) ||
-        !within_embree_range(triangles[i].v2))
+  EmbreeReach& reach = impl_->reach;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Triangle& t = triangles[i];
+    if (!within_embree_range(t.v0) || !within_embree_range(t.v1) || !within_embree_range(t.v2)) {
       if (out_of_range++ == 0) first_out = i;
+      continue;
+    }
+    for (const glm::vec3* v : {&t.v0, &t.v1, &t.v2})
+      for (int a = 0; a < 3; ++a) reach.coordinate = std::max(reach.coordinate, std::abs(static_cast<double>((*v)[a])));
+    const glm::dvec3 a(t.v0), b(t.v1), c(t.v2);
+    for (const glm::dvec3& edge : {b - a, c - b, a - c})
+      reach.edge = std::max({reach.edge, std::abs(edge.x), std::abs(edge.y), std::abs(edge.z)});
+  }
   if (out_of_range > 0)
     throw std::runtime_error("embree: " + std::to_string(out_of_range) + " triangle(s) (the first: triangle " +
                              std::to_string(first_out) +
                              ") have a vertex coordinate beyond ±1.844e18, which Embree's build leaves out; "
                              "the other structures keep them");
+  const auto t0 = Clock::now();
   impl_->vertices.resize(9 * n + 3, 0.0f);
   impl_->indices.resize(3 * n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -350,7 +395,7 @@ void fill_ray(RTCRay& r, const Ray& ray) {
 }  // namespace
 
 Hit EmbreeAccelerator::closest_hit(const Ray& ray, const QueryOptions&, RayStats*, VisitTrace*) const {
-  if (!embree_takes(ray)) [[unlikely]]
+  if (!embree_takes(ray, impl_->reach)) [[unlikely]]
     refuse_ray(*this, ray);
   RTCRayHit rh;
   fill_ray(rh.ray, ray);
@@ -426,7 +471,7 @@ void EmbreeAccelerator::closest_packets_span(std::span<const Ray> rays, std::spa
     RTCRayHit8 rh;
     for (int l = 0; l < 8; ++l) {
       if (l < count) {
-        if (!embree_takes(rays[b + l])) [[unlikely]]
+        if (!embree_takes(rays[b + l], impl_->reach)) [[unlikely]]
           refuse_ray(*this, rays[b + l]);
         fill_lane(rh.ray, l, rays[b + l]);
       }
@@ -460,7 +505,7 @@ void EmbreeAccelerator::any_packets_span(std::span<const Ray> rays, std::span<st
   for_each_packet8(rays.size(), [&](std::size_t b, int count, const int* valid) {
     RTCRay8 r;
     for (int l = 0; l < count; ++l) {
-      if (!embree_takes(rays[b + l])) [[unlikely]]
+      if (!embree_takes(rays[b + l], impl_->reach)) [[unlikely]]
         refuse_ray(*this, rays[b + l]);
       fill_lane(r, l, rays[b + l]);
     }
@@ -470,7 +515,7 @@ void EmbreeAccelerator::any_packets_span(std::span<const Ray> rays, std::span<st
 }
 
 bool EmbreeAccelerator::any_hit(const Ray& ray, const QueryOptions&, RayStats*) const {
-  if (!embree_takes(ray)) [[unlikely]]
+  if (!embree_takes(ray, impl_->reach)) [[unlikely]]
     refuse_ray(*this, ray);
   RTCRay r;
   fill_ray(r, ray);
