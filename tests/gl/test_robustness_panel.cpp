@@ -8,8 +8,10 @@
 
 #include <set>
 
+#include "core/accel/embree_backend.h"
 #include "core/analysis/robustness_lab.h"
 #include "core/scene/load.h"
+#include "tests/core/spatial_test_scenes.h"
 #include "tests/gl/imgui_headless.h"
 #include "ui/panels/panels.h"
 
@@ -77,6 +79,42 @@ TEST(RobustnessPanel, DrawsEveryStateAndReportsRunAndCancel) {
     }
   EXPECT_TRUE(run);
   EXPECT_TRUE(cancel);
+}
+
+// Rays the structure refuses (Embree's limits: here its float triangle test
+// would overflow for the rays from farther out) have their own colour in the
+// per-ray map (they were drawn grey, as "ok").
+TEST(RobustnessPanel, RaysAStructureRefusesHaveTheirOwnColour) {
+  if (!kHaveEmbree) GTEST_SKIP() << "no Embree in this build";
+  RobustnessSnapshot snap;
+  snap.id = 1;
+  snap.state = RobustnessSnapshot::State::done;
+  snap.scene = "cube";
+  snap.structure = "embree";
+  LabOptions o;
+  o.rays = 200;
+  o.structure = "embree";
+  o.threads = 1;
+  snap.result = run_robustness_lab(test_scenes::subdivided_cube(glm::vec3(-2e12f), 4e12f, 3), o);
+  ASSERT_GT(snap.result->structure_rays_refused, 0u);
+  ASSERT_GT(snap.result->variants.size(), 4u);
+  const auto colour_drawn = [](ImU32 colour) {
+    const ImDrawData* d = ImGui::GetDrawData();
+    for (int l = 0; l < d->CmdListsCount; ++l)
+      for (const ImDrawVert& v : d->CmdLists[l]->VtxBuffer)
+        if (v.col == colour) return true;
+    return false;
+  };
+  const ImU32 not_traced = IM_COL32(50, 100, 170, 255);
+  HeadlessImGui ui;
+  panels::RobustnessPanelState st;
+  st.collapsed_at_start = false;
+  st.variant = 4;  // Embree's default mode
+  for (int i = 0; i < 2; ++i) ui.frame(st, &snap, false, ImVec2(-100, -100), false);
+  EXPECT_TRUE(colour_drawn(not_traced));
+  st.variant = 0;  // a lab variant traces every ray
+  for (int i = 0; i < 2; ++i) ui.frame(st, &snap, false, ImVec2(-100, -100), false);
+  EXPECT_FALSE(colour_drawn(not_traced));
 }
 
 TEST(RobustnessPanel, ClickingAVariantRowSelectsItForTheMap) {

@@ -19,9 +19,10 @@ constexpr ImU32 kOk = IM_COL32(70, 70, 70, 255);
 constexpr ImU32 kMiss = IM_COL32(235, 60, 50, 255);
 constexpr ImU32 kDouble = IM_COL32(240, 200, 60, 255);
 constexpr ImU32 kWrong = IM_COL32(220, 80, 220, 255);
+constexpr ImU32 kNotTraced = IM_COL32(50, 100, 170, 255);
 
 ImU32 status_color(std::uint8_t s) {
-  return s == 1 ? kMiss : s == 2 ? kDouble : s == 3 ? kWrong : kOk;
+  return s == 1 ? kMiss : s == 2 ? kDouble : s == 3 ? kWrong : s == 4 ? kNotTraced : kOk;
 }
 
 void legend_chip(ImU32 c, const char* label) {
@@ -99,7 +100,10 @@ RobustnessAction robustness_panel(RobustnessPanelState& st, const RobustnessSnap
         ImGui::TableNextColumn();
         ImGui::Text("%llu", static_cast<unsigned long long>(v.misses));
         ImGui::TableNextColumn();
-        ImGui::Text("%llu", static_cast<unsigned long long>(v.double_hits));
+        if (v.double_hits_counted)
+          ImGui::Text("%llu", static_cast<unsigned long long>(v.double_hits));
+        else  // Embree reports one hit per ray
+          ImGui::TextDisabled("n/a");
         ImGui::TableNextColumn();
         ImGui::Text("%llu", static_cast<unsigned long long>(v.wrong));
         ImGui::TableNextColumn();
@@ -109,6 +113,18 @@ RobustnessAction robustness_panel(RobustnessPanelState& st, const RobustnessSnap
       }
       ImGui::EndTable();
     }
+    // A structure that refuses the scene or some rays (Embree's limits): its rows count the rays it takes.
+    if (!r.structure_refused.empty() || r.structure_rays_refused > 0) {
+      ImGui::PushTextWrapPos(0.0f);
+      if (!r.structure_refused.empty())
+        ImGui::TextColored(ImVec4(1.0f, 0.78f, 0.35f, 1.0f), "%s: not checked: %s", snap->structure.c_str(),
+                           r.structure_refused.c_str());
+      else
+        ImGui::TextColored(ImVec4(1.0f, 0.78f, 0.35f, 1.0f), "%s: %llu of %zu rays not traced (the first, ray %zu: %s)",
+                           snap->structure.c_str(), static_cast<unsigned long long>(r.structure_rays_refused), r.rays,
+                           r.structure_first_refused_ray, r.structure_refused_ray_reason.c_str());
+      ImGui::PopTextWrapPos();
+    }
     if (!r.variants.empty()) {
       st.variant = std::clamp(st.variant, 0, static_cast<int>(r.variants.size()) - 1);
       const LabVariant& v = r.variants[static_cast<std::size_t>(st.variant)];
@@ -117,6 +133,7 @@ RobustnessAction robustness_panel(RobustnessPanelState& st, const RobustnessSnap
       legend_chip(kMiss, "miss");
       legend_chip(kDouble, "double hit");
       legend_chip(kWrong, "wrong");
+      if (v.not_traced > 0) legend_chip(kNotTraced, "not traced");
       ImGui::NewLine();
       const float avail = std::max(ImGui::GetContentRegionAvail().x, 50.0f);
       const std::size_t n = v.per_ray.size();
