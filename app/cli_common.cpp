@@ -10,6 +10,7 @@
 #include <iostream>
 
 #include "core/query/camera.h"
+#include "core/scene/effects.h"
 #include "core/scene/load.h"
 #include "core/util/file_checks.h"
 #include "core/util/output_file.h"
@@ -191,6 +192,18 @@ void require_flattened(const Scene& scene, const std::string& spec, const char* 
                              "animate or flatten with -s tlas)");
 }
 
+std::string level_note(const Scene& scene, const std::string& structure) {
+  if (structure == "brute" || structure == "brute-bbox") return {};  // no structure to speak of
+  const Effect two_level = decide_effects(scene).two_level;
+  if (two_level.on && structure != "tlas")
+    return scene.source + ": " + two_level.reason + ": `-s tlas` builds the two-level structure it calls for; " +
+           structure + " flattens its instances";
+  if (!two_level.on && structure == "tlas")
+    return scene.source + ": no mesh is instanced twice (two-level off): tlas holds its " +
+           count_of(std::max<std::size_t>(1, scene.instances.size()), "instance");
+  return {};
+}
+
 Scene load_scene_noting_warnings(const std::string& spec, bool quiet) {
   Scene scene = load_scene(spec);
   if (!quiet && !scene.report.warnings.empty())
@@ -208,6 +221,8 @@ Scene load_scene_with_progress(const std::string& spec, bool quiet, Progress& pr
 
 std::unique_ptr<Accelerator> build_with_progress(const std::string& structure, const Scene& scene, StructureOptions so,
                                                  Progress& progress, const std::string& label) {
+  if (const std::string note = level_note(scene, structure); !note.empty() && !progress.quiet())
+    std::fprintf(stderr, "accelviz: note: %s\n", note.c_str());
   progress.begin("building " + (label.empty() ? structure : label));
   so.scene = &scene;
   std::unique_ptr<Accelerator> accel = build_accelerator(structure, scene.triangles, so, progress.callback());

@@ -150,6 +150,7 @@ class Progress {
   /// A ProgressCallback for builders and batches (never cancels).
   ProgressCallback callback();
   void end(const std::string& result = {});
+  bool quiet() const { return quiet_; }
 
  private:
   bool quiet_;
@@ -167,8 +168,16 @@ Scene load_scene_with_progress(const std::string& spec, bool quiet, Progress& pr
 /// ("building LABEL", LABEL the structure's name when empty; then its build
 /// ms). "tlas" takes its two levels from the scene's meshes and instances
 /// (so.scene is set to `scene`, which must outlive the structure).
+/// Also notes on stderr (unless quiet) where the level of `structure`
+/// differs from what the scene calls for (level_note).
 std::unique_ptr<Accelerator> build_with_progress(const std::string& structure, const Scene& scene, StructureOptions so,
                                                  Progress& progress, const std::string& label = {});
+
+/// "" or a note that `structure` is not the level the scene's effects call
+/// for: a single-level structure over a scene that instances a mesh more
+/// than once ("...: `-s tlas` builds the two-level structure it calls for;
+/// bvh flattens its instances"), or tlas over one that does not.
+std::string level_note(const Scene& scene, const std::string& structure);
 
 using Clock = std::chrono::steady_clock;
 

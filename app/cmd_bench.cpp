@@ -270,6 +270,12 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   progress.begin("loading " + o.scene);
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
   progress.end(count_of(scene.triangles.size(), "triangle"));
+  // The level the scene calls for: one note for the list (its tlas, or its first structure).
+  if (!global.quiet) {
+    const bool has_tlas = std::find(o.structures.begin(), o.structures.end(), "tlas") != o.structures.end();
+    if (const std::string note = level_note(scene, has_tlas ? "tlas" : o.structures.front()); !note.empty())
+      std::fprintf(stderr, "accelviz: note: %s\n", note.c_str());
+  }
   StructureOptions so = o.structure_opts.to_options(o.threads, /*compute_epo=*/!o.no_epo);
   so.scene = &scene;  // "tlas" builds its two levels from the scene's meshes and instances
 

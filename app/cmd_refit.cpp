@@ -130,8 +130,10 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
   write_png((dir / "refit-ms.png").string(), draw_chart(c, {ms_refit, ms_build}), true);
 
   // ---- text ----
-  std::printf("scene %s: %zu triangles; %d frames, amplitude %g of the diagonal; %zu primary rays\n", o.scene.c_str(),
-              scene.triangles.size(), o.frames, o.amplitude, rays.size());
+  std::printf("scene %s: %s; %s, amplitude %g of the diagonal; %s\n", o.scene.c_str(),
+              count_of(scene.triangles.size(), "triangle").c_str(),
+              count_of(static_cast<std::size_t>(o.frames), "frame").c_str(), o.amplitude,
+              count_of(rays.size(), "primary ray").c_str());
   // The motion is this lab's own: say so, and where the scene's own animation is measured instead.
   if (scene.animations.empty())
     std::printf("motion: synthetic vertex motion (the scene itself is static)\n");

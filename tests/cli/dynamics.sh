@@ -131,4 +131,15 @@ python3 -c '
 import json, sys
 j = json.load(open(sys.argv[1]))
 assert j["motion"] == "synthetic" and j["scene_animations"] > 0, j' "$tmp/refit2/refit.json"
+# The level a scene calls for: a note when the structure is of the other level (not with -q).
+"$accelviz" render 'builtin:forest?size=2000' --size 16x12 -j 1 --out "$tmp/lv1.png" 2> "$tmp/lv1.err" > /dev/null
+grep -q "note: builtin:forest?size=2000: .*\`-s tlas\` builds the two-level structure it calls for; bvh flattens" "$tmp/lv1.err" ||
+  { echo "FAIL: no two-level note: $(cat "$tmp/lv1.err")"; exit 1; }
+"$accelviz" render 'builtin:forest?size=2000' -s tlas --size 16x12 -j 1 --out "$tmp/lv2.png" 2> "$tmp/lv2.err" > /dev/null
+! grep -q "note:" "$tmp/lv2.err" || { echo "FAIL: a note for tlas on an instanced scene: $(cat "$tmp/lv2.err")"; exit 1; }
+"$accelviz" render 'builtin:teapot?size=300' -s tlas --size 16x12 -j 1 --out "$tmp/lv3.png" 2> "$tmp/lv3.err" > /dev/null
+grep -q "no mesh is instanced twice (two-level off): tlas holds its 1 instance" "$tmp/lv3.err" ||
+  { echo "FAIL: no single-level note: $(cat "$tmp/lv3.err")"; exit 1; }
+"$accelviz" -q render 'builtin:forest?size=2000' --size 16x12 -j 1 --out "$tmp/lv4.png" 2> "$tmp/lv4.err" > /dev/null
+[ ! -s "$tmp/lv4.err" ] || { echo "FAIL: -q printed: $(cat "$tmp/lv4.err")"; exit 1; }
 echo "dynamics cli ok"
