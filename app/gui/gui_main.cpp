@@ -849,6 +849,9 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       fail_if(write_new_file(c.arg, doc.dump(2) + "\n"));
       return Status::done;
     }
+    case K::window:
+      panels::request_window(c.arg, c.value == "open");
+      return Status::done;
     case K::scenario:
     case K::dump_scenario:
     case K::dump_insight:

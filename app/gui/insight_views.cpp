@@ -389,6 +389,7 @@ ScriptHost::Status InsightViews::execute(AppState& app, const ScriptCommand& c) 
           scenario_.current = static_cast<int>(i);
           scenario_.value = std::stof(c.value);
           scenario_job_.request(all[i], scenario_.value, {});
+          panels::request_window("Scenarios", true);  // where the run shows
           return ScriptHost::Status::done;
         }
       throw std::runtime_error("scenario: unknown '" + c.arg + "'");
@@ -440,6 +441,7 @@ ScriptHost::Status InsightViews::execute(AppState& app, const ScriptCommand& c) 
     case K::pin_a:
       ab_.pinned = app.config().structure;
       app.set_message("pinned " + describe_choice(*ab_.pinned) + " as A");
+      panels::request_window("A/B compare", true);  // where A and B show
       return ScriptHost::Status::done;
     case K::dump_ab: {
       if (!ab_.pinned) throw std::runtime_error("dump-ab: nothing pinned as A (use pin-a first)");

@@ -153,6 +153,28 @@ TEST(AppScript, InsightRegionAndABCommands) {
   }
 }
 
+// `window open|close TITLE`: a panel by its title (with spaces), checked
+// when the script is read.
+TEST(AppScript, WindowCommandNamesAPanel) {
+  const auto cmds = parse_script("window open A/B compare\nwindow close Tree\n", "s.txt");
+  ASSERT_EQ(cmds.size(), 2u);
+  EXPECT_EQ(cmds[0].kind, K::window);
+  EXPECT_EQ(cmds[0].value, "open");
+  EXPECT_EQ(cmds[0].arg, "A/B compare");
+  EXPECT_EQ(cmds[1].value, "close");
+  EXPECT_EQ(cmds[1].arg, "Tree");
+  EXPECT_EQ(command_name(K::window), "window");
+  for (const auto& [text, expected] : {
+           std::pair{"window\n", "s.txt:1: window: expected open|close TITLE"},
+           std::pair{"window show Tree\n", "s.txt:1: window: expected open|close TITLE"},
+           std::pair{"window open\n", "s.txt:1: window: no panel titled '' (valid: Scene, Structure"},
+           std::pair{"window open tree\n", "s.txt:1: window: no panel titled 'tree' (valid: Scene, Structure"},
+       }) {
+    const std::string e = parse_error(text);
+    EXPECT_EQ(e.rfind(expected, 0), 0u) << "script: " << text << "\ngot: " << e;
+  }
+}
+
 // `frames N` lets N frames draw (the GPU heatmap test watches a trace
 // progress across frames with it).
 TEST(AppScript, FramesCommandTakesACount) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "tests/gl/imgui_headless.h"
+#include "ui/app/window_titles.h"
 #include "ui/panels/insight_panels.h"
 #include "ui/panels/panels.h"
 
@@ -54,9 +55,11 @@ struct Ui : test::HeadlessImGuiContext {
   panels::AccuracyPanelState accuracy;
   panels::RobustnessPanelState robustness;
   panels::FlattenPanelState flatten;
+  DynamicsPlayer player;
   bool cancel = false, scroll = false;
 
-  bool with_flatten = true;  ///< the Flatten what-if is drawn only while a tlas is shown
+  bool with_flatten = true;    ///< the Flatten what-if is drawn only while a tlas is shown
+  bool with_dynamics = false;  ///< the Dynamics panel only while per-frame updates are on
 
   /// Every panel of the layout in a window of w × h.
   void frame(float w, float h) {
@@ -77,6 +80,7 @@ struct Ui : test::HeadlessImGuiContext {
     panels::accuracy_panel(accuracy, nullptr, false, "bvh", l);
     panels::robustness_panel(robustness, nullptr, false, "bvh", l);
     if (with_flatten) panels::flatten_panel(flatten, nullptr, nullptr, false, 0.0, std::nullopt, l);
+    if (with_dynamics) panels::dynamics_panel(player, nullptr, false, l);
     ImGui::Render();
   }
 
@@ -157,6 +161,40 @@ TEST(PanelLayout, FirstUseInASmallerWindowFitsIt) {
   ui.flatten.collapsed_at_start = true;
   for (int i = 0; i < 3; ++i) ui.frame(1280, 720);
   ui.expect_tidy(1280, 720);
+}
+
+// A script's `window open|close TITLE` names the panels by kPanelTitles:
+// each is a panel the app draws, and a request expands or collapses it the
+// next time it is drawn (pin-a and scenario open their windows so).
+TEST(PanelLayout, EveryPanelTitleIsDrawnAndWindowRequestsOpenAndCloseIt) {
+  Ui ui;
+  ui.with_dynamics = true;
+  for (int i = 0; i < 2; ++i) ui.frame(1280, 800);
+  for (const std::string_view t : kPanelTitles)
+    EXPECT_NE(ImGui::FindWindowByName(std::string(t).c_str()), nullptr) << t;
+  const auto collapsed = [](const char* t) { return ImGui::FindWindowByName(t)->Collapsed; };
+  ASSERT_TRUE(collapsed("Tree"));  // the insight windows start collapsed
+  panels::request_window("Tree", true);
+  ui.frame(1280, 800);
+  EXPECT_FALSE(collapsed("Tree"));
+  ui.frame(1280, 800);
+  EXPECT_FALSE(collapsed("Tree")) << "a request is applied once, then the user's clicks rule";
+  panels::request_window("Tree", false);
+  panels::request_window("Scene", false);
+  ui.frame(1280, 800);
+  EXPECT_TRUE(collapsed("Tree"));
+  EXPECT_TRUE(collapsed("Scene"));
+  // A request for a panel not drawn now waits for it.
+  panels::request_window("Dynamics", true);
+  ui.frame(1280, 800);
+  ASSERT_FALSE(collapsed("Dynamics"));
+  ui.with_dynamics = false;
+  ui.frame(1280, 800);
+  panels::request_window("Dynamics", false);
+  ui.frame(1280, 800);
+  ui.with_dynamics = true;
+  ui.frame(1280, 800);
+  EXPECT_TRUE(collapsed("Dynamics"));
 }
 
 // What the 3D view draws behind the windows (hot-node labels) is left out

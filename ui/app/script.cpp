@@ -12,6 +12,7 @@
 #include "ui/app/dynamics.h"
 #include "ui/app/flatten_worker.h"
 #include "ui/app/scenarios.h"
+#include "ui/app/window_titles.h"
 
 namespace accelviz {
 namespace {
@@ -99,6 +100,7 @@ constexpr NamedKind kCommands[] = {
     {"flatten-commit", ScriptCommand::Kind::flatten_commit},
     {"dump-flatten", ScriptCommand::Kind::dump_flatten},
     {"reload-shaders", ScriptCommand::Kind::reload_shaders},
+    {"window", ScriptCommand::Kind::window},
 };
 
 }  // namespace
@@ -264,6 +266,19 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
         AppConfig probe;
         const std::string error = force_effect(probe, c.arg, true);
         if (!error.empty()) fail(error);
+        break;
+      }
+      case ScriptCommand::Kind::window: {
+        std::string_view title;
+        const std::string_view action = first_word(rest, title);
+        if (action != "open" && action != "close") fail("window: expected open|close TITLE");
+        c.value = std::string(action);
+        c.arg = std::string(title);
+        if (std::find(kPanelTitles.begin(), kPanelTitles.end(), title) == kPanelTitles.end()) {
+          std::string valid;
+          for (const std::string_view t : kPanelTitles) valid += (valid.empty() ? "" : ", ") + std::string(t);
+          fail("window: no panel titled '" + c.arg + "' (valid: " + valid + ")");
+        }
         break;
       }
       case ScriptCommand::Kind::play:

@@ -41,6 +41,7 @@ struct ScriptCommand {
     flatten_commit,  ///< commits the last prediction (its instances merged) and waits for the merged scene's build
     dump_flatten,    ///< arg: path; the last prediction's figures as JSON
     reload_shaders,  ///< arg: "" or a folder (then the shader override folder); rebuilds the shader programs
+    window,          ///< value: "open" | "close", arg: a panel's title (kPanelTitles); expands or collapses it
   };
   Kind kind = Kind::wait;
   int line = 0;        ///< 1-based line in the script file

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
+#include <map>
 #include <string>
 #include <thread>
 
@@ -785,8 +786,20 @@ void help_panel(bool& open, const PanelLayout& layout) {
 
 namespace {
 
+/// request_window's requests until each panel is drawn: title -> open.
+std::map<std::string, bool, std::less<>>& window_requests() {
+  static std::map<std::string, bool, std::less<>> requests;
+  return requests;
+}
+
 bool begin_placed(const char* title, const PanelLayout& layout, bool collapsed, int slot = -1) {
   if (collapsed) ImGui::SetNextWindowCollapsed(true, ImGuiCond_FirstUseEver);
+  auto& requests = window_requests();
+  if (const auto it = requests.find(std::string_view(title)); it != requests.end()) {
+    ImGui::SetNextWindowCollapsed(!it->second, ImGuiCond_Always);
+    if (it->second) ImGui::SetNextWindowFocus();
+    requests.erase(it);
+  }
   const bool open = ImGui::Begin(title);
   follow_display(layout, slot);
   if (open) return true;
@@ -799,6 +812,10 @@ bool begin_placed(const char* title, const PanelLayout& layout, bool collapsed, 
 bool begin_panel(const char* title, const PanelLayout& layout, float x, float y, float w, float h, bool collapsed) {
   place(layout, x, y, w, h);
   return begin_placed(title, layout, collapsed);
+}
+
+void request_window(std::string_view title, bool open) {
+  window_requests()[std::string(title)] = open;
 }
 
 bool covered_by_window(float x0, float y0, float x1, float y1) {

@@ -3,6 +3,13 @@
 // draws its window and reports what the user changed (a bool "changed", or
 // an action value); none of them builds, loads, traces or touches GL; the
 // main loop (app/gui/) carries the actions out through AppState.
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
 #include "core/scene/scene.h"
 #include "ui/app/app_config.h"
 #include "ui/app/build_worker.h"
@@ -14,12 +21,6 @@
 #include "ui/app/settings.h"
 #include "ui/app/structure_nodes.h"
 #include "ui/app/sweep_worker.h"
-
-#include <cstddef>
-#include <optional>
-#include <string>
-#include <utility>
-#include <vector>
 
 namespace accelviz::panels {
 
@@ -114,6 +115,10 @@ bool begin_panel(const char* title, const PanelLayout& layout, float x, float y,
 /// the columns.
 bool begin_stacked_panel(const char* title, const PanelLayout& layout, int slot, float w, float h,
                          bool collapsed = true);
+/// Expands (`open`) or collapses the panel titled `title` when it is next
+/// drawn (a script's `window`; pin-a and scenario open their windows); an
+/// opened panel comes to the front.
+void request_window(std::string_view title, bool open);
 /// True when the screen rectangle (x0, y0)-(x1, y1) (ImGui's units) overlaps a
 /// top-level window drawn this frame, or last frame for one not yet drawn
 /// in this one (a collapsed window by its title bar): what is drawn behind
