@@ -8,6 +8,7 @@
 #include "core/accel/bvh/bvh.h"
 #include "core/accel/factory.h"
 #include "core/accel/reference.h"
+#include "core/math/scene_scale.h"
 #include "core/util/parallel.h"
 #include "core/util/random.h"
 #include "core/util/timing.h"
@@ -33,14 +34,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 using Rng = SplitMix64;  // core/util/random.h
-
-/// The power of two at or below `s` (> 0, finite): unit directions scaled by
-/// it keep their aim exactly (nothing rounds) and get t on the scene's scale.
-float power_of_two_at_or_below(float s) {
-  int e = 0;
-  std::frexp(s, &e);
-  return std::ldexp(1.0f, e - 1);
-}
 
 glm::vec3 vertex_of(const Triangle& t, std::size_t i) {
   return i == 0 ? t.v0 : i == 1 ? t.v1 : t.v2;
@@ -223,10 +216,7 @@ std::vector<LabRay> lab_rays(std::span<const Triangle> triangles, std::size_t co
         break;
       }
     }
-    // (Components, not the length: |d|² underflows at 1e-23 and overflows at 1e19.)
-    if (!std::isfinite(d.x) || !std::isfinite(d.y) || !std::isfinite(d.z) ||
-        (d.x == 0.0f && d.y == 0.0f && d.z == 0.0f))
-      d = glm::vec3(0.0f, 0.0f, unit);
+    if (!usable_direction(d)) d = glm::vec3(0.0f, 0.0f, unit);
     out.push_back({Ray(o, d), family});
   }
   return out;

@@ -1,16 +1,17 @@
 #include "core/analysis/verify.h"
 
-#include "core/query/camera.h"
-#include "core/util/parallel.h"
-#include "core/util/random.h"
-#include "core/util/timing.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <mutex>
 #include <sstream>
 #include <stdexcept>
+
+#include "core/math/scene_scale.h"
+#include "core/query/camera.h"
+#include "core/util/parallel.h"
+#include "core/util/random.h"
+#include "core/util/timing.h"
 
 namespace accelviz {
 
@@ -90,21 +91,6 @@ using Rng = SplitMix64;  // core/util/random.h
 
 glm::vec3 in_box(Rng& r, const glm::vec3& lo, const glm::vec3& hi) {
   return {r.uniform(lo.x, hi.x), r.uniform(lo.y, hi.y), r.uniform(lo.z, hi.z)};  // braces: x, y, z in order
-}
-
-/// The power of two at or below `s` (> 0, finite). A unit direction scaled
-/// by it is aimed exactly as before (scaling by a power of two rounds
-/// nothing) while its t is on the scene's scale, as for the rays aimed at a
-/// point (t = 1 there): tolerances of the form 1e-6·max(1, t) then mean the
-/// same at every scale.
-float power_of_two_at_or_below(float s) {
-  int e = 0;
-  std::frexp(s, &e);
-  return std::ldexp(1.0f, e - 1);
-}
-
-bool usable_direction(const glm::vec3& d) {
-  return std::isfinite(d.x) && std::isfinite(d.y) && std::isfinite(d.z) && (d.x != 0.0f || d.y != 0.0f || d.z != 0.0f);
 }
 
 Aabb scene_bounds(std::span<const Triangle> tris) {
