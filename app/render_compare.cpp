@@ -6,7 +6,9 @@
 
 #include "core/analysis/heatmap.h"
 #include "core/analysis/insight/compare_images.h"
+#include "core/query/batch.h"
 #include "core/query/camera.h"
+#include "core/query/ray_sets.h"
 #include "core/scene/load.h"
 
 namespace accelviz::cli {
@@ -163,6 +165,10 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
   nlohmann::json sides = nlohmann::json::object();
   MetricImage images[2];
   const CompareSide* side[2] = {&job.a, &job.b};
+  // What a choice costs in time and what it changes: each side's closest hits of the view's primary rays,
+  // timed without counters (the fast path), then the pixels whose hit differs.
+  const std::vector<Ray> primary = primary_rays(camera, size.width, size.height);
+  std::vector<Hit> hits[2];
   for (int s = 0; s < 2; ++s) {
     const CompareSide& c = *side[s];
     const char* tag = s == 0 ? "A" : "B";
@@ -188,6 +194,19 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
     d["mean"] = fig.mean;
     d["max"] = fig.max;
     d["total"] = total;
+    progress.begin(std::string("timing ") + tag + "'s closest hits");
+    hits[s].resize(primary.size());
+    std::vector<double> runs;  // the median of three passes
+    for (int k = 0; k < 3; ++k) {
+      const auto t0 = Clock::now();
+      trace_closest(*accel, primary, hits[s], query_of(c), resolve_threads(job.threads));
+      runs.push_back(ms_since(t0));
+    }
+    std::sort(runs.begin(), runs.end());
+    const double trace_ms = runs[1];
+    progress.end(std::to_string(static_cast<long long>(std::lround(trace_ms))) + " ms");
+    d["trace_ms"] = trace_ms;
+    d["hits"] = std::count_if(hits[s].begin(), hits[s].end(), [](const Hit& h) { return h.valid(); });
     sides[s == 0 ? "a" : "b"] = d;
   }
   ABFigures ab;
@@ -215,6 +234,14 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
   figures["max_abs_diff"] = ab.max_abs_diff;
   figures["pixels_b_cheaper"] = ab.b_cheaper;
   figures["pixels_b_dearer"] = ab.b_dearer;
+  std::uint64_t changed = 0;  // one side hits and the other misses, or they hit different triangles
+  for (std::size_t i = 0; i < primary.size(); ++i)
+    changed += hits[0][i].valid() != hits[1][i].valid() || (hits[0][i].valid() && hits[0][i].prim != hits[1][i].prim);
+  figures["pixels_hit_changed"] = changed;
+  figures["trace_ratio_b_over_a"] =
+      sides["a"]["trace_ms"].get<double>() > 0.0
+          ? nlohmann::json(sides["b"]["trace_ms"].get<double>() / sides["a"]["trace_ms"].get<double>())
+          : nlohmann::json(nullptr);
   figures["out"] = {{"a", absolute_path(paths.a)}, {"b", absolute_path(paths.b)}, {"diff", absolute_path(paths.diff)}};
   std::cout << absolute_path(paths.a) << "\n" << absolute_path(paths.b) << "\n" << absolute_path(paths.diff) << "\n";
   print_json_line(figures);

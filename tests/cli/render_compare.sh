@@ -44,7 +44,19 @@ for side in (a, b):
         assert k in side, (k, side)
     assert "embree_quality" not in side and side["per_ray_counters"] is True, side
 assert {k: v for k, v in a.items() if k != "triangle_test"}.keys() == {k: v for k, v in b.items() if k != "triangle_test"}.keys()
+# What the choice costs in time and what it changes: each side's timed closest hits, the pixels that differ.
+for side in (a, b):
+    assert side["trace_ms"] > 0 and side["hits"] > 0, side
+assert j["trace_ratio_b_over_a"] > 0 and 0 <= j["pixels_hit_changed"] <= 24 * 18, j
 print("descriptions ok")
+PY
+# Voxels hit voxels, not triangles: every pixel that hits counts as changed.
+out=$("$accelviz" -q render "$scene" --size 24x18 --out "$tmp/vx.png" --compare 'structure=voxels')
+python3 - "$(sed -n 4p <<<"$out")" <<'PY'
+import json, sys
+j = json.loads(sys.argv[1])
+assert j["pixels_hit_changed"] >= j["b"]["hits"] > 0, j
+print("hits changed ok:", j["pixels_hit_changed"])
 PY
 out=$("$accelviz" -q render "$scene" --size 24x18 --out "$tmp/kd.png" -s kdtree --compare 'leaf-cap=8 structure=bvh')
 python3 - "$(sed -n 4p <<<"$out")" <<'PY'
