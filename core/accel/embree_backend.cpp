@@ -55,6 +55,7 @@ std::optional<EmbreeIsa> parse_embree_isa(std::string_view name) {
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <mutex>
 #include <new>
 #include <stdexcept>
@@ -197,6 +198,22 @@ RTCBuildQuality to_rtc(EmbreeQuality q) {
 struct EmbreeReach {
   double coordinate = 0.0;  ///< the largest |vertex component|
   double edge = 0.0;        ///< the largest |component| of a triangle edge
+  // products_fit_embree's bounds on a ray's largest origin (o) and
+  // direction (d) components, from the two above (set by limit()).
+  float o_max = std::numeric_limits<float>::infinity();   ///< o <= it: |C|·|e|² fits
+  float d_max = std::numeric_limits<float>::infinity();   ///< d <= it: |e|²·|D| fits
+  float od_max = std::numeric_limits<float>::infinity();  ///< (o + coordinate)·d <= it: |C|·|e|·|D| fits
+  float coordinate_f = 0.0f;
+  void limit(double product_limit) {
+    coordinate_f = static_cast<float>(coordinate);
+    if (!(edge > 0.0)) return;  // no edge: no product to overflow
+    const auto to_float = [](double x) {
+      return x >= std::numeric_limits<float>::max() ? std::numeric_limits<float>::infinity() : static_cast<float>(x);
+    };
+    o_max = to_float(product_limit / (edge * edge) - coordinate);
+    d_max = to_float(product_limit / (edge * edge));
+    od_max = to_float(product_limit / edge);
+  }
 };
 
 struct EmbreeAccelerator::Impl {
@@ -250,12 +267,16 @@ bool long_enough_for_embree(const glm::vec3& d) {
 /// components) passes 3e38 (FLT_MAX is 3.4e38).
 constexpr double kEmbreeProductLimit = 3e38 / 12.0;
 
-bool products_fit_embree(const Ray& ray, const EmbreeReach& reach) {
+// With |C| <= o + coordinate and e the scene's edge bound: o + coordinate <=
+// limit/e², d <= limit/e² and (o + coordinate)·d <= limit/e, precomputed per
+// scene (EmbreeReach::limit), so the check inside the queries is a few float
+// operations (rounding is far inside the margin).
+[[gnu::always_inline]] inline bool products_fit_embree(const Ray& ray, const EmbreeReach& reach) {
   const auto largest = [](const glm::vec3& v) {
-    return static_cast<double>(std::max(std::abs(v.x), std::max(std::abs(v.y), std::abs(v.z))));
+    return std::max(std::abs(v.x), std::max(std::abs(v.y), std::abs(v.z)));
   };
-  const double c = largest(ray.origin) + reach.coordinate, d = largest(ray.direction), e = reach.edge;
-  return c * e * e <= kEmbreeProductLimit && c * e * d <= kEmbreeProductLimit && e * e * d <= kEmbreeProductLimit;
+  const float o = largest(ray.origin), d = largest(ray.direction);
+  return o <= reach.o_max && d <= reach.d_max && (o + reach.coordinate_f) * d <= reach.od_max;
 }
 
 std::string num_text(float x) {
@@ -330,6 +351,7 @@ EmbreeAccelerator::EmbreeAccelerator(std::span<const Triangle> triangles, const 
     for (const glm::dvec3& edge : {b - a, c - b, a - c})
       reach.edge = std::max({reach.edge, std::abs(edge.x), std::abs(edge.y), std::abs(edge.z)});
   }
+  reach.limit(kEmbreeProductLimit);
   if (out_of_range > 0)
     throw std::runtime_error("embree: " + std::to_string(out_of_range) + " triangle(s) (the first: triangle " +
                              std::to_string(first_out) +
