@@ -14,6 +14,7 @@
 #include "core/accel/brute_force.h"
 #include "core/accel/tlas/tlas.h"
 #include "core/query/camera.h"
+#include "core/util/one_line.h"
 #include "ui/app/app_state.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
@@ -311,7 +312,7 @@ TEST(AppBuildWorker, AnOpenedScenesInstancingChoosesTheLevel) {
   const auto* tlas = dynamic_cast<const Tlas*>(app.current()->accel.get());
   ASSERT_NE(tlas, nullptr);
   EXPECT_NE(app.message().find("no mesh is instanced twice (two-level off): tlas holds its " +
-                               std::to_string(tlas->instances().size()) + " instance(s)"),
+                               count_of(tlas->instances().size(), "instance")),
             std::string::npos)
       << app.message();
   app.open_scene(teapot);

@@ -6,6 +6,7 @@
 #include "core/accel/tlas/tlas.h"
 #include "core/query/camera.h"
 #include "core/scene/effects.h"
+#include "core/util/one_line.h"
 #include "core/util/timing.h"
 
 namespace accelviz {
@@ -146,7 +147,7 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
       // tlas over a scene that instances nothing twice: allowed (to see what a level costs), said.
       if (current_->choice.name == "tlas" && !decide_effects(scene, config().effects).two_level.on)
         switched += "; no mesh is instanced twice (two-level off): tlas holds its " +
-                    std::to_string(std::max<std::size_t>(1, scene.instances.size())) + " instance(s)";
+                    count_of(std::max<std::size_t>(1, scene.instances.size()), "instance");
       if (new_scene) {
         u.scene_changed = true;
         camera_ = ViewCamera::scene_default(scene, aspect_of(view_w_, view_h_));
