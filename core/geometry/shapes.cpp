@@ -1,5 +1,6 @@
 #include "core/geometry/shapes.h"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -95,11 +96,13 @@ bool intersect_cylinder(const Ray& ray, const Cylinder& cyl, float tmin, float t
   return true;
 }
 
-glm::vec3 offset_ray_origin(const glm::vec3& p, const glm::vec3& n) {
+glm::vec3 offset_ray_origin(const glm::vec3& p, const glm::vec3& n, float scale) {
   // Constants from Wachter & Binder 2019: below |1/32| move by a small
-  // absolute amount, otherwise move each coordinate by 256·|n_i| ULPs.
-  constexpr float kOrigin = 1.0f / 32.0f;
-  constexpr float kFloatScale = 1.0f / 65536.0f;
+  // absolute amount, otherwise move each coordinate by 256·|n_i| ULPs; for
+  // coordinates of magnitude `scale` < 1 both absolute figures shrink with it.
+  const float s = scale > 0.0f && scale < 1.0f ? scale : 1.0f;  // NaN: 1
+  const float kOrigin = s / 32.0f;
+  const float kFloatScale = s / 65536.0f;
   constexpr float kIntScale = 256.0f;
   glm::vec3 out;
   for (int i = 0; i < 3; ++i) {
@@ -110,6 +113,12 @@ glm::vec3 offset_ray_origin(const glm::vec3& p, const glm::vec3& n) {
     out[i] = std::fabs(p[i]) < kOrigin ? p[i] + kFloatScale * n[i] : p_i;
   }
   return out;
+}
+
+float coordinate_scale(const Triangle& t) {
+  float m = 0.0f;
+  for (const glm::vec3* v : {&t.v0, &t.v1, &t.v2}) m = std::max({m, std::fabs(v->x), std::fabs(v->y), std::fabs(v->z)});
+  return m;
 }
 
 }  // namespace accelviz

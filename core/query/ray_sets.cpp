@@ -96,7 +96,8 @@ std::vector<Ray> diffuse_rays(std::span<const Triangle> triangles, std::span<con
     glm::vec3 t, b;
     basis(n, t, b);
     const glm::vec3 dir = glm::normalize(lx * t + ly * b + lz * n);
-    rays.emplace_back(offset_ray_origin(hit_point(triangles, h), n), dir, 0.0f, kInfinity);
+    rays.emplace_back(offset_ray_origin(hit_point(triangles, h), n, coordinate_scale(triangles[h.prim])), dir, 0.0f,
+                      kInfinity);
   }
   return rays;
 }
@@ -112,7 +113,7 @@ std::vector<Ray> shadow_rays(std::span<const Triangle> triangles, std::span<cons
     if (!h.valid() || h.prim >= triangles.size()) continue;
     const glm::vec3 n = facing_normal(triangles, primary[i], h);
     if (glm::dot(n, n) == 0.0f) continue;
-    const glm::vec3 p = offset_ray_origin(hit_point(triangles, h), n);
+    const glm::vec3 p = offset_ray_origin(hit_point(triangles, h), n, coordinate_scale(triangles[h.prim]));
     for (const Light& light : lights) {
       glm::vec3 dir;
       float tmax = kInfinity;

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <string>
 
+#include "core/geometry/shapes.h"
 #include "core/query/camera.h"
 #include "core/util/one_line.h"
 
@@ -131,9 +132,12 @@ Light synthetic_light(const Aabb& bounds) {
 
 Ray shadow_ray(const Ray& primary, const Hit& h, const Light& l) {
   const glm::vec3 p = primary.at(h.t);
-  // Offset along the normal, toward the side the ray came from.
-  const glm::vec3 n = glm::dot(h.ng, primary.direction) < 0.0f ? h.ng : -h.ng;
-  const glm::vec3 o = p + n * (1e-4f * (1.0f + glm::length(p)));
+  // Offset along the normal, toward the side the ray came from, on the scale
+  // of the coordinates p was computed from (offset_ray_origin; a fixed floor
+  // of 1e-4 put a tiny scene's origins beyond it).
+  const glm::vec3 n = glm::dot(h.ng, primary.direction) < 0.0f ? h.ng : -h.ng;  // unit
+  const auto largest = [](const glm::vec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); };
+  const glm::vec3 o = offset_ray_origin(p, n, std::max(largest(primary.origin), largest(p)));
   const bool directional = l.kind == Light::Kind::directional;
   const glm::vec3 d = directional ? -l.direction : l.position - o;
   return Ray(o, d, 0.0f, directional ? kInfinity : 1.0f);

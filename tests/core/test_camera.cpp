@@ -10,6 +10,7 @@
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
 #include "core/scene/effects.h"
+#include "tests/core/spatial_test_scenes.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_camera {
@@ -235,6 +236,44 @@ TEST(RaySets, DiffuseRaysLeaveTheSurfaceOnTheCameraSideAndAreSeeded) {
   std::size_t same = 0;
   for (std::size_t i = 0; i < a.size(); ++i) same += a[i].direction == c[i].direction;
   EXPECT_LT(same, a.size() / 100);  // another seed, other directions
+}
+
+// A closed cube and the same cube scaled by 2^-17 (about 7.6e-6; exact in
+// float, so the camera and its rays scale exactly): the secondary rays leave
+// their surfaces alike. The offset's absolute floor of 1/65536 put the tiny
+// cube's origins beyond it: no shadow ray was made, and bounces left from
+// outside the cube.
+TEST(RaySets, SecondaryRaysOfATinySceneAreThoseOfAUnitScene) {
+  const float tiny = std::ldexp(1.0f, -17);
+  std::size_t shadow_count[2] = {}, occluded[2] = {}, bounces_hit[2] = {}, own_hits[2] = {};
+  for (int k = 0; k < 2; ++k) {
+    std::vector<Triangle> tris = test_scenes::subdivided_cube(glm::vec3(-1.0f), 2.0f, 4);
+    if (k == 1)
+      for (Triangle& t : tris) t = {t.v0 * tiny, t.v1 * tiny, t.v2 * tiny};
+    Aabb b;
+    for (const Triangle& t : tris) b.extend(t.bounds());
+    const BruteForce accel(tris);
+    const std::vector<Ray> primary = primary_rays(frame_bounds(b, 4.0f / 3.0f), 32, 24);
+    std::vector<Hit> hits(primary.size());
+    trace_closest(accel, primary, hits, {}, 1u);
+    const Light light = synthetic_light(b);
+    const std::vector<Ray> shadows = shadow_rays(tris, primary, hits, std::span<const Light>(&light, 1));
+    shadow_count[k] = shadows.size();
+    for (const Ray& r : shadows) occluded[k] += accel.any_hit(r, {});
+    const std::vector<Ray> bounces = diffuse_rays(tris, primary, hits, 3);
+    for (std::size_t i = 0, j = 0; i < hits.size(); ++i) {
+      if (!hits[i].valid()) continue;
+      const Hit h = accel.closest_hit(bounces[j++], {});
+      bounces_hit[k] += h.valid();  // the bounces leave the cube's outside: most miss
+      own_hits[k] += h.valid() && h.prim == hits[i].prim;
+    }
+  }
+  EXPECT_GT(shadow_count[0], 20u);
+  EXPECT_EQ(shadow_count[1], shadow_count[0]);
+  EXPECT_EQ(occluded[1], occluded[0]);
+  EXPECT_EQ(own_hits[0], 0u);
+  EXPECT_EQ(own_hits[1], 0u);
+  EXPECT_EQ(bounces_hit[1], bounces_hit[0]);
 }
 
 TEST(RaySets, ShadowRaysGoToLightsInFrontOfTheSurface) {

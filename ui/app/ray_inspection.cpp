@@ -53,7 +53,8 @@ RayInspection inspect_ray(const BuiltStructure& built, const RayInspection& like
   const glm::vec3 p = r.ray.at(r.hit.t);
   glm::vec3 n = r.hit.ng;
   if (glm::dot(n, r.ray.direction) > 0.0f) n = -n;
-  const glm::vec3 origin = offset_ray_origin(p, n);
+  const auto largest = [](const glm::vec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); };
+  const glm::vec3 origin = offset_ray_origin(p, n, std::max(largest(r.ray.origin), largest(p)));
   const auto& lights = built.scene->scene.lights;
   for (std::size_t i = 0; i < lights.size(); ++i) {
     const Light& l = lights[i];
