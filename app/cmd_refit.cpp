@@ -61,9 +61,9 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
   opts.seed = o.seed;
   opts.threads = o.threads;
   opts.bvh = o.structure_opts.to_options(o.threads, false).bvh;
-  progress.begin("refitting " + std::to_string(o.frames) + " frames");
+  progress.begin("refitting " + count_of(static_cast<std::size_t>(o.frames), "frame"));
   const RefitDecayResult r = run_refit_decay(scene.triangles, rays, opts);
-  progress.end(std::to_string(r.rebuilds) + " rebuilds");
+  progress.end(count_of(static_cast<std::size_t>(r.rebuilds), "rebuild"));
 
   // ---- files ----
   std::ostringstream csv;
@@ -139,9 +139,9 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
     std::printf("motion: synthetic vertex motion (the scene itself is static)\n");
   else
     std::printf(
-        "motion: synthetic vertex motion; the scene's own %zu animation(s) are not played here (`accelviz "
-        "animate` plays them)\n",
-        scene.animations.size());
+        "motion: synthetic vertex motion; the scene's own %s %s not played here (`accelviz animate` plays %s)\n",
+        count_of(scene.animations.size(), "animation").c_str(), scene.animations.size() == 1 ? "is" : "are",
+        scene.animations.size() == 1 ? "it" : "them");
   std::printf("%6s %8s %10s %10s %10s %10s %8s %12s %12s %8s\n", "frame", "refits", "refit ms", "build ms", "SAH refit",
               "SAH fresh", "ratio", "nodes refit", "nodes fresh", "rebuilt");
   for (const RefitFrame& f : r.frames)

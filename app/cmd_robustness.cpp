@@ -119,6 +119,11 @@ int run_robustness(const RobustnessOptions& o, const GlobalOptions& global) {
                 "Mrays/s");
   std::cout << line;
   for (const LabVariant& v : r.variants) {
+    if (v.not_traced == r.rays && r.rays > 0) {  // a structure that took none of the rays: nothing to count
+      std::snprintf(line, sizeof line, "%-36s %8s %12s %8s %10s %9s\n", v.name.c_str(), "-", "-", "-", "-", "-");
+      std::cout << line;
+      continue;
+    }
     const std::string doubles = v.double_hits_counted ? std::to_string(v.double_hits) : "n/a";
     std::snprintf(line, sizeof line, "%-36s %8llu %12s %8llu %10.1f %9.2f\n", v.name.c_str(),
                   static_cast<unsigned long long>(v.misses), doubles.c_str(), static_cast<unsigned long long>(v.wrong),

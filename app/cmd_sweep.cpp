@@ -320,9 +320,9 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
     }
 
   // ---- text ----
-  std::printf("scene %s: %zu triangles; %s, %zu %s rays; %u threads; medians of %d; ray budget %g\n", o.scene.c_str(),
-              scene.triangles.size(), o.structure.c_str(), rays.size(), o.rays.c_str(), threads, o.repeat,
-              o.ray_budget);
+  std::printf("scene %s: %s; %s, %zu %s rays; %s; medians of %d; ray budget %g\n", o.scene.c_str(),
+              count_of(scene.triangles.size(), "triangle").c_str(), o.structure.c_str(), rays.size(), o.rays.c_str(),
+              count_of(threads, "thread").c_str(), o.repeat, o.ray_budget);
   if (kind == RayKind::shadow && synthetic) {
     const glm::vec3 p = synthetic_light(scene.bounds()).position;
     std::printf("the scene has no lights: shadow rays aim at a synthetic point light at (%g, %g, %g)\n", p.x, p.y, p.z);

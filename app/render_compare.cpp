@@ -229,11 +229,15 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
   figures["total_a"] = ab.total_a;
   figures["total_b"] = ab.total_b;
   figures["total_diff"] = ab.total_b - ab.total_a;
-  // No ratio of a total of 0 (Embree's, which keeps no counters, or an empty view): null, not 0.
-  figures["ratio_b_over_a"] = ab.total_a > 0.0 ? nlohmann::json(ab.total_b / ab.total_a) : nlohmann::json(nullptr);
-  figures["max_abs_diff"] = ab.max_abs_diff;
-  figures["pixels_b_cheaper"] = ab.b_cheaper;
-  figures["pixels_b_dearer"] = ab.b_dearer;
+  // A side without counters (Embree) has an image of zeros: no comparison of counts (null), not "B cheaper
+  // everywhere"; no ratio of a total of 0 (that, or an empty view) either.
+  const bool counted = sides["a"]["per_ray_counters"].get<bool>() && sides["b"]["per_ray_counters"].get<bool>();
+  const auto if_counted = [&](const nlohmann::json& v) { return counted ? v : nlohmann::json(nullptr); };
+  figures["ratio_b_over_a"] =
+      ab.total_a > 0.0 ? if_counted(nlohmann::json(ab.total_b / ab.total_a)) : nlohmann::json(nullptr);
+  figures["max_abs_diff"] = if_counted(ab.max_abs_diff);
+  figures["pixels_b_cheaper"] = if_counted(ab.b_cheaper);
+  figures["pixels_b_dearer"] = if_counted(ab.b_dearer);
   std::uint64_t changed = 0;  // one side hits and the other misses, or they hit different triangles
   for (std::size_t i = 0; i < primary.size(); ++i)
     changed += hits[0][i].valid() != hits[1][i].valid() || (hits[0][i].valid() && hits[0][i].prim != hits[1][i].prim);

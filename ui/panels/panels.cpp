@@ -149,7 +149,7 @@ void visit_fade_key() {
                                                       col(style.first_visit));
   ImGui::Dummy(ImVec2(w, h));
   ImGui::SameLine();
-  ImGui::TextDisabled("this step's");
+  ImGui::TextDisabled("this step");
 }
 
 bool checkbox(const char* label, bool& v, const char* help = nullptr) {
@@ -683,7 +683,7 @@ std::optional<std::size_t> ray_panel(const RayInspection* ray, std::size_t step,
   // The slider names the step's event, so the replay reads without the list below.
   char format[96];
   const VisitStep& now = steps[std::min(step, last)];
-  std::snprintf(format, sizeof format, "step %%d of %zu: %s %u", last, step_kind_name(now.kind), now.id);
+  std::snprintf(format, sizeof format, "step %%d/%zu: %s %u", last, step_kind_name(now.kind), now.id);
   if (ImGui::SliderInt("##step", &s_i, 0, static_cast<int>(last), format)) moved = static_cast<std::size_t>(s_i);
 
   if (ImGui::BeginTable("steps", 5,
