@@ -161,14 +161,15 @@ const std::vector<Entry>& entries() {
   static const std::vector<Entry> table = [] {
     std::vector<Entry> t;
     // Structure type.
-    std::string names;
-    for (const std::string& n : structure_names()) names += (names.empty() ? "" : "|") + n;
-    t.push_back({{"structure", kept(std::move(names)), "structure to build"},
+    std::string joined;
+    for (const std::string& n : structure_names()) joined += (joined.empty() ? "" : "|") + n;
+    const std::string_view values = kept(std::move(joined));
+    t.push_back({{"structure", values, "structure to build"},
                  [](const AppConfig& c) { return c.structure.name; },
-                 [](AppConfig& c, std::string_view v) -> std::string {
+                 [values](AppConfig& c, std::string_view v) -> std::string {
                    const auto& names = structure_names();
                    if (std::find(names.begin(), names.end(), v) == names.end())
-                     return "expected one of " + structure_names_joined() + ", got " + quoted(v);
+                     return "expected one of " + std::string(values) + ", got " + quoted(v);
                    c.structure.name = std::string(v);
                    return {};
                  }});

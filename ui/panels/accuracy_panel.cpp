@@ -324,9 +324,11 @@ AccuracyAction accuracy_panel(AccuracyPanelState& st, const SweepSnapshot* snap,
     ImGui::InputDouble("Ray budget N", &st.ray_budget, 0, 0, "%.3g");
     if (!(st.ray_budget > 0) || !std::isfinite(st.ray_budget)) st.ray_budget = 1e6;
     const std::size_t best = best_for_budget(res, st.ray_budget);
-    ImGui::SameLine();
-    ImGui::TextColored(ImVec4(0.3f, 0.86f, 0.43f, 1.0f), "best: %s (%.3g ms)", setting_label(res[best].setting).c_str(),
-                       res[best].total_ms(st.ray_budget));
+    // On its own line, wrapped: a long setting label ran off the window beside the budget field.
+    ImGui::PushTextWrapPos(0.0f);
+    ImGui::TextColored(ImVec4(0.3f, 0.86f, 0.43f, 1.0f), "best for N: %s (%.3g ms)",
+                       setting_label(res[best].setting).c_str(), res[best].total_ms(st.ray_budget));
+    ImGui::PopTextWrapPos();
     // The fastest may leak through shared edges: name the fastest that does not.
     if (res[best].edges.probes > 0 && res[best].edges.misses > 0) {
       char clean_text[160] = "";
@@ -340,8 +342,8 @@ AccuracyAction accuracy_panel(AccuracyPanelState& st, const SweepSnapshot* snap,
       ImGui::PopTextWrapPos();
     }
 
-    if (ImGui::CollapsingHeader(snap->probes ? "Build time vs trace time (Pareto front in red: build, trace and leaks)"
-                                             : "Build time vs trace time (Pareto front in red)",
+    if (ImGui::CollapsingHeader(snap->probes ? "Build vs trace time (front in red, leaks counted)"
+                                             : "Build vs trace time (Pareto front in red)",
                                 ImGuiTreeNodeFlags_DefaultOpen)) {
       const int c = pareto_chart(res, st.ray_budget, best);
       if (c >= 0) clicked = c;
