@@ -147,15 +147,21 @@ TEST(RobustnessLab, TinyAndHugeScenesAreProbedAsAdversariallyAsAUnitScene) {
   }
 }
 
+/// The lab with Embree's own rows, on one thread.
+LabOptions embree_lab(std::size_t rays) {
+  LabOptions o;
+  o.rays = rays;
+  o.threads = 1;
+  o.structure = "embree";
+  return o;
+}
+
 // Embree refuses a scene with a vertex beyond ±1.844e18 and rays from
 // origins beyond that bound: the lab's own variants still run (the lab used
 // to stop at the refusal), the structure's variants trace the rays it takes.
 TEST(RobustnessLab, AStructureThatRefusesTheSceneOrRaysLeavesTheLabRunning) {
   if (!kHaveEmbree) GTEST_SKIP() << "no Embree in this build";
-  LabOptions o;
-  o.rays = 400;
-  o.threads = 1;
-  o.structure = "embree";
+  const LabOptions o = embree_lab(400);
   {
     const auto huge = test_scenes::subdivided_cube(glm::vec3(-2e18f), 4e18f, 3);
     const LabResult r = run_robustness_lab(huge, o);
@@ -191,10 +197,7 @@ TEST(RobustnessLab, AStructureThatRefusesTheSceneOrRaysLeavesTheLabRunning) {
 // one hit per ray, so double hits are not counted for it.
 TEST(RobustnessLab, EmbreeRowsAreItsDefaultAndRobustModes) {
   if (!kHaveEmbree) GTEST_SKIP() << "no Embree in this build";
-  LabOptions o;
-  o.rays = 4000;
-  o.threads = 1;
-  o.structure = "embree";
+  const LabOptions o = embree_lab(4000);
   const LabResult r = run_robustness_lab(test_scenes::subdivided_cube(glm::vec3(-1.0f), 2.0f, 4), o);
   ASSERT_EQ(r.variants.size(), 6u);
   const LabVariant &fast = r.variants[4], &robust = r.variants[5];

@@ -36,18 +36,25 @@ struct HeadlessImGui : test::HeadlessImGuiContext {
   }
 };
 
-RobustnessSnapshot done_snapshot() {
+/// A finished lab run of `structure` over `triangles` (named `scene`).
+RobustnessSnapshot done_snapshot(const std::string& scene, const std::string& structure,
+                                 const std::vector<Triangle>& triangles, std::size_t rays) {
   RobustnessSnapshot s;
   s.id = 1;
   s.state = RobustnessSnapshot::State::done;
-  s.scene = "builtin:teapot?size=800";
-  s.structure = "kdtree";
+  s.scene = scene;
+  s.structure = structure;
   LabOptions o;
-  o.rays = 400;
-  o.structure = "kdtree";
+  o.rays = rays;
+  o.structure = structure;
   o.threads = 1;
-  s.result = run_robustness_lab(load_scene(s.scene).triangles, o);
+  s.result = run_robustness_lab(triangles, o);
   return s;
+}
+
+RobustnessSnapshot done_snapshot() {
+  const std::string scene = "builtin:teapot?size=800";
+  return done_snapshot(scene, "kdtree", load_scene(scene).triangles, 400);
 }
 
 TEST(RobustnessPanel, DrawsEveryStateAndReportsRunAndCancel) {
@@ -86,16 +93,8 @@ TEST(RobustnessPanel, DrawsEveryStateAndReportsRunAndCancel) {
 // per-ray map (they were drawn grey, as "ok").
 TEST(RobustnessPanel, RaysAStructureRefusesHaveTheirOwnColour) {
   if (!kHaveEmbree) GTEST_SKIP() << "no Embree in this build";
-  RobustnessSnapshot snap;
-  snap.id = 1;
-  snap.state = RobustnessSnapshot::State::done;
-  snap.scene = "cube";
-  snap.structure = "embree";
-  LabOptions o;
-  o.rays = 200;
-  o.structure = "embree";
-  o.threads = 1;
-  snap.result = run_robustness_lab(test_scenes::subdivided_cube(glm::vec3(-2e12f), 4e12f, 3), o);
+  const RobustnessSnapshot snap =
+      done_snapshot("cube", "embree", test_scenes::subdivided_cube(glm::vec3(-2e12f), 4e12f, 3), 200);
   ASSERT_GT(snap.result->structure_rays_refused, 0u);
   ASSERT_GT(snap.result->variants.size(), 4u);
   const auto colour_drawn = [](ImU32 colour) {
