@@ -44,15 +44,16 @@ bool parse_floats(std::string_view s, std::vector<float>& out) {
 Camera look_at(const glm::vec3& eye, const glm::vec3& target, float yfov_radians) {
   if (!finite3(eye) || !finite3(target)) throw std::invalid_argument("camera: eye and target must be finite");
   const glm::vec3 d = target - eye;
-  const float len = glm::length(d);
-  if (!(len > 0.0f)) throw std::invalid_argument("camera: eye and target are the same point");
-  if (!std::isfinite(len))
+  // The length in double: |d|² overflows float from about 1e19, d itself only near 3.4e38.
+  const double len = glm::length(glm::dvec3(d));
+  if (!(len > 0.0)) throw std::invalid_argument("camera: eye and target are the same point");
+  if (!finite3(d) || !std::isfinite(static_cast<float>(len)))
     throw std::invalid_argument("camera: eye and target lie too far apart (their distance overflows float)");
   if (!(yfov_radians > 0.0f && yfov_radians < kPi))
     throw std::invalid_argument("camera: vertical field of view must lie strictly between 0 and 180 degrees");
   Camera cam;
   cam.position = eye;
-  cam.forward = d / len;
+  cam.forward = glm::vec3(glm::dvec3(d) / len);
   // World +Y is up unless the view looks (nearly) straight up or down.
   glm::vec3 world_up(0.0f, 1.0f, 0.0f);
   if (std::abs(glm::dot(cam.forward, world_up)) > 0.999f) world_up = glm::vec3(0.0f, 0.0f, 1.0f);
@@ -90,7 +91,9 @@ Camera frame_bounds(const Aabb& bounds, float aspect, float yfov_radians) {
     return cam;
   }
   const glm::vec3 centre = bounds.center();
-  float radius = 0.5f * glm::length(bounds.extent());
+  // In double: |extent|² overflows float from about 1e19, though a camera at a
+  // few times that distance is representable.
+  float radius = static_cast<float>(0.5 * glm::length(glm::dvec3(bounds.extent())));
   if (!(radius > 0.0f)) radius = 1.0f;  // a single point: any sensible distance
   // The sphere fits a cone of half-angle a when distance = r / sin(a); the
   // narrower of the two half-angles decides.

@@ -102,9 +102,13 @@ TEST(Camera, FrameBoundsOfHugeBoundsIsARangeError) {
               std::string::npos)
         << e.what();
   }
-  const Aabb big{{-1e18f, -1e18f, -1e18f}, {1e18f, 1e18f, 1e18f}};  // large, but its camera fits
-  const Camera cam = frame_bounds(big, 1.0f);
-  EXPECT_TRUE(std::isfinite(cam.position.x) && std::isfinite(cam.position.y) && std::isfinite(cam.position.z));
+  // Large, but their cameras fit (at 1e20 the extent's squared length
+  // overflows float: it said "beyond the float range" for a camera at ~5e20).
+  for (const float s : {1e18f, 1e20f, 1e36f}) {
+    const Camera cam = frame_bounds(Aabb{glm::vec3(-s), glm::vec3(s)}, 1.0f);
+    EXPECT_TRUE(std::isfinite(cam.position.x) && std::isfinite(cam.position.y) && std::isfinite(cam.position.z)) << s;
+    EXPECT_GT(glm::length(glm::dvec3(cam.position)), 1.7 * s) << s;  // outside the bounding sphere
+  }
 }
 
 TEST(Camera, FrameBoundsContainsBoundingSphere) {
