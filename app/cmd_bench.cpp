@@ -217,12 +217,10 @@ std::vector<std::string> bench_structure_names() {
 }
 
 /// "ray I: why" for the first ray of `rays` that `accel` cannot take (Embree's
-/// limits, Accelerator::ray_problem); empty when it takes every ray.
+/// limits, ray_refusals); empty when it takes every ray.
 std::string first_refused_ray(const Accelerator& accel, const std::vector<Ray>& rays) {
-  for (std::size_t i = 0; i < rays.size(); ++i)
-    if (const std::string problem = accel.ray_problem(rays[i]); !problem.empty())
-      return "ray " + std::to_string(i) + ": " + problem;
-  return {};
+  const RayRefusals r = ray_refusals(accel, rays);
+  return r.count > 0 ? "ray " + std::to_string(r.first) + ": " + r.reason : std::string();
 }
 
 /// Embree refuses scenes it cannot hold (a vertex beyond its range, its
@@ -230,11 +228,6 @@ std::string first_refused_ray(const Accelerator& accel, const std::vector<Ray>& 
 /// an error of the run.
 bool refuses_scenes(const std::string& name) {
   return name == "embree" || name.starts_with("embree-");
-}
-
-std::string without_embree_prefix(std::string text) {
-  if (text.starts_with("embree: ")) text.erase(0, 8);
-  return text;
 }
 
 std::unique_ptr<Accelerator> build_bench_structure(const std::string& name, std::span<const Triangle> tris,
@@ -348,7 +341,7 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
         accels[i] = build_bench_structure(name, scene.triangles, so, progress.callback());
       } catch (const std::runtime_error& e) {
         if (!refuses_scenes(name)) throw;
-        results[i].refused = without_embree_prefix(e.what());  // the others are still measured
+        results[i].refused = without_name_prefix(e.what(), "embree");  // the others are still measured
         progress.end("refused");
         continue;
       }

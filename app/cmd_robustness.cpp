@@ -63,8 +63,7 @@ int run_robustness(const RobustnessOptions& o, const GlobalOptions& global) {
   const bool refused = !r.structure_refused.empty() || r.structure_rays_refused > 0;
   std::string refusal;
   if (!r.structure_refused.empty()) {
-    refusal = o.structure + ": not checked: " +
-              (r.structure_refused.starts_with("embree: ") ? r.structure_refused.substr(8) : r.structure_refused);
+    refusal = o.structure + ": not checked: " + without_name_prefix(r.structure_refused, o.structure);
   } else if (r.structure_rays_refused > 0) {
     refusal = o.structure + ": " + std::to_string(r.structure_rays_refused) + " of " + std::to_string(r.rays) +
               " rays not traced (the first, ray " + std::to_string(r.structure_first_refused_ray) + ": " +

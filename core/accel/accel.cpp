@@ -45,4 +45,23 @@ void Accelerator::any_packets_span(std::span<const Ray> rays, std::span<std::uin
   for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = any_hit(rays[i], opts) ? 1 : 0;
 }
 
+RayRefusals ray_refusals(const Accelerator& accel, std::span<const Ray> rays) {
+  RayRefusals r;
+  r.refused.assign(rays.size(), 0);
+  for (std::size_t i = 0; i < rays.size(); ++i)
+    if (std::string why = accel.ray_problem(rays[i]); !why.empty()) {
+      r.refused[i] = 1;
+      if (r.count++ == 0) {
+        r.first = i;
+        r.reason = std::move(why);
+      }
+    }
+  return r;
+}
+
+std::string without_name_prefix(std::string message, std::string_view name) {
+  if (message.starts_with(name) && message.compare(name.size(), 2, ": ") == 0) message.erase(0, name.size() + 2);
+  return message;
+}
+
 }  // namespace accelviz

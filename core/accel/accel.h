@@ -11,6 +11,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/geometry/hit.h"
@@ -168,5 +169,19 @@ class Accelerator {
   virtual void any_packets_span(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
                                 const QueryOptions& opts) const;
 };
+
+/// The rays of `rays` that `accel` cannot take (Accelerator::ray_problem:
+/// Embree's limits), for the callers that leave them out and name the first.
+struct RayRefusals {
+  std::vector<std::uint8_t> refused;  ///< per ray: 1 when refused (all 0 when none is)
+  std::size_t count = 0;
+  std::size_t first = 0;  ///< the first refused ray (when count > 0)
+  std::string reason;     ///< its ray_problem
+};
+RayRefusals ray_refusals(const Accelerator& accel, std::span<const Ray> rays);
+
+/// A structure's refusal (an exception's message "embree: ...") without its
+/// "NAME: " prefix, for callers that name the structure themselves.
+std::string without_name_prefix(std::string message, std::string_view name);
 
 }  // namespace accelviz

@@ -258,15 +258,13 @@ LabResult run_robustness_lab(std::span<const Triangle> triangles, const LabOptio
       res.structure_refused = e.what();  // a scene Embree cannot hold: the lab's own variants still run
     }
     if (own) {
-      own_refuses.assign(res.rays, 0);
-      for (std::size_t i = 0; i < res.rays; ++i)
-        if (std::string why = own->ray_problem(res.lab_rays[i].ray); !why.empty()) {
-          own_refuses[i] = 1;
-          if (res.structure_rays_refused++ == 0) {
-            res.structure_first_refused_ray = i;
-            res.structure_refused_ray_reason = std::move(why);
-          }
-        }
+      std::vector<Ray> rays;
+      for (const LabRay& l : res.lab_rays) rays.push_back(l.ray);
+      RayRefusals r = ray_refusals(*own, rays);
+      own_refuses = std::move(r.refused);
+      res.structure_rays_refused = r.count;
+      res.structure_first_refused_ray = r.first;
+      res.structure_refused_ray_reason = std::move(r.reason);
     }
   }
   check();

@@ -80,11 +80,6 @@ std::vector<VerifyStructure> parse_verify_structures(const std::string& list, un
 
 namespace {
 
-std::string without_prefix(std::string text, std::string_view prefix) {
-  if (text.starts_with(prefix)) text.erase(0, prefix.size());
-  return text;
-}
-
 // One independent stream per ray index, so the rays do not depend on the
 // order they are generated in.
 using Rng = SplitMix64;  // core/util/random.h
@@ -223,21 +218,14 @@ VerifyResult verify_structures(std::span<const Triangle> triangles, std::span<co
       // Embree refuses a scene it cannot hold (a vertex beyond ±1.844e18):
       // the other structures are still checked.
       if (s.factory_name != "embree") throw;
-      res.not_checked.push_back({s.label, s.named, true, rays.size(), 0, without_prefix(e.what(), "embree: ")});
+      res.not_checked.push_back({s.label, s.named, true, rays.size(), 0, without_name_prefix(e.what(), "embree")});
       continue;
     }
     // Rays the structure cannot take (Embree's limits) are left out of its
     // check, counted and the first named; every other ray is checked.
-    std::vector<std::uint8_t> refused(rays.size(), 0);
-    VerifyNotChecked skipped{s.label, s.named, false, 0, 0, {}};
-    for (std::size_t i = 0; i < rays.size(); ++i)
-      if (std::string problem = accel->ray_problem(rays[i]); !problem.empty()) {
-        refused[i] = 1;
-        if (skipped.rays++ == 0) {
-          skipped.first_ray = i;
-          skipped.reason = std::move(problem);
-        }
-      }
+    RayRefusals refusals = ray_refusals(*accel, rays);
+    const std::vector<std::uint8_t>& refused = refusals.refused;
+    const VerifyNotChecked skipped{s.label, s.named, false, refusals.count, refusals.first, std::move(refusals.reason)};
     if (skipped.rays > 0) res.not_checked.push_back(skipped);
     if (skipped.rays == rays.size() && !rays.empty()) continue;  // no ray to check it on: not among the checked
     const unsigned nt = resolve_threads(threads);
