@@ -195,18 +195,12 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
     d["max"] = fig.max;
     d["total"] = total;
     progress.begin(std::string("timing ") + tag + "'s closest hits");
-    hits[s].resize(primary.size());
-    std::vector<double> runs;  // the median of three passes
-    for (int k = 0; k < 3; ++k) {
-      const auto t0 = Clock::now();
-      trace_closest(*accel, primary, hits[s], query_of(c), resolve_threads(job.threads));
-      runs.push_back(ms_since(t0));
-    }
-    std::sort(runs.begin(), runs.end());
-    const double trace_ms = runs[1];
-    progress.end(std::to_string(static_cast<long long>(std::lround(trace_ms))) + " ms");
-    d["trace_ms"] = trace_ms;
-    d["hits"] = std::count_if(hits[s].begin(), hits[s].end(), [](const Hit& h) { return h.valid(); });
+    TimedClosestHits timed =
+        time_closest_hits(*accel, primary, query_of(c), resolve_threads(job.threads), 3, progress.callback());
+    progress.end(std::to_string(static_cast<long long>(std::lround(timed.trace_ms))) + " ms");
+    d["trace_ms"] = timed.trace_ms;
+    d["hits"] = timed.hit_count;
+    hits[s] = std::move(timed.hits);
     sides[s == 0 ? "a" : "b"] = d;
   }
   ABFigures ab;
@@ -238,10 +232,7 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
   figures["max_abs_diff"] = if_counted(ab.max_abs_diff);
   figures["pixels_b_cheaper"] = if_counted(ab.b_cheaper);
   figures["pixels_b_dearer"] = if_counted(ab.b_dearer);
-  std::uint64_t changed = 0;  // one side hits and the other misses, or they hit different triangles
-  for (std::size_t i = 0; i < primary.size(); ++i)
-    changed += hits[0][i].valid() != hits[1][i].valid() || (hits[0][i].valid() && hits[0][i].prim != hits[1][i].prim);
-  figures["pixels_hit_changed"] = changed;
+  figures["pixels_hit_changed"] = hits_changed(hits[0], hits[1]);  // hit vs miss, or another triangle
   figures["trace_ratio_b_over_a"] =
       sides["a"]["trace_ms"].get<double>() > 0.0
           ? nlohmann::json(sides["b"]["trace_ms"].get<double>() / sides["a"]["trace_ms"].get<double>())

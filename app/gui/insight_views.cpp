@@ -464,6 +464,11 @@ ScriptHost::Status InsightViews::execute(AppState& app, const ScriptCommand& c) 
             out["build_ms_b"] = res.build_ms_b;
             out["sah_a"] = res.sah_a;
             out["sah_b"] = res.sah_b;
+            out["trace_ms_a"] = res.trace_ms_a;
+            out["trace_ms_b"] = res.trace_ms_b;
+            out["hits_a"] = res.hits_a;
+            out["hits_b"] = res.hits_b;
+            out["hits_changed"] = res.hits_changed;
           }
           return out;
         });

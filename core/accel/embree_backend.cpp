@@ -330,7 +330,7 @@ std::string EmbreeAccelerator::ray_problem(const Ray& ray) const {
   if (why.ends_with("component")) why += " that is NaN or beyond ±1.844e18";
   return "cannot trace a ray whose " + why +
          " (Embree's kernels assume 0 <= tmin and finite origins and directions within ±1.844e18; "
-         "the other structures trace it)";
+         "accelviz's own structures trace it)";
 }
 
 EmbreeAccelerator::EmbreeAccelerator(std::span<const Triangle> triangles, const EmbreeOptions& opts)
@@ -353,10 +353,13 @@ EmbreeAccelerator::EmbreeAccelerator(std::span<const Triangle> triangles, const 
   }
   reach.limit(kEmbreeProductLimit);
   if (out_of_range > 0)
-    throw std::runtime_error("embree: " + std::to_string(out_of_range) + " triangle(s) (the first: triangle " +
-                             std::to_string(first_out) +
-                             ") have a vertex coordinate beyond ±1.844e18, which Embree's build leaves out; "
-                             "the other structures keep them");
+    throw std::runtime_error(
+        "embree: " +
+        (out_of_range == 1 ? "triangle " + std::to_string(first_out) + " has"
+                           : std::to_string(out_of_range) + " triangles (the first: triangle " +
+                                 std::to_string(first_out) + ") have") +
+        " a vertex coordinate beyond ±1.844e18, which Embree's build leaves out; accelviz's own structures "
+        "(bvh, kdtree, grid, ...) keep them");
   const auto t0 = Clock::now();
   impl_->vertices.resize(9 * n + 3, 0.0f);
   impl_->indices.resize(3 * n);

@@ -467,10 +467,11 @@ std::string format_tick(double v) {
   return buf;
 }
 
-std::vector<std::string> legend_labels(const std::vector<double>& ticks, bool above_top) {
+std::vector<std::string> legend_labels(const std::vector<double>& ticks, bool above_top, bool below_bottom) {
   std::vector<std::string> labels;
   for (const double v : ticks) labels.push_back(format_tick(v));
   if (above_top && !labels.empty()) labels.back() += '+';
+  if (below_bottom && !labels.empty()) labels.front().insert(0, "<=");
   return labels;
 }
 

@@ -193,8 +193,10 @@ std::vector<double> legend_ticks(double lo, double hi, bool whole);
 
 /// The numbers a legend writes at `ticks` (format_tick), the top one with a
 /// "+" when `above_top`: the image has values above the scale's top, drawn
-/// in its top colour (a locked or fixed scale).
-std::vector<std::string> legend_labels(const std::vector<double>& ticks, bool above_top);
+/// in its top colour (a locked or fixed scale); the bottom one with "<="
+/// before it when `below_bottom`: values below a locked range's low end, drawn
+/// in its bottom colour. A single tick takes both marks.
+std::vector<std::string> legend_labels(const std::vector<double>& ticks, bool above_top, bool below_bottom = false);
 
 /// Whether the metric counts whole things per ray (nodes, primitive tests,
 /// instances), so that its legend marks whole numbers.

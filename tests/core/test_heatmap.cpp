@@ -246,6 +246,10 @@ TEST(Heatmap, TickFormatting) {
   EXPECT_EQ(legend_labels(V{0, 10, 20}, false), (S{"0", "10", "20"}));
   EXPECT_EQ(legend_labels(V{0, 10, 20}, true), (S{"0", "10", "20+"}));
   EXPECT_EQ(legend_labels(V{}, true), S{});
+  // Values below a locked range's low end: its bottom number says so.
+  EXPECT_EQ(legend_labels(V{5, 10, 20}, false, true), (S{"<=5", "10", "20"}));
+  EXPECT_EQ(legend_labels(V{5, 10, 20}, true, true), (S{"<=5", "10", "20+"}));
+  EXPECT_EQ(legend_labels(V{5}, true, true), S{"<=5+"});
 }
 
 TEST(Heatmap, ValueRangeSkipsMissingValues) {

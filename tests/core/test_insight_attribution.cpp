@@ -2,6 +2,7 @@
 // region touched) and the A/B difference images, on hand-computed cases.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -163,4 +164,36 @@ TEST(InsightCompare, DifferenceTotalsAndColours) {
   c.height = 3;
   EXPECT_THROW(difference_image(a, c), std::invalid_argument);
 }
+
+TEST(InsightCompare, TimedClosestHitsAreTheTracedHitsAndTheirCount) {
+  // What a choice costs in time (render --compare, the GUI's A/B): the timed
+  // pass's hits are the closest hits, counted; a cancel stops it.
+  const std::vector<Triangle> tris = side_by_side();
+  const Bvh bvh(tris, one_per_leaf());
+  const std::vector<Ray> rays = four_rays();
+  const TimedClosestHits t = time_closest_hits(bvh, rays, QueryOptions{}, 1, 3);
+  ASSERT_EQ(t.hits.size(), 4u);
+  EXPECT_EQ(t.hits[0].prim, 0u);
+  EXPECT_FALSE(t.hits[1].valid());
+  EXPECT_EQ(t.hits[2].prim, 1u);
+  EXPECT_FALSE(t.hits[3].valid());
+  EXPECT_EQ(t.hit_count, 2u);
+  EXPECT_GE(t.trace_ms, 0.0);
+  EXPECT_THROW(time_closest_hits(bvh, rays, QueryOptions{}, 1, 3, [](double) { return false; }), BuildCancelled);
+}
+
+TEST(InsightCompare, HitsChangedCountsAHitLostGainedOrMovedToAnotherTriangle) {
+  Hit a0, a1, a2, a3, b0, b1, b2, b3;
+  a0.prim = b0.prim = 4;  // same triangle (another t does not count)
+  b0.t = 2.0f;
+  a1.prim = 1;  // lost
+  b2.prim = 2;  // gained
+  a3.prim = 3;  // moved
+  b3.prim = 5;
+  const std::vector<Hit> a = {a0, a1, a2, a3, Hit{}}, b = {b0, b1, b2, b3, Hit{}};
+  EXPECT_EQ(hits_changed(a, b), 3u);
+  EXPECT_EQ(hits_changed(a, a), 0u);
+  EXPECT_THROW(hits_changed(a, std::vector<Hit>(2)), std::invalid_argument);
+}
+
 }  // namespace unity_test_insight_attribution

@@ -151,9 +151,15 @@ TEST_F(Heatmap, LegendGradientAndNumbersFollowTheRange) {
     narrow.heatmap.range_max = 100.0f;
     ASSERT_GT(image_max(values), 100.0f);
     EXPECT_EQ(renderer_->legend_layout(narrow, kWidth, kHeight).labels.back().text, format_tick(100.0) + "+");
-    narrow.heatmap.auto_scale = true;  // the image's own top: never a sign
-    const std::string top = renderer_->legend_layout(narrow, kWidth, kHeight).labels.back().text;
-    EXPECT_NE(top.back(), '+') << top;
+    EXPECT_EQ(renderer_->legend_layout(narrow, kWidth, kHeight).labels[1].text, format_tick(0.0));
+    // A locked bottom above the ramp's smallest value: its number says so too.
+    narrow.heatmap.range_min = 10.0f;
+    ASSERT_LT(metric_value_range(values).min, 10.0f);
+    EXPECT_EQ(renderer_->legend_layout(narrow, kWidth, kHeight).labels[1].text, "<=" + format_tick(10.0));
+    narrow.heatmap.auto_scale = true;  // the image's own range: never a sign
+    const LegendLayout own = renderer_->legend_layout(narrow, kWidth, kHeight);
+    EXPECT_NE(own.labels.back().text.back(), '+') << own.labels.back().text;
+    EXPECT_FALSE(own.labels[1].text.starts_with("<=")) << own.labels[1].text;
   }
 
   const Rgba8Image img = draw(view);

@@ -59,6 +59,31 @@ TEST(InsightJobs, ABCostMetricWeighsEachSideWithItsOwnSahCosts) {
   EXPECT_GT(total, 0.0);  // some rays test triangles: the weights matter
 }
 
+TEST(InsightJobs, ABTimesEachSidesClosestHitsAndCountsTheHitsThatChanged) {
+  // The same choice on both sides: the same hits, none changed, each side timed.
+  auto loaded = std::make_shared<LoadedScene>();
+  loaded->scene = load_scene("builtin:teapot?size=800");
+  ABRequest r;
+  r.scene = loaded;
+  r.b = r.a;
+  r.b.name = "grid";
+  r.a.name = "bvh";
+  r.camera = look_at({6.0f, 4.0f, 8.0f}, {0.0f, 1.2f, 0.0f}, 0.7f);
+  r.width = 32;
+  r.height = 24;
+  r.threads = 1;
+  const std::atomic<bool> cancel{false};
+  const ABResult res = run_ab(r, cancel);
+  EXPECT_GT(res.hits_a, 0u);
+  EXPECT_LT(res.hits_a, 32u * 24u);  // the view also shows background
+  EXPECT_EQ(res.hits_b, res.hits_a);
+  EXPECT_EQ(res.hits_changed, 0u);  // a grid finds the BVH's closest hits
+  EXPECT_GT(res.trace_ms_a, 0.0);
+  EXPECT_GT(res.trace_ms_b, 0.0);
+  EXPECT_GT(res.sah_a, 0.0);
+  EXPECT_EQ(res.sah_b, 0.0);  // a grid reports no SAH (the panel says n/a)
+}
+
 ViewInsight teapot_insight() {
   auto loaded = std::make_shared<LoadedScene>();
   loaded->scene = load_scene("builtin:teapot?size=800");

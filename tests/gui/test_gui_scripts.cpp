@@ -793,6 +793,12 @@ TEST_F(GuiScript, ABFromAScriptAndTheHeatmapsXray) {
   EXPECT_GT(leaf["prims"]["total_b"].get<double>(), leaf["prims"]["total_a"].get<double>());
   EXPECT_LT(leaf["nodes"]["total_b"].get<double>(), leaf["nodes"]["total_a"].get<double>());
   EXPECT_GT(leaf["prims"]["pixels"].get<int>(), 0);
+  // The leaf size changes the tree, not the closest hits; each side is timed.
+  EXPECT_GT(leaf["hits_a"].get<int>(), 0);
+  EXPECT_EQ(leaf["hits_b"], leaf["hits_a"]);
+  EXPECT_EQ(leaf["hits_changed"].get<int>(), 0);
+  EXPECT_GT(leaf["trace_ms_a"].get<double>(), 0.0);
+  EXPECT_GT(leaf["trace_ms_b"].get<double>(), 0.0);
 
   const nlohmann::json plain = read_json(path("plain.json")), xray = read_json(path("xray.json"));
   EXPECT_GT(xray["view"]["mean_prims"].get<double>(), plain["view"]["mean_prims"].get<double>());

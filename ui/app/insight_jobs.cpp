@@ -37,6 +37,8 @@ ABResult run_ab(const ABRequest& r, const std::atomic<bool>& cancel) {
   out.b = r.b;
   const StructureChoice* side[2] = {&r.a, &r.b};
   MetricImage* img[2] = {&out.image_a, &out.image_b};
+  const std::vector<Ray> primary = primary_rays(r.camera, r.width, r.height);
+  std::vector<Hit> hits[2];
   for (int s = 0; s < 2; ++s) {
     StructureOptions so = side[s]->options;
     so.threads = r.threads;
@@ -54,7 +56,13 @@ ABResult run_ab(const ABRequest& r, const std::atomic<bool>& cancel) {
                             .c_isect = so.bvh.cost_intersect,
                             .progress = stopper(cancel)};
     *img[s] = render_metric(*accel, r.camera, ho);
+    // What the choice costs in time and what it changes, as render --compare.
+    TimedClosestHits timed = time_closest_hits(*accel, primary, side[s]->query, r.threads, 3, stopper(cancel));
+    (s == 0 ? out.trace_ms_a : out.trace_ms_b) = timed.trace_ms;
+    (s == 0 ? out.hits_a : out.hits_b) = timed.hit_count;
+    hits[s] = std::move(timed.hits);
   }
+  out.hits_changed = hits_changed(hits[0], hits[1]);
   out.diff = difference_image(out.image_a, out.image_b, &out.figures);
   out.locked_max = locked_scale_max(out.image_a, out.image_b, 0.0f);
   out.diff_scale = out.figures.max_abs_diff > 0.0 ? static_cast<float>(out.figures.max_abs_diff) : 1.0f;

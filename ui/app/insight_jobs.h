@@ -89,7 +89,10 @@ struct ABResult {
   float locked_max = 1.0f;  ///< one colour scale for A and B
   float diff_scale = 1.0f;  ///< symmetric scale of the difference
   double build_ms_a = 0.0, build_ms_b = 0.0;
-  double sah_a = 0.0, sah_b = 0.0;
+  double sah_a = 0.0, sah_b = 0.0;            ///< 0 where a structure has no SAH (grid, voxels, embree)
+  double trace_ms_a = 0.0, trace_ms_b = 0.0;  ///< the view's closest hits without counters (median of 3)
+  std::uint64_t hits_a = 0, hits_b = 0;       ///< rays that hit something
+  std::uint64_t hits_changed = 0;             ///< rays whose hit differs (hit vs miss, or another triangle)
 };
 
 /// Builds both sides and renders them (throws BuildCancelled when `cancel` is set).

@@ -76,7 +76,19 @@ ABAction ab_panel(ABPanelState& st, const ABResult* r, bool busy, const std::str
                 std::string(metric_name(r->image_a.metric)).c_str());
     ImGui::Text("pixels  B cheaper %" PRIu64 "   B dearer %" PRIu64 "   locked scale 0..%.3g", f.b_cheaper, f.b_dearer,
                 static_cast<double>(r->locked_max));
-    ImGui::Text("build ms  A %.1f   B %.1f    SAH  A %.2f   B %.2f", r->build_ms_a, r->build_ms_b, r->sah_a, r->sah_b);
+    const auto two = [](double v, bool known) {
+      char buf[32] = "n/a";
+      if (known) std::snprintf(buf, sizeof buf, "%.2f", v);
+      return std::string(buf);
+    };
+    const auto sah = [&](double v) { return two(v, v > 0.0); };
+    ImGui::Text("build ms  A %.1f   B %.1f    SAH  A %s   B %s", r->build_ms_a, r->build_ms_b, sah(r->sah_a).c_str(),
+                sah(r->sah_b).c_str());
+    // What the choice costs in time and what it changes (the counter-free closest hits, as render --compare).
+    ImGui::Text("closest hits ms  A %.2f   B %.2f   B/A %s", r->trace_ms_a, r->trace_ms_b,
+                two(r->trace_ms_b / r->trace_ms_a, r->trace_ms_a > 0.0).c_str());
+    ImGui::Text("rays hit  A %" PRIu64 "   B %" PRIu64 "   hit changed %" PRIu64 " of %zu", r->hits_a, r->hits_b,
+                r->hits_changed, r->image_a.values.size());
     const float avail = ImGui::GetContentRegionAvail().x;
     const int w = r->image_a.width, h = r->image_a.height;
     const float cell =

@@ -594,8 +594,9 @@ bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout
         ImGui::TextColored(kWarnColour, "values up to %.4g lie above the range: drawn in its top colour (legend: %s+)",
                            info.value_max, format_tick(info.range_max).c_str());
       if (below)
-        ImGui::TextColored(kWarnColour, "values down to %.4g lie below the range: drawn in its bottom colour",
-                           info.value_min);
+        ImGui::TextColored(kWarnColour,
+                           "values down to %.4g lie below the range: drawn in its bottom colour (legend: <=%s)",
+                           info.value_min, format_tick(info.range_min).c_str());
       ImGui::PopTextWrapPos();
     }
   } else {

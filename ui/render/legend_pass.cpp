@@ -38,7 +38,7 @@ void add_rect(std::vector<OverlayVertex>& out, float x0, float y0, float x1, flo
 }  // namespace
 
 LegendLayout layout_legend(int width, int height, const glm::vec2& range, std::string_view title, bool whole,
-                           bool above_top) {
+                           bool above_top, bool below_bottom) {
   LegendLayout L;
   // Proportions (glyph scale, padding, bar width) and ticks (legend_ticks) follow core's
   // CPU legend (colorize), so both read alike.
@@ -47,7 +47,7 @@ LegendLayout layout_legend(int width, int height, const glm::vec2& range, std::s
   L.scale = s;
 
   const std::vector<double> ticks = legend_ticks(range.x, range.y, whole);
-  const std::vector<std::string> numbers = legend_labels(ticks, above_top);
+  const std::vector<std::string> numbers = legend_labels(ticks, above_top, below_bottom);
   int widest = 0;
   for (const std::string& n : numbers) widest = std::max(widest, text_width(n, s));
   const int panel_w = std::max(pad + tick + bar_w + pad + widest + pad, text_width(title, s) + 2 * pad);

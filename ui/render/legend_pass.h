@@ -37,9 +37,10 @@ struct LegendLayout {
 
 /// Lays out a legend for `range` (low, high) in a width × height viewport;
 /// `above_top`: the image has values above the range, and the top number
-/// says so ("20+", core's legend_labels).
+/// says so ("20+", core's legend_labels); `below_bottom`: values below it,
+/// and the bottom number says so ("<=5").
 LegendLayout layout_legend(int width, int height, const glm::vec2& range, std::string_view title, bool whole = false,
-                           bool above_top = false);
+                           bool above_top = false, bool below_bottom = false);
 
 class LegendPass {
  public:

@@ -117,7 +117,7 @@ LegendLayout Renderer::legend_layout(const RenderView& view, int width, int heig
   const std::string title = h.title.empty() ? std::string(metric_short_label(heatmap_.metric())) : h.title;
   const glm::vec2 range = heatmap_range(h);
   return layout_legend(width, height, range, title, metric_counts(heatmap_.metric()),
-                       heatmap_.value_range().max > range.y);
+                       heatmap_.value_range().max > range.y, heatmap_.value_range().min < range.x);
 }
 
 void Renderer::render(const RenderView& view, int width, int height) {

@@ -1,10 +1,13 @@
 #include "core/analysis/insight/compare_images.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
+
+#include "core/query/batch.h"
 
 namespace accelviz {
 
@@ -86,6 +89,39 @@ RgbImage colorize_difference(const MetricImage& diff, float scale, LegendPlaceme
   draw_text(out, (xl + xr) / 2 - text_width("0", g) / 2, ty, "0", ink, g);
   draw_text(out, std::max(0, xr - text_width(hi, g) / 2), ty, hi, ink, g);
   return out;
+}
+
+TimedClosestHits time_closest_hits(const Accelerator& accel, std::span<const Ray> rays, const QueryOptions& query,
+                                   unsigned threads, int passes, const ProgressCallback& progress) {
+  TimedClosestHits out;
+  out.hits.resize(rays.size());
+  std::vector<double> runs;
+  for (int k = 0; k < std::max(passes, 1); ++k) {
+    BatchOptions batch{threads};
+    if (progress) {
+      const double share = 1.0 / std::max(passes, 1);
+      batch.progress = [&progress, k, share](double f) { return progress((k + f) * share); };
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    const bool done = trace_closest(accel, rays, out.hits, query, batch);
+    runs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    if (!done) throw BuildCancelled();
+  }
+  std::sort(runs.begin(), runs.end());
+  out.trace_ms = runs[runs.size() / 2];
+  out.hit_count = static_cast<std::uint64_t>(
+      std::count_if(out.hits.begin(), out.hits.end(), [](const Hit& h) { return h.valid(); }));
+  return out;
+}
+
+std::uint64_t hits_changed(std::span<const Hit> a, std::span<const Hit> b) {
+  if (a.size() != b.size())
+    throw std::invalid_argument("hits_changed: A has " + std::to_string(a.size()) + " hits, B " +
+                                std::to_string(b.size()));
+  std::uint64_t changed = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    changed += a[i].valid() != b[i].valid() || (a[i].valid() && a[i].prim != b[i].prim);
+  return changed;
 }
 
 }  // namespace accelviz

@@ -3,6 +3,10 @@
 // scale for both, and the difference B - A on a diverging colour map
 // (blue: B cheaper, white: equal, red: B dearer) whose scale is symmetric
 // about 0. Shared by `accelviz render --compare` and the GUI's A/B panel.
+#include <span>
+#include <vector>
+
+#include "core/accel/accel.h"
 #include "core/analysis/heatmap.h"
 
 namespace accelviz {
@@ -28,5 +32,22 @@ glm::u8vec3 difference_color(float value, float scale, const glm::vec3& backgrou
 /// The difference image in colour with a legend bar below ("-S", "0", "+S",
 /// "B - A"); scale <= 0: the image's own largest |value| (1 when all zero).
 RgbImage colorize_difference(const MetricImage& diff, float scale, LegendPlacement legend = LegendPlacement::bottom);
+
+/// What a choice costs in time and what it changes: one side's closest hits of
+/// the view's primary rays, timed on the counter-free fast path.
+struct TimedClosestHits {
+  std::vector<Hit> hits;        ///< one per ray
+  double trace_ms = 0.0;        ///< the median of the passes
+  std::uint64_t hit_count = 0;  ///< rays that hit something
+};
+
+/// Traces `rays` `passes` times (at least 1) on `threads` threads and keeps the
+/// median time. Throws BuildCancelled when `progress` returns false.
+TimedClosestHits time_closest_hits(const Accelerator& accel, std::span<const Ray> rays, const QueryOptions& query,
+                                   unsigned threads, int passes = 3, const ProgressCallback& progress = {});
+
+/// Rays whose hit differs between A and B: one hits and the other misses, or
+/// they hit different triangles. Throws std::invalid_argument when the sizes differ.
+std::uint64_t hits_changed(std::span<const Hit> a, std::span<const Hit> b);
 
 }  // namespace accelviz
