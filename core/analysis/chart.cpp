@@ -10,6 +10,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "core/analysis/label_placement.h"
+
 namespace accelviz {
 
 namespace {
@@ -181,17 +183,69 @@ RgbImage draw_chart(const ChartOptions& opts, const std::vector<ChartSeries>& se
       if (s.points)
         for (int dy = -s.marker; dy <= s.marker; ++dy)
           for (int dx = -s.marker; dx <= s.marker; ++dx) put(img, x + dx, y + dy, s.color);
-      if (i < s.labels.size() && !s.labels[i].empty())
-        draw_text(img, x + s.marker + 3, y - s.marker - 8, s.labels[i], s.color, 1);
     }
   }
 
-  // ---- legend, top right ----
-  int ly = top + 4;
+  // ---- legend, top right; the points' labels where they overlap nothing ----
+  int legend_w = 0, legend_rows = 0;
+  for (const ChartSeries& s : series)
+    if (!s.name.empty()) legend_w = std::max(legend_w, text_width(s.name, 1) + 16), ++legend_rows;
+  // The legend in the first corner of the plot that covers no point: top right, top left, bottom right, bottom left.
+  const int legend_h = 12 * legend_rows + 2;
+  const auto covers_a_point = [&](const LabelRect& box) {
+    for (const ChartSeries& s : series)
+      for (std::size_t i = 0; i < s.x.size(); ++i) {
+        if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
+        const float x = static_cast<float>(px(s.x[i])), y = static_cast<float>(py(s.y[i])), m = s.marker + 1.0f;
+        if (box.overlaps({x - m, y - m, x + m, y + m})) return true;
+      }
+    return false;
+  };
+  const auto corner = [&](bool at_right, bool at_top) {
+    const int x1 = at_right ? right : left + 4 + legend_w, y0 = at_top ? top + 2 : bottom - 4 - legend_h;
+    return LabelRect{static_cast<float>(x1 - legend_w - 2), static_cast<float>(y0), static_cast<float>(x1),
+                     static_cast<float>(y0 + legend_h)};
+  };
+  LabelRect legend_box = corner(true, true);  // also where every corner covers a point
+  for (const auto& [at_right, at_top] : {std::pair{true, true}, {false, true}, {true, false}, {false, false}})
+    if (!covers_a_point(corner(at_right, at_top))) {
+      legend_box = corner(at_right, at_top);
+      break;
+    }
+  std::vector<LabelRequest> requests;
+  std::vector<std::pair<const ChartSeries*, std::size_t>> labelled;  // one per request: series, point
+  std::vector<std::size_t> starts;                                   // each series' first request
+  for (const ChartSeries& s : series) {
+    starts.push_back(requests.size());
+    for (std::size_t i = 0; i < s.x.size(); ++i) {
+      if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
+      const bool has = i < s.labels.size() && !s.labels[i].empty();
+      requests.push_back({static_cast<float>(px(s.x[i])), static_cast<float>(py(s.y[i])),
+                          has ? static_cast<float>(text_width(s.labels[i], 1)) : 0.0f, has ? 9.0f : 0.0f});
+      labelled.emplace_back(&s, i);
+    }
+  }
+  starts.push_back(requests.size());
+  std::vector<std::size_t> priority;  // the last series' labels first: it is drawn on top (a Pareto front)
+  for (std::size_t k = series.size(); k-- > 0;)
+    for (std::size_t r = starts[k]; r < starts[k + 1]; ++r) priority.push_back(r);
+  LabelLayout layout;
+  layout.marker = 0.0f;
+  for (const ChartSeries& s : series) layout.marker = std::max(layout.marker, static_cast<float>(s.marker));
+  layout.bounds = {static_cast<float>(left + 1), static_cast<float>(top), static_cast<float>(right),
+                   static_cast<float>(bottom)};
+  if (legend_rows > 0) layout.taken = std::span<const LabelRect>(&legend_box, 1);
+  const std::vector<std::optional<LabelRect>> spots = place_point_labels(requests, layout, priority);
+  for (std::size_t k = 0; k < spots.size(); ++k)
+    if (spots[k]) {
+      const auto& [s, i] = labelled[k];
+      draw_text(img, static_cast<int>(spots[k]->x0), static_cast<int>(spots[k]->y0), s->labels[i], s->color, 1);
+    }
+  int ly = static_cast<int>(legend_box.y0) + 2;
   for (const ChartSeries& s : series) {
     if (s.name.empty()) continue;
     const int w = text_width(s.name, 1);
-    const int x = right - w - 16;
+    const int x = static_cast<int>(legend_box.x1) - w - 16;
     for (int dy = -2; dy <= 2; ++dy)
       for (int dx = 0; dx < 8; ++dx) put(img, x + dx, ly + 3 + dy, s.color);
     draw_text(img, x + 12, ly, s.name, kText, 1);

@@ -16,7 +16,10 @@ namespace accelviz {
 struct ChartSeries {
   std::string name;                 ///< legend entry (empty: none)
   std::vector<double> x, y;         ///< same size; non-finite points are skipped
-  std::vector<std::string> labels;  ///< optional, one per point, drawn beside it
+  /// Optional, one per point, drawn beside it where it covers no other label,
+  /// point or the legend (label_placement.h; the last series' labels placed
+  /// first), else left out.
+  std::vector<std::string> labels;
   glm::u8vec3 color{31, 119, 180};
   bool lines = true;                ///< join consecutive points
   bool points = true;               ///< draw a marker per point

@@ -3,8 +3,6 @@
 // lists: build time vs trace time with the Pareto front, each figure against
 // the swept parameter, total time for a ray budget, and the calibrated SAH
 // constants. Clicking a point (or a bar) asks to apply that setting.
-#include "ui/panels/panels.h"
-
 #include <imgui.h>
 #include <imgui_stdlib.h>
 
@@ -14,6 +12,9 @@
 #include <limits>
 #include <string>
 #include <vector>
+
+#include "core/analysis/label_placement.h"
+#include "ui/panels/panels.h"
 
 namespace accelviz::panels {
 namespace {
@@ -142,14 +143,33 @@ int pareto_chart(const std::vector<SweepResult>& res, double budget, std::size_t
   std::vector<ImVec2> screen;
   for (const ParetoPoint& p : pts) screen.push_back(plot.map(p.x, p.y));
   for (std::size_t k = 1; k < front.size(); ++k) dl->AddLine(screen[front[k - 1]], screen[front[k]], kFront, 2.0f);
+  // Labels: the best setting's first, then the front's, then (up to ten settings) the others', each
+  // where it covers no other label or point; the tooltip names the rest.
   const bool label_all = res.size() <= 10;
+  std::vector<std::string> names(res.size());
+  std::vector<LabelRequest> requests(res.size());
+  std::vector<std::size_t> priority;
+  if (best < res.size()) priority.push_back(best);
+  priority.insert(priority.end(), front.begin(), front.end());
   for (std::size_t i = 0; i < res.size(); ++i) {
     const bool on_front = std::find(front.begin(), front.end(), i) != front.end();
     dl->AddCircleFilled(screen[i], on_front ? 4.5f : 3.5f, on_front ? kFront : kPoint);
     if (i == best) dl->AddCircle(screen[i], 8.0f, kBest, 0, 2.0f);
-    if (on_front || label_all)
-      dl->AddText(ImVec2(screen[i].x + 6, screen[i].y - 14), kText, setting_label(res[i].setting).c_str());
+    requests[i] = {screen[i].x, screen[i].y, 0.0f, 0.0f};
+    if (on_front || label_all || i == best) {
+      names[i] = setting_label(res[i].setting);
+      const ImVec2 size = ImGui::CalcTextSize(names[i].c_str());
+      requests[i].w = size.x;
+      requests[i].h = size.y;
+      if (!on_front && i != best) priority.push_back(i);
+    }
   }
+  LabelLayout layout;
+  layout.marker = 4.5f;
+  layout.bounds = {plot.p0.x + 1.0f, plot.p0.y, plot.p1.x, plot.p1.y};
+  const std::vector<std::optional<LabelRect>> spots = place_point_labels(requests, layout, priority);
+  for (std::size_t i = 0; i < res.size(); ++i)
+    if (spots[i]) dl->AddText(ImVec2(spots[i]->x0, spots[i]->y0), kText, names[i].c_str());
   int hit = plot.hovered ? nearest(screen, 9.0f) : -1;
   if (hit >= 0) result_tooltip(res[static_cast<std::size_t>(hit)], budget);
   return plot.clicked ? hit : -1;
