@@ -183,7 +183,7 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
   note_instanced_triangles(figures, *accel);
   // render_ms includes counting for the counter metrics; Embree keeps no
   // per-ray counters (its nodes/prims/cost images are all 0), so nothing was counted.
-  const bool counters = o.structure != "embree";
+  const bool counters = accel->inspectable();
   figures["per_ray_counters"] = counters;
   if (metric_needs_stats(metric)) {
     figures["instrumented"] = counters;

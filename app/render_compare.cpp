@@ -137,7 +137,6 @@ nlohmann::json describe_side(const CompareSide& side, HeatMetric metric) {
     d["embree_quality"] = side.structure_opts.embree_quality;
     d["embree_robust"] = side.structure_opts.embree_robust;
   }
-  d["per_ray_counters"] = st != "embree";  // Embree keeps none: its counter images are all 0
   return d;
 }
 
@@ -184,13 +183,14 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
     double total = 0.0;
     for (const float v : images[s].values)
       if (std::isfinite(v)) total += v;
-    if (c.structure == "embree" && !global.quiet)
+    if (!accel->inspectable() && !global.quiet)
       std::cerr << "accelviz: " << tag << ": embree keeps no per-ray counters: its " << job.metric
                 << " image is all 0\n";
     nlohmann::json d = describe_side(c, metric);
     d["build_ms"] = accel->build_stats().build_ms;
-    d["sah_cost"] = c.structure == "embree" ? nlohmann::json(nullptr)  // Embree does not expose its tree
-                                            : nlohmann::json(accel->build_stats().sah_cost);
+    d["per_ray_counters"] = accel->inspectable();  // Embree keeps none: its counter images are all 0
+    d["sah_cost"] = accel->build_stats().sah_cost > 0.0 ? nlohmann::json(accel->build_stats().sah_cost)
+                                                        : nlohmann::json(nullptr);  // none (embree, grid, voxels)
     d["mean"] = fig.mean;
     d["max"] = fig.max;
     d["total"] = total;

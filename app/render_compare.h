@@ -36,7 +36,7 @@ ComparePaths compare_paths(const std::string& out);
 /// for Embree; splitter, buckets (binned), leaf, leaf_cap, xray for bvh and
 /// tlas; order for those and kdtree, octree; ctrav, cisect for bvh, tlas and
 /// the cost metric; embree_quality, embree_robust for Embree), and
-/// per_ray_counters (false for Embree: its counter images are all 0).
+/// per_ray_counters is added once the side is built (Accelerator::inspectable()).
 nlohmann::json describe_side(const CompareSide& side, HeatMetric metric);
 
 /// QueryOptions of a side (order, x-ray, triangle test).

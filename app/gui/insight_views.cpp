@@ -457,9 +457,18 @@ ScriptHost::Status InsightViews::execute(AppState& app, const ScriptCommand& c) 
             rm.metric = m;
             const ABResult res = run_ab(rm, cancel);
             const ABFigures& f = res.figures;
-            out[std::string(metric_name(m))] = {
-                {"total_a", f.total_a},     {"total_b", f.total_b},   {"mean_a", f.mean_a}, {"mean_b", f.mean_b},
-                {"b_cheaper", f.b_cheaper}, {"b_dearer", f.b_dearer}, {"pixels", f.pixels}};
+            // A side that counts nothing per ray (embree): no count compares (null), as render --compare.
+            const auto counted = [&](const nlohmann::json& v) {
+              return res.uncounted.empty() ? v : nlohmann::json(nullptr);
+            };
+            out[std::string(metric_name(m))] = {{"total_a", counted(f.total_a)},
+                                                {"total_b", counted(f.total_b)},
+                                                {"mean_a", counted(f.mean_a)},
+                                                {"mean_b", counted(f.mean_b)},
+                                                {"b_cheaper", counted(f.b_cheaper)},
+                                                {"b_dearer", counted(f.b_dearer)},
+                                                {"pixels", f.pixels}};
+            out["per_ray_counters"] = res.uncounted.empty();
             out["build_ms_a"] = res.build_ms_a;
             out["build_ms_b"] = res.build_ms_b;
             out["sah_a"] = res.sah_a;

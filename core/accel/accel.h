@@ -153,6 +153,13 @@ class Accelerator {
 
   virtual const BuildStats& build_stats() const = 0;
 
+  /// Whether the structure can be looked into: it fills RayStats per ray
+  /// (nodes visited, primitives tested) and its build_stats() count its
+  /// nodes, leaves and depth. Every structure of ours can; Embree, the
+  /// production reference, keeps its tree and its counters to itself, so its
+  /// counter heatmaps are all 0 and its node figures 0, which the views say.
+  virtual bool inspectable() const { return true; }
+
   /// Why this structure cannot trace `ray` ("" when it can): every structure
   /// of ours takes any ray; Embree refuses a few (EmbreeAccelerator). The
   /// queries throw std::invalid_argument with this text on such a ray; a

@@ -81,6 +81,7 @@ class EmbreeAccelerator final : public Accelerator {
   /// that is NaN or beyond ±1.844e18 (Embree's FLT_LARGE): those are refused
   /// (the queries throw std::invalid_argument "embree: ..."), never traced.
   std::string ray_problem(const Ray& ray) const override;
+  bool inspectable() const override { return false; }
   Hit closest_hit(const Ray& ray, const QueryOptions& opts, RayStats* stats = nullptr,
                   VisitTrace* trace = nullptr) const override;
   bool any_hit(const Ray& ray, const QueryOptions& opts, RayStats* stats = nullptr) const override;

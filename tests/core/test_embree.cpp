@@ -257,8 +257,11 @@ TEST(EmbreeOracle, SharedMeshesClosestAndAnyHitAgreeWithTheBvh) {
 }
 
 TEST(Embree, LeavesRayStatsAtZero) {
+  // ... and says so: the views show n/a, not 0 nodes (Accelerator::inspectable()).
   const std::vector<Triangle> tris = random_soup(100, 3);
   const EmbreeAccelerator embree(tris);
+  EXPECT_FALSE(embree.inspectable());
+  EXPECT_TRUE(Bvh(tris).inspectable());
   RayStats st;
   embree.closest_hit(Ray({0, 0, -5}, {0, 0, 1}), {}, &st);
   embree.any_hit(Ray({0, 0, -5}, {0, 0, 1}), {}, &st);

@@ -84,6 +84,30 @@ TEST(InsightJobs, ABTimesEachSidesClosestHitsAndCountsTheHitsThatChanged) {
   EXPECT_EQ(res.sah_b, 0.0);  // a grid reports no SAH (the panel says n/a)
 }
 
+#ifdef ACCELVIZ_HAVE_EMBREE
+TEST(InsightJobs, ABWithASideThatCountsNothingSaysSo) {
+  // Embree counts nothing per ray: its images are 0, so no count compares (the panel and dump-ab say
+  // so); its closest hits are still timed and compared.
+  auto loaded = std::make_shared<LoadedScene>();
+  loaded->scene = load_scene("builtin:teapot?size=800");
+  ABRequest r;
+  r.scene = loaded;
+  r.b.name = "embree";
+  r.camera = look_at({6.0f, 4.0f, 8.0f}, {0.0f, 1.2f, 0.0f}, 0.7f);
+  r.width = 32;
+  r.height = 24;
+  r.threads = 1;
+  const std::atomic<bool> cancel{false};
+  const ABResult res = run_ab(r, cancel);
+  EXPECT_EQ(res.uncounted, "embree");
+  EXPECT_EQ(res.figures.total_b, 0.0);
+  EXPECT_GT(res.hits_b, 0u);
+  EXPECT_LE(res.hits_changed, res.hits_a / 20);  // a few edge pixels at most: the same scene
+  r.b.name = "kdtree";
+  EXPECT_EQ(run_ab(r, cancel).uncounted, "");
+}
+#endif
+
 ViewInsight teapot_insight() {
   auto loaded = std::make_shared<LoadedScene>();
   loaded->scene = load_scene("builtin:teapot?size=800");

@@ -370,7 +370,26 @@ TEST_F(GuiScript, SwitchingStructuresRebuildsAndTheHeatmapFollows) {
   EXPECT_EQ(node_counts.size(), 3u) << "three different structures were built";
   EXPECT_NE(shots[0].pixels, shots[1].pixels);
   EXPECT_NE(shots[1].pixels, shots[2].pixels);
+  for (const char* s : {"bvh", "kdtree", "grid"})
+    EXPECT_EQ(read_json(path(std::string(s) + "-stats.json"))["build"]["inspectable"], true) << s;
 }
+
+#ifdef ACCELVIZ_HAVE_EMBREE
+// Embree keeps its tree and per-ray counters to itself: the Stats panel says
+// n/a rather than 0 nodes, and its counter heatmap is 0 everywhere (the View
+// panel says so); its hits are shown.
+TEST_F(GuiScript, EmbreeShownSaysItCountsNothing) {
+  const RunResult r =
+      run(std::string("open ") + kTeapot + "\nsize 320 240\ncamera " + kCamera +
+          "\nset heatmap full\nstructure embree\nwait\ndump-stats " + path("e.json").string() + "\nquit\n");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = read_json(path("e.json"));
+  EXPECT_EQ(j["structure"], "embree");
+  EXPECT_EQ(j["build"]["inspectable"], false);
+  EXPECT_EQ(j["view"]["mean_nodes"].get<double>(), 0.0);
+  EXPECT_GT(j["view"]["hits"].get<int>(), 0);
+}
+#endif
 
 TEST_F(GuiScript, ABadScenePathIsReportedAndTheAppKeepsRunning) {
   const std::string missing = path("no-such-model.glb").string();

@@ -386,10 +386,16 @@ nlohmann::json AppState::stats_json() const {
       options[std::string(key)] = option_value(c, key);
     j["options"] = options;
     const BuildStats& b = current_->accel->build_stats();
-    j["build"] = {
-        {"build_ms", b.build_ms},         {"wall_ms", current_->wall_ms}, {"nodes", b.node_count},
-        {"leaves", b.leaf_count},         {"max_depth", b.max_depth},     {"avg_leaf_depth", b.avg_leaf_depth},
-        {"memory_bytes", b.memory_bytes}, {"sah_cost", b.sah_cost},       {"extra", b.extra}};
+    j["build"] = {{"build_ms", b.build_ms},
+                  {"wall_ms", current_->wall_ms},
+                  {"nodes", b.node_count},
+                  {"leaves", b.leaf_count},
+                  {"max_depth", b.max_depth},
+                  {"avg_leaf_depth", b.avg_leaf_depth},
+                  {"memory_bytes", b.memory_bytes},
+                  {"sah_cost", b.sah_cost},
+                  {"extra", b.extra},
+                  {"inspectable", current_->accel->inspectable()}};
   }
   if (heatmap_) {
     const HeatmapSummary& s = heatmap_->summary;

@@ -46,6 +46,7 @@ ABResult run_ab(const ABRequest& r, const std::atomic<bool>& cancel) {
     const auto accel = build_accelerator(side[s]->name, r.scene->scene.triangles, so, stopper(cancel));
     (s == 0 ? out.build_ms_a : out.build_ms_b) = accel->build_stats().build_ms;
     (s == 0 ? out.sah_a : out.sah_b) = accel->build_stats().sah_cost;
+    if (!accel->inspectable()) out.uncounted = accel->name();
     // The cost metric with each side's own SAH costs, as render --compare.
     const HeatmapOptions ho{.metric = r.metric,
                             .width = r.width,

@@ -93,6 +93,7 @@ struct ABResult {
   double trace_ms_a = 0.0, trace_ms_b = 0.0;  ///< the view's closest hits without counters (median of 3)
   std::uint64_t hits_a = 0, hits_b = 0;       ///< rays that hit something
   std::uint64_t hits_changed = 0;             ///< rays whose hit differs (hit vs miss, or another triangle)
+  std::string uncounted;  ///< a side that counts nothing per ray (embree): its images are 0, no count compares
 };
 
 /// Builds both sides and renders them (throws BuildCancelled when `cancel` is set).

@@ -70,12 +70,19 @@ ABAction ab_panel(ABPanelState& st, const ABResult* r, bool busy, const std::str
   if (!error.empty()) ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.4f, 1.0f), "%s", error.c_str());
   if (r && r->image_a.width > 0) {
     const ABFigures& f = r->figures;
-    ImGui::Text("totals  A %.0f   B %.0f   B/A %.3f", f.total_a, f.total_b,
-                f.total_a > 0 ? f.total_b / f.total_a : 0.0);
-    ImGui::Text("mean per ray  A %.2f   B %.2f   (%s)", f.mean_a, f.mean_b,
-                std::string(metric_name(r->image_a.metric)).c_str());
-    ImGui::Text("pixels  B cheaper %" PRIu64 "   B dearer %" PRIu64 "   locked scale 0..%.3g", f.b_cheaper, f.b_dearer,
-                static_cast<double>(r->locked_max));
+    if (r->uncounted.empty()) {
+      ImGui::Text("totals  A %.0f   B %.0f   B/A %.3f", f.total_a, f.total_b,
+                  f.total_a > 0 ? f.total_b / f.total_a : 0.0);
+      ImGui::Text("mean per ray  A %.2f   B %.2f   (%s)", f.mean_a, f.mean_b,
+                  std::string(metric_name(r->image_a.metric)).c_str());
+      ImGui::Text("pixels  B cheaper %" PRIu64 "   B dearer %" PRIu64 "   locked scale 0..%.3g", f.b_cheaper,
+                  f.b_dearer, static_cast<double>(r->locked_max));
+    } else {
+      ImGui::PushTextWrapPos(0.0f);
+      ImGui::TextDisabled("%s counts nothing per ray: its image is 0 and no count compares (the times and hits do)",
+                          r->uncounted.c_str());
+      ImGui::PopTextWrapPos();
+    }
     const auto two = [](double v, bool known) {
       char buf[32] = "n/a";
       if (known) std::snprintf(buf, sizeof buf, "%.2f", v);

@@ -369,12 +369,19 @@ void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const Pa
     ImGui::TableSetupColumn("value", ImGuiTableColumnFlags_WidthStretch);
     row("build ms", "%.2f", b.build_ms);
     row("wall ms", "%.2f", built->wall_ms);
-    row("nodes", "%" PRIu64, b.node_count);
-    row("leaves", "%" PRIu64, b.leaf_count);
-    row("max depth", "%u", b.max_depth);
-    row("avg leaf depth", "%.2f", b.avg_leaf_depth);
+    if (built->accel->inspectable()) {
+      row("nodes", "%" PRIu64, b.node_count);
+      row("leaves", "%" PRIu64, b.leaf_count);
+      row("max depth", "%u", b.max_depth);
+      row("avg leaf depth", "%.2f", b.avg_leaf_depth);
+    } else {
+      row("nodes", "n/a: %s keeps its tree to itself", built->accel->name().c_str());
+    }
     row("memory", "%s", bytes_text(b.memory_bytes).c_str());
-    row("SAH cost", "%.4g", b.sah_cost);
+    if (b.sah_cost > 0.0)
+      row("SAH cost", "%.4g", b.sah_cost);
+    else
+      row("SAH cost", "n/a");
     if (const auto it = b.extra.find("epo"); it != b.extra.end()) row("EPO", "%.4g", it->second);
     for (const auto& [k, v] : b.extra) {
       if (k == "epo") continue;
@@ -397,8 +404,14 @@ void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const Pa
       ImGui::TableSetupColumn("value", ImGuiTableColumnFlags_WidthStretch);
       row("pixels", "%d x %d%s", view->image.width, view->image.height,
           view->complete ? "" : (" (1 in " + std::to_string(view->stride * view->stride) + ")").c_str());
-      row("nodes / pixel", "mean %.2f, max %u", s.mean_nodes, s.max_nodes);
-      row("prim tests / pixel", "mean %.2f, max %u", s.mean_prims, s.max_prims);
+      const bool counted =
+          !view->request.structure || !view->request.structure->accel || view->request.structure->accel->inspectable();
+      if (!counted) {
+        row("nodes / pixel", "n/a: %s counts nothing per ray", view->request.structure->accel->name().c_str());
+      } else {
+        row("nodes / pixel", "mean %.2f, max %u", s.mean_nodes, s.max_nodes);
+        row("prim tests / pixel", "mean %.2f, max %u", s.mean_prims, s.max_prims);
+      }
       if (view->request.structure && view->request.structure->accel && view->request.structure->accel->name() == "tlas")
         row("instances / pixel", "mean %.2f, max %u", s.mean_instances, s.max_instances);
       row("hits", "%" PRIu64 " of %" PRIu64, s.hits, s.rays);
@@ -408,8 +421,10 @@ void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const Pa
         const bool synthetic = view->request.shadow_lights.front().name == "synthetic";
         row("shadow rays", "%" PRIu64 " (%" PRIu64 " occluded)%s", s.shadow_rays, s.shadowed,
             synthetic ? ", to a synthetic light" : "");
-        row("nodes / shadow ray", "%.2f", s.mean_shadow_nodes);
-        row("prim tests / shadow ray", "%.2f", s.mean_shadow_prims);
+        if (counted) {
+          row("nodes / shadow ray", "%.2f", s.mean_shadow_nodes);
+          row("prim tests / shadow ray", "%.2f", s.mean_shadow_prims);
+        }
       }
       ImGui::EndTable();
     }
@@ -533,6 +548,12 @@ bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout
   if (v.metric == HeatMetric::instances && info.node_kind != "tlas") {
     ImGui::PushTextWrapPos(0.0f);
     ImGui::TextDisabled("only a two-level structure (tlas) enters instances: this one shows 0 everywhere");
+    ImGui::PopTextWrapPos();
+  } else if (metric_needs_stats(v.metric) && !info.uncounted.empty()) {
+    ImGui::PushTextWrapPos(0.0f);
+    ImGui::TextDisabled(
+        "%s counts nothing per ray: this metric is 0 everywhere (shaded and hit distance show its hits)",
+        info.uncounted.c_str());
     ImGui::PopTextWrapPos();
   }
   int device = v.heatmap_gpu ? 1 : 0;
