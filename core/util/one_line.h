@@ -15,10 +15,10 @@ namespace accelviz {
 inline constexpr std::size_t kMaxMessageChars = 300;
 
 /// First non-blank line of `text`, trimmed of spaces and tabs and cut to
-/// kMaxMessageChars, with every other control byte (a NUL from a decoded
-/// URI, say, which would end the message where what() is read) shown as '?';
-/// "unknown error" when there is none.
-inline std::string first_line(const std::string& text) {
+/// `max_chars` (kMaxMessageChars unless said), with every other control byte
+/// (a NUL from a decoded URI, say, which would end the message where what() is
+/// read) shown as '?'; "unknown error" when there is none.
+inline std::string first_line(const std::string& text, std::size_t max_chars = kMaxMessageChars) {
   std::size_t start = 0;
   while (start < text.size()) {
     std::size_t end = text.find_first_of("\r\n", start);
@@ -27,7 +27,7 @@ inline std::string first_line(const std::string& text) {
     const auto first = line.find_first_not_of(" \t");
     if (first != std::string::npos) {
       line = line.substr(first, line.find_last_not_of(" \t") - first + 1);
-      if (line.size() > kMaxMessageChars) line = line.substr(0, kMaxMessageChars) + "...";
+      if (line.size() > max_chars) line = line.substr(0, max_chars) + "...";
       for (char& c : line)
         if ((static_cast<unsigned char>(c) < 0x20 && c != '\t') || c == 0x7F) c = '?';
       return line;

@@ -143,7 +143,9 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
       std::string valid;
       for (const std::string_view name : script_command_names())
         valid += (valid.empty() ? "" : ", ") + std::string(name);
-      fail("unknown command '" + std::string(word) + "' (valid: " + valid + ")");
+      // The word as written, at most 40 characters of it: the list of commands is what the line is for.
+      const std::string said = word.size() > 40 ? std::string(word.substr(0, 40)) + "..." : std::string(word);
+      fail("unknown command '" + said + "' (valid: " + valid + ")");
     }
 
     ScriptCommand c;

@@ -62,9 +62,10 @@ std::vector<std::string_view> script_command_names();
 class ScriptError : public std::runtime_error {
  public:
   /// The message is made one line (first_line: control bytes such as a NUL
-  /// shown as '?', at most 300 characters), whatever the script held.
+  /// shown as '?', at most 500 characters: room for the list of commands),
+  /// whatever the script held.
   ScriptError(const std::string& file, int line, const std::string& message)
-      : std::runtime_error(file + ":" + std::to_string(line) + ": " + first_line(message)), line_(line) {}
+      : std::runtime_error(file + ":" + std::to_string(line) + ": " + first_line(message, 500)), line_(line) {}
   int line() const { return line_; }
 
  private:
