@@ -1,5 +1,5 @@
 // accelviz refit SCENE --frames F --amplitude A [--rebuild-ratio R] --out DIR:
-// refit decay of the BVH under smooth deterministic vertex motion, frame by
+// refit decay of the BVH under a deterministic synthetic motion, frame by
 // frame against a fresh build (core/analysis/refit_decay.h), written as
 // refit.csv, refit.json and charts.
 #include "app/cli_common.h"
@@ -24,6 +24,7 @@ namespace fs = std::filesystem;
 struct RefitCliOptions {
   std::string scene;
   int frames = 30;
+  std::string motion = "explode";
   float amplitude = 0.02f;
   double frame_step = 0.05;
   double rebuild_ratio = 0;
@@ -58,6 +59,7 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
   opts.amplitude = o.amplitude;
   opts.frame_step = o.frame_step;
   opts.rebuild_ratio = o.rebuild_ratio;
+  opts.motion = parse_refit_motion(o.motion).value();  // CLI11 checked the name
   opts.seed = o.seed;
   opts.threads = o.threads;
   opts.bvh = o.structure_opts.to_options(o.threads, false).bvh;
@@ -94,6 +96,7 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
                             {"triangles", scene.triangles.size()},
                             {"frames", o.frames},
                             {"motion", "synthetic"},
+                            {"motion_kind", o.motion},
                             {"scene_animations", scene.animations.size()},
                             {"amplitude_relative_to_diagonal", o.amplitude},
                             {"frame_step_periods", o.frame_step},
@@ -114,12 +117,13 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
     fresh.x.push_back(x), fresh.y.push_back(f.sah_fresh);
     nodes_refit.x.push_back(x), nodes_refit.y.push_back(f.nodes_per_ray_refit);
     nodes_fresh.x.push_back(x), nodes_fresh.y.push_back(f.nodes_per_ray_fresh);
+    if (f.frame == 0) continue;  // the rest pose: built, not refitted
     ms_refit.x.push_back(x), ms_refit.y.push_back(f.refit_ms);
     ms_build.x.push_back(x), ms_build.y.push_back(f.rebuild_ms);
   }
   ChartOptions c;
   c.x_label = "frame";
-  c.title = "sah cost: refit vs fresh build";
+  c.title = "sah cost: refit vs fresh build (" + o.motion + " motion)";
   c.y_label = "sah cost";
   write_png((dir / "refit-sah.png").string(), draw_chart(c, {refit, fresh}), true);
   c.title = "nodes visited per ray";
@@ -136,12 +140,14 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
               count_of(rays.size(), "primary ray").c_str());
   // The motion is this lab's own: say so, and where the scene's own animation is measured instead.
   if (scene.animations.empty())
-    std::printf("motion: synthetic vertex motion (the scene itself is static)\n");
+    std::printf("motion: synthetic %s motion from the rest pose (frame 0; the scene itself is static)\n",
+                o.motion.c_str());
   else
     std::printf(
-        "motion: synthetic vertex motion; the scene's own %s %s not played here (`accelviz animate` plays %s)\n",
-        count_of(scene.animations.size(), "animation").c_str(), scene.animations.size() == 1 ? "is" : "are",
-        scene.animations.size() == 1 ? "it" : "them");
+        "motion: synthetic %s motion from the rest pose (frame 0); the scene's own %s %s not played here "
+        "(`accelviz animate` plays %s)\n",
+        o.motion.c_str(), count_of(scene.animations.size(), "animation").c_str(),
+        scene.animations.size() == 1 ? "is" : "are", scene.animations.size() == 1 ? "it" : "them");
   std::printf("%6s %8s %10s %10s %10s %10s %8s %12s %12s %8s\n", "frame", "refits", "refit ms", "build ms", "SAH refit",
               "SAH fresh", "ratio", "nodes refit", "nodes fresh", "rebuilt");
   for (const RefitFrame& f : r.frames)
@@ -155,10 +161,15 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
 Command add_refit_command(CLI::App& parent, const GlobalOptions& global) {
   auto o = std::make_shared<RefitCliOptions>();
   CLI::App* sub = parent.add_subcommand(
-      "refit", "Refit decay: BVH quality under smooth vertex motion, refitted frame by frame against fresh builds");
+      "refit", "Refit decay: BVH quality under a synthetic motion, refitted frame by frame against fresh builds");
   sub->add_option("SCENE", o->scene, "Scene file (.gltf, .glb, .obj) or builtin:NAME[?key=value&...]")->required();
   sub->add_option("--frames", o->frames, "Frames after the rest pose")->check(CLI::Range(1, 100000))->capture_default_str();
-  sub->add_option("--amplitude", o->amplitude, "Vertex motion amplitude, relative to the scene diagonal")
+  sub->add_option("--motion", o->motion,
+                  "explode: every triangle drifts rigidly on its own (the tree's grouping goes stale); wave: a "
+                  "smooth bend (neighbours move alike); jitter: every vertex on its own (the mesh crumples)")
+      ->check(CLI::IsMember({"explode", "wave", "jitter"}))
+      ->capture_default_str();
+  sub->add_option("--amplitude", o->amplitude, "Motion amplitude, relative to the scene diagonal")
       ->capture_default_str();
   sub->add_option("--frame-step", o->frame_step, "Time advance per frame, in motion periods")->capture_default_str();
   sub->add_option("--rebuild-ratio", o->rebuild_ratio,

@@ -27,9 +27,32 @@ glm::vec3 displace(const glm::vec3& p, float amplitude, double time, std::uint64
   const double z = 2.0 * unit(mix64(h + 1)) - 1.0, phi = 6.283185307179586 * unit(mix64(h + 2));
   const double phase = unit(mix64(h + 3));
   const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-  const double s = amplitude * std::sin(6.283185307179586 * (time + phase));
+  // Starts at the rest pose (0 at time 0), as far as 2 * amplitude half a period later, back at whole periods.
+  const double s = amplitude * (std::sin(6.283185307179586 * (time + phase)) - std::sin(6.283185307179586 * phase));
   return p + glm::vec3(static_cast<float>(s * r * std::cos(phi)), static_cast<float>(s * r * std::sin(phi)),
                        static_cast<float>(s * z));
+}
+
+/// Direction (unit) and phase of a triangle, hashed from its rest vertices.
+void triangle_motion(const Triangle& t, std::uint64_t seed, glm::dvec3& dir, double& phase) {
+  std::uint32_t bits[9];
+  std::memcpy(bits, &t.v0, 3 * sizeof(float));
+  std::memcpy(bits + 3, &t.v1, 3 * sizeof(float));
+  std::memcpy(bits + 6, &t.v2, 3 * sizeof(float));
+  std::uint64_t h = mix64(seed ^ kGolden64 ^ 0x9E3779B1u);
+  for (std::uint32_t b : bits) h = mix64(h ^ b);
+  const double z = 2.0 * unit(mix64(h + 1)) - 1.0, phi = 6.283185307179586 * unit(mix64(h + 2));
+  const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+  dir = glm::dvec3(r * std::cos(phi), r * std::sin(phi), z);
+  phase = unit(mix64(h + 3));
+}
+
+/// A seeded unit vector (the wave's direction and displacement).
+glm::dvec3 seeded_direction(std::uint64_t seed, std::uint64_t salt) {
+  const std::uint64_t h = mix64(seed ^ kGolden64 ^ salt);
+  const double z = 2.0 * unit(mix64(h + 1)) - 1.0, phi = 6.283185307179586 * unit(mix64(h + 2));
+  const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+  return {r * std::cos(phi), r * std::sin(phi), z};
 }
 
 void count(const Accelerator& accel, std::span<const Ray> rays, unsigned threads, double& nodes, double& prims) {
@@ -59,6 +82,56 @@ std::vector<Triangle> animate_vertices(std::span<const Triangle> rest, float amp
   return out;
 }
 
+std::string_view refit_motion_name(RefitMotion m) {
+  switch (m) {
+    case RefitMotion::jitter:
+      return "jitter";
+    case RefitMotion::explode:
+      return "explode";
+    case RefitMotion::wave:
+      return "wave";
+  }
+  return "?";
+}
+
+std::optional<RefitMotion> parse_refit_motion(std::string_view name) {
+  for (const RefitMotion m : {RefitMotion::jitter, RefitMotion::explode, RefitMotion::wave})
+    if (refit_motion_name(m) == name) return m;
+  return std::nullopt;
+}
+
+std::vector<Triangle> animate_triangles(std::span<const Triangle> rest, RefitMotion motion, float amplitude,
+                                        float diagonal, double time, std::uint64_t seed) {
+  constexpr double kTwoPi = 6.283185307179586;
+  if (motion == RefitMotion::jitter) return animate_vertices(rest, amplitude, time, seed);
+  std::vector<Triangle> out(rest.begin(), rest.end());
+  if (motion == RefitMotion::explode) {
+    for (Triangle& t : out) {
+      glm::dvec3 dir;
+      double phase = 0;
+      triangle_motion(t, seed, dir, phase);
+      const glm::vec3 d(dir * (amplitude * (std::sin(kTwoPi * (time + phase)) - std::sin(kTwoPi * phase))));
+      t.v0 += d;
+      t.v1 += d;
+      t.v2 += d;
+    }
+    return out;
+  }
+  // wave: one wavelength across the scene's diagonal.
+  const glm::dvec3 k = seeded_direction(seed, 1) / std::max(static_cast<double>(diagonal), 1e-30);
+  const glm::dvec3 u = seeded_direction(seed, 2);
+  const auto move = [&](glm::vec3& p) {
+    const double x = glm::dot(k, glm::dvec3(p));
+    p += glm::vec3(u * (amplitude * (std::sin(kTwoPi * (time + x)) - std::sin(kTwoPi * x))));
+  };
+  for (Triangle& t : out) {
+    move(t.v0);
+    move(t.v1);
+    move(t.v2);
+  }
+  return out;
+}
+
 RefitDecayResult run_refit_decay(std::span<const Triangle> rest, std::span<const Ray> rays,
                                  const RefitDecayOptions& opts, const FrameSource& source) {
   if (opts.frames < 1) throw std::invalid_argument("refit decay: frames must be at least 1");
@@ -77,8 +150,20 @@ RefitDecayResult run_refit_decay(std::span<const Triangle> rest, std::span<const
   auto tree = std::make_unique<Bvh>(current, bo);
   int refits = 0;
   RefitDecayResult result;
+  {  // frame 0: the rest pose the tree was built on, the baseline (refit = fresh build)
+    RefitFrame f;
+    f.rebuild_ms = tree->build_stats().build_ms;
+    f.sah_refit = f.sah_fresh = tree->build_stats().sah_cost;
+    f.ratio = 1.0;
+    count(*tree, rays, threads, f.nodes_per_ray_refit, f.prims_per_ray_refit);
+    f.nodes_per_ray_fresh = f.nodes_per_ray_refit;
+    f.prims_per_ray_fresh = f.prims_per_ray_refit;
+    result.frames.push_back(f);
+  }
   for (int k = 1; k <= opts.frames; ++k) {
-    current = source ? source(k) : animate_vertices(rest, amplitude, k * opts.frame_step, opts.seed);
+    current = source ? source(k)
+                     : animate_triangles(rest, opts.motion, amplitude, glm::length(box.extent()), k * opts.frame_step,
+                                         opts.seed);
     if (current.size() != rest.size()) throw std::invalid_argument("refit decay: frame changed the triangle count");
     RefitFrame f;
     f.frame = k;

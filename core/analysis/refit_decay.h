@@ -5,24 +5,49 @@
 // rebuild time, SAH of the refitted tree and of a fresh build, and the
 // measured traversal cost (nodes and triangle tests per ray) of both on a
 // fixed ray set.
-#include "core/accel/bvh/bvh.h"
-
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
+#include <string_view>
 #include <vector>
+
+#include "core/accel/bvh/bvh.h"
 
 namespace accelviz {
 
 /// Vertex positions at `time` (in periods): every vertex moves along its own
-/// seeded direction by amplitude · sin(2π(time + phase)), with the direction
-/// and phase hashed from its rest position, so vertices shared by several
-/// triangles move together and closed meshes stay closed.
+/// seeded direction by amplitude · (sin(2π(time + phase)) − sin(2π·phase)),
+/// with the direction and phase hashed from its rest position, so vertices
+/// shared by several triangles move together and closed meshes stay closed.
+/// Time 0 is the rest pose; a vertex is at most 2 · amplitude from it, and
+/// back at every whole period.
 std::vector<Triangle> animate_vertices(std::span<const Triangle> rest, float amplitude, double time,
                                        std::uint64_t seed);
 
+/// The synthetic motions of the refit experiment, each starting at the rest
+/// pose and back at every whole period:
+/// - jitter: animate_vertices (every vertex on its own: the mesh crumples, a
+///   fresh tree degrades almost as much as the refitted one);
+/// - explode: every triangle moves rigidly along its own seeded direction by
+///   amplitude · (sin(2π(time + phase)) − sin(2π·phase)), direction and phase
+///   hashed from its rest vertices (triangles keep their shape and drift apart
+///   and through each other: the tree's grouping goes stale, the classic decay);
+/// - wave: a smooth bend, every vertex displaced along one seeded direction by
+///   amplitude · (sin(2π(time + k·p)) − sin(2π k·p)) with k a seeded wave vector
+///   of one wavelength across the scene (neighbours move alike: refit holds).
+enum class RefitMotion { jitter, explode, wave };
+std::string_view refit_motion_name(RefitMotion m);  ///< "jitter", "explode", "wave"
+std::optional<RefitMotion> parse_refit_motion(std::string_view name);
+
+/// Triangles at `time` under `motion` (amplitude in scene units; `diagonal`
+/// is the scene's bounding-box diagonal, the wave's wavelength).
+std::vector<Triangle> animate_triangles(std::span<const Triangle> rest, RefitMotion motion, float amplitude,
+                                        float diagonal, double time, std::uint64_t seed);
+
 struct RefitDecayOptions {
   int frames = 30;                 ///< frames after the rest pose (>= 1)
+  RefitMotion motion = RefitMotion::explode;
   float amplitude = 0.02f;         ///< motion amplitude relative to the scene's bounding-box diagonal
   double frame_step = 0.05;        ///< time advance per frame, in motion periods
   double rebuild_ratio = 0;        ///< > 0: rebuild when refit SAH / fresh SAH exceeds it; 0: never
@@ -32,7 +57,7 @@ struct RefitDecayOptions {
 };
 
 struct RefitFrame {
-  int frame = 0;                 ///< 1-based
+  int frame = 0;                 ///< 0: the rest pose the first tree was built on (ratio 1), then 1, 2, ...
   double refit_ms = 0;           ///< refitting the tree in use
   double rebuild_ms = 0;         ///< the fresh build's own build time
   double sah_refit = 0;          ///< SAH of the refitted tree (before any rebuild this frame)
@@ -45,7 +70,7 @@ struct RefitFrame {
 };
 
 struct RefitDecayResult {
-  std::vector<RefitFrame> frames;
+  std::vector<RefitFrame> frames;  ///< frame 0 (the rest pose: no refit, rebuild_ms the first build's) and 1..frames
   int rebuilds = 0;
 };
 

@@ -122,7 +122,7 @@ for ids in "0,,1" "0," "x" "99999" "2-1"; do
 done
 # refit's motion is its own: it says so, for a static scene and for an animated one alike.
 "$accelviz" -q refit 'builtin:teapot?size=300' --frames 1 --size 16x12 -j 1 --out "$tmp/refit1" > "$tmp/refit1.txt"
-grep -q "motion: synthetic vertex motion (the scene itself is static)" "$tmp/refit1.txt" ||
+grep -q "motion: synthetic explode motion from the rest pose (frame 0; the scene itself is static)" "$tmp/refit1.txt" ||
   { echo "FAIL: refit on a static scene: $(cat "$tmp/refit1.txt")"; exit 1; }
 "$accelviz" -q refit 'builtin:dynamic?size=1200' --frames 1 --size 16x12 -j 1 --out "$tmp/refit2" > "$tmp/refit2.txt"
 grep -q "the scene's own [0-9]* animations* \(is\|are\) not played here" "$tmp/refit2.txt" ||
@@ -130,7 +130,11 @@ grep -q "the scene's own [0-9]* animations* \(is\|are\) not played here" "$tmp/r
 python3 -c '
 import json, sys
 j = json.load(open(sys.argv[1]))
-assert j["motion"] == "synthetic" and j["scene_animations"] > 0, j' "$tmp/refit2/refit.json"
+assert j["motion"] == "synthetic" and j["motion_kind"] == "explode" and j["scene_animations"] > 0, j
+# frame 0 is the rest pose the first tree was built on: refit and fresh alike
+f0 = j["per_frame"][0]
+assert f0["frame"] == 0 and f0["ratio"] == 1 and f0["sah_refit"] == f0["sah_fresh"], f0
+assert [f["frame"] for f in j["per_frame"]] == [0, 1], j["per_frame"]' "$tmp/refit2/refit.json"
 # The level a scene calls for: a note when the structure is of the other level (not with -q).
 "$accelviz" render 'builtin:forest?size=2000' --size 16x12 -j 1 --out "$tmp/lv1.png" 2> "$tmp/lv1.err" > /dev/null
 grep -q "note: builtin:forest?size=2000: .*\`-s tlas\` builds the two-level structure it calls for; bvh flattens" "$tmp/lv1.err" ||
