@@ -99,17 +99,39 @@ class JsonPrecheck final : public nlohmann::json_sax<nlohmann::json> {
     // tinygltf silently ignores a negative index, offset, length or count
     // (keeping its default 0), which would load other bytes than the file
     // names; reject them here (found by tests/core/test_malformed_files.cpp).
-    if (v < 0 && is_unsigned_key(last_key_)) {
+    if (v < 0 && is_unsigned_key(last_key_) && !in_extras()) {
       error = "invalid glTF: negative " + last_key_ + " (" + std::to_string(v) + ")";
       return false;
     }
     return value();
   }
-  bool number_unsigned(number_unsigned_t) override { return element(true) && value(); }
-  bool number_float(number_float_t, const string_t&) override { return element(true) && value(); }
+  bool number_unsigned(number_unsigned_t v) override {
+    if (!element(true)) return false;
+    // tinygltf keeps an index in an int: 2^32 wrapped to 0 (another mesh, node or accessor than the file names).
+    if (v > 0x7FFFFFFFu && is_index_key()) {
+      error = "invalid glTF: \"" + last_key_ + "\" " + std::to_string(v) + " is beyond any index (2^31 - 1)";
+      return false;
+    }
+    return value();
+  }
+  bool number_float(number_float_t, const string_t& text) override {
+    if (!element(true)) return false;
+    // tinygltf skips a fractional or float-typed index ("mesh": 0.0, "indices": 1.0): the node lost its mesh,
+    // the primitive its index buffer, with nothing said.
+    if (is_index_key()) {
+      error = "invalid glTF: \"" + last_key_ + "\" is " + text.substr(0, 40) +
+              ": an index is a whole number written without a point or exponent";
+      return false;
+    }
+    return value();
+  }
   bool binary(binary_t&) override { return element(false) && value(); }
   bool string(string_t& s) override {
     if (!element(false)) return false;
+    if (is_unsigned_key(last_key_) && !in_extras()) {
+      error = "invalid glTF: \"" + last_key_ + "\" is the string \"" + s.substr(0, 40) + "\", not a number";
+      return false;
+    }
     if (frames_.size() == 2 && frames_[1].array && frames_[0].key == "extensionsRequired") required.push_back(s);
     return value();
   }
@@ -134,6 +156,18 @@ class JsonPrecheck final : public nlohmann::json_sax<nlohmann::json> {
   }
 
  private:
+  /// Inside free-form "extras", where any key name may hold any value.
+  bool in_extras() const {
+    for (const Frame& f : frames_)
+      if (f.key == "extras") return true;
+    return false;
+  }
+  /// The value belongs to an index or enum (tinygltf's int fields): not a byte size or count, which it
+  /// reads as size_t and checks itself, and not inside "extras".
+  bool is_index_key() const {
+    const std::string& k = last_key_;
+    return is_unsigned_key(k) && k != "byteOffset" && k != "byteLength" && k != "count" && !in_extras();
+  }
   static bool is_unsigned_key(const std::string& k) {
     static const char* const keys[] = {
         "byteOffset", "byteLength", "byteStride", "count",    "buffer",    "bufferView", "componentType",

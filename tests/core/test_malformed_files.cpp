@@ -318,6 +318,27 @@ TEST_F(Malformed, NegativeAndHugeNodeIndices) {
   EXPECT_FALSE(gltf_error(write("r.gltf", gltf_text(d))).empty());
 }
 
+TEST_F(Malformed, IndicesThatAreNotWholeNumbersOrBeyondAnIntAreNamed) {
+  // tinygltf keeps an index in an int and skips a float or string one: "mesh": 4294967296 loaded mesh 0,
+  // "mesh": 0.0 dropped the node's mesh, "indices": 1.0 read the positions without their index buffer.
+  Doc big = triangle_doc();
+  big.j["nodes"][0]["mesh"] = 4294967296LL;
+  expect_gltf_error(write("big.gltf", gltf_text(big)), "\"mesh\" 4294967296 is beyond any index");
+  Doc point = triangle_doc();
+  point.j["nodes"][0]["mesh"] = 0.0;
+  expect_gltf_error(write("point.gltf", gltf_text(point)), "\"mesh\" is 0.0: an index is a whole number");
+  Doc pos = triangle_doc();
+  pos.j["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = 0.5;
+  expect_gltf_error(write("pos.gltf", gltf_text(pos)), "\"POSITION\" is 0.5");
+  Doc str = triangle_doc();
+  str.j["scenes"][0]["nodes"] = {"0"};
+  expect_gltf_error(write("str.gltf", gltf_text(str)), "\"nodes\" is the string \"0\", not a number");
+  // Free-form extras may use these names for anything.
+  Doc extras = triangle_doc();
+  extras.j["nodes"][0]["extras"] = {{"mesh", "a name"}, {"count", -1}, {"node", 2.5}, {"children", {"x"}}};
+  EXPECT_EQ(gltf_error(write("extras.gltf", gltf_text(extras))), "");
+}
+
 TEST_F(Malformed, GlbChunkTypeAndAlignment) {
   std::string bytes = glb(triangle_doc());
   std::string wrong_type = bytes;
