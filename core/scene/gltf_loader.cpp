@@ -373,6 +373,7 @@ class GltfConverter {
       : path_(path), model_(model), scene_(scene) {}
 
   void run() {
+    check_mesh_triangle_count();
     convert_meshes();
     convert_nodes();
     validate_forest();
@@ -1104,6 +1105,30 @@ class GltfConverter {
     const std::size_t more = w.size() - kMaxWarnings;
     w.resize(kMaxWarnings);
     w.push_back("... and " + std::to_string(more) + " more warnings");
+  }
+
+  /// Before any mesh is read: the triangles the primitives would unroll to,
+  /// from their accessors' counts. One accessor used by many primitives would
+  /// otherwise be copied that many times (a 12 MB file took 3 GB and more).
+  void check_mesh_triangle_count() const {
+    std::uint64_t total = 0;
+    for (const tinygltf::Mesh& gm : model_.meshes)
+      for (const tinygltf::Primitive& prim : gm.primitives) {
+        const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+        if (mode < TINYGLTF_MODE_TRIANGLES || mode > TINYGLTF_MODE_TRIANGLE_FAN) continue;
+        int accessor = prim.indices;
+        if (accessor < 0) {
+          const auto pos = prim.attributes.find("POSITION");
+          if (pos == prim.attributes.end()) continue;
+          accessor = pos->second;
+        }
+        if (accessor < 0 || static_cast<std::size_t>(accessor) >= model_.accessors.size()) continue;  // named later
+        const std::uint64_t n = model_.accessors[static_cast<std::size_t>(accessor)].count;
+        total += mode == TINYGLTF_MODE_TRIANGLES ? n / 3 : (n >= 3 ? n - 2 : 0);
+      }
+    if (total > kMaxWorldTriangles)
+      fail("the meshes' primitives declare " + std::to_string(total) +
+           " triangles (their accessors' counts), more than the limit of " + std::to_string(kMaxWorldTriangles));
   }
 
   void check_world_triangle_count() const {

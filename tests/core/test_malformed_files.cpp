@@ -339,6 +339,19 @@ TEST_F(Malformed, IndicesThatAreNotWholeNumbersOrBeyondAnIntAreNamed) {
   EXPECT_EQ(gltf_error(write("extras.gltf", gltf_text(extras))), "");
 }
 
+TEST_F(Malformed, PrimitivesSharingOneHugeAccessorAreRefusedBeforeAnyIsRead) {
+  // 300 primitives of one mesh on one accessor of 3M indices: 300M triangles from a 12 MB file took 3 GB
+  // before the world-triangle limit (which counts instances) could see them.
+  Doc d = triangle_doc();
+  d.j["accessors"][1]["count"] = 3'000'000;
+  const json prim = d.j["meshes"][0]["primitives"][0];
+  d.j["meshes"][0]["primitives"] = json::array();
+  for (int k = 0; k < 300; ++k) d.j["meshes"][0]["primitives"].push_back(prim);
+  expect_gltf_error(write("prims.glb", glb(d)),
+                    "the meshes' primitives declare 300000000 triangles (their accessors' counts), more than the "
+                    "limit of 268435456");
+}
+
 TEST_F(Malformed, GlbChunkTypeAndAlignment) {
   std::string bytes = glb(triangle_doc());
   std::string wrong_type = bytes;
