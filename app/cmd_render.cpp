@@ -192,7 +192,10 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
   }
   figures["device"] = o.device;
   for (const auto& [key, value] : gpu_figures.items()) figures[key] = value;
-  return colorize(img, co);
+  RgbImage rgb = colorize(img, co);
+  // All 0 because nothing was counted, not because nothing was visited: the image says so itself.
+  if (metric_needs_stats(metric) && !counters) draw_note(rgb, "n/a: " + accel->name() + " counts nothing per ray");
+  return rgb;
 }
 
 int run_render(const RenderOptions& o, const GlobalOptions& global) {

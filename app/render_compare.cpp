@@ -1,7 +1,9 @@
 #include "app/render_compare.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <sstream>
 
 #include "core/analysis/heatmap.h"
@@ -210,9 +212,23 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
   co.map = parse_colormap(job.colormap).value();
   co.max = locked;
   co.legend = parse_legend_placement(job.legend).value();
-  write_png(paths.a, colorize(images[0], co), job.force);
-  write_png(paths.b, colorize(images[1], co), job.force);
-  write_png(paths.diff, colorize_difference(diff, 0.0f, co.legend), job.force);
+  // A side without counters (Embree): its image is all 0 and no difference compares; the images say so.
+  RgbImage rgb[2] = {colorize(images[0], co), colorize(images[1], co)};
+  std::string uncounted;
+  for (int s = 0; s < 2; ++s)
+    if (!sides[s == 0 ? "a" : "b"]["per_ray_counters"].get<bool>()) {
+      uncounted = side[s]->structure;
+      draw_note(rgb[s], "n/a: " + uncounted + " counts nothing per ray");
+    }
+  MetricImage shown_diff = diff;
+  if (!uncounted.empty())  // no value anywhere: the background, not "B cheaper everywhere"
+    std::fill(shown_diff.values.begin(), shown_diff.values.end(), std::numeric_limits<float>::quiet_NaN());
+  RgbImage rgb_diff = colorize_difference(shown_diff, 0.0f, co.legend);
+  if (!uncounted.empty())
+    draw_note(rgb_diff, "n/a: " + uncounted + " counts nothing per ray, so no difference compares");
+  write_png(paths.a, rgb[0], job.force);
+  write_png(paths.b, rgb[1], job.force);
+  write_png(paths.diff, rgb_diff, job.force);
 
   nlohmann::json figures = sides;
   figures["scene"] = job.scene;
@@ -222,11 +238,11 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
   figures["scale_max"] = locked;
   figures["total_a"] = ab.total_a;
   figures["total_b"] = ab.total_b;
-  figures["total_diff"] = ab.total_b - ab.total_a;
   // A side without counters (Embree) has an image of zeros: no comparison of counts (null), not "B cheaper
   // everywhere"; no ratio of a total of 0 (that, or an empty view) either.
-  const bool counted = sides["a"]["per_ray_counters"].get<bool>() && sides["b"]["per_ray_counters"].get<bool>();
+  const bool counted = uncounted.empty();
   const auto if_counted = [&](const nlohmann::json& v) { return counted ? v : nlohmann::json(nullptr); };
+  figures["total_diff"] = if_counted(ab.total_b - ab.total_a);
   figures["ratio_b_over_a"] =
       ab.total_a > 0.0 ? if_counted(nlohmann::json(ab.total_b / ab.total_a)) : nlohmann::json(nullptr);
   figures["max_abs_diff"] = if_counted(ab.max_abs_diff);

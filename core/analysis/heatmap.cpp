@@ -449,6 +449,32 @@ void draw_text(RgbImage& img, int x, int y, std::string_view text, glm::u8vec3 c
   }
 }
 
+void draw_note(RgbImage& img, std::string_view text) {
+  if (img.width <= 0 || img.height <= 0) return;
+  const int s = img.width >= 480 ? 2 : 1, pad = 4 * s, line_h = (kGlyphRows + 2) * s;
+  const int room = std::max(1, (img.width - 2 * pad) / (kAdvance * s));  // characters per line
+  std::vector<std::string> lines(1);
+  std::size_t at = 0;
+  while (at < text.size()) {
+    std::size_t end = text.find(' ', at);
+    if (end == std::string_view::npos) end = text.size();
+    const std::string_view word = text.substr(at, end - at);
+    std::string& line = lines.back();
+    if (!line.empty() && static_cast<int>(line.size() + 1 + word.size()) > room) lines.emplace_back();
+    if (!lines.back().empty()) lines.back() += ' ';
+    lines.back() += word;
+    at = end + 1;
+  }
+  const int band = static_cast<int>(lines.size()) * line_h + 2 * pad;
+  const int y0 = std::max(0, (img.height - band) / 2);
+  fill_rect(img, 0, y0, img.width, std::min(band, img.height - y0), glm::u8vec3(24, 24, 24));
+  for (std::size_t k = 0; k < lines.size(); ++k) {
+    const int w = text_width(lines[k], s);
+    draw_text(img, std::max(pad, (img.width - w) / 2), y0 + pad + static_cast<int>(k) * line_h, lines[k],
+              glm::u8vec3(235, 235, 235), s);
+  }
+}
+
 std::string format_tick(double v) {
   if (v == 0.0 || !std::isfinite(v)) return "0";
   const double a = std::abs(v);

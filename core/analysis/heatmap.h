@@ -181,6 +181,11 @@ inline constexpr int kFontGlyphW = 5, kFontGlyphH = 7, kFontGlyphRows = 9, kFont
 int text_width(std::string_view text, int scale);
 void draw_text(RgbImage& img, int x, int y, std::string_view text, glm::u8vec3 color, int scale);
 
+/// A note across the middle of an image, in light text on a dark band, the
+/// words wrapped to the image's width: what an image cannot show ("n/a:
+/// embree counts nothing per ray" over its all-zero counter image).
+void draw_note(RgbImage& img, std::string_view text);
+
 /// A legend number: "0", "12", "0.25", "1.5k", "2.3M", "1e-05".
 std::string format_tick(double v);
 

@@ -82,7 +82,47 @@ for side in (a, b):
 assert j["total_a"] == 0 and j["ratio_b_over_a"] is None, j
 # No counts to compare: not "B cheaper everywhere".
 assert j["pixels_b_cheaper"] is None and j["pixels_b_dearer"] is None and j["max_abs_diff"] is None, j
+assert j["total_diff"] is None, j
 print("embree sides ok")
+PY
+  # bvh against embree: A's counts are real, B's all 0; no difference compares, and the images say so.
+  out=$("$accelviz" -q render "$scene" --size 160x120 --out "$tmp/eb.png" --compare 'structure=embree')
+  python3 - "$(sed -n 4p <<<"$out")" "$tmp/eb-diff.png" "$tmp/eb-b.png" "$tmp/eb-a.png" <<'PY'
+import json, sys, zlib
+j = json.loads(sys.argv[1])
+assert j["total_a"] > 0 and j["total_b"] == 0 and j["total_diff"] is None and j["max_abs_diff"] is None, j
+def rows(path):  # the pixel rows of an 8-bit RGB PNG, unfiltered
+    data = open(path, "rb").read()
+    chunks, i = [], 8
+    while i < len(data):
+        n = int.from_bytes(data[i:i + 4], "big")
+        if data[i + 4:i + 8] == b"IDAT":
+            chunks.append(data[i + 8:i + 8 + n])
+        i += 12 + n
+    raw, w = zlib.decompress(b"".join(chunks)), int.from_bytes(data[16:20], "big")
+    stride, out, prev = 3 * w, [], bytes(3 * w)
+    for r in range(len(raw) // (stride + 1)):
+        f, line = raw[r * (stride + 1)], bytearray(raw[r * (stride + 1) + 1:(r + 1) * (stride + 1)])
+        for x in range(stride):
+            a = line[x - 3] if x >= 3 else 0
+            b, c = prev[x], prev[x - 3] if x >= 3 else 0
+            if f == 1: line[x] = (line[x] + a) & 255
+            elif f == 2: line[x] = (line[x] + b) & 255
+            elif f == 3: line[x] = (line[x] + (a + b) // 2) & 255
+            elif f == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[x] = (line[x] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        out.append(bytes(line))
+        prev = line
+    return out
+def has_note(path):  # the dark band (24, 24, 24) across the middle with light text (235) in it
+    r = rows(path)
+    mid = r[len(r) // 2]
+    return mid.count(bytes([24, 24, 24])) > 40
+assert has_note(sys.argv[2]) and has_note(sys.argv[3]), "the diff and B images carry the n/a note"
+assert not has_note(sys.argv[4]), "A (bvh) has its counts, no note"
+print("bvh vs embree ok")
 PY
 fi
 
