@@ -13,10 +13,25 @@ BruteForce::BruteForce(std::span<const Triangle> triangles, const BruteForceOpti
     for (const Triangle& t : tris_) boxes_.push_back(t.bounds());
   }
   stats_.build_ms = ms_since(t0);
-  stats_.node_count = 0;
-  stats_.leaf_count = 1;
   stats_.memory_bytes = boxes_.size() * sizeof(Aabb);
-  stats_.sah_cost = static_cast<double>(tris_.size());  // every ray tests every primitive (C_isect = 1)
+  if (!opts_.bbox_early_out) {
+    stats_.node_count = 0;
+    stats_.leaf_count = 1;
+    stats_.sah_cost = static_cast<double>(tris_.size());  // every ray tests every primitive (C_isect = 1)
+  } else {
+    // A flat tree of one-triangle leaves: every ray tests every box (a node visit, C_trav = 1) and a
+    // triangle where it enters its box (C_isect = 1, with the box's share of the root's area).
+    Aabb root = Aabb::empty();
+    for (const Aabb& b : boxes_) root.extend(b);
+    double entered = 0.0;
+    const double root_area = root.surface_area();
+    for (const Aabb& b : boxes_) entered += root_area > 0.0 ? b.surface_area() / root_area : 1.0;
+    stats_.node_count = tris_.size();
+    stats_.leaf_count = tris_.size();
+    stats_.max_depth = 1;
+    stats_.avg_leaf_depth = 1.0;
+    stats_.sah_cost = static_cast<double>(tris_.size()) + entered;
+  }
 }
 
 Hit BruteForce::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, VisitTrace* trace) const {
@@ -26,7 +41,7 @@ Hit BruteForce::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* st
   for (std::size_t i = 0; i < tris_.size(); ++i) {
     if (opts_.bbox_early_out) {
       SlabInterval iv;
-      if (stats) ++stats->box_tests;
+      if (stats) ++stats->box_tests, ++stats->nodes_visited;  // a one-triangle leaf's box, as the trees count
       if (!intersect_slab(boxes_[i], ray.origin, ray.inv_dir, ray.tmin, tmax, iv)) continue;
     }
     if (stats) ++stats->prim_tests;
@@ -50,7 +65,7 @@ bool BruteForce::any_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats
   for (std::size_t i = 0; i < tris_.size(); ++i) {
     if (opts_.bbox_early_out) {
       SlabInterval iv;
-      if (stats) ++stats->box_tests;
+      if (stats) ++stats->box_tests, ++stats->nodes_visited;
       if (!intersect_slab(boxes_[i], ray, iv)) continue;
     }
     if (stats) ++stats->prim_tests;
