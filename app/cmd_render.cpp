@@ -51,6 +51,7 @@ struct RenderOptions {
   std::string view = "heatmap";
   RasterOptions raster;
   std::string ray_pixel;
+  std::string ray_camera;         ///< the camera --ray-pixel's ray is cast from ("": the view's, --camera)
   std::string device = "cpu";     ///< where the heatmap's rays are traced: cpu, gpu (compute shader, bvh only)
   std::optional<std::string> gl;  ///< --device gpu's context: auto (default: EGL on a GPU, else OSMesa), egl, osmesa
 };
@@ -86,6 +87,10 @@ int run_render_raster(const RenderOptions& o, const GlobalOptions& global) {
 
   RasterOptions ro = o.raster;
   if (!o.ray_pixel.empty()) ro.ray_pixel = parse_pixel(o.ray_pixel);
+  if (!o.ray_camera.empty()) {
+    if (o.ray_pixel.empty()) throw UsageError("--ray-camera needs --ray-pixel");
+    ro.ray_camera = camera_for(o.ray_camera, scene, size);  // seen from --camera: the ray's path, not a dot
+  }
   QueryOptions query;
   query.triangle_test = parse_triangle_test(o.triangle_test);
   nlohmann::json figures = {{"scene", o.scene},
@@ -222,8 +227,9 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
   if (o.view == "raster" && !raster_available()) throw UsageError(needs_renderer("--view raster"));
   if (o.view == "raster") return run_render_raster(o, global);
   if (o.raster.box_depth >= 0 || o.raster.box_depth_last >= 0 || o.raster.leaves || !o.ray_pixel.empty() ||
-      o.raster.blend > 0.0f || o.raster.wireframe)
-    throw UsageError("--depth, --depth-last, --leaves, --ray-pixel, --blend and --wireframe need --view raster");
+      !o.ray_camera.empty() || o.raster.blend > 0.0f || o.raster.wireframe)
+    throw UsageError(
+        "--depth, --depth-last, --leaves, --ray-pixel, --ray-camera, --blend and --wireframe need --view raster");
   nlohmann::json figures;
   const RgbImage rgb = render_job(o, global, figures);
   write_png(o.out, rgb, o.force);
@@ -317,6 +323,9 @@ Command add_render_command(CLI::App& parent, const GlobalOptions& global) {
   sub->add_option("--ray-pixel", o->ray_pixel,
                   "raster: draw the primary ray of pixel X,Y (row 0 at the top): its path, hit, normal, the boxes "
                   "it entered in order and the primitives it tested");
+  sub->add_option("--ray-camera", o->ray_camera,
+                  "raster: cast --ray-pixel's ray from this camera (as --camera reads it) while --camera shows the "
+                  "view: the ray's path from the side, not a dot where it leaves the eye");
   sub->add_option("--blend", o->raster.blend,
                   "raster: blend the --metric heatmap over the mesh with this opacity (0: none, 1: full screen)")
       ->check(finite_range(0.0, 1.0));

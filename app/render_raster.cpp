@@ -63,7 +63,7 @@ void render_raster(const Scene& scene, const Accelerator& accel, const Camera& c
     if (px < 0 || py < 0 || px >= size.width || py >= size.height)
       throw UsageError("--ray-pixel " + std::to_string(px) + "," + std::to_string(py) + " lies outside the " +
                        std::to_string(size.width) + "x" + std::to_string(size.height) + " image");
-    const Ray ray = primary_ray(camera, px, py, size.width, size.height);
+    const Ray ray = primary_ray(ro.ray_camera.value_or(camera), px, py, size.width, size.height);
     VisitTrace trace;
     RayStats stats;
     const Hit hit = accel.closest_hit(ray, query, &stats, &trace);
@@ -72,6 +72,8 @@ void render_raster(const Scene& scene, const Accelerator& accel, const Camera& c
     path.highlighted = tested_primitives(trace);
     renderer.set_ray_path(path);
     figures["ray"] = {{"pixel", {px, py}},
+                      {"origin", {ray.origin.x, ray.origin.y, ray.origin.z}},
+                      {"direction", {ray.direction.x, ray.direction.y, ray.direction.z}},
                       {"hit", hit.valid()},
                       {"prim", hit.valid() ? static_cast<long long>(hit.prim) : -1},
                       {"t", hit.valid() ? hit.t : -1.0f},

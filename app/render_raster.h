@@ -16,6 +16,7 @@ struct RasterOptions {
   int box_depth_last = -1;  ///< last depth (inclusive); -1: same as box_depth
   bool leaves = false;      ///< draw every leaf box instead of a depth
   std::optional<std::pair<int, int>> ray_pixel;  ///< pixel whose primary ray path is drawn
+  std::optional<Camera> ray_camera;              ///< the camera that ray is cast from (default: the view's)
   float blend = 0.0f;       ///< heatmap opacity over the mesh (0: no heatmap)
   bool wireframe = false;
 };

@@ -53,7 +53,25 @@ print("picked ray agrees with trace:", prim, t)
 PY
 
 # Usage errors: raster-only options without --view raster, boxes of a structure without any.
-for opt in "--depth 2" "--depth-last 3" "--leaves" "--ray-pixel 1,1" "--blend 0.5" "--wireframe"; do
+# --ray-camera: the ray of pixel 80,60 of that camera, drawn in --camera's view (the ray from the side,
+# not a dot where it leaves the eye): the same ray as that camera's own --ray-pixel.
+own=$("$accelviz" -q render "$scene" --view raster --ray-pixel 80,60 --size 160x120 --camera gltf:0 --out "$tmp/own.png" | sed -n 2p)
+side=$("$accelviz" -q render "$scene" --view raster --ray-pixel 80,60 --ray-camera gltf:0 --camera 12,5,-2,0,1,0,45 \
+  --size 160x120 --out "$tmp/side.png" | sed -n 2p)
+moved=$("$accelviz" -q render "$scene" --view raster --ray-pixel 80,60 --camera 12,5,-2,0,1,0,45 --size 160x120 \
+  --out "$tmp/moved.png" | sed -n 2p)
+python3 - "$own" "$side" "$moved" <<'PY'
+import json, sys
+own, side, moved = (json.loads(a)["ray"] for a in sys.argv[1:])
+assert own["origin"] == side["origin"] and own["direction"] == side["direction"] and own["prim"] == side["prim"], (own, side)
+assert moved["origin"] != own["origin"], "without --ray-camera the ray leaves --camera's eye"
+print("--ray-camera ok")
+PY
+if "$accelviz" -q render "$scene" --view raster --ray-camera gltf:0 --out "$tmp/rc.png" 2>"$tmp/err"; then
+  echo "FAIL: --ray-camera without --ray-pixel"; exit 1
+fi
+grep -q -- "--ray-camera needs --ray-pixel" "$tmp/err" || { echo "FAIL: --ray-camera message"; cat "$tmp/err"; exit 1; }
+for opt in "--depth 2" "--depth-last 3" "--leaves" "--ray-pixel 1,1" "--ray-camera gltf:0" "--blend 0.5" "--wireframe"; do
   # shellcheck disable=SC2086
   if "$accelviz" -q render "$scene" $opt --out "$tmp/x.png" 2>"$tmp/err"; then echo "FAIL: $opt without raster"; exit 1; fi
   grep -q "need --view raster" "$tmp/err" || { echo "FAIL: $opt message"; cat "$tmp/err"; exit 1; }

@@ -44,6 +44,7 @@ ScreenshotInfo test_info() {
   info.scale_min = 0.0f;
   info.scale_max = 39.0f;
   info.ray_pixel = std::make_pair(32, 24);
+  info.ray_camera = info.camera;  // clicked in the view shown
   return info;
 }
 
@@ -185,6 +186,42 @@ TEST(AppScreenshot, SideCarSaysHowToReproduceThePicture) {
   EXPECT_NE(std::find(script.begin(), script.end(), "click 32 24"), script.end());
   EXPECT_EQ(script.back(), "quit");
   EXPECT_TRUE(j["reproduce"]["notes"].empty());
+}
+
+// A ray clicked in one view and shown from another (the camera moved after
+// the click): the replay set the new camera and then clicked, casting another
+// ray (another triangle hit); it now clicks from the view of the click first,
+// and the raster command casts the ray from that camera (--ray-camera).
+TEST(AppScreenshot, ARayClickedInAnEarlierViewIsCastFromThatView) {
+  ScreenshotInfo info = test_info();
+  const Camera clicked_in = info.camera;
+  info.camera_spec = "12,3,-2,0,1,0,45";
+  info.camera = look_at({12, 3, -2}, {0, 1, 0}, 45.0f * 3.14159265f / 180.0f);
+  info.ray_camera = clicked_in;
+  const nlohmann::json j = screenshot_sidecar(info, "shot.png");
+  const std::string ray_spec = explicit_camera_spec(clicked_in);
+  EXPECT_EQ(j["ray_camera"], ray_spec);
+  EXPECT_NE(j["caption"].get<std::string>().find("ray of pixel 32,24 of an earlier view"), std::string::npos)
+      << j["caption"];
+  std::vector<std::string> script = j["reproduce"]["script"];
+  const auto at = [&](const std::string& line) {
+    return std::find(script.begin(), script.end(), line) - script.begin();
+  };
+  ASSERT_LT(at("click 32 24"), static_cast<long>(script.size()));
+  EXPECT_LT(at("camera " + ray_spec), at("click 32 24"));
+  EXPECT_GT(at("camera 12,3,-2,0,1,0,45"), at("click 32 24"));
+  const std::string raster = j["reproduce"]["render_raster"];
+  EXPECT_NE(raster.find("--ray-camera " + ray_spec), std::string::npos) << raster;
+  EXPECT_NE(raster.find("--camera 12,3,-2,0,1,0,45"), std::string::npos) << raster;
+  // The spec reproduces the camera's ray.
+  const Camera back = camera_from_spec(ray_spec, Scene{}, 4.0f / 3.0f);
+  const Ray a = primary_ray(clicked_in, 32, 24, 64, 48), b = primary_ray(back, 32, 24, 64, 48);
+  EXPECT_LT(glm::length(a.origin - b.origin), 1e-4f);
+  EXPECT_LT(glm::length(a.direction - b.direction), 1e-4f);
+  // Clicked in the view shown: no --ray-camera, the click after the camera as before.
+  const nlohmann::json same = screenshot_sidecar(test_info(), "shot.png");
+  EXPECT_TRUE(same["ray_camera"].is_null());
+  EXPECT_EQ(same["reproduce"]["render_raster"].get<std::string>().find("--ray-camera"), std::string::npos);
 }
 
 // The traversal's order and x-ray are render options: the commands carry

@@ -449,6 +449,7 @@ ScreenshotInfo AppState::screenshot_info(float scale_min, float scale_max) const
   info.scale_max = scale_max;
   if (inspection_) {
     info.ray_pixel = std::make_pair(inspection_->x, inspection_->y);
+    info.ray_camera = inspection_->camera;
     info.ray_steps = inspection_->trace.steps.size();
     if (replay_step_ + 1 < info.ray_steps) info.ray_step = replay_step_;
   }

@@ -148,6 +148,13 @@ ViewCamera ViewCamera::from_spec(const std::string& spec, const Scene& scene, fl
   return v;
 }
 
+std::string explicit_camera_spec(const Camera& cam) {
+  const glm::vec3 e = cam.position, t = cam.position + cam.forward;
+  std::string s;
+  for (float x : {e.x, e.y, e.z, t.x, t.y, t.z}) s += format_number(x) + ",";
+  return s + format_number(cam.yfov * 180.0 / 3.14159265358979);
+}
+
 std::string ViewCamera::spec() const {
   if (fixed && is_default) return "";
   if (fixed && scene_camera >= 0) return "gltf:" + std::to_string(scene_camera);

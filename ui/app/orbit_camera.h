@@ -80,4 +80,8 @@ struct ViewCamera {
   std::string spec() const;
 };
 
+/// "ex,ey,ez,tx,ty,tz,fov" for any camera (the target one unit along its
+/// view): a `--camera` value for a view that no longer is the window's.
+std::string explicit_camera_spec(const Camera& camera);
+
 }  // namespace accelviz

@@ -33,6 +33,7 @@ RayInspection inspect_pixel(const BuiltStructure& built, const Camera& camera, i
   like.y = y;
   like.width = width;
   like.height = height;
+  like.camera = camera;
   like.ray = primary_ray(camera, x, y, width, height);
   return inspect_ray(built, like, query);
 }
@@ -43,6 +44,7 @@ RayInspection inspect_ray(const BuiltStructure& built, const RayInspection& like
   r.y = like.y;
   r.width = like.width;
   r.height = like.height;
+  r.camera = like.camera;
   r.ray = like.ray;
   r.structure = built.accel->name();
   r.hit = built.accel->closest_hit(r.ray, query, &r.stats, &r.trace);

@@ -27,6 +27,7 @@ struct ShadowRay {
 struct RayInspection {
   int x = 0, y = 0;           ///< pixel, row 0 at the top
   int width = 0, height = 0;  ///< of the view it was cast in
+  Camera camera;              ///< the view's camera when it was cast (the window's may have moved since)
   std::string structure;      ///< Accelerator::name()
   Ray ray;
   Hit hit;

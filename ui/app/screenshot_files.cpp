@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "core/util/output_file.h"
+#include "ui/app/orbit_camera.h"
 
 namespace accelviz {
 namespace fs = std::filesystem;
@@ -148,6 +149,11 @@ RgbImage add_caption(const RgbImage& frame, const std::string& caption) {
   return out;
 }
 
+/// The shown ray was cast from another view than the one shown (the camera moved after the click).
+bool ray_from_another_view(const ScreenshotInfo& info) {
+  return info.ray_pixel && explicit_camera_spec(info.ray_camera) != explicit_camera_spec(info.camera);
+}
+
 std::string render_command(const ScreenshotInfo& info, bool raster, const std::string& out,
                            std::vector<std::string>* notes) {
   const AppConfig& c = info.config;
@@ -222,6 +228,7 @@ std::string render_command(const ScreenshotInfo& info, bool raster, const std::s
     if (v.heatmap == HeatmapDisplay::full_screen) cmd += " --blend 1";
     if (info.ray_pixel && v.show_ray_path) {
       cmd += " --ray-pixel " + std::to_string(info.ray_pixel->first) + "," + std::to_string(info.ray_pixel->second);
+      if (ray_from_another_view(info)) cmd += " --ray-camera " + shell_quote(explicit_camera_spec(info.ray_camera));
       if (notes && info.ray_step)
         notes->push_back("raster: --ray-pixel draws the whole traversal; the window showed its replay at step " +
                          std::to_string(*info.ray_step) + " of " + std::to_string(info.ray_steps) +
@@ -242,6 +249,7 @@ std::string screenshot_caption(const ScreenshotInfo& info) {
   if (info.boxes_by_visits) s += ", coloured by visits";
   if (info.ray_pixel && info.config.view.show_ray_path) {
     s += ", ray of pixel " + std::to_string(info.ray_pixel->first) + "," + std::to_string(info.ray_pixel->second);
+    if (ray_from_another_view(info)) s += " of an earlier view";
     if (info.ray_step) s += " at step " + std::to_string(*info.ray_step) + " of " + std::to_string(info.ray_steps);
   }
   return s;
@@ -271,10 +279,21 @@ nlohmann::json screenshot_sidecar(const ScreenshotInfo& info, const fs::path& pn
   std::vector<std::string> script = {"open " + info.scene,
                                      "size " + std::to_string(info.width) + " " + std::to_string(info.height)};
   for (const auto& [key, value] : option_values(c)) script.push_back("set " + key + " " + value);
-  if (!info.camera_spec.empty()) script.push_back("camera " + info.camera_spec);
-  script.push_back("wait");
-  if (info.ray_pixel)
-    script.push_back("click " + std::to_string(info.ray_pixel->first) + " " + std::to_string(info.ray_pixel->second));
+  const std::string click =
+      info.ray_pixel ? "click " + std::to_string(info.ray_pixel->first) + " " + std::to_string(info.ray_pixel->second)
+                     : std::string();
+  if (ray_from_another_view(info)) {
+    // The click first, from the view it was made in; then the view the picture shows.
+    script.push_back("camera " + explicit_camera_spec(info.ray_camera));
+    script.push_back("wait");
+    script.push_back(click);
+    script.push_back("camera " + (info.camera_spec.empty() ? explicit_camera_spec(info.camera) : info.camera_spec));
+    script.push_back("wait");
+  } else {
+    if (!info.camera_spec.empty()) script.push_back("camera " + info.camera_spec);
+    script.push_back("wait");
+    if (info.ray_pixel) script.push_back(click);
+  }
   if (info.ray_pixel && info.ray_step) script.push_back("step " + std::to_string(*info.ray_step));
   script.push_back("screenshot " + stem + "-replay.png");
   script.push_back("quit");
@@ -314,6 +333,8 @@ nlohmann::json screenshot_sidecar(const ScreenshotInfo& info, const fs::path& pn
       {"options", all_options},
       {"ray_pixel", info.ray_pixel ? nlohmann::json::array({info.ray_pixel->first, info.ray_pixel->second})
                                    : nlohmann::json(nullptr)},
+      {"ray_camera",
+       ray_from_another_view(info) ? nlohmann::json(explicit_camera_spec(info.ray_camera)) : nlohmann::json(nullptr)},
       {"reproduce",
        {{"render_heatmap", heatmap_cmd}, {"render_raster", raster_cmd}, {"notes", notes}, {"script", script}}},
   };

@@ -44,6 +44,7 @@ struct ScreenshotInfo {
   float scale_min = 0.0f;  ///< the heatmap range actually drawn
   float scale_max = 1.0f;
   std::optional<std::pair<int, int>> ray_pixel;  ///< the inspected pixel, when a ray is shown
+  Camera ray_camera;  ///< the camera that pixel's ray was cast from (the view may have moved since)
   /// The ray's replay when it stops before the traversal's end: the step
   /// shown (0-based) and the steps in all.
   std::optional<std::size_t> ray_step;
