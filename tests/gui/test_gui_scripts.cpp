@@ -279,6 +279,34 @@ TEST_F(GuiScript, DumpsNeverReplaceAFile) {
   EXPECT_FALSE(fs::exists(path("no")));
 }
 
+// A ray clicked in one view and shown from another: the screenshot's side-car
+// script casts the same ray again (it set the new camera first and clicked
+// there: another ray, another triangle).
+TEST_F(GuiScript, TheSideCarReplaysARayClickedInAnEarlierView) {
+  const RunResult r = run(std::string("open ") + kTeapot + "\nsize 320 240\ncamera " + kCamera +
+                          "\nwait\nclick 160 120\ndump-ray " + path("clicked.json").string() +
+                          "\ncamera 12,5,-2,0,1,0,45\nwait\nscreenshot " + path("side.png").string() + "\nquit\n");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json car = read_json(path("side.json"));
+  ASSERT_FALSE(car["ray_camera"].is_null()) << car.dump();
+  std::string replay;
+  for (const std::string line : car["reproduce"]["script"]) {
+    if (line.rfind("screenshot ", 0) == 0) {
+      replay += "dump-ray " + path("replayed.json").string() + "\n";
+      continue;
+    }
+    replay += line + "\n";
+  }
+  const RunResult again = run(replay);
+  ASSERT_EQ(again.code, 0) << again.err << "\n" << replay;
+  const nlohmann::json a = read_json(path("clicked.json")), b = read_json(path("replayed.json"));
+  EXPECT_EQ(a["hit"]["prim"], b["hit"]["prim"]);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(a["ray"]["origin"][k].get<double>(), b["ray"]["origin"][k].get<double>(), 1e-4);
+    EXPECT_NEAR(a["ray"]["direction"][k].get<double>(), b["ray"]["direction"][k].get<double>(), 1e-4);
+  }
+}
+
 TEST_F(GuiScript, ClickCastsThePixelRayAndReplaysItsTraversal) {
   const RunResult r = run(std::string("open ") + kTeapot + "\n" +
                           "size 640 480\n"
