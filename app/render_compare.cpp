@@ -213,7 +213,12 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
   co.max = locked;
   co.legend = parse_legend_placement(job.legend).value();
   // A side without counters (Embree): its image is all 0 and no difference compares; the images say so.
-  RgbImage rgb[2] = {colorize(images[0], co), colorize(images[1], co)};
+  ColorizeOptions side_co[2] = {co, co};  // which side each image is, on one shared scale
+  side_co[0].title_prefix = "A: ";
+  side_co[0].scale_note = "scale shared with B";
+  side_co[1].title_prefix = "B: ";
+  side_co[1].scale_note = "scale shared with A";
+  RgbImage rgb[2] = {colorize(images[0], side_co[0]), colorize(images[1], side_co[1])};
   std::string uncounted;
   for (int s = 0; s < 2; ++s)
     if (!sides[s == 0 ? "a" : "b"]["per_ray_counters"].get<bool>()) {

@@ -494,8 +494,19 @@ std::string format_tick(double v) {
 }
 
 std::vector<std::string> legend_labels(const std::vector<double>& ticks, bool above_top, bool below_bottom) {
+  // One unit for the thousands of one legend: "7.5k" beside "10k", not "7500".
+  bool kilo = false;
+  for (const double v : ticks) kilo = kilo || (std::abs(v) >= 1e4 && std::abs(v) < 999.5e3);
   std::vector<std::string> labels;
-  for (const double v : ticks) labels.push_back(format_tick(v));
+  for (const double v : ticks) {
+    if (kilo && std::abs(v) >= 999.5 && std::abs(v) < 1e4) {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%.3gk", v / 1e3);
+      labels.emplace_back(buf);
+    } else {
+      labels.push_back(format_tick(v));
+    }
+  }
   if (above_top && !labels.empty()) labels.back() += '+';
   if (below_bottom && !labels.empty()) labels.front().insert(0, "<=");
   return labels;
@@ -578,7 +589,17 @@ RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
 
   if (legend == LegendPlacement::bottom) {
     const int y0 = h;
-    const std::string title = std::string(metric_label(image.metric)) + (opts.max > 0.0f ? "  (fixed max)" : "");
+    // The longest title that fits: "fixed max" cut to "(fixed max" at 640 wide, "(fi" at 160.
+    const std::string note = !opts.scale_note.empty() ? "  (" + opts.scale_note + ")"
+                             : opts.max > 0.0f        ? std::string("  (fixed max)")
+                                                      : std::string();
+    const std::string label(metric_label(image.metric)), short_label(metric_short_label(image.metric));
+    std::string title = opts.title_prefix + short_label;
+    for (const std::string& t : {opts.title_prefix + label + note, opts.title_prefix + short_label + note})
+      if (text_width(t, s) <= out.width - 2 * pad) {
+        title = t;
+        break;
+      }
     draw_text(out, pad, y0 + pad, title, ink, s);
     const int margin = std::max(pad, widest / 2 + pad);
     const int xl = margin, xr = std::max(xl + 1, w - 1 - margin);
@@ -587,12 +608,22 @@ RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
       const float t = static_cast<float>(x - xl) / static_cast<float>(xr - xl);
       fill_rect(out, x, bar_y, 1, bar, to_rgb8(colormap(opts.map, t)));
     }
+    // Every tick marked; a number drawn where it keeps a glyph's gap from its neighbours: the ends
+    // always, an inner one only when it touches neither ("10k10.9k" at 640 wide before).
+    const auto label_x = [&](std::size_t k) {
+      const int x = xl + static_cast<int>(std::lround(static_cast<double>(xr - xl) * at(k)));
+      return std::clamp(x - text_width(labels[k], s) / 2, 0, std::max(0, out.width - text_width(labels[k], s)));
+    };
+    const std::size_t last = ticks.size() - 1;
+    int drawn_end = -1;  // right edge of the last number drawn
     for (std::size_t k = 0; k < ticks.size(); ++k) {
       const int x = xl + static_cast<int>(std::lround(static_cast<double>(xr - xl) * at(k)));
       fill_rect(out, x - (s - 1) / 2, bar_y + bar, s, tick, ink);
-      const int lw = text_width(labels[k], s);
-      const int lx = std::clamp(x - lw / 2, 0, std::max(0, out.width - lw));
+      const int lx = label_x(k), lw = text_width(labels[k], s), gap = kAdvance * s;
+      const bool inner = k > 0 && k < last;
+      if (inner && (lx < drawn_end + gap || lx + lw + gap > label_x(last))) continue;
       draw_text(out, lx, bar_y + bar + tick + s, labels[k], ink, s);
+      drawn_end = lx + lw;
     }
   } else if (legend == LegendPlacement::right) {
     const int x0 = w + pad;

@@ -149,6 +149,11 @@ struct ColorizeOptions {
   float max = 0.0f;  ///< top of the scale; <= 0: the image's own maximum
   LegendPlacement legend = LegendPlacement::bottom;
   glm::vec3 background{0.3f, 0.3f, 0.3f};  ///< pixels without a value (and the shaded metric's misses)
+  /// The bottom legend's title: title_prefix, the metric's label, then
+  /// "(fixed max)" for a fixed top or "(scale_note)" when given; shortened
+  /// (the short label, then no note) until it fits the image's width.
+  std::string title_prefix;  ///< e.g. "A: " for one side of an A/B pair
+  std::string scale_note;    ///< e.g. "scale shared with B"
 };
 
 /// The smallest and largest finite value of `image` (both 0 when it has none).

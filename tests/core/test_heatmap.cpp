@@ -275,6 +275,9 @@ TEST(Heatmap, TickFormatting) {
   EXPECT_EQ(legend_labels(V{5, 10, 20}, false, true), (S{"<=5", "10", "20"}));
   EXPECT_EQ(legend_labels(V{5, 10, 20}, true, true), (S{"<=5", "10", "20+"}));
   EXPECT_EQ(legend_labels(V{5}, true, true), S{"<=5+"});
+  // One unit for the thousands of a legend.
+  EXPECT_EQ(legend_labels(V{0, 2500, 5000, 7500, 10000, 10886}, false), (S{"0", "2.5k", "5k", "7.5k", "10k", "10.9k"}));
+  EXPECT_EQ(legend_labels(V{0, 2500, 5000}, false), (S{"0", "2500", "5000"}));
 }
 
 TEST(Heatmap, ValueRangeSkipsMissingValues) {
