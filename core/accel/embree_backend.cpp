@@ -318,13 +318,13 @@ std::string EmbreeAccelerator::ray_problem(const Ray& ray) const {
   else if (!long_enough_for_embree(ray.direction))
     return "cannot trace a ray whose direction " + vec_text(ray.direction) +
            " has no component of 1e-15 or more (Embree clamps 1/d at 1e18 in its box tests and would miss what "
-           "the ray hits; the other structures trace it)";
+           "the ray hits; accelviz's own structures trace it)";
   else if (!products_fit_embree(ray, impl_->reach))
     return "cannot trace a ray from " + vec_text(ray.origin) + " along " + vec_text(ray.direction) +
            " in this scene (vertex coordinates up to " + num_text(static_cast<float>(impl_->reach.coordinate)) +
            ", edge components up to " + num_text(static_cast<float>(impl_->reach.edge)) +
            "): Embree's float triangle test would overflow (products like |v0 - o|·|e1|·|e2| near FLT_MAX) and miss "
-           "what the ray hits; the other structures trace it";
+           "what the ray hits; accelviz's own structures trace it";
   else
     return {};
   if (why.ends_with("component")) why += " that is NaN or beyond ±1.844e18";

@@ -60,9 +60,16 @@ bool intersect_watertight(const Ray& ray, const WatertightRay& wr, const Triangl
   //    double from the same sheared float coordinates (the products are exact
   //    in double), as the paper prescribes.
   if (U == 0.0f || V == 0.0f || W == 0.0f) {
-    U = static_cast<float>(static_cast<double>(cx) * by - static_cast<double>(cy) * bx);
-    V = static_cast<float>(static_cast<double>(ax) * cy - static_cast<double>(ay) * cx);
-    W = static_cast<float>(static_cast<double>(bx) * ay - static_cast<double>(by) * ax);
+    const double Ud = static_cast<double>(cx) * by - static_cast<double>(cy) * bx;
+    const double Vd = static_cast<double>(ax) * cy - static_cast<double>(ay) * cx;
+    const double Wd = static_cast<double>(bx) * ay - static_cast<double>(by) * ax;
+    U = static_cast<float>(Ud);
+    V = static_cast<float>(Vd);
+    W = static_cast<float>(Wd);
+    // Below about 1e-22 the products underflow float altogether (1e-23 squared is under its smallest
+    // denormal): every edge function read 0, "degenerate", and a scene of 1e-23 was missed by every ray.
+    if ((U == 0.0f && Ud != 0.0) || (V == 0.0f && Vd != 0.0) || (W == 0.0f && Wd != 0.0))
+      return intersect_watertight_double(ray, wr, tri, tmin, tmax, hit);
   }
   // 6. Inside test, both windings (no backface culling).
   if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return false;
