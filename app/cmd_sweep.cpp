@@ -2,8 +2,10 @@
 // in time. Thin over core/analysis/sweep.h: parse, load, make the ray set,
 // run the sweep, then write sweep.csv, sweep.json and the charts, and print
 // the Pareto-optimal settings and the best setting for a few ray budgets.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -97,24 +99,29 @@ const Figure kFigures[] = {
 };
 
 /// (a) build time against trace time for the budget, Pareto front joined and labelled.
-RgbImage pareto_chart(const std::vector<SweepResult>& results, const std::vector<std::size_t>& front,
-                      double budget, const std::string& scene) {
-  ChartSeries all{"settings", {}, {}, {}, kPalette[0], false, true, 3};
-  ChartSeries pf{"pareto front", {}, {}, {}, kPalette[3], true, true, 4};
-  for (const SweepResult& r : results) {
-    all.x.push_back(r.build_ms);
-    all.y.push_back(r.trace_ms(budget));
+RgbImage pareto_chart(const std::vector<SweepResult>& results, const std::vector<std::size_t>& front, double budget,
+                      const std::string& scene, bool leaks) {
+  // With shared-edge probes the front is over build, trace and leaks: not a line in two dimensions, so
+  // its points are not joined, and each label says its leaks.
+  ChartSeries all{"other settings", {}, {}, {}, kPalette[0], false, true, 3};
+  ChartSeries pf{
+      leaks ? "pareto front (build, trace, leaks)" : "pareto front", {}, {}, {}, kPalette[3], !leaks, true, 4};
+  const auto label = [&](const SweepResult& r) {
+    return setting_label(r.setting) + (leaks ? " (" + count_of(r.edges.misses, "leak") + ")" : std::string());
+  };
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    if (std::find(front.begin(), front.end(), i) != front.end()) continue;
+    all.x.push_back(results[i].build_ms);
+    all.y.push_back(results[i].trace_ms(budget));
+    // Label the dominated points too when there are few, so every dot is identifiable.
+    if (results.size() <= 16) all.labels.push_back(label(results[i]));
   }
+  if (all.x.empty()) all.name.clear();  // every setting is on the front: no legend entry without points
   for (std::size_t i : front) {
     pf.x.push_back(results[i].build_ms);
     pf.y.push_back(results[i].trace_ms(budget));
-    pf.labels.push_back(setting_label(results[i].setting));
+    pf.labels.push_back(label(results[i]));
   }
-  // Label the dominated points too when there are few, so every dot is identifiable.
-  if (results.size() <= 16)
-    for (std::size_t i = 0; i < results.size(); ++i)
-      all.labels.push_back(std::find(front.begin(), front.end(), i) == front.end() ? setting_label(results[i].setting)
-                                                                                   : "");
   ChartOptions o;
   o.width = 800;
   o.height = 520;
@@ -152,8 +159,17 @@ RgbImage figure_chart(const std::vector<SweepResult>& results, const std::vector
     it->second.x.push_back(static_cast<double>(xi));
     it->second.y.push_back(fig.get(r, budget));
   }
+  // Values that are names (splitter, triangle test) have no order: their points are not joined.
+  const bool named = std::none_of(params[p].values.begin(), params[p].values.end(), [](const std::string& v) {
+    char* end = nullptr;
+    std::strtod(v.c_str(), &end);
+    return end != v.c_str() && *end == '\0';
+  });
   std::vector<ChartSeries> series;
-  for (const std::string& n : order) series.push_back(by_rest[n]);
+  for (const std::string& n : order) {
+    series.push_back(by_rest[n]);
+    if (named) series.back().lines = false;
+  }
   ChartOptions o;
   o.title = std::string(fig.title) + " vs " + params[p].name;
   o.x_label = params[p].name;
@@ -303,6 +319,8 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
     }
     j["best_for_budget"].push_back(e);
   }
+  const TimingScatter scatter = timing_scatter(results);
+  j["timing_scatter"] = {{"rays_per_s", scatter.rays_per_s}, {"build_ms", scatter.build_ms}};
   write_output_text(dir / "sweep.json", j.dump(2) + "\n");
 
   std::vector<std::string> charts;
@@ -310,7 +328,7 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
     write_png((dir / name).string(), img, true);
     charts.push_back(name);
   };
-  chart("sweep-pareto.png", pareto_chart(results, front, o.ray_budget, o.scene));
+  chart("sweep-pareto.png", pareto_chart(results, front, o.ray_budget, o.scene, !probes.empty()));
   for (std::size_t p = 0; p < params.size(); ++p)
     for (const Figure& f : kFigures) {
       if (f.key == std::string("sah_cost") && o.structure != "bvh" && o.structure != "kdtree" && o.structure != "octree")
@@ -372,6 +390,16 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
     }
     std::printf("\n");
   }
+  // Times are measurements: say how far one setting's own runs lie apart, and when other work shares the cores.
+  if (scatter.rays_per_s > 0.1 || scatter.build_ms > 0.1)
+    std::printf(
+        "note: one setting's own runs lie up to %.0f %% apart (rays/s) and %.0f %% (build): differences in "
+        "time below that are no ranking; SAH, nodes and tests per ray do not scatter\n",
+        100.0 * scatter.rays_per_s, 100.0 * scatter.build_ms);
+  // (The run's own threads count in the load: more than one above the hardware threads is others' work.)
+  if (const double load = load_average(); load > static_cast<double>(std::thread::hardware_concurrency()) + 1.0)
+    std::printf("note: load average %.2f on %u hardware threads: other work shared the cores while this was timed\n",
+                load, std::thread::hardware_concurrency());
   std::printf("wrote %s: sweep.csv, sweep.json and %zu charts\n", absolute_path(o.out).c_str(), charts.size());
   return 0;
 }

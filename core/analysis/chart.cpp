@@ -177,13 +177,6 @@ RgbImage draw_chart(const ChartOptions& opts, const std::vector<ChartSeries>& se
       prev_x = x;
       prev_y = y;
     }
-    for (std::size_t i = 0; i < s.x.size(); ++i) {
-      if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
-      const int x = px(s.x[i]), y = py(s.y[i]);
-      if (s.points)
-        for (int dy = -s.marker; dy <= s.marker; ++dy)
-          for (int dx = -s.marker; dx <= s.marker; ++dx) put(img, x + dx, y + dy, s.color);
-    }
   }
 
   // ---- legend, top right; the points' labels where they overlap nothing ----
@@ -236,6 +229,22 @@ RgbImage draw_chart(const ChartOptions& opts, const std::vector<ChartSeries>& se
                    static_cast<float>(bottom)};
   if (legend_rows > 0) layout.taken = std::span<const LabelRect>(&legend_box, 1);
   const std::vector<std::optional<LabelRect>> spots = place_point_labels(requests, layout, priority);
+  // Leaders first (from a point to its label's nearest corner: in a cluster, which label is whose), then
+  // the markers over them, then the labels.
+  for (std::size_t k = 0; k < spots.size(); ++k)
+    if (spots[k]) {
+      const LabelRect& b = *spots[k];
+      const float cx = requests[k].x < b.x0 ? b.x0 : b.x1, cy = requests[k].y < b.y0 ? b.y0 : b.y1;
+      line(img, static_cast<int>(requests[k].x), static_cast<int>(requests[k].y), static_cast<int>(cx),
+           static_cast<int>(cy), labelled[k].first->color);
+    }
+  for (const ChartSeries& s : series)
+    for (std::size_t i = 0; s.points && i < s.x.size(); ++i) {
+      if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
+      const int x = px(s.x[i]), y = py(s.y[i]);
+      for (int dy = -s.marker; dy <= s.marker; ++dy)
+        for (int dx = -s.marker; dx <= s.marker; ++dx) put(img, x + dx, y + dy, s.color);
+    }
   for (std::size_t k = 0; k < spots.size(); ++k)
     if (spots[k]) {
       const auto& [s, i] = labelled[k];

@@ -558,6 +558,20 @@ std::optional<std::size_t> best_without_leaks(std::span<const SweepResult> resul
   return best;
 }
 
+TimingScatter timing_scatter(std::span<const SweepResult> results) {
+  const auto spread = [](const std::vector<double>& runs) {
+    if (runs.size() < 2) return 0.0;
+    const auto [lo, hi] = std::minmax_element(runs.begin(), runs.end());
+    return *lo > 0.0 ? (*hi - *lo) / *lo : 0.0;
+  };
+  TimingScatter t;
+  for (const SweepResult& r : results) {
+    t.rays_per_s = std::max(t.rays_per_s, spread(r.rays_per_s_runs));
+    t.build_ms = std::max(t.build_ms, spread(r.build_ms_runs));
+  }
+  return t;
+}
+
 std::string sweep_csv(std::span<const SweepResult> results, double ray_budget) {
   std::ostringstream os;
   os.precision(10);

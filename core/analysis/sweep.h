@@ -242,6 +242,15 @@ std::size_t best_for_budget(std::span<const SweepResult> results, double rays);
 /// when no probe was made or every result leaks.
 std::optional<std::size_t> best_without_leaks(std::span<const SweepResult> results, double rays);
 
+/// How far one setting's timed runs lie apart, the largest over the settings:
+/// (max - min) / min of its rays/s passes and of its builds (0 with fewer than
+/// two runs). Time differences between settings below it are not a ranking;
+/// the tree figures (SAH, nodes and tests per ray) do not scatter.
+struct TimingScatter {
+  double rays_per_s = 0.0, build_ms = 0.0;
+};
+TimingScatter timing_scatter(std::span<const SweepResult> results);
+
 /// CSV with a header row: the swept parameters as columns, then the figures.
 std::string sweep_csv(std::span<const SweepResult> results, double ray_budget);
 

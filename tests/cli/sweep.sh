@@ -47,6 +47,8 @@ assert {b["rays"] for b in j["best_for_budget"]} >= {1e6, 1e9}, j["best_for_budg
 assert len(j["best_for_budget"]) == 2, j["best_for_budget"]  # the default budget 1e6 is listed once
 for b in j["best_for_budget"]:
     assert "edge_leaks" in b and "best_without_leaks" in b, b  # edges were probed
+# One repeat: no setting has two runs to lie apart.
+assert j["timing_scatter"] == {"rays_per_s": 0.0, "build_ms": 0.0}, j["timing_scatter"]
 for png in glob.glob(os.path.join(out, "*.png")):
     data = open(png, "rb").read()
     assert data[:8] == b"\x89PNG\r\n\x1a\n", png

@@ -57,7 +57,8 @@ TEST(Chart, CategoricalAxisAndEmptyChartDraw) {
 
 TEST(Chart, LabelsOfNearbyPointsDoNotCoverEachOther) {
   // Two points 0.4 apart (about 8 pixels): without placement B's label would
-  // be drawn over A's. A's pixels are the same whether B is drawn or not.
+  // be drawn over A's (a "WWWW" label is some 60 pixels). A's pixels are the same whether B is drawn or
+  // not, but for a pixel or two where B's leader line (point to label) crosses A's.
   const ChartSeries a{"", {0, 5, 10}, {0, 5, 10}, {"", "WWWW", ""}, {200, 0, 0}, false, true, 3};
   const ChartSeries b{"", {5.4}, {5}, {"WWWW"}, {0, 0, 200}, false, true, 3};
   ChartOptions o;
@@ -65,7 +66,7 @@ TEST(Chart, LabelsOfNearbyPointsDoNotCoverEachOther) {
   o.height = 200;
   const int alone = count_color(draw_chart(o, {a}), {200, 0, 0});
   const RgbImage both = draw_chart(o, {a, b});
-  EXPECT_EQ(count_color(both, {200, 0, 0}), alone);
+  EXPECT_GE(count_color(both, {200, 0, 0}), alone - 2);
   EXPECT_GT(count_color(both, {0, 0, 200}), 49);  // B's marker and its label, placed elsewhere
 }
 

@@ -450,5 +450,17 @@ TEST(Sweep, CsvHasAHeaderAndOneRowPerSetting) {
   EXPECT_NE(csv.find("\"buckets=4 leaf=2\""), std::string::npos);
 }
 
+TEST(Sweep, TimingScatterIsTheWidestSpreadOfOneSettingsOwnRuns) {
+  std::vector<SweepResult> r(3);
+  r[0].rays_per_s_runs = {100, 110, 105};  // 10 %
+  r[0].build_ms_runs = {2.0, 3.0};         // 50 %
+  r[1].rays_per_s_runs = {50, 75};         // 50 %
+  r[2].rays_per_s_runs = {7};              // one run: no spread
+  const TimingScatter t = timing_scatter(r);
+  EXPECT_DOUBLE_EQ(t.rays_per_s, 0.5);
+  EXPECT_DOUBLE_EQ(t.build_ms, 0.5);
+  EXPECT_DOUBLE_EQ(timing_scatter(std::vector<SweepResult>(2)).rays_per_s, 0.0);
+}
+
 }  // namespace
 }  // namespace accelviz::unity_test_sweep

@@ -169,7 +169,12 @@ int pareto_chart(const std::vector<SweepResult>& res, double budget, std::size_t
   layout.bounds = {plot.p0.x + 1.0f, plot.p0.y, plot.p1.x, plot.p1.y};
   const std::vector<std::optional<LabelRect>> spots = place_point_labels(requests, layout, priority);
   for (std::size_t i = 0; i < res.size(); ++i)
-    if (spots[i]) dl->AddText(ImVec2(spots[i]->x0, spots[i]->y0), kText, names[i].c_str());
+    if (spots[i]) {
+      const LabelRect& b = *spots[i];  // a leader to the label's nearest corner, as the PNG charts draw
+      const ImVec2 corner(screen[i].x < b.x0 ? b.x0 : b.x1, screen[i].y < b.y0 ? b.y0 : b.y1);
+      dl->AddLine(screen[i], corner, kText, 1.0f);
+      dl->AddText(ImVec2(b.x0, b.y0), kText, names[i].c_str());
+    }
   int hit = plot.hovered ? nearest(screen, 9.0f) : -1;
   if (hit >= 0) result_tooltip(res[static_cast<std::size_t>(hit)], budget);
   return plot.clicked ? hit : -1;
