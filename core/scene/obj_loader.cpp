@@ -193,7 +193,8 @@ ObjScan scan_obj(const std::string& path, const std::string& text) {
       for (std::size_t k = 1; k < tok.size(); ++k) {
         double value = 0;
         if (!parse_coordinate(tok[k], value))
-          fail(path, where + "vertex coordinate " + quoted(tok[k]) + " is not a number");
+          fail(path, where + "vertex coordinate " + quoted(tok[k]) + " is not a number" +
+                         (tok[k].starts_with('#') ? " (a comment starts its own line)" : ""));
         if (k <= 3) xyz[k - 1] = value;
       }
       if (!std::isfinite(xyz[0]) || !std::isfinite(xyz[1]) || !std::isfinite(xyz[2]))
@@ -221,7 +222,9 @@ ObjScan scan_obj(const std::string& path, const std::string& text) {
           }
         }
         long long v = 0, other = 0;
-        if (!parse_integer(parts[0], v)) fail(path, where + "malformed vertex reference " + quoted(ref));
+        if (!parse_integer(parts[0], v))
+          fail(path, where + "malformed vertex reference " + quoted(ref) +
+                         (ref.starts_with('#') ? " (a comment starts its own line)" : ""));
         // Only the texture slot of v//vn may be empty; "v/" and "v/vt/" are malformed.
         for (std::size_t p = 1; p < count; ++p) {
           if (parts[p].empty() && p == 1 && count == 3) continue;

@@ -432,6 +432,12 @@ TEST(Tlas, SingularTransformIsRefused) {
       << message();
   s.instances[0].transform[3][1] = std::numeric_limits<float>::quiet_NaN();  // it said "not invertible (determinant 1)"
   EXPECT_EQ(message(), "tlas: instance 0: its transform has a non-finite entry");
+  // A uniform scale whose float determinant overflows (1e13: 1e39) or underflows (1e-16: 1e-48) is no
+  // singular transform: both were refused as "singular (determinant inf / 0)".
+  for (const float scale : {1e13f, 1e-16f}) {
+    s.instances[0].transform = glm::scale(glm::mat4(1.0f), glm::vec3(scale));
+    EXPECT_EQ(message(), "(built)") << scale;
+  }
 }
 
 // A frame with one bad transform is refused whole: the instances stay where they were.

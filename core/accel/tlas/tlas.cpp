@@ -68,11 +68,16 @@ std::string transform_problem(const glm::mat4& to_world) {
   for (int c = 0; c < 4; ++c)
     for (int r = 0; r < 4; ++r)
       if (!std::isfinite(to_world[c][r])) return "its transform has a non-finite entry";
-  const float det = glm::determinant(glm::mat3(to_world));
-  if (!std::isfinite(det) || det == 0.0f)
-    return "its transform is singular (determinant " + std::to_string(det) +
+  // In double: a uniform scale of 1e13 (determinant 1e39) or 1e-16 (1e-48) is no singular transform,
+  // though its float determinant overflows or underflows.
+  const double det = glm::determinant(glm::dmat3(glm::mat3(to_world)));
+  if (!std::isfinite(det) || det == 0.0) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", det);
+    return std::string("its transform is singular (determinant ") + text +
            ": a scale of 0 flattens it), so rays cannot be carried into its space; the single-level "
            "structures (bvh, ...) take the scene";
+  }
   return {};
 }
 
