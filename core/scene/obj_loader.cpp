@@ -16,8 +16,9 @@
 //      or one that is not a regular file of at most 64 MiB, is only a
 //      warning;
 //   3. each shape becomes one Mesh with its own compacted vertices and an
-//      identity instance; polygons are fan-triangulated (v0, vi, vi+1), so a
-//      polygon of n vertices always gives n-2 triangles in file order;
+//      identity instance; convex polygons are fan-triangulated (v0, vi, vi+1),
+//      concave ones ear-clipped (core/geometry/polygon.h), so a polygon of n
+//      vertices always gives n-2 triangles, in file order;
 //   4. coordinates our scan read as NaN/inf are restored, so flatten() drops
 //      those triangles and counts them instead of placing them at the origin.
 #include <tiny_obj_loader.h>
@@ -37,6 +38,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/geometry/polygon.h"
 #include "core/scene/load.h"
 #include "core/util/file_checks.h"
 #include "core/util/one_line.h"
@@ -46,7 +48,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-[[noreturn]] void fail(const std::string& path, const std::string& problem) {
+[[noreturn]] void obj_fail(const std::string& path, const std::string& problem) {
   throw SceneError(path + ": " + first_line(problem));
 }
 
@@ -188,27 +190,28 @@ ObjScan scan_obj(const std::string& path, const std::string& text) {
 
     if (tok[0] == "v") {
       if (tok.size() < 4)
-        fail(path, where + "vertex has " + std::to_string(tok.size() - 1) + " coordinates (expected at least 3)");
+        obj_fail(path, where + "vertex has " + std::to_string(tok.size() - 1) + " coordinates (expected at least 3)");
       double xyz[3] = {0, 0, 0};
       for (std::size_t k = 1; k < tok.size(); ++k) {
         double value = 0;
         if (!parse_coordinate(tok[k], value))
-          fail(path, where + "vertex coordinate " + quoted(tok[k]) + " is not a number" +
-                         (tok[k].starts_with('#') ? " (a comment starts its own line)" : ""));
+          obj_fail(path, where + "vertex coordinate " + quoted(tok[k]) + " is not a number" +
+                             (tok[k].starts_with('#') ? " (a comment starts its own line)" : ""));
         if (k <= 3) xyz[k - 1] = value;
       }
       if (!std::isfinite(xyz[0]) || !std::isfinite(xyz[1]) || !std::isfinite(xyz[2]))
         scan.nonfinite.emplace_back(scan.vertex_count, glm::vec3(float(xyz[0]), float(xyz[1]), float(xyz[2])));
       ++scan.vertex_count;
-      if (scan.vertex_count > std::size_t(INT_MAX)) fail(path, where + "more than 2^31 vertices");
+      if (scan.vertex_count > std::size_t(INT_MAX)) obj_fail(path, where + "more than 2^31 vertices");
       return;
     }
 
     const bool face = tok[0] == "f";
     if (face || tok[0] == "l" || tok[0] == "p") {
       const std::size_t refs = tok.size() - 1;
-      if (face && refs < 3) fail(path, where + "face has " + std::to_string(refs) + " vertices (expected at least 3)");
-      if (!face && refs < 1) fail(path, where + "'" + std::string(tok[0]) + "' element has no vertices");
+      if (face && refs < 3)
+        obj_fail(path, where + "face has " + std::to_string(refs) + " vertices (expected at least 3)");
+      if (!face && refs < 1) obj_fail(path, where + "'" + std::string(tok[0]) + "' element has no vertices");
       for (std::size_t k = 1; k < tok.size(); ++k) {
         // v, v/vt, v//vn or v/vt/vn; only v is used, but all must be integers.
         const std::string_view ref = tok[k];
@@ -216,26 +219,26 @@ ObjScan scan_obj(const std::string& path, const std::string& text) {
         std::size_t count = 0, start = 0;
         for (std::size_t i = 0; i <= ref.size(); ++i) {
           if (i == ref.size() || ref[i] == '/') {
-            if (count == 3) fail(path, where + "malformed vertex reference " + quoted(ref));
+            if (count == 3) obj_fail(path, where + "malformed vertex reference " + quoted(ref));
             parts[count++] = ref.substr(start, i - start);
             start = i + 1;
           }
         }
         long long v = 0, other = 0;
         if (!parse_integer(parts[0], v))
-          fail(path, where + "malformed vertex reference " + quoted(ref) +
-                         (ref.starts_with('#') ? " (a comment starts its own line)" : ""));
+          obj_fail(path, where + "malformed vertex reference " + quoted(ref) +
+                             (ref.starts_with('#') ? " (a comment starts its own line)" : ""));
         // Only the texture slot of v//vn may be empty; "v/" and "v/vt/" are malformed.
         for (std::size_t p = 1; p < count; ++p) {
           if (parts[p].empty() && p == 1 && count == 3) continue;
-          if (!parse_integer(parts[p], other)) fail(path, where + "malformed vertex reference " + quoted(ref));
+          if (!parse_integer(parts[p], other)) obj_fail(path, where + "malformed vertex reference " + quoted(ref));
           if (other == 0)
-            fail(path, where + "texture/normal index 0 in " + quoted(ref) + " is invalid (OBJ indices start at 1)");
+            obj_fail(path, where + "texture/normal index 0 in " + quoted(ref) + " is invalid (OBJ indices start at 1)");
         }
-        if (v == 0) fail(path, where + "vertex index 0 is invalid (OBJ indices start at 1)");
+        if (v == 0) obj_fail(path, where + "vertex index 0 is invalid (OBJ indices start at 1)");
         if (v < 0 && -v > static_cast<long long>(scan.vertex_count))
-          fail(path, where + "relative vertex index " + std::to_string(v) + " is out of range (only " +
-                         std::to_string(scan.vertex_count) + " vertices so far)");
+          obj_fail(path, where + "relative vertex index " + std::to_string(v) + " is out of range (only " +
+                             std::to_string(scan.vertex_count) + " vertices so far)");
         if (v > max_forward) {
           max_forward = v;
           max_forward_line = line_number;
@@ -250,8 +253,8 @@ ObjScan scan_obj(const std::string& path, const std::string& text) {
     }
   });
   if (max_forward > static_cast<long long>(scan.vertex_count))
-    fail(path, "line " + std::to_string(max_forward_line) + ": vertex index " + std::to_string(max_forward) +
-                   " is out of range (the file has " + std::to_string(scan.vertex_count) + " vertices)");
+    obj_fail(path, "line " + std::to_string(max_forward_line) + ": vertex index " + std::to_string(max_forward) +
+                       " is out of range (the file has " + std::to_string(scan.vertex_count) + " vertices)");
   return scan;
 }
 
@@ -259,12 +262,12 @@ std::string read_text(const std::string& path) {
   std::uintmax_t size = 0;
   if (const std::string problem = input_file_problem(path, std::numeric_limits<std::uintmax_t>::max(), size);
       !problem.empty())
-    fail(path, problem);
+    obj_fail(path, problem);
   std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "cannot open for reading");
+  if (!in) obj_fail(path, "cannot open for reading");
   std::ostringstream ss;
   ss << in.rdbuf();
-  if (in.bad()) fail(path, "read error");
+  if (in.bad()) obj_fail(path, "read error");
   return std::move(ss).str();
 }
 
@@ -337,7 +340,7 @@ Scene load_obj(const std::string& path) {
   BoundedMaterialReader material_reader(base_dir + "/");
   const bool ok = tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &stream, &material_reader,
                                    /*triangulate=*/false, /*default_vcols_fallback=*/false);
-  if (!ok) fail(path, err.empty() ? "tinyobjloader failed" : err);
+  if (!ok) obj_fail(path, err.empty() ? "tinyobjloader failed" : err);
 
   Scene scene;
   scene.source = path;
@@ -351,8 +354,8 @@ Scene load_obj(const std::string& path) {
 
   std::vector<float>& v = attrib.vertices;
   if (v.size() != scan.vertex_count * 3)
-    fail(path, "tinyobjloader read " + std::to_string(v.size() / 3) + " vertices, the file has " +
-                   std::to_string(scan.vertex_count));
+    obj_fail(path, "tinyobjloader read " + std::to_string(v.size() / 3) + " vertices, the file has " +
+                       std::to_string(scan.vertex_count));
   // Step 4 (early, so that the meshes copy the right values).
   for (const auto& [index, xyz] : scan.nonfinite) {
     v[3 * index + 0] = xyz.x;
@@ -375,7 +378,7 @@ Scene load_obj(const std::string& path) {
     auto local = [&](const tinyobj::index_t& idx) -> std::uint32_t {
       const int g = idx.vertex_index;
       if (g < 0 || std::size_t(g) >= nv)  // the scan makes this unreachable; never index out of bounds
-        fail(path, "vertex index " + std::to_string(g + 1) + " is out of range in shape '" + shape.name + "'");
+        obj_fail(path, "vertex index " + std::to_string(g + 1) + " is out of range in shape '" + shape.name + "'");
       if (owner[std::size_t(g)] != mesh_id) {
         owner[std::size_t(g)] = mesh_id;
         slot[std::size_t(g)] = std::uint32_t(mesh.positions.size());
@@ -384,16 +387,20 @@ Scene load_obj(const std::string& path) {
       return slot[std::size_t(g)];
     };
     std::size_t offset = 0;
+    std::vector<std::uint32_t> face_ids;
+    std::vector<glm::vec3> face_corners;
     for (const unsigned int n : sm.num_face_vertices) {
-      if (offset + n > sm.indices.size()) fail(path, "tinyobjloader returned inconsistent face data");
+      if (offset + n > sm.indices.size()) obj_fail(path, "tinyobjloader returned inconsistent face data");
       if (n >= 3) {
-        const std::uint32_t first = local(sm.indices[offset]);
-        std::uint32_t prev = local(sm.indices[offset + 1]);
-        for (unsigned int k = 2; k < n; ++k) {
-          const std::uint32_t next = local(sm.indices[offset + k]);
-          mesh.indices.emplace_back(first, prev, next);
-          prev = next;
+        // A fan for convex faces, ear clipping for concave ones (core/geometry/polygon.h).
+        face_ids.clear();
+        face_corners.clear();
+        for (unsigned int k = 0; k < n; ++k) {
+          face_ids.push_back(local(sm.indices[offset + k]));
+          face_corners.push_back(mesh.positions[face_ids.back()]);
         }
+        for (const auto& [a, b, c] : triangulate_polygon(face_corners))
+          mesh.indices.emplace_back(face_ids[a], face_ids[b], face_ids[c]);
       }
       offset += n;
     }
@@ -410,7 +417,7 @@ Scene load_obj(const std::string& path) {
   }
 
   scene.flatten();
-  if (scene.triangles.empty()) fail(path, no_triangles_message(scene.report));
+  if (scene.triangles.empty()) obj_fail(path, no_triangles_message(scene.report));
   cap_warnings(scene.report);
   return scene;
 }

@@ -73,6 +73,30 @@ TEST_F(ObjLoader, PolygonsAreFanTriangulatedInFileOrder) {
   EXPECT_EQ(s.triangles.size(), 5u);
 }
 
+// A concave face (a U) is ear-clipped: its fan covered the notch between the
+// U's arms (6 triangles of area 11 for a polygon of area 7), so rays through
+// the notch hit; a self-intersecting outline still gets its n - 2 triangles.
+TEST_F(ObjLoader, ConcaveFacesAreEarClippedNotFanned) {
+  const Scene s =
+      load_obj(write("v 0 0 0\nv 3 0 0\nv 3 3 0\nv 2 3 0\nv 2 1 0\nv 1 1 0\nv 1 3 0\nv 0 3 0\n"
+                     "f 1 2 3 4 5 6 7 8\n"));
+  ASSERT_EQ(s.triangles.size(), 6u);
+  double area = 0.0;
+  const glm::vec3 notch(1.5f, 2.0f, 0.0f);
+  for (const Triangle& t : s.triangles) {
+    const glm::vec3 n = glm::cross(t.v1 - t.v0, t.v2 - t.v0);
+    area += 0.5 * glm::length(n);
+    EXPECT_GT(n.z, 0.0f) << "the face's winding";
+    // The notch point lies outside every triangle (same side of all three edges means inside).
+    const auto side = [&](const glm::vec3& a, const glm::vec3& b) { return glm::cross(b - a, notch - a).z > 0.0f; };
+    EXPECT_FALSE(side(t.v0, t.v1) && side(t.v1, t.v2) && side(t.v2, t.v0));
+  }
+  EXPECT_NEAR(area, 7.0, 1e-5);
+  // A bow tie (self-intersecting): no ear everywhere, still n - 2 triangles over its corners.
+  const Scene bow = load_obj(write("v 0 0 0\nv 2 2 0\nv 2 0 0\nv 0 2 0\nv 1 -1 0\nf 1 2 3 4 5\n", "bow.obj"));
+  EXPECT_EQ(bow.triangles.size(), 3u);
+}
+
 // tinyobjloader keeps a face's vertex count in an unsigned char: a face of
 // 256 or more vertices lost triangles (300 gave 42) and misread the faces
 // after it. Such faces are split before it reads them, into fans that make

@@ -1,0 +1,19 @@
+#pragma once
+// Triangulating one planar polygon (an OBJ face of four or more vertices).
+#include <array>
+#include <cstdint>
+#include <glm/vec3.hpp>
+#include <span>
+#include <vector>
+
+namespace accelviz {
+
+/// n − 2 triangles over the polygon's corners (indices into `corners`, in the
+/// polygon's winding). A convex polygon (or one with no usable plane) is
+/// fan-triangulated from its first corner: (0, k, k+1). A concave one is
+/// ear-clipped in the plane of its Newell normal, so no triangle covers area
+/// outside the polygon (a fan of a U shape covered its notch); where no ear is
+/// found (a self-intersecting outline) the rest is fanned.
+std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(std::span<const glm::vec3> corners);
+
+}  // namespace accelviz
