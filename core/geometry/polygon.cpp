@@ -50,26 +50,32 @@ std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(std::span<const gl
   }
   // Ear clipping: a corner whose triangle with its neighbours turns the polygon's way and holds no
   // other remaining corner.
+  // Walks around the ring from where the last ear was cut; a whole round without an ear (a
+  // self-intersecting outline) or a spent budget of corner checks (4 n^2: no face, however shaped,
+  // takes long) leaves the rest to the fan.
   std::vector<std::uint32_t> rest = order;
-  while (rest.size() > 3) {
+  std::size_t checks = 0, i = 0, since_ear = 0;
+  const std::size_t budget = 4 * n * n;
+  while (rest.size() > 3 && since_ear < rest.size() && checks < budget) {
     const std::size_t r = rest.size();
-    bool clipped = false;
-    for (std::size_t i = 0; i < r && !clipped; ++i) {
-      const std::uint32_t a = rest[(i + r - 1) % r], b = rest[i], c = rest[(i + 1) % r];
-      if (cross2(p[a], p[b], p[c]) <= 0.0) continue;  // reflex or flat: no ear
-      bool empty = true;
-      for (std::size_t k = 0; k < r && empty; ++k) {
-        const std::uint32_t q = rest[k];
-        if (q == a || q == b || q == c || p[q] == p[a] || p[q] == p[b] || p[q] == p[c]) continue;
-        empty =
-            !(cross2(p[a], p[b], p[q]) >= 0.0 && cross2(p[b], p[c], p[q]) >= 0.0 && cross2(p[c], p[a], p[q]) >= 0.0);
-      }
-      if (!empty) continue;
-      out.push_back({a, b, c});
-      rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(i));
-      clipped = true;
+    i %= r;
+    const std::uint32_t a = rest[(i + r - 1) % r], b = rest[i], c = rest[(i + 1) % r];
+    bool ear = cross2(p[a], p[b], p[c]) > 0.0;  // reflex or flat: no ear
+    for (std::size_t k = 0; k < r && ear; ++k) {
+      ++checks;
+      const std::uint32_t q = rest[k];
+      if (q == a || q == b || q == c || p[q] == p[a] || p[q] == p[b] || p[q] == p[c]) continue;
+      ear = !(cross2(p[a], p[b], p[q]) >= 0.0 && cross2(p[b], p[c], p[q]) >= 0.0 && cross2(p[c], p[a], p[q]) >= 0.0);
     }
-    if (!clipped) break;  // no ear: a self-intersecting outline
+    if (!ear) {
+      ++i;
+      ++since_ear;
+      continue;
+    }
+    out.push_back({a, b, c});
+    rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(i));
+    since_ear = 0;
+    if (i > 0) --i;  // the previous corner may have become an ear
   }
   fan(rest, out);
   return out;
