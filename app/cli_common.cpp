@@ -343,6 +343,31 @@ std::string format_bytes(std::uint64_t bytes) {
   return buf;
 }
 
+void parse_scale_top(const std::string& text, float& value, double& percentile) {
+  const bool pct = !text.empty() && (text[0] == 'p' || text[0] == 'P');
+  const std::string number = pct ? text.substr(1) : text;
+  char* end = nullptr;
+  const double v = std::strtod(number.c_str(), &end);
+  const bool whole = !number.empty() && end == number.c_str() + number.size() && std::isfinite(v);
+  if (pct) {
+    if (!whole || !(v > 0.0 && v <= 100.0))
+      throw UsageError("--max " + text + ": a percentile is p followed by a number above 0 and at most 100 (p99)");
+    percentile = v;
+    value = 0.0f;
+    return;
+  }
+  if (!whole || !(v > 0.0) || v > 3.4e38)
+    throw UsageError("--max " + text + ": expected a finite number above 0, or pNN for a percentile (p99)");
+  value = static_cast<float>(v);
+  percentile = 0.0;
+}
+
+std::string format_number_short(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
 std::vector<CommandFactory>& registered_commands() {
   static std::vector<CommandFactory> commands;  // function-local: safe from static initialisation order
   return commands;

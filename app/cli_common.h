@@ -56,6 +56,12 @@ class UsageError : public std::runtime_error {
 
 // ---- values ------------------------------------------------------------------
 
+/// --max's text: a finite value > 0 (into `value`) or "pNN" with 0 < NN <= 100 (into `percentile`); a
+/// UsageError naming the text otherwise.
+void parse_scale_top(const std::string& text, float& value, double& percentile);
+/// "99", "99.5": a number as short as it reads.
+std::string format_number_short(double v);
+
 /// parse_image_size (core/util/image_size.h), or a UsageError naming the text.
 ImageSize parse_size(const std::string& text);
 /// CLI11 validator for parse_size.

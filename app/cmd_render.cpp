@@ -40,7 +40,9 @@ struct RenderOptions {
   std::string size = "800x600";
   std::string colormap = "viridis";
   std::string legend = "bottom";
-  float max = 0.0f;
+  std::string max_text;         ///< --max: "M" (a value) or "pNN" (the NNth percentile of the image's values)
+  float max = 0.0f;             ///< parsed from max_text: a fixed top (0: none)
+  double max_percentile = 0.0;  ///< parsed from max_text: the top at this percentile (0: none)
   unsigned threads = 0;
   std::string triangle_test = "watertight";
   bool force = false;
@@ -161,6 +163,11 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
   ColorizeOptions co;
   co.map = parse_colormap(o.colormap).value();
   co.max = o.max;
+  if (o.max_percentile > 0.0) {  // --max pNN: the top where NN % of the pixels' values lie below
+    const MetricImage* images[] = {&img};
+    co.max = metric_percentile(images, o.max_percentile);
+    co.scale_note = "top: " + format_number_short(o.max_percentile) + "th percentile";
+  }
   co.legend = parse_legend_placement(o.legend).value();
 
   figures = {
@@ -178,7 +185,7 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
       {"rays_per_s", fig.rays_per_s},
       {"mean", fig.mean},
       {"max", fig.max},
-      {"scale_max", heatmap_scale_max(img, o.max)},
+      {"scale_max", heatmap_scale_max(img, co.max)},
       {"colormap", o.colormap},
       {"camera",
        {{"eye", {camera.position.x, camera.position.y, camera.position.z}},
@@ -203,7 +210,9 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
   return rgb;
 }
 
-int run_render(const RenderOptions& o, const GlobalOptions& global) {
+int run_render(const RenderOptions& given, const GlobalOptions& global) {
+  RenderOptions o = given;
+  if (!o.max_text.empty()) parse_scale_top(o.max_text, o.max, o.max_percentile);
   if (const std::string problem = png_name_problem(o.out); !problem.empty()) throw UsageError(problem);
   if (o.gl && o.device != "gpu") throw UsageError("--gl needs --device gpu");
   if (o.device == "gpu") {
@@ -219,12 +228,15 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
   if (o.compare) {
     if (o.view != "heatmap") throw UsageError("--compare needs --view heatmap");
     CompareJob job{o.scene, o.camera, o.size, o.metric, o.colormap, o.legend, o.max, o.threads, o.out, o.force, {}, {}};
+    job.max_percentile = o.max_percentile;
     job.a = compare_side(o);
     job.b = parse_compare_spec(*o.compare, job.a);
     return run_render_compare(job, global);
   }
   check_output_path(o.out, o.force);  // before any long work
   if (o.view == "raster" && !raster_available()) throw UsageError(needs_renderer("--view raster"));
+  if (o.view == "raster" && o.max_percentile > 0.0)
+    throw UsageError("--max " + o.max_text + ": a percentile top is for the heatmap view; give --view raster a value");
   if (o.view == "raster") return run_render_raster(o, global);
   if (o.raster.box_depth >= 0 || o.raster.box_depth_last >= 0 || o.raster.leaves || !o.ray_pixel.empty() ||
       !o.ray_camera.empty() || o.raster.blend > 0.0f || o.raster.wireframe)
@@ -290,8 +302,10 @@ Command add_render_command(CLI::App& parent, const GlobalOptions& global) {
   sub->add_option("--colormap", o->colormap, "Colour map: viridis, inferno, turbo")
       ->check(CLI::IsMember({"viridis", "inferno", "turbo"}))
       ->capture_default_str();
-  sub->add_option("--max", o->max, "Top of the colour scale (default: the image's maximum); values above are clamped")
-      ->check(finite_positive());
+  sub->add_option("--max", o->max_text,
+                  "Top of the colour scale: a value, or pNN for the NNth percentile of the image's values (p99: a "
+                  "few outliers do not set it); default: the image's maximum; values above are clamped")
+      ->option_text("M|pNN");
   sub->add_option("--legend", o->legend, "Legend bar placement: bottom, right, none")
       ->check(CLI::IsMember({"bottom", "right", "none"}))
       ->capture_default_str();

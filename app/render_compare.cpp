@@ -207,7 +207,10 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
   }
   ABFigures ab;
   const MetricImage diff = difference_image(images[0], images[1], &ab);
-  const float locked = locked_scale_max(images[0], images[1], job.max);
+  const MetricImage* both[] = {&images[0], &images[1]};
+  const float locked = job.max_percentile > 0.0
+                           ? heatmap_scale_max(ValueRange{0.0f, metric_percentile(both, job.max_percentile)}, 0.0f)
+                           : locked_scale_max(images[0], images[1], job.max);
   ColorizeOptions co;
   co.map = parse_colormap(job.colormap).value();
   co.max = locked;

@@ -59,6 +59,7 @@ struct CompareJob {
   std::string out;
   bool force = false;
   CompareSide a, b;
+  double max_percentile = 0.0;  ///< > 0: the shared top at this percentile of both images' values
 };
 
 /// Runs the comparison: prints the three paths, then one JSON line with both

@@ -300,6 +300,19 @@ float heatmap_scale_max(const ValueRange& values, float fixed_max) {
   return values.max > 0.0f ? values.max : 1.0f;
 }
 
+float metric_percentile(std::span<const MetricImage* const> images, double percent) {
+  std::vector<float> values;
+  for (const MetricImage* img : images)
+    for (const float v : img->values)
+      if (std::isfinite(v)) values.push_back(v);
+  if (values.empty()) return 0.0f;
+  const double p = std::clamp(percent, 0.0, 100.0) / 100.0;
+  const std::size_t rank = std::min(
+      values.size() - 1, static_cast<std::size_t>(std::ceil(p * static_cast<double>(values.size()))) - (p > 0.0));
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(rank), values.end());
+  return values[rank];
+}
+
 float heatmap_scale_max(const MetricImage& image, float fixed_max) {
   if (fixed_max > 0.0f && std::isfinite(fixed_max)) return fixed_max;
   return heatmap_scale_max(metric_value_range(image), fixed_max);

@@ -162,6 +162,11 @@ struct ValueRange {
 };
 ValueRange metric_value_range(const MetricImage& image);
 
+/// The value below which `percent` % of the images' finite values lie (the
+/// nearest rank; 0 when they have none): a colour scale's top that a few
+/// outliers (a silhouette's grazing rays) do not set, `render --max p99`.
+float metric_percentile(std::span<const MetricImage* const> images, double percent);
+
 /// Top of the colour scale for `image`: `fixed_max` when > 0, else the image's
 /// maximum; never 0 (an all-zero image uses 1) so the scale stays defined.
 float heatmap_scale_max(const MetricImage& image, float fixed_max);

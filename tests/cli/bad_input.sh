@@ -59,7 +59,9 @@ expect 2 "--threads" -- render 'builtin:soup?size=10' --out "$tmp/y.png" -j 4294
 # (CLI11's own checks let nan through and printed 0.000000 to 1797693...).
 expect 2 "--ctrav: must be a finite number > 0, got nan" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --ctrav nan
 expect 2 "--cisect: must be a finite number > 0, got 1e308" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --cisect 1e308
-expect 2 "--max: must be a finite number > 0, got nan" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --max nan
+expect 2 "--max nan: expected a finite number above 0, or pNN for a percentile (p99)" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --max nan
+expect 2 "--max p0: a percentile is p followed by a number above 0 and at most 100" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --max p0
+expect 2 "--max p99: a percentile top is for the heatmap view" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --max p99 --view raster
 expect 2 "--blend: must be a number from 0 to 1, got nan" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --view raster --blend nan
 expect 2 "--structure: 'bvh' is listed twice" -- bench 'builtin:soup?size=10' -s bvh,bvh -n 1 --size 4x4
 expect 2 "--ray-budget: must be a finite number > 0, got inf" -- sweep 'builtin:soup?size=10' -p leaf=2 --ray-budget inf --out "$tmp/swb"

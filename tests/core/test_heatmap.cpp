@@ -135,6 +135,27 @@ TEST(Heatmap, BruteForceWithBoxesCountsEveryBoxAsANodeVisit) {
   EXPECT_EQ(plain.build_stats().sah_cost, static_cast<double>(tris.size()));
 }
 
+TEST(Heatmap, PercentileOfTheImagesFiniteValues) {
+  MetricImage a, b;
+  a.width = 5;
+  a.height = 1;
+  a.values = {1, 2, 3, 4, std::numeric_limits<float>::quiet_NaN()};  // misses do not count
+  b.width = 6;
+  b.height = 1;
+  b.values = {5, 6, 7, 8, 9, 100};
+  const MetricImage* one[] = {&a};
+  const MetricImage* two[] = {&a, &b};
+  EXPECT_EQ(metric_percentile(one, 100.0), 4.0f);
+  EXPECT_EQ(metric_percentile(one, 50.0), 2.0f);  // nearest rank: ceil(0.5 * 4) = 2nd
+  EXPECT_EQ(metric_percentile(two, 90.0), 9.0f);  // 10 values: the 9th; the outlier 100 is the 10th
+  EXPECT_EQ(metric_percentile(two, 100.0), 100.0f);
+  EXPECT_EQ(metric_percentile(two, 1.0), 1.0f);
+  MetricImage none;
+  none.values = {std::numeric_limits<float>::quiet_NaN()};
+  const MetricImage* empty[] = {&none};
+  EXPECT_EQ(metric_percentile(empty, 99.0), 0.0f);
+}
+
 TEST(Heatmap, PngHasTheColourTheMapGives) {
   const std::vector<Triangle> tris = tiny_scene();
   const BruteForce accel(tris, BruteForceOptions{.bbox_early_out = true});
