@@ -1,58 +1,53 @@
 // Refit decay experiment (see refit_decay.h).
 #include "core/analysis/refit_decay.h"
 
-#include "core/query/batch.h"
-#include "core/util/parallel.h"
-#include "core/util/random.h"
-#include "core/util/timing.h"
-
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
 
+#include "core/query/batch.h"
+#include "core/util/parallel.h"
+#include "core/util/random.h"
+#include "core/util/timing.h"
+
 namespace accelviz {
 
 namespace {
 
+constexpr double kTwoPi = 6.283185307179586;
 
 double unit(std::uint64_t h) { return static_cast<double>(h >> 11) * 0x1.0p-53; }
 
-/// Motion of the vertex at rest position p: a unit direction and a phase, from its bits.
+/// The seed, salted, then the bits of `floats`, mixed: the same draw for the same rest geometry.
+std::uint64_t hash_of(std::span<const float> floats, std::uint64_t seed, std::uint64_t salt) {
+  std::uint64_t h = mix64(seed ^ kGolden64 ^ salt);
+  for (const float f : floats) h = mix64(h ^ std::bit_cast<std::uint32_t>(f));
+  return h;
+}
+
+/// A unit direction, uniform on the sphere, and a phase in [0, 1), from a hash.
+struct Draw {
+  glm::dvec3 dir;
+  double phase = 0.0;
+};
+Draw draw(std::uint64_t h) {
+  const double z = 2.0 * unit(mix64(h + 1)) - 1.0, phi = kTwoPi * unit(mix64(h + 2));
+  const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+  return {{r * std::cos(phi), r * std::sin(phi), z}, unit(mix64(h + 3))};
+}
+
+/// The swing of every motion: 0 at time 0 (the rest pose), at most 2 · amplitude half a period later,
+/// back at whole periods.
+double swing(double amplitude, double time, double phase) {
+  return amplitude * (std::sin(kTwoPi * (time + phase)) - std::sin(kTwoPi * phase));
+}
+
+/// The vertex at rest position p moved along its own direction (jitter).
 glm::vec3 displace(const glm::vec3& p, float amplitude, double time, std::uint64_t seed) {
-  std::uint32_t bits[3];
-  std::memcpy(bits, &p, sizeof bits);
-  std::uint64_t h = mix64(seed ^ kGolden64);
-  for (std::uint32_t b : bits) h = mix64(h ^ b);
-  const double z = 2.0 * unit(mix64(h + 1)) - 1.0, phi = 6.283185307179586 * unit(mix64(h + 2));
-  const double phase = unit(mix64(h + 3));
-  const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-  // Starts at the rest pose (0 at time 0), as far as 2 * amplitude half a period later, back at whole periods.
-  const double s = amplitude * (std::sin(6.283185307179586 * (time + phase)) - std::sin(6.283185307179586 * phase));
-  return p + glm::vec3(static_cast<float>(s * r * std::cos(phi)), static_cast<float>(s * r * std::sin(phi)),
-                       static_cast<float>(s * z));
-}
-
-/// Direction (unit) and phase of a triangle, hashed from its rest vertices.
-void triangle_motion(const Triangle& t, std::uint64_t seed, glm::dvec3& dir, double& phase) {
-  std::uint32_t bits[9];
-  std::memcpy(bits, &t.v0, 3 * sizeof(float));
-  std::memcpy(bits + 3, &t.v1, 3 * sizeof(float));
-  std::memcpy(bits + 6, &t.v2, 3 * sizeof(float));
-  std::uint64_t h = mix64(seed ^ kGolden64 ^ 0x9E3779B1u);
-  for (std::uint32_t b : bits) h = mix64(h ^ b);
-  const double z = 2.0 * unit(mix64(h + 1)) - 1.0, phi = 6.283185307179586 * unit(mix64(h + 2));
-  const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-  dir = glm::dvec3(r * std::cos(phi), r * std::sin(phi), z);
-  phase = unit(mix64(h + 3));
-}
-
-/// A seeded unit vector (the wave's direction and displacement).
-glm::dvec3 seeded_direction(std::uint64_t seed, std::uint64_t salt) {
-  const std::uint64_t h = mix64(seed ^ kGolden64 ^ salt);
-  const double z = 2.0 * unit(mix64(h + 1)) - 1.0, phi = 6.283185307179586 * unit(mix64(h + 2));
-  const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-  return {r * std::cos(phi), r * std::sin(phi), z};
+  const Draw d = draw(hash_of({&p.x, 3}, seed, 0));
+  return p + glm::vec3(d.dir * swing(amplitude, time, d.phase));
 }
 
 void count(const Accelerator& accel, std::span<const Ray> rays, unsigned threads, double& nodes, double& prims) {
@@ -102,24 +97,22 @@ std::optional<RefitMotion> parse_refit_motion(std::string_view name) {
 
 std::vector<Triangle> animate_triangles(std::span<const Triangle> rest, RefitMotion motion, float amplitude,
                                         float diagonal, double time, std::uint64_t seed) {
-  constexpr double kTwoPi = 6.283185307179586;
   if (motion == RefitMotion::jitter) return animate_vertices(rest, amplitude, time, seed);
   std::vector<Triangle> out(rest.begin(), rest.end());
   if (motion == RefitMotion::explode) {
     for (Triangle& t : out) {
-      glm::dvec3 dir;
-      double phase = 0;
-      triangle_motion(t, seed, dir, phase);
-      const glm::vec3 d(dir * (amplitude * (std::sin(kTwoPi * (time + phase)) - std::sin(kTwoPi * phase))));
-      t.v0 += d;
-      t.v1 += d;
-      t.v2 += d;
+      const float corners[9] = {t.v0.x, t.v0.y, t.v0.z, t.v1.x, t.v1.y, t.v1.z, t.v2.x, t.v2.y, t.v2.z};
+      const Draw d = draw(hash_of(corners, seed, 0x9E3779B1u));
+      const glm::vec3 shift(d.dir * swing(amplitude, time, d.phase));
+      t.v0 += shift;
+      t.v1 += shift;
+      t.v2 += shift;
     }
     return out;
   }
   // wave: one wavelength across the scene's diagonal.
-  const glm::dvec3 k = seeded_direction(seed, 1) / std::max(static_cast<double>(diagonal), 1e-30);
-  const glm::dvec3 u = seeded_direction(seed, 2);
+  const glm::dvec3 k = draw(hash_of({}, seed, 1)).dir / std::max(static_cast<double>(diagonal), 1e-30);
+  const glm::dvec3 u = draw(hash_of({}, seed, 2)).dir;
   const auto move = [&](glm::vec3& p) {
     const double x = glm::dot(k, glm::dvec3(p));
     p += glm::vec3(u * (amplitude * (std::sin(kTwoPi * (time + x)) - std::sin(kTwoPi * x))));

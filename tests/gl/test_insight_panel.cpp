@@ -30,20 +30,26 @@ struct InsightPanelHarness : test::HeadlessImGuiContext {
   }
 };
 
-TEST(InsightJobs, ABCostMetricWeighsEachSideWithItsOwnSahCosts) {
-  // The A/B compare's cost image is c_trav * nodes + c_isect * prims with
-  // the side's own costs (as the view and render --compare), not 1 and 1.
+/// A and B (bvh, default options) over an 800-triangle teapot, 32 x 24 pixels, one thread.
+ABRequest teapot_ab() {
   auto loaded = std::make_shared<LoadedScene>();
   loaded->scene = load_scene("builtin:teapot?size=800");
   ABRequest r;
   r.scene = loaded;
-  r.a.options.bvh.cost_traversal = 2.0f;
-  r.a.options.bvh.cost_intersect = 3.0f;
-  r.b = r.a;
   r.camera = look_at({6.0f, 4.0f, 8.0f}, {0.0f, 1.2f, 0.0f}, 0.7f);
   r.width = 32;
   r.height = 24;
   r.threads = 1;
+  return r;
+}
+
+TEST(InsightJobs, ABCostMetricWeighsEachSideWithItsOwnSahCosts) {
+  // The A/B compare's cost image is c_trav * nodes + c_isect * prims with
+  // the side's own costs (as the view and render --compare), not 1 and 1.
+  ABRequest r = teapot_ab();
+  r.a.options.bvh.cost_traversal = 2.0f;
+  r.a.options.bvh.cost_intersect = 3.0f;
+  r.b = r.a;
   const std::atomic<bool> cancel{false};
   const auto image = [&](HeatMetric m) {
     r.metric = m;
@@ -61,17 +67,8 @@ TEST(InsightJobs, ABCostMetricWeighsEachSideWithItsOwnSahCosts) {
 
 TEST(InsightJobs, ABTimesEachSidesClosestHitsAndCountsTheHitsThatChanged) {
   // The same choice on both sides: the same hits, none changed, each side timed.
-  auto loaded = std::make_shared<LoadedScene>();
-  loaded->scene = load_scene("builtin:teapot?size=800");
-  ABRequest r;
-  r.scene = loaded;
-  r.b = r.a;
+  ABRequest r = teapot_ab();
   r.b.name = "grid";
-  r.a.name = "bvh";
-  r.camera = look_at({6.0f, 4.0f, 8.0f}, {0.0f, 1.2f, 0.0f}, 0.7f);
-  r.width = 32;
-  r.height = 24;
-  r.threads = 1;
   const std::atomic<bool> cancel{false};
   const ABResult res = run_ab(r, cancel);
   EXPECT_GT(res.hits_a, 0u);
@@ -88,15 +85,8 @@ TEST(InsightJobs, ABTimesEachSidesClosestHitsAndCountsTheHitsThatChanged) {
 TEST(InsightJobs, ABWithASideThatCountsNothingSaysSo) {
   // Embree counts nothing per ray: its images are 0, so no count compares (the panel and dump-ab say
   // so); its closest hits are still timed and compared.
-  auto loaded = std::make_shared<LoadedScene>();
-  loaded->scene = load_scene("builtin:teapot?size=800");
-  ABRequest r;
-  r.scene = loaded;
+  ABRequest r = teapot_ab();
   r.b.name = "embree";
-  r.camera = look_at({6.0f, 4.0f, 8.0f}, {0.0f, 1.2f, 0.0f}, 0.7f);
-  r.width = 32;
-  r.height = 24;
-  r.threads = 1;
   const std::atomic<bool> cancel{false};
   const ABResult res = run_ab(r, cancel);
   EXPECT_EQ(res.uncounted, "embree");
