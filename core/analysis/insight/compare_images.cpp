@@ -96,16 +96,13 @@ TimedClosestHits time_closest_hits(const Accelerator& accel, std::span<const Ray
   TimedClosestHits out;
   out.hits.resize(rays.size());
   std::vector<double> runs;
-  for (int k = 0; k < std::max(passes, 1); ++k) {
-    BatchOptions batch{threads};
-    if (progress) {
-      const double share = 1.0 / std::max(passes, 1);
-      batch.progress = [&progress, k, share](double f) { return progress((k + f) * share); };
-    }
+  const int n = std::max(passes, 1);
+  for (int k = 0; k < n; ++k) {
+    // No callback inside a timed pass (it would be timed too): progress and a cancel between passes.
     const auto t0 = std::chrono::steady_clock::now();
-    const bool done = trace_closest(accel, rays, out.hits, query, batch);
+    trace_closest(accel, rays, out.hits, query, BatchOptions{threads});
     runs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    if (!done) throw BuildCancelled();
+    if (progress && !progress(static_cast<double>(k + 1) / n)) throw BuildCancelled();
   }
   std::sort(runs.begin(), runs.end());
   out.trace_ms = runs[runs.size() / 2];

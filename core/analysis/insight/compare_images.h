@@ -42,7 +42,8 @@ struct TimedClosestHits {
 };
 
 /// Traces `rays` `passes` times (at least 1) on `threads` threads and keeps the
-/// median time. Throws BuildCancelled when `progress` returns false.
+/// median time. `progress` is called after each pass, never inside one (it
+/// would be timed too); throws BuildCancelled when it returns false.
 TimedClosestHits time_closest_hits(const Accelerator& accel, std::span<const Ray> rays, const QueryOptions& query,
                                    unsigned threads, int passes = 3, const ProgressCallback& progress = {});
 
