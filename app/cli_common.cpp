@@ -362,10 +362,14 @@ void parse_scale_top(const std::string& text, float& value, double& percentile) 
   percentile = 0.0;
 }
 
-std::string format_number_short(double v) {
+std::string ordinal(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
+  std::string s = buf;
+  if (v != std::floor(v)) return s + "th";
+  const long n = static_cast<long>(v) % 100;
+  const char* suffix = (n / 10 == 1) ? "th" : n % 10 == 1 ? "st" : n % 10 == 2 ? "nd" : n % 10 == 3 ? "rd" : "th";
+  return s + suffix;
 }
 
 std::vector<CommandFactory>& registered_commands() {

@@ -59,8 +59,8 @@ class UsageError : public std::runtime_error {
 /// --max's text: a finite value > 0 (into `value`) or "pNN" with 0 < NN <= 100 (into `percentile`); a
 /// UsageError naming the text otherwise.
 void parse_scale_top(const std::string& text, float& value, double& percentile);
-/// "99", "99.5": a number as short as it reads.
-std::string format_number_short(double v);
+/// "99th", "1st", "22nd", "99.5th": a percentile's rank in words.
+std::string ordinal(double v);
 
 /// parse_image_size (core/util/image_size.h), or a UsageError naming the text.
 ImageSize parse_size(const std::string& text);

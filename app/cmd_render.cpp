@@ -166,7 +166,7 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
   if (o.max_percentile > 0.0) {  // --max pNN: the top where NN % of the pixels' values lie below
     const MetricImage* images[] = {&img};
     co.max = metric_percentile(images, o.max_percentile);
-    co.scale_note = "top: " + format_number_short(o.max_percentile) + "th percentile";
+    co.scale_note = "top: " + ordinal(o.max_percentile) + " percentile";
   }
   co.legend = parse_legend_placement(o.legend).value();
 
