@@ -46,9 +46,16 @@ inline std::string count_of(std::size_t n, std::string_view word) {
   return out + (es ? "es" : "s");
 }
 
-/// `text` with every newline made a space (nothing is dropped).
+/// `text` with every newline (and CR, tab) made a space and every other
+/// control byte shown as '?' (nothing is dropped): the one line `accelviz:`
+/// prints, whatever a file name held.
 inline std::string joined_line(std::string text) {
-  std::replace(text.begin(), text.end(), '\n', ' ');
+  for (char& c : text) {
+    if (c == '\n' || c == '\r' || c == '\t')
+      c = ' ';
+    else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7F)
+      c = '?';  // an ESC in a file name recoloured the terminal
+  }
   return text;
 }
 

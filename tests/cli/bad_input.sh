@@ -29,6 +29,9 @@ expect() {
 
 # Missing, unsupported and malformed scene files.
 expect 1 "$tmp/none.glb" -- info "$tmp/none.glb"
+# A control byte in a file name is shown as '?', not sent to the terminal (an ESC recoloured it).
+expect 1 "bad?[31mname.gltf" -- info "$tmp/bad"$'\x1b'"[31mname.gltf"
+if grep -q $'\x1b' "$tmp/stderr"; then echo "FAIL: an ESC reached stderr"; fail=1; fi
 echo "hello" >"$tmp/scene.txt"
 expect 1 "$tmp/scene.txt" -- info "$tmp/scene.txt"
 head -c 100 /dev/urandom >"$tmp/garbage.glb"
