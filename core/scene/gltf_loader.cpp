@@ -1237,7 +1237,25 @@ bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, in
 std::string tinygltf_problem(const std::string& err) {
   const std::string line = first_line(err);
   const std::string not_found = "File not found : ";
-  if (line.rfind(not_found, 0) == 0) return "external buffer file '" + line.substr(not_found.size()) + "' not found";
+  if (line.rfind(not_found, 0) == 0) {
+    const std::string uri = line.substr(not_found.size());
+    // A URI tinygltf does not read falls through to a file lookup: say what it is instead.
+    if (uri.rfind("data:", 0) == 0)
+      return "invalid glTF: a buffer's data URI is not one that can be read (base64, media type "
+             "application/octet-stream or application/gltf-buffer)";
+    if (const auto colon = uri.find("://"); colon != std::string::npos && colon < 10)
+      return "invalid glTF: a buffer's URI scheme '" + uri.substr(0, colon) +
+             "' is not supported (a file path relative to the glTF, or a base64 data URI)";
+    return "external buffer file '" + uri + "' not found";
+  }
+  // tinygltf says "must be the multiple of 4" of any value out of range, 300 included.
+  if (line.rfind("Invalid `byteStride' value.", 0) == 0 || line.rfind("Invalid 'byteStride' value.", 0) == 0) {
+    const auto colon = line.rfind(": ");
+    return "invalid glTF: a bufferView's byteStride " +
+           (colon == std::string::npos ? "" : line.substr(colon + 2) + " ") + "is not a multiple of 4 from 4 to 252";
+  }
+  if (line == "JSON string too short.")
+    return "invalid glTF: the JSON is empty or too short (a glTF needs at least \"asset\": {\"version\": \"2.0\"})";
   // Its message would quote the whole data URI.
   if (line.rfind("Failed to decode 'uri' : data:", 0) == 0)
     return "invalid glTF: a buffer's data URI cannot be decoded or its size differs from byteLength";

@@ -213,6 +213,24 @@ TEST_F(Malformed, ByteStrideOutOfRange) {
     EXPECT_FALSE(gltf_error(write(std::to_string(stride) + "s.gltf", gltf_text(d))).empty())
         << "byteStride " << stride << " loaded";
   }
+  // tinygltf's own words said "must be the multiple of 4" of 300, a multiple of 4.
+  Doc d = triangle_doc();
+  d.j["bufferViews"][0]["byteStride"] = 300;
+  expect_gltf_error(write("300s.gltf", gltf_text(d)),
+                    "a bufferView's byteStride 300 is not a multiple of 4 from 4 to 252");
+}
+
+TEST_F(Malformed, UrisTinygltfDoesNotReadAreNamedForWhatTheyAre) {
+  // They fell through to a file lookup: "external buffer file 'data:...' not found".
+  Doc other = triangle_doc();
+  std::string text = gltf_text(other);
+  const std::string from = "data:application/octet-stream;base64,";
+  text.replace(text.find(from), from.size(), "data:application/x-binary;base64,");
+  expect_gltf_error(write("media.gltf", text), "a buffer's data URI is not one that can be read");
+  Doc web = triangle_doc();
+  web.j["buffers"][0]["uri"] = "http://example.org/x.bin";
+  expect_gltf_error(write("web.gltf", web.j.dump()), "a buffer's URI scheme 'http' is not supported");
+  expect_gltf_error(write("empty.gltf", "{}"), "the JSON is empty or too short (a glTF needs at least \"asset\"");
 }
 
 TEST_F(Malformed, AccessorOffsetsOutOfRange) {
