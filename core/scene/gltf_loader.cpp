@@ -866,19 +866,20 @@ class GltfConverter {
   }
 
   /// Depth-first, pre-order, roots and children in file order: the order
-  /// that numbers primitives. world = parent_world · local.
+  /// that numbers primitives. world = parent_world · local, composed in
+  /// double (a chain of 100,000 translations drifted in float).
   void traverse(const std::vector<int>& roots) {
-    std::vector<glm::mat4> world(scene_.nodes.size(), glm::mat4(1.0f));
+    std::vector<glm::dmat4> world(scene_.nodes.size(), glm::dmat4(1.0));
     std::vector<std::size_t> stack;
     for (auto it = roots.rbegin(); it != roots.rend(); ++it) {
-      world[std::size_t(*it)] = local_[std::size_t(*it)];
+      world[std::size_t(*it)] = glm::dmat4(local_[std::size_t(*it)]);
       stack.push_back(std::size_t(*it));
     }
     while (!stack.empty()) {
       const std::size_t i = stack.back();
       stack.pop_back();
       Node& node = scene_.nodes[i];
-      const glm::mat4& m = world[i];
+      const glm::mat4 m(world[i]);
       if (node.mesh >= 0) {
         Instance inst;
         inst.mesh = std::uint32_t(node.mesh);
@@ -890,7 +891,7 @@ class GltfConverter {
       if (camera >= 0) node.camera = add_camera(std::size_t(camera), i, m);
       if (node_light_[i] >= 0) node.light = add_light(std::size_t(node_light_[i]), i, m);
       for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) {
-        world[std::size_t(*c)] = m * local_[std::size_t(*c)];
+        world[std::size_t(*c)] = world[i] * glm::dmat4(local_[std::size_t(*c)]);
         stack.push_back(std::size_t(*c));
       }
     }

@@ -233,6 +233,26 @@ TEST_F(GltfLoader, TwoNodesSharingAMeshBecomeInstances) {
   expect_vec3_near(s.meshes[0].positions[0], {0, 0, 0});
 }
 
+// World transforms are composed in double: a chain of 1,000 nodes each moved
+// by 0.001 put its mesh at z = 0.99899 in float, not 1.
+TEST_F(GltfLoader, ADeepChainOfSmallMovesLandsWhereItsSumSays) {
+  GltfBuilder b;
+  quad_mesh(b);
+  constexpr int kDepth = 1000;
+  for (int k = 0; k < kDepth; ++k) {
+    json n = {{"translation", {0, 0, 0.001}}};
+    if (k + 1 < kDepth)
+      n["children"] = {k + 1};
+    else
+      n["mesh"] = 0;
+    b.node(n);
+  }
+  b.scene({0});
+  const Scene s = load_gltf(write_gltf(b));
+  ASSERT_EQ(s.triangles.size(), 2u);
+  EXPECT_NEAR(s.triangles[0].v0.z, 1.0f, 1e-5f);
+}
+
 // Files that are valid JSON but not what glTF 2.0 allows are loaded with a
 // warning that says what was assumed, not silently.
 TEST_F(GltfLoader, ProjectiveMatrixAndOtherAssetVersionsAreWarnedAbout) {
