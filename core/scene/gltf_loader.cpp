@@ -90,7 +90,8 @@ std::string hex32(std::uint32_t v) {
 class JsonPrecheck final : public nlohmann::json_sax<nlohmann::json> {
  public:
   std::vector<std::string> required;
-  std::string error;  ///< empty when the JSON is acceptable
+  std::string error;                  ///< empty when the JSON is acceptable
+  std::vector<std::string> warnings;  ///< what the file breaks that tinygltf reads past in silence
 
   bool null() override { return element(false) && value(); }
   bool boolean(bool) override { return element(false) && value(); }
@@ -136,12 +137,24 @@ class JsonPrecheck final : public nlohmann::json_sax<nlohmann::json> {
     return value();
   }
   bool start_object(std::size_t) override { return element(false) && open(true); }
-  bool end_object() override { return close(); }
+  bool end_object() override {
+    // A node's object closes: tinygltf skips translation/rotation/scale once it read a matrix.
+    if (in_node_object() && node_matrix_ && node_trs_)
+      warnings.push_back(
+          "node " + std::to_string(frames_[1].elements - 1) +
+          " has both a matrix and translation/rotation/scale, which glTF 2.0 forbids; the matrix is used");
+    if (in_node_object()) node_matrix_ = node_trs_ = false;
+    return close();
+  }
   bool start_array(std::size_t) override { return element(false, true) && open(false); }
   bool end_array() override { return close(); }
   bool key(string_t& k) override {
     last_key_ = k;
     if (!frames_.empty()) frames_.back().key = k;
+    if (in_node_object()) {
+      node_matrix_ = node_matrix_ || k == "matrix";
+      node_trs_ = node_trs_ || k == "translation" || k == "rotation" || k == "scale";
+    }
     return true;
   }
   bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& ex) override {
@@ -180,6 +193,11 @@ class JsonPrecheck final : public nlohmann::json_sax<nlohmann::json> {
     return false;
   }
   std::string last_key_;  ///< the most recent key at any depth (the one a scalar or array element belongs to)
+  bool node_matrix_ = false, node_trs_ = false;  ///< keys of the node object open now
+  /// Directly inside one of "nodes"' objects.
+  bool in_node_object() const {
+    return frames_.size() == 3 && frames_[0].key == "nodes" && frames_[1].array && !frames_[2].array;
+  }
 
   /// An open object or array: its current key, or how many elements it has begun.
   struct Frame {
@@ -1217,7 +1235,7 @@ GlbLayout check_glb(const std::string& path, const std::vector<unsigned char>& d
   return layout;
 }
 
-void precheck_json(const std::string& path, const unsigned char* text, std::size_t length) {
+std::vector<std::string> precheck_json(const std::string& path, const unsigned char* text, std::size_t length) {
   JsonPrecheck sax;
   const char* begin = reinterpret_cast<const char*>(text);
   nlohmann::json::sax_parse(begin, begin + length, &sax);
@@ -1225,6 +1243,7 @@ void precheck_json(const std::string& path, const unsigned char* text, std::size
   for (const std::string& ext : sax.required)
     if (!required_extension_supported(ext))
       fail_file(path, "requires extension '" + ext + "', which is not supported");
+  return sax.warnings;
 }
 
 /// We trace geometry only; decoding textures would cost time and add failure
@@ -1305,15 +1324,16 @@ Scene load_gltf(const std::string& path) {
   gltf.SetFsCallbacks(
       {&external_file_exists, &tinygltf::ExpandFilePath, &read_external_file, &tinygltf::WriteWholeFile, nullptr});
   std::string err, warn;
+  std::vector<std::string> json_warnings;
   const std::string base_dir = fs::path(path).parent_path().string();
   bool ok = false;
   if (binary || ext == ".glb") {
     const GlbLayout layout = check_glb(path, data);
-    precheck_json(path, data.data() + layout.json_offset, layout.json_length);
+    json_warnings = precheck_json(path, data.data() + layout.json_offset, layout.json_length);
     ok = gltf.LoadBinaryFromMemory(&model, &err, &warn, data.data(), unsigned(layout.total_length), base_dir);
   } else {
     if (data.empty()) fail_file(path, "empty file");
-    precheck_json(path, data.data(), data.size());
+    json_warnings = precheck_json(path, data.data(), data.size());
     ok = gltf.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(data.data()), unsigned(data.size()),
                                   base_dir);
   }
@@ -1321,6 +1341,7 @@ Scene load_gltf(const std::string& path) {
 
   Scene scene;
   scene.source = path;
+  scene.report.warnings = json_warnings;
   for (const std::string& line : lines_of(warn)) scene.report.warnings.push_back(line);
   for (const std::string& line : lines_of(err)) scene.report.warnings.push_back(line);  // non-fatal notes
   GltfConverter(path, model, scene).run();

@@ -233,6 +233,23 @@ TEST_F(GltfLoader, TwoNodesSharingAMeshBecomeInstances) {
   expect_vec3_near(s.meshes[0].positions[0], {0, 0, 0});
 }
 
+// glTF 2.0 forbids a matrix beside TRS: the matrix wins (tinygltf then skips the TRS), and a warning
+// says so (it was silent).
+TEST_F(GltfLoader, AMatrixBesideTrsIsUsedAndWarnedAbout) {
+  GltfBuilder b;
+  quad_mesh(b);
+  b.node({{"mesh", 0}, {"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 5, 0, 0, 1}}, {"translation", {0, 7, 0}}});
+  b.node({{"mesh", 0}, {"translation", {0, 7, 0}}, {"extras", {{"matrix", 1}}}});  // extras' keys are not the node's
+  b.scene({0, 1});
+  const Scene s = load_gltf(write_gltf(b));
+  ASSERT_EQ(s.triangles.size(), 4u);
+  expect_vec3_near(s.triangles[0].v0, {5, 0, 0});
+  std::string all;
+  for (const std::string& w : s.report.warnings) all += w + "\n";
+  EXPECT_NE(all.find("node 0 has both a matrix and translation/rotation/scale"), std::string::npos) << all;
+  EXPECT_EQ(all.find("node 1"), std::string::npos) << all;
+}
+
 // World transforms are composed in double: a chain of 1,000 nodes each moved
 // by 0.001 put its mesh at z = 0.99899 in float, not 1.
 TEST_F(GltfLoader, ADeepChainOfSmallMovesLandsWhereItsSumSays) {
