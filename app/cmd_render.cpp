@@ -213,6 +213,8 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
 int run_render(const RenderOptions& given, const GlobalOptions& global) {
   RenderOptions o = given;
   if (!o.max_text.empty()) parse_scale_top(o.max_text, o.max, o.max_percentile);
+  if (o.view == "raster" && o.max_percentile > 0.0)
+    throw UsageError("--max " + o.max_text + ": a percentile top is for the heatmap view; give --view raster a value");
   if (const std::string problem = png_name_problem(o.out); !problem.empty()) throw UsageError(problem);
   if (o.gl && o.device != "gpu") throw UsageError("--gl needs --device gpu");
   if (o.device == "gpu") {
@@ -235,8 +237,6 @@ int run_render(const RenderOptions& given, const GlobalOptions& global) {
   }
   check_output_path(o.out, o.force);  // before any long work
   if (o.view == "raster" && !raster_available()) throw UsageError(needs_renderer("--view raster"));
-  if (o.view == "raster" && o.max_percentile > 0.0)
-    throw UsageError("--max " + o.max_text + ": a percentile top is for the heatmap view; give --view raster a value");
   if (o.view == "raster") return run_render_raster(o, global);
   if (o.raster.box_depth >= 0 || o.raster.box_depth_last >= 0 || o.raster.leaves || !o.ray_pixel.empty() ||
       !o.ray_camera.empty() || o.raster.blend > 0.0f || o.raster.wireframe)
