@@ -220,6 +220,9 @@ bool watertight(uint k, float tmin, float tmax, out float t_out) {
     U = float(dU);
     V = float(dV);
     W = float(dW);
+    // Below about 1e-22 the products underflow float altogether: the whole test in double.
+    if ((U == 0.0 && dU != 0.0LF) || (V == 0.0 && dV != 0.0LF) || (W == 0.0 && dW != 0.0LF))
+      return watertight_double(k, tmin, tmax, t_out);
   }
   if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
   precise float det = (U + V) + W;
