@@ -9,8 +9,12 @@
 namespace accelviz {
 
 /// n − 2 triangles over the polygon's corners (indices into `corners`, in the
-/// polygon's winding). A convex polygon (or one with no usable plane) is
-/// fan-triangulated from its first corner: (0, k, k+1). A concave one is
+/// polygon's winding). A convex quad (or a polygon with no usable plane) is
+/// fan-triangulated from its first corner: (0, k, k+1); a convex polygon of
+/// five or more corners is cut by (0, t, 2t), t = (n+1)/3, and each arc left
+/// by (first, middle, last) and its halves the same way, so that a
+/// many-cornered face is not n − 2 slivers from one corner (fatter
+/// triangles, fewer overlapping boxes). A concave one is
 /// ear-clipped in the plane of its Newell normal, so no triangle covers area
 /// outside the polygon (a fan of a U shape covered its notch); where no ear is
 /// found (a self-intersecting outline) the rest is fanned.

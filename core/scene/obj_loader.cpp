@@ -11,13 +11,14 @@
 //      `l`/`p` elements are counted as skipped primitives;
 //   2. tinyobjloader parses the same bytes into shapes (one per o/g group;
 //      `usemtl` does not split one) without triangulating (a face of more
-//      than 255 vertices first rewritten as faces of at most 255 with the
-//      same fan: split_long_faces); a missing .mtl,
+//      than 255 vertices first rewritten as pieces of at most 255:
+//      split_long_faces); a missing .mtl,
 //      or one that is not a regular file of at most 64 MiB, is only a
 //      warning;
 //   3. each shape becomes one Mesh with its own compacted vertices and an
-//      identity instance; convex polygons are fan-triangulated (v0, vi, vi+1),
-//      concave ones ear-clipped (core/geometry/polygon.h), so a polygon of n
+//      identity instance; convex quads are cut along v0-v2, larger convex
+//      polygons split in halves, concave ones ear-clipped
+//      (core/geometry/polygon.h), so a polygon of n
 //      vertices always gives n-2 triangles, in file order;
 //   4. coordinates our scan read as NaN/inf are restored, so flatten() drops
 //      those triangles and counts them instead of placing them at the origin.
@@ -35,6 +36,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -135,12 +137,38 @@ void for_each_line(const std::string& text, const F& f) {
 /// it are misread (silently wrong triangles).
 constexpr std::size_t kMaxTinyObjFace = 255;
 
+/// Writes the face of corners `refs` (vertex references as in the file) as
+/// faces of at most kMaxTinyObjFace corners: the outline cut into arcs of
+/// consecutive corners, each closed by its chord, and the polygon of the arcs'
+/// ends (itself cut the same way while it is too long). The pieces tile the
+/// face where it is convex, in n − 2 triangles together, and each stays a
+/// stretch of the outline (a fan of pieces from the first corner made every
+/// piece a thin wedge across the whole face).
+void write_face_pieces(std::span<const std::string_view> refs, std::string& out) {
+  const std::size_t n = refs.size();
+  if (n <= kMaxTinyObjFace) {
+    out += 'f';
+    for (const std::string_view r : refs) {
+      out += ' ';
+      out.append(r);
+    }
+    out += '\n';
+    return;
+  }
+  const std::size_t step = kMaxTinyObjFace - 1;  // an arc's corners: step + 1
+  std::vector<std::string_view> ends;
+  for (std::size_t i = 0; i + 1 < n; i += step) {
+    const std::size_t j = std::min(i + step, n - 1);
+    ends.push_back(refs[i]);
+    if (j - i >= 2) write_face_pieces(refs.subspan(i, j - i + 1), out);  // two corners: an edge of the ends' polygon
+  }
+  ends.push_back(refs[n - 1]);
+  write_face_pieces(ends, out);
+}
+
 /// `text` with every face of more than kMaxTinyObjFace vertices written as
-/// consecutive faces of at most that many that share its first vertex, each
-/// starting at the previous one's last: their fans (v0, vi, vi+1) together
-/// are the whole face's fan, the same n-2 triangles in the same order. Other
-/// lines are kept as they are; relative (negative) indices stay valid, as
-/// no vertex line moves.
+/// pieces of at most that many (write_face_pieces). Other lines are kept as
+/// they are; relative (negative) indices stay valid, as no vertex line moves.
 std::string split_long_faces(const std::string& text) {
   std::string out;
   out.reserve(text.size() + text.size() / 64);
@@ -151,18 +179,7 @@ std::string split_long_faces(const std::string& text) {
       out += '\n';
       return;
     }
-    const std::size_t n = tok.size() - 1;  // references tok[1..n]
-    for (std::size_t i = 2; i < n;) {      // a chunk: tok[1], tok[i .. j]
-      const std::size_t j = std::min(i + kMaxTinyObjFace - 2, n);
-      out += "f ";
-      out.append(tok[1]);
-      for (std::size_t k = i; k <= j; ++k) {
-        out += ' ';
-        out.append(tok[k]);
-      }
-      out += '\n';
-      i = j;
-    }
+    write_face_pieces(std::span<const std::string_view>(tok).subspan(1), out);
   });
   return out;
 }
@@ -392,7 +409,7 @@ Scene load_obj(const std::string& path) {
     for (const unsigned int n : sm.num_face_vertices) {
       if (offset + n > sm.indices.size()) obj_fail(path, "tinyobjloader returned inconsistent face data");
       if (n >= 3) {
-        // A fan for convex faces, ear clipping for concave ones (core/geometry/polygon.h).
+        // Convex faces split, concave ones ear-clipped (core/geometry/polygon.h).
         face_ids.clear();
         face_corners.clear();
         for (unsigned int k = 0; k < n; ++k) {

@@ -1,8 +1,9 @@
-// Polygon triangulation (core/geometry/polygon.h): convex faces keep their
-// fan, concave ones are ear-clipped inside their outline within a bounded
+// Polygon triangulation (core/geometry/polygon.h): convex quads keep their
+// fan, larger convex faces are split in halves, concave ones are ear-clipped inside their outline within a bounded
 // number of steps.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <glm/geometric.hpp>
 #include <vector>
@@ -32,11 +33,44 @@ double covered(const std::vector<glm::vec3>& p, const std::vector<std::array<std
   return a;
 }
 
-TEST(Polygon, AConvexFaceKeepsItsFan) {
+TEST(Polygon, AConvexQuadKeepsItsFan) {
+  const std::vector<glm::vec3> quad = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  const auto tris = triangulate_polygon(quad);
+  ASSERT_EQ(tris.size(), 2u);
+  EXPECT_EQ(tris[0], (std::array<std::uint32_t, 3>{0, 1, 2}));
+  EXPECT_EQ(tris[1], (std::array<std::uint32_t, 3>{0, 2, 3}));
+}
+
+// A convex polygon of five or more corners is cut (0, t, 2t) and then by halves, not fanned: the
+// hexagon's middle triangle and its three ears; a 4,000-gon tiled exactly once, in its winding,
+// with no corner in more than a few triangles (the fan put corner 0 in all 3,998, each a sliver
+// across the face) and a total edge length of a few dozen times the outline's (the fan's: n).
+TEST(Polygon, ALargerConvexFaceIsSplitInHalvesNotFanned) {
   const std::vector<glm::vec3> hexagon = {{2, 0, 0}, {1, 2, 0}, {-1, 2, 0}, {-2, 0, 0}, {-1, -2, 0}, {1, -2, 0}};
-  const auto tris = triangulate_polygon(hexagon);
-  ASSERT_EQ(tris.size(), 4u);
-  for (std::uint32_t k = 0; k < 4; ++k) EXPECT_EQ(tris[k], (std::array<std::uint32_t, 3>{0, k + 1, k + 2}));
+  const std::vector<std::array<std::uint32_t, 3>> expected = {{0, 2, 4}, {0, 1, 2}, {2, 3, 4}, {4, 5, 0}};
+  EXPECT_EQ(triangulate_polygon(hexagon), expected);
+
+  const std::size_t n = 4000;  // more, and a circle stops being convex in float
+  std::vector<glm::vec3> circle;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double a = 6.283185307179586 * static_cast<double>(i) / n;
+    circle.push_back({static_cast<float>(std::cos(a)), static_cast<float>(std::sin(a)), 0.0f});
+  }
+  const auto tris = triangulate_polygon(circle);
+  ASSERT_EQ(tris.size(), n - 2);
+  EXPECT_NEAR(covered(circle, tris), shoelace(circle), 1e-9 * n);
+  std::vector<int> degree(n, 0);
+  double edges = 0.0;
+  for (const auto& [i, j, k] : tris) {
+    EXPECT_GT(glm::cross(circle[j] - circle[i], circle[k] - circle[i]).z, 0.0f);
+    ++degree[i];
+    ++degree[j];
+    ++degree[k];
+    edges += glm::length(circle[j] - circle[i]) + glm::length(circle[k] - circle[j]) + glm::length(circle[i] - circle[k]);
+  }
+  EXPECT_EQ(std::count(degree.begin(), degree.end(), 0), 0);
+  EXPECT_LE(*std::max_element(degree.begin(), degree.end()), 40);
+  EXPECT_LT(edges, 40.0 * 6.283185307179586);
 }
 
 TEST(Polygon, AConcaveCombIsCoveredExactlyOnceInItsOwnWinding) {
