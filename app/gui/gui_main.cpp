@@ -727,7 +727,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       if (app_.loading_scene() || !app_.rest()) return Status::again;
       if (!flatten_wait_) {
         const std::string name = app_.rest()->accel->name();
-        if (name != "tlas") throw std::runtime_error("flatten: the structure is " + name + "; the what-if needs tlas");
+        if (name != "tlas") throw std::runtime_error("the structure is " + name + "; the what-if needs tlas");
         std::vector<std::uint32_t> ids = parse_instance_ids(c.arg, app_.rest()->scene->scene.instances.size());
         flatten_scene_ = app_.rest()->scene;
         flatten_panel_.scene_identity = flatten_scene_.get();
@@ -749,7 +749,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       if (!flatten_wait_) {
         const std::shared_ptr<const FlattenResult> r = flatten_.latest();
         if (!r || !r->figures || !app_.rest() || r->scene != app_.rest()->scene.get())
-          throw std::runtime_error("flatten-commit: no prediction of the shown scene (run flatten IDS first)");
+          throw std::runtime_error("no prediction of the shown scene (run flatten IDS first)");
         flatten_wait_ = request_flatten(FlattenRequest::Kind::commit, r->instances);
       }
       const std::shared_ptr<const FlattenResult> r = flatten_.latest();
@@ -772,7 +772,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
         doc = flatten_result_json(*r, flatten_spec_of(*r));
       } else {
         if (!flatten_prediction_)
-          throw std::runtime_error("dump-flatten: no flatten prediction yet (run flatten IDS first)");
+          throw std::runtime_error("no flatten prediction yet (run flatten IDS first)");
         doc = flatten_result_json(*flatten_prediction_, flatten_prediction_spec_);
         // A commit of that prediction since: the merged scene it opened.
         if (r && r->kind == FlattenRequest::Kind::commit && r->committed &&
@@ -789,7 +789,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       if (app_.loading_scene() || !app_.current()) return Status::again;
       const SceneEffects* fx = effects();
       if (!fx || !fx->per_frame_updates.on)
-        throw std::runtime_error("play: " + app_.scene_spec() + ": per-frame updates are off (" +
+        throw std::runtime_error(app_.scene_spec() + ": per-frame updates are off (" +
                                  (fx ? fx->per_frame_updates.reason : std::string("no scene")) + ")");
       const std::shared_ptr<const DynamicsSnapshot> snap = dynamics_.latest();
       const bool ours = snap && snap->scene == app_.rest()->scene.get();
@@ -810,7 +810,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
     }
     case K::dump_dynamics: {
       const SceneEffects* fx = effects();
-      if (!fx) throw std::runtime_error("dump-dynamics: no scene shown yet");
+      if (!fx) throw std::runtime_error("no scene shown yet");
       nlohmann::json doc = {{"scene", app_.scene_spec()}, {"effects", effects_json(*fx)}};
       const std::shared_ptr<const DynamicsSnapshot> snap = dynamics_.latest();
       if (snap && app_.rest() && snap->scene == app_.rest()->scene.get()) {
@@ -850,9 +850,30 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       fail_if(write_new_file(c.arg, doc.dump(2) + "\n"));
       return Status::done;
     }
-    case K::window:
-      panels::request_window(c.arg, c.value == "open");
+    case K::window: {
+      // Two panels show only while the scene or structure calls for them: an
+      // open request for one that is not drawn would wait, unseen, until it
+      // is (a later scene's panel popping open), so it fails instead; a close
+      // request has nothing to do then.
+      const bool open = c.value == "open";
+      if (c.arg == "Flatten what-if" || c.arg == "Dynamics") {
+        if (!app_.settled()) return Status::again;
+        std::string why;
+        if (c.arg == "Flatten what-if") {
+          const std::string name = app_.rest() ? app_.rest()->accel->name() : std::string("none");
+          if (name != "tlas") why = "the structure is " + name + "; the panel shows while a tlas is shown";
+        } else if (const SceneEffects* fx = effects(); !fx || !fx->per_frame_updates.on) {
+          why = app_.scene_spec() + ": per-frame updates are off (" +
+                (fx ? fx->per_frame_updates.reason : std::string("no scene")) + "); the panel shows while they are on";
+        }
+        if (!why.empty()) {
+          if (open) throw std::runtime_error(c.arg + " is not shown now: " + why);
+          return Status::done;
+        }
+      }
+      panels::request_window(c.arg, open);
       return Status::done;
+    }
     case K::scenario:
     case K::dump_scenario:
     case K::dump_insight:

@@ -392,12 +392,12 @@ ScriptHost::Status InsightViews::execute(AppState& app, const ScriptCommand& c) 
           panels::request_window("Scenarios", true);  // where the run shows
           return ScriptHost::Status::done;
         }
-      throw std::runtime_error("scenario: unknown '" + c.arg + "'");
+      throw std::runtime_error("unknown '" + c.arg + "'");
     }
     case K::dump_scenario: {
       if (scenario_job_.busy()) return ScriptHost::Status::again;
       if (!scenario_job_.error().empty()) throw std::runtime_error("scenario: " + scenario_job_.error());
-      if (!scenario_job_.figures()) throw std::runtime_error("dump-scenario: no scenario run yet (use scenario first)");
+      if (!scenario_job_.figures()) throw std::runtime_error("no scenario run yet (use scenario first)");
       if (const std::string err = write_new_file(c.arg, figures_json(*scenario_job_.figures()).dump(2) + "\n");
           !err.empty())
         throw std::runtime_error(err);

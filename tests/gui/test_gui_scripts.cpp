@@ -458,6 +458,31 @@ TEST_F(GuiScript, ScriptErrorsNameTheLineAndExitWithOne) {
   EXPECT_EQ(read_file(path("taken.png")), "mine");
 }
 
+// The panels a scene or structure calls for: opening one that is not shown
+// fails with the reason (it used to wait unseen and pop open with a later
+// scene); closing it does nothing; a failing command's name is said once.
+TEST_F(GuiScript, OpeningAPanelTheSceneDoesNotCallForSaysWhy) {
+  RunResult r = run(std::string("open ") + kTeapot + "\nwait\nwindow open Dynamics\nquit\n");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find(":3: window: Dynamics is not shown now: " + std::string(kTeapot) + ": per-frame updates are off ("),
+            std::string::npos)
+      << r.err;
+  r = run(std::string("open ") + kTeapot + "\nstructure kdtree\nwait\nwindow open Flatten what-if\nquit\n");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find(":4: window: Flatten what-if is not shown now: the structure is kdtree; the panel shows while a "
+                       "tlas is shown"),
+            std::string::npos)
+      << r.err;
+  r = run(std::string("open ") + kTeapot + "\nwait\nwindow close Dynamics\nwindow close Flatten what-if\nquit\n");
+  EXPECT_EQ(r.code, 0) << r.err;
+  r = run(std::string("open ") + kTeapot + "\nwait\nplay 2\nquit\n");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find(":3: play: " + std::string(kTeapot) + ": per-frame updates are off"), std::string::npos) << r.err;
+  // A panel that is shown opens as before.
+  r = run("open builtin:dynamic?size=6000\nwait\nwindow open Dynamics\nwait\nquit\n");
+  EXPECT_EQ(r.code, 0) << r.err;
+}
+
 TEST_F(GuiScript, SceneArgumentOpensBeforeTheScript) {
   const RunResult r = run("wait\ndump-stats " + path("s.json").string() + "\nquit\n", "'builtin:teapot?size=300'");
   ASSERT_EQ(r.code, 0) << r.err;
