@@ -443,6 +443,9 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
         {"memory_bytes", r.stats.memory_bytes}, {"sah_cost", r.stats.sah_cost},
     };
     for (const auto& [k, v] : r.stats.extra) s["build"][k] = v;
+    // The constants the SAH cost is under: SAH costs compare only under the same ones.
+    if (const auto c = sah_constants(r.name, so); c && r.stats.sah_cost > 0.0)
+      s["build"]["sah_constants"] = {{"c_trav", c->first}, {"c_isect", c->second}};
     if (r.embree_bvh) {
       s["embree_binary_bvh"] = {
           {"sah_cost", r.embree_bvh->sah_cost},
@@ -518,7 +521,10 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
       std::printf(", nodes %llu, leaves %llu, depth %u", static_cast<unsigned long long>(r.stats.node_count),
                   static_cast<unsigned long long>(r.stats.leaf_count), r.stats.max_depth);
     std::printf(", memory %s", format_bytes(r.stats.memory_bytes).c_str());
-    if (r.stats.sah_cost > 0.0) std::printf(", SAH %.3f", r.stats.sah_cost);
+    if (r.stats.sah_cost > 0.0) {
+      const std::string c = sah_constants_text(r.name, so);
+      std::printf(", SAH %.3f%s", r.stats.sah_cost, c.empty() ? "" : (" (" + c + ")").c_str());
+    }
     for (const auto& [k, v] : r.stats.extra) std::printf(", %s %.4g", k.c_str(), v);
     std::printf("\n");
     if (r.embree_bvh)

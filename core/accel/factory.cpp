@@ -1,5 +1,6 @@
 #include "core/accel/factory.h"
 
+#include <cstdio>
 #include <stdexcept>
 
 namespace accelviz {
@@ -17,6 +18,22 @@ std::string structure_names_joined() {
   std::string s;
   for (const std::string& n : structure_names()) s += (s.empty() ? "" : ", ") + n;
   return s;
+}
+
+std::optional<std::pair<float, float>> sah_constants(std::string_view name, const StructureOptions& opts) {
+  if (name == "bvh" || name == "tlas") return std::pair{opts.bvh.cost_traversal, opts.bvh.cost_intersect};
+  if (name == "kdtree") return std::pair{opts.kdtree.cost_traversal, opts.kdtree.cost_intersect};
+  if (name == "octree" || name == "brute" || name == "brute-bbox") return std::pair{1.0f, 1.0f};
+  return std::nullopt;
+}
+
+std::string sah_constants_text(std::string_view name, const StructureOptions& opts) {
+  const auto c = sah_constants(name, opts);
+  if (!c) return "";
+  char text[96];
+  std::snprintf(text, sizeof text, "C_trav %g, C_isect %g", static_cast<double>(c->first),
+                static_cast<double>(c->second));
+  return text;
 }
 
 std::unique_ptr<Accelerator> build_accelerator(std::string_view name, std::span<const Triangle> triangles,

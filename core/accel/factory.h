@@ -13,9 +13,11 @@
 #include "core/accel/voxels/voxels.h"
 
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace accelviz {
@@ -43,6 +45,16 @@ const std::vector<std::string>& structure_names();
 
 /// "brute, brute-bbox, bvh, kdtree, ...": for messages and help texts.
 std::string structure_names_joined();
+
+/// The cost constants (C_trav, C_isect) the structure's SAH cost
+/// (BuildStats::sah_cost) is computed with: its options' for "bvh", "tlas"
+/// and "kdtree" (whose C_isect defaults to 1.5), 1 and 1 for "octree",
+/// "brute" and "brute-bbox"; none for the structures without an SAH cost.
+/// SAH costs of two structures compare only under the same constants.
+std::optional<std::pair<float, float>> sah_constants(std::string_view name, const StructureOptions& opts);
+
+/// "C_trav 1, C_isect 1.5" for sah_constants, or "" where there are none.
+std::string sah_constants_text(std::string_view name, const StructureOptions& opts);
 
 /// Builds the structure `name` over `triangles` (which must outlive it).
 /// Throws std::invalid_argument listing the valid names for an unknown name,

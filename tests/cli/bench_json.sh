@@ -103,3 +103,16 @@ print("embree isa ok")'
   [ "$(wc -l <"$tmp/isa_err.txt")" -le 2 ] && grep -q "embree-isa" "$tmp/isa_err.txt" ||
     { echo "FAIL: --embree-isa avx3: $(cat "$tmp/isa_err.txt")"; exit 1; }
 fi
+# Each SAH cost says the constants it is under (the K-D tree's C_isect is 1.5 by default); none for the grid.
+"$accelviz" -q bench 'builtin:soup?size=2000' --structure bvh,kdtree,octree,grid --rays primary --size 8x8 \
+  --repeat 1 --json >"$tmp/sah.json"
+python3 -c '
+import json, sys
+s = {x["name"]: x["build"] for x in json.load(open(sys.argv[1]))["structures"]}
+assert s["bvh"]["sah_constants"] == {"c_trav": 1, "c_isect": 1}, s["bvh"]
+assert s["kdtree"]["sah_constants"] == {"c_trav": 1, "c_isect": 1.5}, s["kdtree"]
+assert s["octree"]["sah_constants"] == {"c_trav": 1, "c_isect": 1}, s["octree"]
+assert "sah_constants" not in s["grid"], s["grid"]
+print("bench sah constants ok")' "$tmp/sah.json"
+"$accelviz" -q bench 'builtin:soup?size=2000' --structure kdtree --rays primary --size 8x8 --repeat 1 |
+  grep -q ', SAH [0-9.]* (C_trav 1, C_isect 1.5),' || { echo "FAIL: no SAH constants in the text"; exit 1; }

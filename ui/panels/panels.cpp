@@ -240,7 +240,10 @@ bool bvh_option_widgets(BvhOptions& b) {
   }
   if (b.splitter == BvhSplitter::binned_sah)
     changed |= slider_int("Buckets", b.buckets, 2, 256, "binned SAH bucket count");
-  if (slider_int("Max leaf size", b.max_leaf_size, 1, 255, "nodes with at most this many triangles are leaves")) {
+  // Not "max leaf size": leaves grow past it up to the cap where the SAH rates them cheaper.
+  if (slider_int("Always-leaf size", b.max_leaf_size, 1, 255,
+                 "a node with at most this many triangles is always a leaf (max_leaf_size, --leaf); larger "
+                 "leaves, up to the cap below, where the SAH rates them cheaper than a split")) {
     b.leaf_size_cap = std::max(b.leaf_size_cap, b.max_leaf_size);
     changed = true;
   }
@@ -378,9 +381,12 @@ void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const Pa
       row("nodes", "n/a: %s keeps its tree to itself", built->accel->name().c_str());
     }
     row("memory", "%s", bytes_text(b.memory_bytes).c_str());
-    if (b.sah_cost > 0.0)
-      row("SAH cost", "%.4g", b.sah_cost);
-    else
+    if (b.sah_cost > 0.0) {
+      // Under the structure's own constants (the K-D tree's C_isect is 1.5): compare SAH costs of
+      // two structures only under the same ones.
+      const std::string c = sah_constants_text(built->accel->name(), built->choice.options);
+      row("SAH cost", "%.4g%s", b.sah_cost, c.empty() ? "" : ("  (" + c + ")").c_str());
+    } else
       row("SAH cost", "n/a");
     if (const auto it = b.extra.find("epo"); it != b.extra.end()) row("EPO", "%.4g", it->second);
     for (const auto& [k, v] : b.extra) {
