@@ -15,7 +15,10 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <new>
 #include <string>
@@ -43,7 +46,9 @@ std::string builtin_list() {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(int argc, char** argv) {
   using namespace accelviz;
   CLI::App app{
       "accelviz: a lab for ray-tracing acceleration structures.\n"
@@ -125,4 +130,23 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "accelviz: %s\n", joined_line(e.what()).c_str());
     return 1;
   }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Past the file-size limit (ulimit -f) a write fails with EFBIG instead of
+  // the signal killing the process: the write's error is reported and the
+  // output's temporary file removed, as for a full disk.
+  std::signal(SIGXFSZ, SIG_IGN);
+  const int code = run(argc, argv);
+  // What went to stdout (tables, JSON) must have arrived: `bench --json >
+  // full-disk/results.json` said nothing and exited 0 with the file cut short.
+  errno = 0;
+  const bool flushed = std::fflush(stdout) == 0;
+  if (!flushed || std::ferror(stdout)) {
+    std::fprintf(stderr, "accelviz: stdout: write failed%s%s\n", errno ? ": " : "", errno ? std::strerror(errno) : "");
+    return code == 0 ? 1 : code;
+  }
+  return code;
 }

@@ -171,4 +171,26 @@ expect 2 "$tmp/x.obj: the output's name must end in .glb or .gltf" -- export 'bu
 # Missing output directory.
 expect 1 "$tmp/no/dir/a.png" -- render 'builtin:soup?size=10' --out "$tmp/no/dir/a.png"
 
+# Past the file-size limit: the write's error, exit 1, no temporary file left (the signal killed it, 153).
+mkdir "$tmp/fsz"
+(ulimit -f 100; "$accelviz" -q rays 'builtin:soup?size=200' -o "$tmp/fsz/big.rays" --size 400x400 -j 1) \
+  2>"$tmp/stderr"
+rc=$?
+if [ "$rc" -ne 1 ] || ! grep -qF "$tmp/fsz/big.rays: write failed: File too large" "$tmp/stderr"; then
+  echo "FAIL: file-size limit: exit $rc: $(cat "$tmp/stderr")"; fail=1
+elif [ -n "$(ls -A "$tmp/fsz")" ]; then
+  echo "FAIL: file-size limit left $(ls -A "$tmp/fsz")"; fail=1
+else echo "ok: file-size limit: $(cat "$tmp/stderr")"; fi
+# What goes to stdout must arrive: a full disk behind stdout is an error, not exit 0.
+if [ -w /dev/full ]; then
+  for args in "info builtin:soup?size=20" "bench builtin:soup?size=200 -s bvh --rays primary --size 8x8 -n 1 -j 1 --json"; do
+    # shellcheck disable=SC2086
+    "$accelviz" -q $args >/dev/full 2>"$tmp/stderr"
+    rc=$?
+    if [ "$rc" -ne 1 ] || ! grep -q "^accelviz: stdout: write failed" "$tmp/stderr"; then
+      echo "FAIL: stdout to /dev/full ($args): exit $rc: $(cat "$tmp/stderr")"; fail=1
+    else echo "ok: stdout to /dev/full ($args): $(cat "$tmp/stderr")"; fi
+  done
+fi
+
 exit $fail
