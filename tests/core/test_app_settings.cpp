@@ -104,7 +104,12 @@ TEST(AppSettings, CorruptedFileIsReportedAndReplacedByDefaults) {
     const LoadedSettings loaded = load_settings(file);
     EXPECT_EQ(loaded.error.rfind(file.string() + ": ", 0), 0u) << loaded.error;
     EXPECT_NE(loaded.error.find(c.problem), std::string::npos) << c.text << " -> " << loaded.error;
-    EXPECT_NE(loaded.error.find("(using defaults)"), std::string::npos);
+    // The defaults replace the file at the next save: a copy is kept first, never over an earlier one.
+    const std::string kept = "(using defaults; the file is kept as " + file.string() + ".bad";
+    ASSERT_NE(loaded.error.find(kept), std::string::npos) << loaded.error;
+    const std::size_t from = loaded.error.find(kept) + std::string("(using defaults; the file is kept as ").size();
+    const std::string copy = loaded.error.substr(from, loaded.error.size() - 1 - from);
+    EXPECT_EQ(read_file(copy), c.text) << copy;
     EXPECT_EQ(loaded.error.find('\n'), std::string::npos) << "one line";
     EXPECT_EQ(option_values(loaded.settings.config), option_values(AppConfig{})) << c.text;
     EXPECT_EQ(loaded.settings.last_scene, "");

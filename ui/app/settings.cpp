@@ -136,7 +136,18 @@ LoadedSettings load_settings(const std::filesystem::path& file) {
     std::string what = e.what();
     std::replace(what.begin(), what.end(), '\n', ' ');
     out.settings = AppSettings{};
-    out.error = file.string() + ": " + what + " (using defaults)";
+    // The defaults replace the file at the next save: its recent list, folders and window size
+    // would be lost for one bad value, so a copy is kept first under a fresh name.
+    std::string kept;
+    for (int k = 1; k <= 1000 && kept.empty(); ++k) {
+      const std::filesystem::path copy = file.string() + (k == 1 ? ".bad" : ".bad-" + std::to_string(k));
+      const OutputWrite w = write_output_file(copy.string(), {text}, /*overwrite=*/false);
+      if (w.ok())
+        kept = "the file is kept as " + copy.string();
+      else if (!w.exists)
+        kept = "no copy kept: " + copy.string() + ": " + w.problem;
+    }
+    out.error = file.string() + ": " + what + " (using defaults; " + (kept.empty() ? "no copy kept" : kept) + ")";
   }
   return out;
 }
