@@ -123,11 +123,13 @@ std::vector<Ray> shadow_rays(std::span<const Triangle> triangles, std::span<cons
         if (!(len > 0.0f)) continue;
         dir /= len;
       } else {
-        const glm::vec3 d = light.position - p;
-        const float dist = glm::length(d);
-        if (!(dist > 0.0f) || !std::isfinite(dist)) continue;
-        dir = d / dist;
-        tmax = dist * kShortOfLight;
+        // In double: a light beyond about 1.8e19 squared its distance past float's range, and its
+        // shadow rays were dropped (0 rays) as if the light were at infinity.
+        const glm::dvec3 d = glm::dvec3(light.position) - glm::dvec3(p);
+        const double dist = glm::length(d);
+        if (!(dist > 0.0) || !std::isfinite(dist) || !(static_cast<float>(dist) < kInfinity)) continue;
+        dir = glm::vec3(d / dist);
+        tmax = static_cast<float>(dist) * kShortOfLight;
       }
       if (glm::dot(dir, n) <= 0.0f) continue;  // light behind the surface
       rays.emplace_back(p, dir, 0.0f, tmax);

@@ -327,4 +327,26 @@ TEST(RaySets, ShadowRaysGoToLightsInFrontOfTheSurface) {
   const Light synthetic = synthetic_light(Aabb{{-5, 0, -5}, {5, 6, 5}});
   EXPECT_GT(synthetic.position.y, 6.0f);
 }
+
+// A light farther than about 1.8e19 squared its distance past float's range: its shadow rays were
+// dropped, none at all, as if it lit nothing. Up to float's largest finite distance each lit hit has one.
+TEST(RaySets, ShadowRaysReachAVeryFarLight) {
+  const std::vector<Triangle> tris = floor_and_wall();
+  const BruteForce accel(tris);
+  const std::vector<Ray> primary = primary_rays(look_at({1, 3, 9}, {0, 1, -3}, 0.9f), 16, 12);
+  std::vector<Hit> hits(primary.size());
+  trace_closest(accel, primary, hits, {}, 1u);
+  Light near_light, far_light;
+  near_light.position = {0.0f, 4.0f, 1.0f};
+  far_light.position = glm::normalize(glm::vec3(0.0f, 4.0f, 1.0f)) * 1e38f;
+  const std::size_t near = shadow_rays(tris, primary, hits, std::vector<Light>{near_light}).size();
+  const std::vector<Ray> far = shadow_rays(tris, primary, hits, std::vector<Light>{far_light});
+  EXPECT_GT(near, 0u);
+  EXPECT_GE(far.size(), near / 2) << "the far light lights what faces it";
+  for (const Ray& r : far) {
+    EXPECT_TRUE(std::isfinite(r.tmax));
+    EXPECT_GT(r.tmax, 9e37f);
+    EXPECT_NEAR(glm::length(r.direction), 1.0f, 1e-5f);
+  }
+}
 }  // namespace unity_test_camera
