@@ -189,6 +189,11 @@ struct ObjScan {
   std::size_t face_count = 0;
   std::size_t long_faces = 0;  ///< faces of more than kMaxTinyObjFace vertices (split_long_faces)
   std::uint64_t lines_and_points = 0;
+  /// Lines whose statement OBJ does not have (a typo such as `F 1 2 3` or `fo 1 2 3`: tinyobjloader
+  /// drops them without a word) and free-form geometry (`curv`, `curv2`, `surf`: not read); the
+  /// first of each as "line N 'KEYWORD'".
+  std::uint64_t unknown_statements = 0, free_form = 0;
+  std::string first_unknown, first_free_form;
   /// (vertex index, xyz as read) for every vertex with a NaN/inf coordinate.
   std::vector<std::pair<std::size_t, glm::vec3>> nonfinite;
 };
@@ -267,6 +272,19 @@ ObjScan scan_obj(const std::string& path, const std::string& text) {
       } else {
         ++scan.lines_and_points;
       }
+      return;
+    }
+    // The statements of the OBJ specification (Wavefront, version 3.0) that are not read above.
+    static constexpr std::string_view kKnown[] = {
+        "vt",    "vn",       "vp",       "o",          "g",         "s",     "mg",    "mtllib", "usemtl",
+        "maplib", "usemap",  "lod",      "bevel",      "c_interp",  "d_interp", "shadow_obj", "trace_obj",
+        "ctech", "stech",    "cstype",   "deg",        "bmat",      "step",  "parm",  "trim",   "hole",
+        "scrv",  "sp",       "end",      "con",        "call",      "csh"};
+    if (tok[0] == "curv" || tok[0] == "curv2" || tok[0] == "surf") {
+      if (scan.free_form++ == 0) scan.first_free_form = "line " + std::to_string(line_number) + " " + quoted(tok[0]);
+    } else if (std::find(std::begin(kKnown), std::end(kKnown), tok[0]) == std::end(kKnown)) {
+      if (scan.unknown_statements++ == 0)
+        scan.first_unknown = "line " + std::to_string(line_number) + " " + quoted(tok[0]);
     }
   });
   if (max_forward > static_cast<long long>(scan.vertex_count))
@@ -368,6 +386,12 @@ Scene load_obj(const std::string& path) {
     scene.report.warnings.push_back(std::to_string(scan.lines_and_points) +
                                     " line/point elements skipped (only faces are traced)");
   }
+  if (scan.unknown_statements > 0)
+    scene.report.warnings.push_back(count_of(scan.unknown_statements, "line") +
+                                    " ignored: a statement OBJ does not have (first: " + scan.first_unknown + ")");
+  if (scan.free_form > 0)
+    scene.report.warnings.push_back("free-form curves and surfaces not read (only polygonal faces are): " +
+                                    std::to_string(scan.free_form) + " (first: " + scan.first_free_form + ")");
 
   std::vector<float>& v = attrib.vertices;
   if (v.size() != scan.vertex_count * 3)
@@ -434,7 +458,14 @@ Scene load_obj(const std::string& path) {
   }
 
   scene.flatten();
-  if (scene.triangles.empty()) obj_fail(path, no_triangles_message(scene.report));
+  if (scene.triangles.empty()) {
+    // The statements it ignored may be why (`F 1 2 3` on every face line).
+    std::string also;
+    for (const std::string& w : scene.report.warnings)
+      if (w.find("a statement OBJ does not have") != std::string::npos || w.starts_with("free-form"))
+        also += "; " + w;
+    obj_fail(path, no_triangles_message(scene.report) + also);
+  }
   cap_warnings(scene.report);
   return scene;
 }

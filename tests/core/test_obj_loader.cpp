@@ -242,6 +242,33 @@ TEST_F(ObjLoader, LinesAndPointsAreSkippedWithAWarning) {
   EXPECT_NE(s.report.warnings.back().find("2 line/point elements skipped"), std::string::npos);
 }
 
+// tinyobjloader drops a line whose statement it does not know without a word:
+// a typo (`F`, `fo`, `f2`) lost faces silently. Such lines, and free-form
+// geometry it does not read, are a warning; with no triangles left, the error
+// says so. The statements of the specification it ignores (groups, smoothing,
+// materials, texture vertices) are not.
+TEST_F(ObjLoader, StatementsOBJDoesNotHaveAreAWarning) {
+  const Scene s = load_obj(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvn 0 0 1\ng a\ns 1\no b\n"
+                                 "usemtl m\nf 1 2 3\nF 2 4 3\nfo 1 2 4\nf2 4 3\ncstype bspline\ncurv 0 1 1 2\n"));
+  EXPECT_EQ(s.triangles.size(), 1u);
+  const auto has = [&](const std::string& w) {
+    return std::find(s.report.warnings.begin(), s.report.warnings.end(), w) != s.report.warnings.end();
+  };
+  EXPECT_TRUE(has("3 lines ignored: a statement OBJ does not have (first: line 12 'F')"));
+  EXPECT_TRUE(has("free-form curves and surfaces not read (only polygonal faces are): 1 (first: line 16 'curv')"));
+  try {
+    load_obj(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nF 1 2 3\n", "typo.obj"));
+    ADD_FAILURE() << "a file of no faces loaded";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "typo.obj: scene contains no triangles; 1 line ignored: a statement OBJ does not have (first: line 4 'F')"),
+              std::string::npos)
+        << e.what();
+  }
+  const Scene clean = load_obj(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\ng a\ns off\nmtllib\nf 1 2 3\n", "c.obj"));
+  for (const std::string& w : clean.report.warnings) EXPECT_EQ(w.find("statement OBJ"), std::string::npos) << w;
+}
+
 TEST_F(ObjLoader, NonFiniteVerticesAreDroppedAndCounted) {
   // tinyobjloader alone would read "nan" and "inf" as 0 and keep the triangles.
   const Scene s =
