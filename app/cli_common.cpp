@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 
@@ -239,10 +241,28 @@ bool is_output_file(const fs::path& p, const std::string& prefix) {
 
 }  // namespace
 
+namespace {
+
+/// Why files cannot be made in the folder `dir`, or its nearest existing
+/// parent where it does not exist yet ("" when they can): checked before
+/// the work, which ran to its end before the write failed (a read-only folder).
+std::string unwritable_folder(const fs::path& dir) {
+  std::error_code ec;
+  fs::path d = dir.empty() ? fs::path(".") : dir;
+  while (!fs::exists(d, ec) && d.has_parent_path() && d.parent_path() != d) d = d.parent_path();
+  if (!fs::exists(d, ec)) d = ".";
+  if (::access(d.c_str(), W_OK | X_OK) != 0) return "cannot write in " + d.string() + ": " + std::strerror(errno);
+  return "";
+}
+
+}  // namespace
+
 void check_output_dir(const std::string& dir, const std::string& prefix, bool force) {
   std::error_code ec;
   const fs::path p(dir);
+  if (dir.empty()) throw std::runtime_error("the output folder's name is empty");
   if (fs::exists(p, ec) && !fs::is_directory(p, ec)) throw std::runtime_error(dir + ": exists and is not a directory");
+  if (const std::string problem = unwritable_folder(p); !problem.empty()) throw std::runtime_error(dir + ": " + problem);
   if (!fs::is_directory(p, ec)) return;
   for (const auto& e : fs::directory_iterator(p, ec))
     if (is_output_file(e.path(), prefix))
@@ -282,6 +302,7 @@ void check_output_path(const std::string& path, bool force) {
   if (!force && fs::exists(p, ec)) throw std::runtime_error(path + ": exists (use --force to overwrite)");
   const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
   if (!fs::is_directory(dir, ec)) throw std::runtime_error(path + ": directory " + dir.string() + " does not exist");
+  if (const std::string problem = unwritable_folder(dir); !problem.empty()) throw std::runtime_error(path + ": " + problem);
 }
 
 std::string absolute_path(const std::string& path) {

@@ -171,6 +171,32 @@ expect 2 "$tmp/x.obj: the output's name must end in .glb or .gltf" -- export 'bu
 # Missing output directory.
 expect 1 "$tmp/no/dir/a.png" -- render 'builtin:soup?size=10' --out "$tmp/no/dir/a.png"
 
+# A folder the user cannot write in is refused before the work (it failed after it), as is an empty name.
+expect 1 "the output folder's name is empty" -- sweep 'builtin:soup?size=20' --param buckets=2,4 -o ""
+mkdir "$tmp/ro" && chmod 555 "$tmp/ro"
+as_user=()
+runner="$accelviz"
+if [ "$(id -u)" -eq 0 ]; then
+  # root writes anywhere: run a copy as nobody where the system has setpriv.
+  if command -v setpriv >/dev/null; then
+    chmod 755 "$tmp" && cp "$accelviz" "$tmp/accelviz-copy" && runner="$tmp/accelviz-copy"
+    as_user=(setpriv --reuid=65534 --regid=65534 --clear-groups)
+  else runner=""; fi
+fi
+if [ -n "$runner" ]; then
+  for args in "render builtin:soup?size=20 --size 8x8 -o $tmp/ro/x.png" \
+    "sweep builtin:soup?size=20 --param buckets=2,4 -o $tmp/ro/sweep" \
+    "sweep builtin:soup?size=20 --param buckets=2,4 -o $tmp/ro/new/deeper"; do
+    # shellcheck disable=SC2086
+    "${as_user[@]}" "$runner" -q $args >/dev/null 2>"$tmp/stderr"
+    rc=$?
+    if [ "$rc" -ne 1 ] || ! grep -qF ": cannot write in $tmp/ro: Permission denied" "$tmp/stderr"; then
+      echo "FAIL: unwritable folder ($args): exit $rc: $(cat "$tmp/stderr")"; fail=1
+    else echo "ok: unwritable folder: $(cat "$tmp/stderr")"; fi
+  done
+fi
+chmod 755 "$tmp/ro"
+
 # Past the file-size limit: the write's error, exit 1, no temporary file left (the signal killed it, 153).
 mkdir "$tmp/fsz"
 (ulimit -f 100; "$accelviz" -q rays 'builtin:soup?size=200' -o "$tmp/fsz/big.rays" --size 400x400 -j 1) \
