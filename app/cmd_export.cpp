@@ -27,10 +27,13 @@ int run_export(const ExportOptions& o, const GlobalOptions& global) {
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
   write_gltf(scene, o.out, binary, o.force);
   // The result goes to stdout whatever -q says (-q silences progress only).
-  std::printf("wrote %s: %s, %s, %s, %s, %s\n", absolute_path(o.out).c_str(),
+  // glTF animations are not written (the nodes at rest): said, not dropped silently.
+  const std::string left_out =
+      scene.animations.empty() ? "" : "; not written: " + count_of(scene.animations.size(), "animation") + " (the nodes at rest)";
+  std::printf("wrote %s: %s, %s, %s, %s, %s%s\n", absolute_path(o.out).c_str(),
               count_of(scene.triangles.size(), "triangle").c_str(), count_of(scene.meshes.size(), "mesh").c_str(),
               count_of(scene.instances.size(), "instance").c_str(), count_of(scene.lights.size(), "light").c_str(),
-              count_of(scene.cameras.size(), "camera").c_str());
+              count_of(scene.cameras.size(), "camera").c_str(), left_out.c_str());
   return 0;
 }
 

@@ -31,6 +31,9 @@ out=$("$accelviz" -q export 'builtin:teapot?size=800' "$tmp/small.glb")
 grep -q "^wrote $tmp/small.glb: 992 triangles, 1 mesh, 1 instance, 1 light, 1 camera$" <<<"$out" || {
   echo "FAIL: export's line: $out"; exit 1
 }
+# Animations are not written, and the line says so (they were dropped without a word).
+out=$("$accelviz" -q export 'builtin:dynamic?size=2000' "$tmp/dynamic.glb")
+grep -q "; not written: 1 animation (the nodes at rest)$" <<<"$out" || { echo "FAIL: export's line: $out"; exit 1; }
 
 # export refuses to overwrite, and names the file.
 if "$accelviz" -q export builtin:teapot "$tmp/teapot.glb" 2>"$tmp/err"; then
