@@ -440,13 +440,48 @@ TEST(Tlas, SingularTransformIsRefused) {
   }
 }
 
+// A scale of 0 on every axis (glTF's way to hide a node, often animated) is
+// no singular transform to refuse: the instance has no surface and is left out
+// of the top level; `animate` stopped at the frame a scale reached 0. The
+// flattened scene's triangles of it are points: no structure hits them.
+TEST(Tlas, AnInstanceScaledToZeroIsHiddenNotRefused) {
+  Scene s = make_instanced_scene(40, 4);
+  const glm::mat4 hidden = glm::scale(glm::translate(glm::mat4(1.0f), {1, 2, 3}), glm::vec3(0.0f));
+  Scene at_zero = s;
+  at_zero.instances[1].transform = hidden;
+  at_zero.flatten();
+  Tlas built(at_zero);
+  EXPECT_TRUE(built.instances()[1].world_bounds.is_empty());
+  const Bvh flat(at_zero.triangles);
+  Comparison c;
+  compare(at_zero, flat, built, make_rays(at_zero, 5000, 8), c);
+  EXPECT_EQ(c.unexplained.load(), 0u) << c.report();
+  // Animated: to 0 and back again, each frame as a fresh build of the same pose.
+  s.flatten();
+  Tlas two(s);
+  std::vector<glm::mat4> pose;
+  for (const Instance& inst : s.instances) pose.push_back(inst.transform);
+  std::vector<glm::mat4> zero = pose;
+  zero[1] = hidden;
+  two.update_transforms(zero);
+  Comparison z;
+  compare(at_zero, flat, two, make_rays(at_zero, 5000, 9), z);
+  EXPECT_EQ(z.unexplained.load(), 0u) << z.report();
+  two.update_transforms(pose);
+  const Bvh again(s.triangles);
+  Comparison back;
+  compare(s, again, two, make_rays(s, 5000, 10), back);
+  EXPECT_EQ(back.unexplained.load(), 0u) << back.report();
+  EXPECT_FALSE(two.instances()[1].world_bounds.is_empty());
+}
+
 // A frame with one bad transform is refused whole: the instances stay where they were.
 TEST(Tlas, ARefusedFrameMovesNoInstance) {
   Scene s = make_instanced_scene(40, 4);
   Tlas two(s);
   std::vector<glm::mat4> moved;
   for (const Instance& inst : s.instances) moved.push_back(glm::translate(glm::mat4(1.0f), {3, 0, 0}) * inst.transform);
-  moved.back() = glm::mat4(0.0f);
+  moved.back() = glm::scale(glm::mat4(1.0f), glm::vec3(1.0f, 0.0f, 1.0f));  // flattened to a plane: singular
   try {
     two.update_transforms(moved);
     ADD_FAILURE() << "a singular transform was taken";

@@ -62,12 +62,25 @@ BvhOptions quiet(BvhOptions o) {
   return o;
 }
 
+/// A transform whose linear part is all zero (a scale of 0 on every axis,
+/// glTF's usual way to hide a node, often animated): every point of the
+/// instance lands on one, it has no surface, and it is left out of the top
+/// level instead of refused as singular (`animate` stopped at the frame a
+/// scale reached 0).
+bool collapses_to_a_point(const glm::mat4& to_world) {
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r)
+      if (to_world[c][r] != 0.0f) return false;
+  return true;
+}
+
 /// Why the two-level structure cannot carry an instance with this transform
 /// ("" when it can): rays go into the instance's space through its inverse.
 std::string transform_problem(const glm::mat4& to_world) {
   for (int c = 0; c < 4; ++c)
     for (int r = 0; r < 4; ++r)
       if (!std::isfinite(to_world[c][r])) return "its transform has a non-finite entry";
+  if (collapses_to_a_point(to_world)) return {};
   // In double: a uniform scale of 1e13 (determinant 1e39) or 1e-16 (1e-48) is no singular transform,
   // though its float determinant overflows or underflows.
   const double det = glm::determinant(glm::dmat3(glm::mat3(to_world)));
@@ -75,7 +88,7 @@ std::string transform_problem(const glm::mat4& to_world) {
     char text[32];
     std::snprintf(text, sizeof text, "%g", det);
     return std::string("its transform is singular (determinant ") + text +
-           ": a scale of 0 flattens it), so rays cannot be carried into its space; the single-level "
+           ": a scale of 0 on one or two axes flattens it), so rays cannot be carried into its space; the single-level "
            "structures (bvh, ...) take the scene";
   }
   return {};
@@ -188,8 +201,15 @@ int Tlas::blas_of_mesh(std::uint32_t mesh) const {
 void Tlas::set_instance_transform(TlasInstance& inst, const glm::mat4& to_world) {
   if (const std::string problem = transform_problem(to_world); !problem.empty())
     throw std::invalid_argument("tlas: " + problem);
-  const float det = glm::determinant(glm::mat3(to_world));
   inst.to_world = to_world;
+  if (collapses_to_a_point(to_world)) {  // hidden: no surface, no box, not in the top level
+    inst.to_object = glm::mat4(0.0f);
+    inst.mirrored = false;
+    inst.normal_to_world = glm::mat3(0.0f);
+    inst.world_bounds = Aabb{};
+    return;
+  }
+  const float det = glm::determinant(glm::mat3(to_world));
   // The inverse in double: nearly singular transforms (a 1e-4 squash) keep
   // their digits.
   const glm::dmat4 inv = glm::inverse(glm::dmat4(to_world));
@@ -200,6 +220,7 @@ void Tlas::set_instance_transform(TlasInstance& inst, const glm::mat4& to_world)
 }
 
 void Tlas::update_world_bounds(TlasInstance& inst) const {
+  if (collapses_to_a_point(inst.to_world)) return;  // hidden: stays without a box
   const Bvh& b = *blas_[inst.blas];
   inst.world_bounds = b.nodes().empty() ? Aabb{} : transform_box(b.nodes()[0].bounds, inst.to_world);
 }
