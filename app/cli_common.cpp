@@ -114,13 +114,14 @@ StructureOptions StructureCli::to_options(unsigned threads, bool compute_epo) co
   return o;
 }
 
-Camera camera_for(const std::string& spec, const Scene& scene, const ImageSize& size) {
+Camera camera_for(const std::string& spec, const Scene& scene, const ImageSize& size, bool has_camera_option) {
   try {
     return camera_from_spec(spec, scene, static_cast<float>(size.width) / static_cast<float>(size.height));
   } catch (const std::invalid_argument& e) {
     throw UsageError(std::string("--camera: ") + e.what());
   } catch (const std::range_error& e) {  // the framing camera of a scene near the float range: not a usage error
-    throw std::runtime_error(scene.source + ": " + e.what() + " (give a camera with --camera)");
+    throw std::runtime_error(scene.source + ": " + e.what() +
+                             (has_camera_option ? " (give a camera with --camera)" : " (this command has no --camera)"));
   }
 }
 

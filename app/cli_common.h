@@ -88,8 +88,10 @@ struct StructureCli {
   StructureOptions to_options(unsigned threads, bool compute_epo) const;
 };
 
-/// camera_from_spec with a bad spec reported as a usage error.
-Camera camera_for(const std::string& spec, const Scene& scene, const ImageSize& size);
+/// camera_from_spec with a bad spec reported as a usage error. A scene no
+/// framing camera can see (near the float range) is a runtime error that
+/// points at --camera where the command has one.
+Camera camera_for(const std::string& spec, const Scene& scene, const ImageSize& size, bool has_camera_option = true);
 
 /// Adds --triangle-test (watertight | fast, the names parse_triangle_test
 /// reads) to `sub`, stored in `value`; `help` replaces the usual help text.

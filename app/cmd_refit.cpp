@@ -52,7 +52,7 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
   require_flattened(scene, o.scene, "refit");
   progress.end(std::to_string(scene.triangles.size()) + " triangles");
   // The camera frames the rest pose; the motion is small against the scene, so it stays framed.
-  const std::vector<Ray> rays = primary_rays(camera_for("", scene, size), size.width, size.height);
+  const std::vector<Ray> rays = primary_rays(camera_for("", scene, size, /*has_camera_option=*/false), size.width, size.height);
 
   RefitDecayOptions opts;
   opts.frames = o.frames;

@@ -157,6 +157,9 @@ printf 'v -3e38 0 0\nv 3e38 0 0\nv 0 3e38 0\nf 1 2 3\n' >"$tmp/huge.obj"
 expect 1 "$tmp/huge.obj: cannot frame the scene: a camera that sees its bounds" -- \
   render "$tmp/huge.obj" --size 8x6 --out "$tmp/huge.png"
 expect 1 "$tmp/huge.obj: cannot frame the scene" -- verify "$tmp/huge.obj" --rays 100
+# refit and calibrate frame the scene themselves: no advice to use an option they do not have.
+expect 1 "would stand beyond the float range (this command has no --camera)" -- refit "$tmp/huge.obj" --out "$tmp/rf"
+expect 1 "would stand beyond the float range (this command has no --camera)" -- calibrate --scene "$tmp/huge.obj"
 [ ! -e "$tmp/huge.png" ] || { echo "FAIL: a PNG of an unframable scene"; fail=1; }
 
 # export: the extension in any case, -f for --force; a name that is only
