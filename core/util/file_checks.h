@@ -15,14 +15,18 @@ namespace accelviz {
 
 /// "" when `path` names a regular file (a symbolic link counts as what it
 /// names) of at most `max_bytes`, its size then in `size`; else the problem,
-/// without the path: "no such file", "is a directory, not a file", "is not a
-/// regular file", "cannot read its size: ...", and for a larger file
+/// without the path: "no such file", "cannot be read: ..." (a loop of
+/// symbolic links, a folder without permission), "is a directory, not a
+/// file", "is not a regular file", "cannot read its size: ...", and for a larger file
 /// `too_large` (a reader's own words for its limit), by default "is larger
 /// than N bytes".
 inline std::string input_file_problem(const std::string& path, std::uintmax_t max_bytes, std::uintmax_t& size,
                                       std::string_view too_large = {}) {
   std::error_code ec;
   const std::filesystem::file_status st = std::filesystem::status(path, ec);
+  // A loop of symbolic links or a folder without search permission read as "no such file".
+  if (ec && ec != std::errc::no_such_file_or_directory && ec != std::errc::not_a_directory)
+    return "cannot be read: " + ec.message();
   if (ec || !std::filesystem::exists(st)) return "no such file";
   if (std::filesystem::is_directory(st)) return "is a directory, not a file";
   if (!std::filesystem::is_regular_file(st)) return "is not a regular file";

@@ -28,7 +28,9 @@ expect() {
 }
 
 # Missing, unsupported and malformed scene files.
-expect 1 "$tmp/none.glb" -- info "$tmp/none.glb"
+expect 1 "$tmp/none.glb: no such file" -- info "$tmp/none.glb"
+ln -s "$tmp/loop.glb" "$tmp/loop.glb"  # a link to itself: it said "no such file"
+expect 1 "$tmp/loop.glb: cannot be read: Too many levels of symbolic links" -- info "$tmp/loop.glb"
 # A control byte in a file name is shown as '?', not sent to the terminal (an ESC recoloured it).
 expect 1 "bad?[31mname.gltf" -- info "$tmp/bad"$'\x1b'"[31mname.gltf"
 if grep -q $'\x1b' "$tmp/stderr"; then echo "FAIL: an ESC reached stderr"; fail=1; fi
