@@ -50,11 +50,33 @@ inline std::string count_of(std::size_t n, std::string_view word) {
 /// control byte shown as '?' (nothing is dropped): the one line `accelviz:`
 /// prints, whatever a file name held.
 inline std::string joined_line(std::string text) {
-  for (char& c : text) {
-    if (c == '\n' || c == '\r' || c == '\t')
+  for (std::size_t i = 0; i < text.size();) {
+    char& c = text[i];
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '\n' || c == '\r' || c == '\t') {
       c = ' ';
-    else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7F)
+    } else if (u < 0x20 || u == 0x7F) {
       c = '?';  // an ESC in a file name recoloured the terminal
+    } else if (u >= 0x80) {
+      // UTF-8 (a file name in any language) is kept; a byte that starts no well-formed sequence
+      // (a binary file's bytes quoted in a JSON error) is '?', not sent to the terminal raw.
+      const std::size_t len = u >= 0xC2 && u <= 0xDF ? 2 : u >= 0xE0 && u <= 0xEF ? 3 : u >= 0xF0 && u <= 0xF4 ? 4 : 0;
+      bool ok = len > 0 && i + len <= text.size();
+      for (std::size_t k = 1; ok && k < len; ++k) ok = (static_cast<unsigned char>(text[i + k]) & 0xC0) == 0x80;
+      if (ok && len == 3) {
+        const auto b1 = static_cast<unsigned char>(text[i + 1]);
+        ok = !(u == 0xE0 && b1 < 0xA0) && !(u == 0xED && b1 >= 0xA0);  // overlong, surrogate
+      } else if (ok && len == 4) {
+        const auto b1 = static_cast<unsigned char>(text[i + 1]);
+        ok = !(u == 0xF0 && b1 < 0x90) && !(u == 0xF4 && b1 >= 0x90);  // overlong, beyond U+10FFFF
+      }
+      if (ok) {
+        i += len;
+        continue;
+      }
+      c = '?';
+    }
+    ++i;
   }
   return text;
 }
