@@ -71,6 +71,14 @@ struct StructureResult {
   std::vector<std::pair<std::string, QueryFigures>> queries;
 };
 
+/// A rate in Mrays/s with two decimals, or three significant digits below
+/// 0.1: a grid's 0.0035 on a stadium read "0.00", as if nothing were traced.
+std::string rate_text(double mrays_per_s) {
+  char text[32];
+  std::snprintf(text, sizeof text, mrays_per_s > 0.0 && mrays_per_s < 0.1 ? "%.3g" : "%.2f", mrays_per_s);
+  return text;
+}
+
 double mrays(std::size_t n, double ms) {
   return ms > 0.0 ? static_cast<double>(n) / (ms * 1e3) : 0.0;
 }
@@ -534,7 +542,8 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
     std::printf("  %-8s %15s %15s %15s %15s %10s %10s\n", "Mrays/s", "closest 1T", closest_nt.c_str(), "any 1T",
                 any_nt.c_str(), "nodes/ray", "prims/ray");
     for (const auto& [set, f] : r.queries) {
-      std::printf("  %-8s %15.2f %15.2f %15.2f %15.2f", set.c_str(), f.closest_1t, f.closest_nt, f.any_1t, f.any_nt);
+      std::printf("  %-8s %15s %15s %15s %15s", set.c_str(), rate_text(f.closest_1t).c_str(),
+                  rate_text(f.closest_nt).c_str(), rate_text(f.any_1t).c_str(), rate_text(f.any_nt).c_str());
       if (has_counters) {
         std::printf(" %10.1f %10.1f\n", f.closest_nodes, f.closest_prims);
       } else {

@@ -116,3 +116,12 @@ assert "sah_constants" not in s["grid"], s["grid"]
 print("bench sah constants ok")' "$tmp/sah.json"
 "$accelviz" -q bench 'builtin:soup?size=2000' --structure kdtree --rays primary --size 8x8 --repeat 1 |
   grep -q ', SAH [0-9.]* (C_trav 1, C_isect 1.5),' || { echo "FAIL: no SAH constants in the text"; exit 1; }
+# A slow structure's rate keeps its digits (a grid on the stadium read "0.00" Mrays/s).
+row=$("$accelviz" -q bench 'builtin:teapot-stadium?size=30000&ratio=1000' -s grid --rays primary --size 8x6 \
+  --repeat 1 -j 1 | grep '^  primary  *0')
+python3 -c '
+import sys
+tokens = sys.argv[1].split()[1:5]
+assert all(float(x) > 0 for x in tokens), sys.argv[1]
+assert all(float(x) >= 0.1 or len(x.replace(".", "").lstrip("0")) >= 2 for x in tokens), sys.argv[1]
+print("bench slow rates ok")' "$row"
