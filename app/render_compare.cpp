@@ -221,6 +221,7 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
   side_co[0].scale_note = "scale shared with B";
   side_co[1].title_prefix = "B: ";
   side_co[1].scale_note = "scale shared with A";
+  for (int s = 0; s < 2; ++s) side_co[s].structure = side[s]->structure;
   RgbImage rgb[2] = {colorize(images[0], side_co[0]), colorize(images[1], side_co[1])};
   std::string uncounted;
   for (int s = 0; s < 2; ++s)

@@ -340,6 +340,7 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
   panels::ViewInfo vi;
   if (const BuiltStructure* b = app_.current().get()) {
     vi.node_kind = b->nodes.kind();
+    vi.structure = b->accel->name();
     if (!b->accel->inspectable()) vi.uncounted = b->accel->name();
     vi.max_depth = b->nodes.max_depth();
     vi.node_count = b->nodes.size();

@@ -205,6 +205,9 @@ RenderView SceneView::render_view(const AppState& app) const {
   h.range_min = v.scale_min;
   h.range_max = v.scale_max;
   h.show_legend = v.show_legend;
+  // The legend in the traced structure's words: a grid's nodes are cells.
+  if (heatmap_frame_ && heatmap_frame_->request.structure && heatmap_frame_->request.structure->accel)
+    h.title = metric_short_label(heatmap_frame_->image.metric, heatmap_frame_->request.structure->accel->name());
   return r;
 }
 

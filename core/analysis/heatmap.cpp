@@ -68,6 +68,36 @@ std::string_view metric_label(HeatMetric m) {
   return "";
 }
 
+namespace {
+
+/// What `structure` calls the nodes it visits, where not "nodes".
+std::string_view node_word(std::string_view structure) {
+  if (structure == "grid") return "cells";
+  if (structure == "voxels") return "octants";
+  return {};
+}
+
+}  // namespace
+
+std::string metric_label(HeatMetric m, std::string_view structure) {
+  const std::string_view word = node_word(structure);
+  if (m != HeatMetric::nodes || word.empty()) return std::string(metric_label(m));
+  return std::string(word) + " visited per ray";
+}
+
+std::string metric_short_label(HeatMetric m, std::string_view structure) {
+  const std::string_view word = node_word(structure);
+  if (m != HeatMetric::nodes || word.empty()) return std::string(metric_short_label(m));
+  return std::string(word);
+}
+
+std::string metric_not_counted(HeatMetric m, std::string_view structure) {
+  if (m == HeatMetric::prims && structure == "voxels") return "the sparse voxels test no triangles (a hit is a voxel)";
+  if (m == HeatMetric::instances && !structure.empty() && structure != "tlas")
+    return "only a two-level structure (tlas) enters instances";
+  return "";
+}
+
 std::optional<HeatMetric> parse_metric(std::string_view name) {
   for (HeatMetric m : {HeatMetric::nodes, HeatMetric::prims, HeatMetric::cost, HeatMetric::shaded, HeatMetric::depth,
                        HeatMetric::instances})
@@ -569,7 +599,8 @@ RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
   if (legend == LegendPlacement::bottom) extra_h = pad + glyph_h + pad + bar + tick + s + glyph_h + pad;
   if (legend == LegendPlacement::right)
     extra_w =
-        std::max(pad + bar + tick + 3 * s + widest + pad, text_width(metric_short_label(image.metric), s) + 2 * pad);
+        std::max(pad + bar + tick + 3 * s + widest + pad,
+                 text_width(metric_short_label(image.metric, opts.structure), s) + 2 * pad);
 
   const glm::u8vec3 panel(24, 24, 24), ink(235, 235, 235);
   RgbImage out;  // every pixel written below: the heatmap's rows on all threads, then the legend's
@@ -606,7 +637,8 @@ RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
     const std::string note = !opts.scale_note.empty() ? "  (" + opts.scale_note + ")"
                              : opts.max > 0.0f        ? std::string("  (fixed max)")
                                                       : std::string();
-    const std::string label(metric_label(image.metric)), short_label(metric_short_label(image.metric));
+    const std::string label = metric_label(image.metric, opts.structure),
+                      short_label = metric_short_label(image.metric, opts.structure);
     std::string title = opts.title_prefix + short_label;
     for (const std::string& t : {opts.title_prefix + label + note, opts.title_prefix + short_label + note})
       if (text_width(t, s) <= out.width - 2 * pad) {
@@ -640,7 +672,7 @@ RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
     }
   } else if (legend == LegendPlacement::right) {
     const int x0 = w + pad;
-    draw_text(out, x0, pad, metric_short_label(image.metric), ink, s);
+    draw_text(out, x0, pad, metric_short_label(image.metric, opts.structure), ink, s);
     const int yt = pad + glyph_h + pad + glyph_h / 2;
     const int yb = std::max(yt + 1, h - 1 - pad - glyph_h / 2);
     for (int y = yt; y <= yb; ++y) {

@@ -33,6 +33,16 @@ std::string_view metric_label(HeatMetric m);  ///< legend title, e.g. "nodes vis
 /// A narrow legend's title: the name, but "distance" for `depth` (the hit's
 /// t, not a tree depth).
 std::string_view metric_short_label(HeatMetric m);
+/// The same on `structure`, in its own words where the metric counts what it
+/// calls otherwise: a grid's nodes visited are cells ("cells visited per
+/// ray", "cells"), the sparse voxels' are octants; "" or any other structure:
+/// the metric's own words.
+std::string metric_label(HeatMetric m, std::string_view structure);
+std::string metric_short_label(HeatMetric m, std::string_view structure);
+/// Why `structure` leaves the counter metric `m` at 0 on every ray by its
+/// nature ("" when it counts it): the sparse voxels test no triangles (a hit
+/// is a voxel), only the two-level structure enters instances.
+std::string metric_not_counted(HeatMetric m, std::string_view structure);
 std::optional<HeatMetric> parse_metric(std::string_view name);
 /// Whether the metric needs per-ray counters (a slower, instrumented pass).
 bool metric_needs_stats(HeatMetric m);
@@ -154,6 +164,7 @@ struct ColorizeOptions {
   /// (the short label, then no note) until it fits the image's width.
   std::string title_prefix;  ///< e.g. "A: " for one side of an A/B pair
   std::string scale_note;    ///< e.g. "scale shared with B"
+  std::string structure;     ///< the structure traced: the title in its words (metric_label); "" generic
 };
 
 /// The smallest and largest finite value of `image` (both 0 when it has none).

@@ -202,6 +202,34 @@ TEST(Heatmap, FixedMaxClampsAndBackgroundForMisses) {
   EXPECT_FLOAT_EQ(heatmap_scale_max(img, 0.0f), 4.0f);
 }
 
+// A grid's "nodes visited" are the cells it steps through, the sparse voxels'
+// the octants: the legend says so; other structures keep the metric's words.
+// Metrics a structure cannot count by its nature say why.
+TEST(Heatmap, LegendTitlesInTheStructuresWords) {
+  EXPECT_EQ(metric_label(HeatMetric::nodes, "grid"), "cells visited per ray");
+  EXPECT_EQ(metric_short_label(HeatMetric::nodes, "grid"), "cells");
+  EXPECT_EQ(metric_label(HeatMetric::nodes, "voxels"), "octants visited per ray");
+  EXPECT_EQ(metric_label(HeatMetric::nodes, "bvh"), "nodes visited per ray");
+  EXPECT_EQ(metric_label(HeatMetric::nodes, ""), "nodes visited per ray");
+  EXPECT_EQ(metric_label(HeatMetric::prims, "grid"), "primitive tests per ray");
+  EXPECT_EQ(metric_short_label(HeatMetric::depth, "grid"), "distance");
+  MetricImage img;
+  img.width = 320;
+  img.height = 48;
+  img.values.assign(320 * 48, 3.0f);
+  ColorizeOptions co;
+  const RgbImage generic = colorize(img, co);
+  co.structure = "bvh";
+  EXPECT_EQ(colorize(img, co).pixels, generic.pixels);
+  co.structure = "grid";
+  EXPECT_NE(colorize(img, co).pixels, generic.pixels) << "the grid's legend title is its own";
+  EXPECT_EQ(metric_not_counted(HeatMetric::prims, "voxels"), "the sparse voxels test no triangles (a hit is a voxel)");
+  EXPECT_EQ(metric_not_counted(HeatMetric::instances, "bvh"), "only a two-level structure (tlas) enters instances");
+  EXPECT_EQ(metric_not_counted(HeatMetric::instances, "tlas"), "");
+  EXPECT_EQ(metric_not_counted(HeatMetric::nodes, "voxels"), "");
+  EXPECT_EQ(metric_not_counted(HeatMetric::prims, "grid"), "");
+}
+
 TEST(Heatmap, LegendPlacements) {
   MetricImage img;
   img.width = 64;

@@ -551,9 +551,9 @@ bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout
     v.metric = static_cast<HeatMetric>(metric);
     changed = true;
   }
-  if (v.metric == HeatMetric::instances && info.node_kind != "tlas") {
+  if (const std::string why = metric_not_counted(v.metric, info.structure); !why.empty()) {
     ImGui::PushTextWrapPos(0.0f);
-    ImGui::TextDisabled("only a two-level structure (tlas) enters instances: this one shows 0 everywhere");
+    ImGui::TextDisabled("%s: this metric is 0 everywhere", why.c_str());
     ImGui::PopTextWrapPos();
   } else if (metric_needs_stats(v.metric) && !info.uncounted.empty()) {
     ImGui::PushTextWrapPos(0.0f);

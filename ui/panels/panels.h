@@ -61,6 +61,7 @@ void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const Pa
 // ---- View ------------------------------------------------------------------------------
 struct ViewInfo {
   std::string node_kind;  ///< StructureNodes::kind() ("" when the structure has none)
+  std::string structure;  ///< the shown structure's name ("" before one is built)
   std::string uncounted;  ///< the structure's name when it counts nothing per ray (embree), else ""
   std::uint32_t max_depth = 0;
   std::uint64_t node_count = 0;
