@@ -148,12 +148,17 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
         "(`accelviz animate` plays %s)\n",
         o.motion.c_str(), count_of(scene.animations.size(), "animation").c_str(),
         scene.animations.size() == 1 ? "is" : "are", scene.animations.size() == 1 ? "it" : "them");
-  std::printf("%6s %8s %10s %10s %10s %10s %8s %12s %12s %8s\n", "frame", "refits", "refit ms", "build ms", "SAH refit",
-              "SAH fresh", "ratio", "nodes refit", "nodes fresh", "rebuilt");
+  std::printf("%6s %8s %10s %10s %10s %10s %8s %16s %16s %8s\n", "frame", "refits", "refit ms", "build ms", "SAH refit",
+              "SAH fresh", "ratio", "refit nodes/ray", "fresh nodes/ray", "rebuilt");
   for (const RefitFrame& f : r.frames)
-    std::printf("%6d %8d %10.3f %10.3f %10.3f %10.3f %8.3f %12.2f %12.2f %8s\n", f.frame, f.refits_since_build,
+    std::printf("%6d %8d %10.3f %10.3f %10.3f %10.3f %8.3f %16.2f %16.2f %8s\n", f.frame, f.refits_since_build,
                 f.refit_ms, f.rebuild_ms, f.sah_refit, f.sah_fresh, f.ratio, f.nodes_per_ray_refit,
                 f.nodes_per_ray_fresh, f.rebuilt ? "yes" : "");
+  std::printf("refits: of the tree in use since it was built; ratio: SAH refit / SAH fresh; nodes/ray: nodes visited "
+              "per primary ray%s\n",
+              o.rebuild_ratio > 0.0 ? "; rebuilt: the ratio passed --rebuild-ratio, so the fresh tree replaced the "
+                                      "refitted one this row measured (the next frame refits it)"
+                                    : "");
   std::printf("rebuilds: %d; wrote %s\n", r.rebuilds, absolute_path(o.out).c_str());
   return 0;
 }

@@ -127,6 +127,12 @@ grep -q "motion: synthetic explode motion from the rest pose (frame 0; the scene
 "$accelviz" -q refit 'builtin:dynamic?size=1200' --frames 1 --size 16x12 -j 1 --out "$tmp/refit2" > "$tmp/refit2.txt"
 grep -q "the scene's own [0-9]* animations* \(is\|are\) not played here" "$tmp/refit2.txt" ||
   { echo "FAIL: refit on an animated scene: $(cat "$tmp/refit2.txt")"; exit 1; }
+# The table's key: what refits, ratio and nodes/ray count; with --rebuild-ratio, what a rebuilt row holds.
+grep -q "^refits: of the tree in use since it was built; ratio: SAH refit / SAH fresh; nodes/ray: nodes visited per primary ray$" \
+  "$tmp/refit1.txt" || { echo "FAIL: refit's key: $(cat "$tmp/refit1.txt")"; exit 1; }
+"$accelviz" -q refit 'builtin:teapot?size=300' --frames 1 --size 16x12 -j 1 --rebuild-ratio 1 --out "$tmp/refit3" |
+  grep -q "; rebuilt: the ratio passed --rebuild-ratio, so the fresh tree replaced the refitted one this row measured" ||
+  { echo "FAIL: refit's key with --rebuild-ratio"; exit 1; }
 python3 -c '
 import json, sys
 j = json.load(open(sys.argv[1]))
