@@ -255,11 +255,16 @@ void InsightViews::draw(AppState& app, const panels::PanelLayout& layout, std::o
 
   // A click in the 3D view: the leaf its hit lies in becomes the selection
   // (its path opens in the tree, which scrolls to it). The ray is cast again
-  // when another structure is shown, so a click's selection follows it.
+  // when another structure is shown, so a click's selection follows it, but
+  // only while the view still shows that selection: boxes chosen meanwhile
+  // (a box mode set while the build ran) are the user's, not overridden.
   if (app.inspection_version() != inspection_seen_) {
     inspection_seen_ = app.inspection_version();
     const auto& insp = app.inspection();
-    if (insight_state_.click_selects_leaf && insp && app.current())
+    const ViewSettings& v = app.config().view;
+    const bool still_shown = selection_of_ != nullptr && v.show_boxes && v.box_mode == BoxMode::subtree &&
+                             v.box_node == static_cast<int>(selected_id_);
+    if (insight_state_.click_selects_leaf && insp && app.current() && (!app.inspection_recast() || still_shown))
       if (const auto leaf = hit_leaf(insp->trace, insp->hit, app.current()->nodes)) {
         select(app, *leaf);
         insight_state_.region.reset();

@@ -773,6 +773,20 @@ TEST_F(GuiScript, AClicksSelectionFollowsTheStructureShown) {
   EXPECT_EQ(brute["box-mode"], "leaves") << "nothing to select: the box view before the click";
 }
 
+// A box mode chosen while the next structure builds is the user's: the click's
+// ray, cast again on the new build, no longer puts the view back to its leaf
+// (it did: `box-mode depth` set before the grid was built was lost).
+TEST_F(GuiScript, ABoxModeSetDuringARebuildIsNotOverriddenByTheClick) {
+  const RunResult r = run(std::string("open ") + kTeapot + "\nsize 320 240\ncamera " + kCamera +
+                          "\nwait\nclick 160 120\nwait\ndump-stats " + path("before.json").string() +
+                          "\nstructure kdtree\nset box-mode depth\nwait\ndump-stats " + path("after.json").string() +
+                          "\nscreenshot " + path("kd.png").string() + "\nquit\n");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(read_json(path("kd.json"))["options"]["box-mode"], "depth");
+  EXPECT_EQ(read_json(path("after.json"))["structure"], "kdtree");
+  EXPECT_GT(read_json(path("after.json"))["boxes"]["drawn"].get<int>(), 1) << "the depth's boxes, not one leaf";
+}
+
 // A node id typed into the subtree mode says what it names in the structure
 // shown, and, once another build is shown, that it was set in an earlier one
 // (node ids are per build) until an id is set again (the same one too).

@@ -342,6 +342,7 @@ std::string AppState::cast_ray(int x, int y) {
   inspection_ = inspect_pixel(*current_, camera(), x, y, view_w_, view_h_, config().structure.query);
   inspected_query_ = config().structure.query;
   ++inspection_version_;
+  inspection_recast_ = false;
   replay_step_ = inspection_->trace.steps.empty() ? 0 : inspection_->trace.steps.size() - 1;
   return {};
 }
@@ -351,6 +352,7 @@ void AppState::recast() {
   inspection_ = inspect_ray(*current_, *inspection_, config().structure.query);
   inspected_query_ = config().structure.query;
   ++inspection_version_;
+  inspection_recast_ = true;
   replay_step_ = inspection_->trace.steps.empty() ? 0 : inspection_->trace.steps.size() - 1;
 }
 

@@ -134,6 +134,9 @@ class AppState {
   const std::optional<RayInspection>& inspection() const { return inspection_; }
   /// Changes whenever the inspection is cast, re-cast or cleared (for redraws).
   std::uint64_t inspection_version() const { return inspection_version_; }
+  /// Whether the last change to the inspection was a re-cast of the same ray
+  /// (another structure, other query options), not a click.
+  bool inspection_recast() const { return inspection_recast_; }
   std::size_t replay_step() const { return replay_step_; }
   /// Moves the replay to `step` (clamped to the trace).
   void set_replay_step(std::size_t step);
@@ -207,6 +210,7 @@ class AppState {
   QueryOptions inspected_query_;  ///< the query options inspection_ was cast with
   std::size_t replay_step_ = 0;
   std::uint64_t inspection_version_ = 0;
+  bool inspection_recast_ = false;
 
   std::string error_, message_;
   std::vector<std::string> new_errors_;
