@@ -927,7 +927,9 @@ class GltfConverter {
       return -1;
     }
     const double yfov = gc.perspective.yfov;
-    if (!(yfov > 0.0 && yfov < 3.14159265358979)) {
+    // In float, as it is kept: 3.14159265 rounds to float's pi, a 180-degree view whose tan(yfov/2)
+    // is negative.
+    if (!(yfov > 0.0 && static_cast<float>(yfov) < static_cast<float>(3.14159265358979))) {
       warn(name + " has an invalid yfov " + std::to_string(yfov) + "; skipped");
       return -1;
     }
@@ -951,7 +953,12 @@ class GltfConverter {
     }
     cam.up = up / ulen;
     cam.yfov = float(yfov);
-    cam.aspect = gc.perspective.aspectRatio > 0.0 ? float(gc.perspective.aspectRatio) : 0.0f;
+    // aspectRatio is optional (0 when absent: the view's own); a negative, non-finite or absurd one
+    // is said and the view's used.
+    const double aspect = gc.perspective.aspectRatio;
+    if (aspect != 0.0 && !(aspect >= 1e-4 && aspect <= 1e4))
+      warn(name + " has an invalid aspectRatio " + std::to_string(aspect) + "; the view's own is used");
+    cam.aspect = aspect >= 1e-4 && aspect <= 1e4 ? float(aspect) : 0.0f;
     scene_.cameras.push_back(cam);
     return int(scene_.cameras.size() - 1);
   }

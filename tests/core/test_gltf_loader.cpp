@@ -539,6 +539,31 @@ TEST_F(GltfLoader, PerspectiveCameraConvertedToWorldSpace) {
   EXPECT_TRUE(warned);
 }
 
+// A yfov that rounds to float's pi (3.14159265) is a 180-degree view: tan(yfov/2) came out
+// negative and the camera was taken. An aspectRatio that is negative or absurd was dropped without
+// a word; it is said, and the view's own aspect is used.
+TEST_F(GltfLoader, CameraYfovOfPiInFloatAndBadAspectRatiosAreSaid) {
+  GltfBuilder b = one_triangle();
+  b.doc["cameras"] = json::array({json{{"type", "perspective"}, {"perspective", {{"yfov", 3.14159265}, {"znear", 0.1}}}},
+                                  json{{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"aspectRatio", -2.0}, {"znear", 0.1}}}},
+                                  json{{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"aspectRatio", 1e30}, {"znear", 0.1}}}}});
+  const int c0 = b.node({{"camera", 0}, {"translation", {0, 0, 5}}});
+  const int c1 = b.node({{"camera", 1}, {"translation", {0, 0, 5}}});
+  const int c2 = b.node({{"camera", 2}, {"translation", {0, 0, 5}}});
+  b.scene({0, c0, c1, c2});
+  const Scene s = load_gltf(write_gltf(b));
+  ASSERT_EQ(s.cameras.size(), 2u) << "the 180-degree one is skipped";
+  for (const Camera& c : s.cameras) EXPECT_EQ(c.aspect, 0.0f) << "the view's own aspect";
+  const auto said = [&](const std::string& part) {
+    for (const std::string& w : s.report.warnings)
+      if (w.find(part) != std::string::npos) return true;
+    return false;
+  };
+  EXPECT_TRUE(said("camera 0 (node 1) has an invalid yfov 3.14159"));
+  EXPECT_TRUE(said("camera 1 (node 2) has an invalid aspectRatio -2.000000; the view's own is used"));
+  EXPECT_TRUE(said("camera 2 (node 3) has an invalid aspectRatio"));
+}
+
 TEST_F(GltfLoader, PunctualLightsConvertedToWorldSpace) {
   GltfBuilder b = one_triangle();
   b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
