@@ -59,11 +59,11 @@ void StructureCli::add_to(CLI::App* app, bool with_embree) {
       ->capture_default_str()
       ->group("Structure");
   app->add_option("--ctrav", ctrav, "SAH cost of visiting an inner node (C_trav)")
-      ->check(finite_positive())
+      ->check(cost_constant())
       ->capture_default_str()
       ->group("Structure");
   app->add_option("--cisect", cisect, "SAH cost of one ray-triangle test (C_isect)")
-      ->check(finite_positive())
+      ->check(cost_constant())
       ->capture_default_str()
       ->group("Structure");
   app->add_option("--wide", wide,
@@ -170,6 +170,19 @@ CLI::Validator finite_positive() {
         return {};
       },
       "POSITIVE");
+}
+
+CLI::Validator cost_constant() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        double v = 0.0;
+        if (!option_number(text, v)) return "expected a number, got '" + text + "'";
+        // At most the GUI's 1e6: only the ratio of the two matters to a build, and 3e38 overflowed the
+        // cost metric (the cost of a ray read inf).
+        if (!std::isfinite(v) || !(v > 0.0) || v > 1e6) return "must be a number > 0 and at most 1e6, got " + text;
+        return {};
+      },
+      "(0 - 1e6]");
 }
 
 CLI::Validator finite_range(double lo, double hi) {

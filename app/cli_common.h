@@ -107,6 +107,8 @@ inline constexpr unsigned kMaxThreads = 1024;
 /// through, and word the positive range as "0.000000 to 1797693...".)
 CLI::Validator finite_positive();
 CLI::Validator finite_range(double lo, double hi);
+/// A C_trav or C_isect: > 0 and at most 1e6, as the GUI's fields.
+CLI::Validator cost_constant();
 
 /// `--threads,-j N` (0: all hardware threads), checked to 0..kMaxThreads.
 CLI::Option* add_threads_option(CLI::App* sub, unsigned& value, const char* help);

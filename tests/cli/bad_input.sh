@@ -62,8 +62,10 @@ expect 2 "--threads: Value 100000 not in range 0 to 1024" -- bench 'builtin:soup
 expect 2 "--threads" -- render 'builtin:soup?size=10' --out "$tmp/y.png" -j 4294967295
 # Floating-point options: NaN, infinity and overflow are refused, in words
 # (CLI11's own checks let nan through and printed 0.000000 to 1797693...).
-expect 2 "--ctrav: must be a finite number > 0, got nan" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --ctrav nan
-expect 2 "--cisect: must be a finite number > 0, got 1e308" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --cisect 1e308
+expect 2 "--ctrav: must be a number > 0 and at most 1e6, got nan" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --ctrav nan
+expect 2 "--cisect: must be a number > 0 and at most 1e6, got 1e308" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --cisect 1e308
+# At most the GUI's 1e6: 3e38 overflowed the cost metric (a ray's cost read inf).
+expect 2 "--ctrav: must be a number > 0 and at most 1e6, got 3e38" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --ctrav 3e38 -m cost
 expect 2 "--max nan: expected a finite number above 0, or pNN for a percentile (p99)" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --max nan
 expect 2 "--max p0: a percentile is p followed by a number above 0 and at most 100" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --max p0
 expect 2 "--max p99: a percentile top is for the heatmap view" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --max p99 --view raster
