@@ -98,7 +98,9 @@ Command add_animate_command(CLI::App& parent, const GlobalOptions& global) {
       "animate", "Play a scene's motion on the two-level structure: per-frame TLAS rebuild, BLAS refit/rebuild, SAH");
   sub->add_option("SCENE", o->scene, "Scene file (.gltf, .glb, .obj) or builtin:NAME[?key=value&...]")->required();
   sub->add_option("--frames", o->frames, "Frames to play")->check(CLI::Range(1, 100000))->capture_default_str();
-  sub->add_option("--dt", o->dt, "Seconds between frames")->capture_default_str();
+  // At most 1e4 s: 3e38 overflowed the frames' times (a transform of inf), 1e30 lost every step to
+  // float's rounding (nothing moved).
+  sub->add_option("--dt", o->dt, "Seconds between frames")->check(finite_range(1e-6, 1e4))->capture_default_str();
   sub->add_option("--rebuild-ratio", o->rebuild_ratio,
                   "Rebuild a deforming BLAS when refit SAH / fresh SAH exceeds this (0: always refit)")
       ->capture_default_str();

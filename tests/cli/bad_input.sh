@@ -64,6 +64,8 @@ expect 2 "--threads" -- render 'builtin:soup?size=10' --out "$tmp/y.png" -j 4294
 # (CLI11's own checks let nan through and printed 0.000000 to 1797693...).
 expect 2 "--ctrav: must be a number > 0 and at most 1e6, got nan" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --ctrav nan
 expect 2 "--cisect: must be a number > 0 and at most 1e6, got 1e308" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --cisect 1e308
+# animate --dt: 3e38 overflowed the frames' times (a transform of inf), 1e30 moved nothing.
+expect 2 "--dt: must be a number from 1e-06 to 10000, got 3e38" -- animate 'builtin:dynamic?size=2000' --frames 3 --dt 3e38
 # At most the GUI's 1e6: 3e38 overflowed the cost metric (a ray's cost read inf).
 expect 2 "--ctrav: must be a number > 0 and at most 1e6, got 3e38" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --ctrav 3e38 -m cost
 expect 2 "--max nan: expected a finite number above 0, or pNN for a percentile (p99)" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --max nan
