@@ -1,5 +1,6 @@
 #include "core/query/ray_file.h"
 
+#include <algorithm>
 #include <bit>
 #include <cerrno>
 #include <cmath>
@@ -128,6 +129,13 @@ std::vector<Ray> read_rays(const std::string& path) {
     if (std::isinf(o.x) || std::isinf(o.y) || std::isinf(o.z)) fail(path, where + "infinite origin");
     if (std::isinf(d.x) || std::isinf(d.y) || std::isinf(d.z)) fail(path, where + "infinite direction");
     if (d.x == 0.0f && d.y == 0.0f && d.z == 0.0f) fail(path, where + "zero direction");
+    // Distances along a direction this short overflow float (t = distance / length): the structures
+    // disagreed on such a ray, a miss in some and a hit at t = inf in others.
+    if (std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)}) < kMinRayDirection) {
+      char text[128];
+      std::snprintf(text, sizeof text, "direction (%g, %g, %g) is shorter than %g", d.x, d.y, d.z, kMinRayDirection);
+      fail(path, where + text + ": distances along it overflow float");
+    }
     if (std::isnan(tmin) || std::isnan(tmax)) fail(path, where + "NaN in tmin/tmax");
     if (tmin > tmax)
       fail(path, where + "tmin > tmax (" + std::to_string(tmin) + " > " + std::to_string(tmax) + ")");

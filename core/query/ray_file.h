@@ -19,6 +19,10 @@
 
 namespace accelviz {
 
+/// A ray file's direction needs a component of at least this magnitude:
+/// distances along a shorter one overflow float (t = distance / length).
+inline constexpr float kMinRayDirection = 1e-30f;
+
 /// Every ray-file error; the message is one line, "<file>: <problem>".
 class RayFileError : public std::runtime_error {
  public:
