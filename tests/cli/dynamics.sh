@@ -120,6 +120,10 @@ for ids in "0,,1" "0," "x" "99999" "2-1"; do
   [ $rc -eq 2 ] || { echo "FAIL: flatten --instances $ids: exit $rc, expected 2"; exit 1; }
   grep -q -- "--instances" <<<"$msg" || { echo "FAIL: message should name --instances: $msg"; exit 1; }
 done
+# An id too large for any scene is said as such (it read "not a range LO-HI with LO <= HI").
+msg=$("$accelviz" flatten 'builtin:forest?size=2000' --instances 0-99999999999 2>&1) && exit 1
+grep -q -- "--instances: '0-99999999999' has an id beyond 4294967295, the largest there can be" <<<"$msg" ||
+  { echo "FAIL: a too-large id: $msg"; exit 1; }
 # refit's motion is its own: it says so, for a static scene and for an animated one alike.
 "$accelviz" -q refit 'builtin:teapot?size=300' --frames 1 --size 16x12 -j 1 --out "$tmp/refit1" > "$tmp/refit1.txt"
 grep -q "motion: synthetic explode motion from the rest pose (frame 0; the scene itself is static)" "$tmp/refit1.txt" ||

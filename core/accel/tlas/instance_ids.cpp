@@ -21,6 +21,13 @@ bool parse_u32(std::string_view s, std::uint32_t& out) {
   return true;
 }
 
+/// Digits only, but more than an id holds: said as such, not as bad syntax.
+bool too_large(std::string_view s) {
+  std::uint32_t v = 0;
+  return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; }) &&
+         !parse_u32(s, v);
+}
+
 struct IdRange {
   std::uint32_t lo = 0, hi = 0;
   bool all = false;
@@ -52,6 +59,9 @@ std::vector<IdRange> parse_id_ranges(std::string_view text) {
     const std::size_t dash = item.find('-');
     if (item == "all") {
       r.all = true;
+    } else if (too_large(item.substr(0, dash)) ||
+               (dash != std::string_view::npos && too_large(item.substr(dash + 1)))) {
+      throw std::invalid_argument("instances: '" + r.text + "' has an id beyond 4294967295, the largest there can be");
     } else if (dash == std::string_view::npos) {
       if (!parse_u32(item, r.lo))
         throw std::invalid_argument("instances: '" + r.text + "' is not an instance id (expected e.g. 0,2,5-9 or all)");
