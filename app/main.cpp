@@ -124,7 +124,12 @@ int run(int argc, char** argv) {
     std::fprintf(stderr, "accelviz: cancelled\n");
     return 1;
   } catch (const std::bad_alloc&) {
-    std::fprintf(stderr, "accelviz: out of memory\n");
+    // Which file and options asked for it: the command line, cut to one line.
+    std::string args;
+    for (int i = 1; i < argc; ++i) args += (i > 1 ? " " : "") + std::string(argv[i]);
+    if (args.size() > 200) args = args.substr(0, 197) + "...";
+    std::fprintf(stderr, "accelviz: out of memory running '%s' (a smaller scene, size or ray count needs less)\n",
+                 joined_line(args).c_str());
     return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "accelviz: %s\n", joined_line(e.what()).c_str());
