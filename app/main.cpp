@@ -86,6 +86,16 @@ int run(int argc, char** argv) {
   }
 
   try {
+    // An option given an empty value (`--camera ""`: a variable that was not set) is a usage error,
+    // not the option's default taken in silence.
+    for (const cli::Command& c : commands) {
+      if (!c.app->parsed()) continue;
+      for (const CLI::Option* opt : c.app->get_options())
+        if (opt->count() > 0 && opt->get_items_expected_min() > 0)
+          for (const std::string& value : opt->results())
+            if (value.empty())
+              throw cli::UsageError(opt->get_name() + ": an empty value (leave the option out for its default)");
+    }
     for (const cli::Command& c : commands)
       if (c.app->parsed()) return c.run();
     if (!scene_arg.empty() && !looks_like_scene(scene_arg)) {

@@ -28,9 +28,12 @@ VerifyCounts& VerifyCounts::operator+=(const VerifyCounts& o) {
 std::vector<VerifyStructure> parse_verify_structures(const std::string& list, unsigned threads) {
   std::vector<std::string> names;
   std::stringstream ss(list);
-  for (std::string item; std::getline(ss, item, ',');)
-    if (!item.empty()) names.push_back(item);
-  if (names.empty()) throw std::invalid_argument("--structure: empty list");
+  for (std::string item; std::getline(ss, item, ',');) names.push_back(item);
+  if (!list.empty() && list.back() == ',') names.emplace_back();
+  if (list.empty()) throw std::invalid_argument("--structure: empty list");
+  // An empty item is a typo ("bvh,,kdtree"), as in the GUI's instance lists: said, not skipped.
+  if (std::find(names.begin(), names.end(), std::string()) != names.end())
+    throw std::invalid_argument("--structure: an empty item in '" + list + "'");
   std::vector<VerifyStructure> out;
   auto add = [&](const std::string& label, const std::string& factory, BvhSplitter splitter = BvhSplitter::binned_sah,
                  bool named = false) {

@@ -181,7 +181,12 @@ expect 2 "$tmp/x.obj: the output's name must end in .glb or .gltf" -- export 'bu
 expect 1 "$tmp/no/dir/a.png" -- render 'builtin:soup?size=10' --out "$tmp/no/dir/a.png"
 
 # A folder the user cannot write in is refused before the work (it failed after it), as is an empty name.
-expect 1 "the output folder's name is empty" -- sweep 'builtin:soup?size=20' --param buckets=2,4 -o ""
+expect 2 "--out: an empty value (leave the option out for its default)" -- sweep 'builtin:soup?size=20' --param buckets=2,4 -o ""
+# An empty value is a usage error, not the default taken in silence (a shell variable that was not set).
+expect 2 "--camera: an empty value" -- render 'builtin:soup?size=20' --camera "" -o "$tmp/e.png"
+expect 2 "--max: an empty value" -- render 'builtin:soup?size=20' --max "" -o "$tmp/e.png"
+expect 2 "--structure: an empty value" -- robustness 'builtin:soup?size=20' -s ""
+expect 2 "--structure: an empty item in 'bvh,,kdtree'" -- verify 'builtin:soup?size=20' -s bvh,,kdtree
 mkdir "$tmp/ro" && chmod 555 "$tmp/ro"
 as_user=()
 runner="$accelviz"
