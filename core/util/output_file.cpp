@@ -55,7 +55,12 @@ OutputWrite write_output_file(const std::string& path, std::initializer_list<std
   // temporary lies in its folder (rename stays in one file system).
   fs::path target = path;
   if (present && fs::is_symlink(link_status)) {
-    target = fs::weakly_canonical(path, ec);
+    // Through the link's own text: weakly_canonical of a dangling link stops at the link itself, and
+    // the rename replaced the link with a file.
+    fs::path dest = fs::read_symlink(path, ec);
+    if (ec) return fail("cannot follow the link: " + ec.message());
+    if (dest.is_relative()) dest = fs::path(path).parent_path() / dest;
+    target = fs::weakly_canonical(dest, ec);
     if (ec) return fail("cannot follow the link: " + ec.message());
   }
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");

@@ -73,6 +73,17 @@ TEST_F(OutputFile, OverwritingThroughALinkReplacesTheFileItNames) {
   EXPECT_EQ(read_file(path("real.json")), "new");
 }
 
+// With overwrite, a dangling link is followed too: the file it names is made
+// and the link stays (the link itself was replaced by a regular file).
+TEST_F(OutputFile, OverwritingThroughADanglingLinkMakesTheFileItNames) {
+  fs::create_directories(path("sub"));
+  fs::create_symlink("sub/made.json", path("dangling.json"));
+  const OutputWrite w = write_output_file(path("dangling.json"), {"new"}, true);
+  ASSERT_TRUE(w.ok()) << w.problem;
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(path("dangling.json"))));
+  EXPECT_EQ(read_file(path("sub/made.json")), "new");
+}
+
 // What lies beside the target under the names a writer might have used for
 // its temporary (export used OUT.part: a link there made it overwrite the
 // file the link named, a FIFO there made it hang) is never opened.
