@@ -1245,6 +1245,14 @@ GlbLayout check_glb(const std::string& path, const std::vector<unsigned char>& d
 std::vector<std::string> precheck_json(const std::string& path, const unsigned char* text, std::size_t length) {
   JsonPrecheck sax;
   const char* begin = reinterpret_cast<const char*>(text);
+  // The parser stops at a NUL byte as at the end: what follows one was never read (junk after it was
+  // accepted, though junk after the JSON itself is an error). NUL padding at the end is let be.
+  if (const void* nul = std::memchr(begin, '\0', length)) {
+    const std::size_t at = static_cast<std::size_t>(static_cast<const char*>(nul) - begin);
+    for (std::size_t i = at; i < length; ++i)
+      if (begin[i] != '\0' && begin[i] != ' ' && begin[i] != '\n' && begin[i] != '\r' && begin[i] != '\t')
+        fail_file(path, "malformed JSON: a NUL byte at offset " + std::to_string(at) + " with more after it");
+  }
   nlohmann::json::sax_parse(begin, begin + length, &sax);
   if (!sax.error.empty()) fail_file(path, sax.error);
   for (const std::string& ext : sax.required)

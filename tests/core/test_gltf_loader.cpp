@@ -794,6 +794,11 @@ TEST_F(GltfLoader, MalformedJson) {
   std::string text = one_triangle().gltf_text();
   write_file(dir_ / "bad.gltf", text.substr(0, text.size() / 2));
   expect_error(path("bad.gltf"), "malformed JSON");
+  // The parser stops at a NUL as at the end: junk after one was accepted. NUL padding is let be.
+  write_file(dir_ / "nul.gltf", text + std::string(1, '\0') + "junk");
+  expect_error(path("nul.gltf"), "malformed JSON: a NUL byte at offset " + std::to_string(text.size()) + " with more after it");
+  write_file(dir_ / "padded.gltf", text + std::string(3, '\0'));
+  EXPECT_EQ(load_gltf(path("padded.gltf")).triangles.size(), 1u);
   write_file(dir_ / "empty.gltf", "");
   expect_error(path("empty.gltf"), "empty file");
   write_file(dir_ / "array.gltf", "[1, 2, 3]");
