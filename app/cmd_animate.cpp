@@ -4,6 +4,7 @@
 // the instance overlap of the frame's instance boxes).
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 #include <memory>
 
 #include "app/cli_common.h"
@@ -64,9 +65,20 @@ int run_animate(const AnimateOptions& o, const GlobalOptions& global) {
   if (!fx.per_frame_updates.on) still.overlap = instance_overlap(tlas);
   for (int f = 0; f < o.frames; ++f) {
     FrameStats s = still;
-    if (fx.per_frame_updates.on)
-      s = animator.step(static_cast<float>(f * o.dt));
-    else
+    if (fx.per_frame_updates.on) {
+      try {
+        s = animator.step(static_cast<float>(f * o.dt));
+      } catch (const std::invalid_argument& e) {
+        // Which file and which moment: "tlas: instance 3: ..." alone named neither.
+        // The advice to take a single-level structure is for the views that can; animate cannot.
+        std::string what = e.what();
+        if (const std::size_t cut = what.find("; the single-level structures"); cut != std::string::npos)
+          what = what.substr(0, cut) + " (animate plays the two-level structure only)";
+        char when[64];
+        std::snprintf(when, sizeof when, "frame %d (t = %g s): ", f, f * o.dt);
+        throw std::runtime_error(o.scene + ": " + when + what);
+      }
+    } else
       s.time = static_cast<float>(f * o.dt);
     if (o.json) {
       print_json_line({{"frame", f},

@@ -156,4 +156,29 @@ grep -q "no mesh is instanced twice (two-level off): tlas holds its 1 instance" 
   { echo "FAIL: no single-level note: $(cat "$tmp/lv3.err")"; exit 1; }
 "$accelviz" -q render 'builtin:forest?size=2000' --size 16x12 -j 1 --out "$tmp/lv4.png" 2> "$tmp/lv4.err" > /dev/null
 [ ! -s "$tmp/lv4.err" ] || { echo "FAIL: -q printed: $(cat "$tmp/lv4.err")"; exit 1; }
+# A frame whose transform flattens an instance stops animate with the file, the frame and its time
+# ("tlas: instance 0: ..." alone named neither). A glTF whose node 0's y scale steps to 0 at t = 0.5.
+python3 - "$tmp/flat.gltf" <<'PY'
+import base64, json, struct, sys
+pos = struct.pack('<9f', 0,0,0, 1,0,0, 0,1,0)
+times = struct.pack('<3f', 0.0, 0.5, 1.0)
+scales = struct.pack('<9f', 1,1,1, 1,0,1, 1,0,1)
+buf = pos + times + scales
+doc = {
+ "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+ "nodes": [{"mesh": 0, "name": "flattened"}, {"mesh": 0, "translation": [3, 0, 0]}],
+ "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+ "buffers": [{"byteLength": len(buf), "uri": "data:application/octet-stream;base64," + base64.b64encode(buf).decode()}],
+ "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 12},
+                 {"buffer": 0, "byteOffset": 48, "byteLength": 36}],
+ "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]},
+               {"bufferView": 1, "componentType": 5126, "count": 3, "type": "SCALAR", "min": [0], "max": [1]},
+               {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC3"}],
+ "animations": [{"samplers": [{"input": 1, "output": 2, "interpolation": "STEP"}],
+                 "channels": [{"sampler": 0, "target": {"node": 0, "path": "scale"}}]}]}
+json.dump(doc, open(sys.argv[1], "w"))
+PY
+msg=$("$accelviz" -q animate "$tmp/flat.gltf" --frames 4 --dt 0.25 -j 1 2>&1 >/dev/null) && { echo "FAIL: animate went on"; exit 1; }
+grep -q "^accelviz: $tmp/flat.gltf: frame 2 (t = 0.5 s): tlas: instance 0: its transform is singular .* (animate plays the two-level structure only)$" <<<"$msg" ||
+  { echo "FAIL: animate's singular frame: $msg"; exit 1; }
 echo "dynamics cli ok"
