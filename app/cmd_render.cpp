@@ -12,6 +12,7 @@
 #include "app/render_raster.h"
 #include "core/accel/bvh/bvh.h"
 #include "core/accel/tlas/tlas.h"
+#include "core/analysis/caption.h"
 #include "core/analysis/heatmap.h"
 #include "core/query/camera.h"
 #include "core/scene/load.h"
@@ -56,7 +57,49 @@ struct RenderOptions {
   std::string ray_camera;         ///< the camera --ray-pixel's ray is cast from ("": the view's, --camera)
   std::string device = "cpu";     ///< where the heatmap's rays are traced: cpu, gpu (compute shader, bvh only)
   std::optional<std::string> gl;  ///< --device gpu's context: auto (default: EGL on a GPU, else OSMesa), egl, osmesa
+  std::string caption = "auto";   ///< the strip under the heatmap: auto (render_caption), none, or this text
 };
+
+std::string short_number(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", x);
+  return text;
+}
+
+/// What the heatmap shows, as the command that draws it: the scene, the
+/// structure, the metric, the size and every option that differs from its
+/// default (not the output, the colours or the threads): on the picture, so
+/// that a heatmap pasted into a lecture or a bug report still says what it is.
+std::string render_caption(const RenderOptions& o) {
+  const RenderOptions d;
+  const StructureCli& s = o.structure_opts;
+  const StructureCli& ds = d.structure_opts;
+  std::string c = "accelviz render " + o.scene + " -s " + o.structure + " -m " + o.metric + " --size " + o.size;
+  const auto add = [&c](bool differs, const std::string& text) {
+    if (differs) c += " " + text;
+  };
+  add(!o.camera.empty(), "--camera " + o.camera);
+  add(o.triangle_test != d.triangle_test, "--triangle-test " + o.triangle_test);
+  add(o.order != d.order, "--order " + o.order);
+  add(o.xray, "--xray");
+  add(!o.max_text.empty(), "--max " + o.max_text);
+  add(o.device != d.device, "--device " + o.device);
+  if (o.structure == "bvh" || o.structure == "tlas") {
+    add(s.splitter != ds.splitter, "--splitter " + s.splitter);
+    add(s.buckets != ds.buckets, "--buckets " + std::to_string(s.buckets));
+    add(s.leaf != ds.leaf, "--leaf " + std::to_string(s.leaf));
+    add(s.leaf_cap != ds.leaf_cap, "--leaf-cap " + std::to_string(s.leaf_cap));
+  }
+  if (o.structure == "bvh" || o.structure == "tlas" || o.metric == "cost") {
+    add(s.ctrav != ds.ctrav, "--ctrav " + short_number(s.ctrav));
+    add(s.cisect != ds.cisect, "--cisect " + short_number(s.cisect));
+  }
+  if (o.structure == "embree") {
+    add(s.embree_quality != ds.embree_quality, "--embree-quality " + s.embree_quality);
+    add(s.embree_robust, "--embree-robust");
+  }
+  return c;
+}
 
 /// --ray-pixel "X,Y".
 std::pair<int, int> parse_pixel(const std::string& text) {
@@ -245,7 +288,11 @@ int run_render(const RenderOptions& given, const GlobalOptions& global) {
     throw UsageError(
         "--depth, --depth-last, --leaves, --ray-pixel, --ray-camera, --blend and --wireframe need --view raster");
   nlohmann::json figures;
-  const RgbImage rgb = render_job(o, global, figures);
+  RgbImage rgb = render_job(o, global, figures);
+  if (o.caption != "none") {
+    figures["caption"] = o.caption == "auto" ? render_caption(o) : o.caption;
+    rgb = add_caption(rgb, figures["caption"].get<std::string>());
+  }
   write_png(o.out, rgb, o.force);
   const std::string abs = absolute_path(o.out);
   figures["out"] = abs;
@@ -355,6 +402,10 @@ Command add_render_command(CLI::App& parent, const GlobalOptions& global) {
                   "--device gpu's headless OpenGL context: auto (the default: EGL on a GPU when the machine has "
                   "one, else OSMesa), egl (EGL on a device: a GPU, else Mesa's software device), osmesa (llvmpipe)")
       ->check(CLI::IsMember({"auto", "egl", "osmesa"}));
+  sub->add_option("--caption", o->caption,
+                  "heatmap: a strip under the picture that says what it shows: auto (the command line that draws it: "
+                  "scene, structure, metric, size and every option not at its default), none, or this text")
+      ->capture_default_str();
   o->structure_opts.add_to(sub);
   return {sub, [o, &global] { return run_render(*o, global); }};
 }
@@ -365,7 +416,8 @@ int run_demo(const GlobalOptions& global) {
   o.structure = "bvh";
   o.metric = "nodes";
   nlohmann::json figures;
-  const RgbImage rgb = render_job(o, global, figures);
+  const RgbImage rgb = add_caption(render_job(o, global, figures), render_caption(o));
+  figures["caption"] = render_caption(o);  // the command that draws the same picture
   const std::string abs = absolute_path(write_unique_demo_png(rgb));
   figures["out"] = abs;
   std::cout << "No display: rendered the demo heatmap to " << abs << "\n" << abs << "\n";

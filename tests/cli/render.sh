@@ -15,8 +15,10 @@ import json, struct, sys
 png = open(sys.argv[1], "rb").read()
 assert png[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
 w, h = struct.unpack(">II", png[16:24])
-assert w == 64 and h > 48, (w, h)  # legend below the 64x48 picture
+assert w == 64 and h > 48, (w, h)  # legend and caption below the 64x48 picture
 j = json.loads(sys.argv[2])
+# The caption is the command that draws the picture (the options not at their default too).
+assert j["caption"] == "accelviz render builtin:teapot?size=2000 -s bvh -m nodes --size 64x48", j["caption"]
 for k in ["mean", "max", "render_ms", "rays_per_s", "build_ms", "rays", "out"]:
     assert k in j, k
 assert j["rays"] == 64 * 48 and j["max"] >= j["mean"] > 0
@@ -48,4 +50,19 @@ import json, sys
 j = json.load(sys.stdin)
 assert 0 < j["scale_max"] < j["max"], j
 print("--max p90 ok")'
+# The caption: every option not at its default, in the picture's own strip; none leaves it out; a text of one's own.
+cap=$("$accelviz" -q render "$scene" --size 40x30 --out "$tmp/c1.png" --max 10 --camera 0,5,20,0,0,0,30 \
+  --triangle-test fast --splitter median --buckets 8 --order unordered | sed -n 2p |
+  python3 -c 'import json, sys; print(json.load(sys.stdin)["caption"])')
+[ "$cap" = "accelviz render $scene -s bvh -m nodes --size 40x30 --camera 0,5,20,0,0,0,30 --triangle-test fast --order unordered --max 10 --splitter median --buckets 8" ] ||
+  { echo "FAIL: caption: $cap"; exit 1; }
+"$accelviz" -q render "$scene" --size 40x30 --out "$tmp/c2.png" --caption none >/dev/null
+"$accelviz" -q render "$scene" --size 40x30 --out "$tmp/c3.png" --caption "fig. 3: the teapot" >/dev/null
+"$accelviz" -q render "$scene" --size 40x30 --out "$tmp/c4.png" >/dev/null
+python3 - "$tmp" <<'PY'
+import struct, sys
+h = lambda n: struct.unpack(">II", open(f"{sys.argv[1]}/{n}.png", "rb").read()[16:24])[1]
+assert h("c2") < h("c3") and h("c2") < h("c4"), (h("c2"), h("c3"), h("c4"))
+print("caption ok")
+PY
 echo "render ok"

@@ -2,6 +2,7 @@
 // Screenshot files: where they go, what they are called, the caption line
 // drawn under the picture and the JSON side-car that says how to reproduce
 // it. GL-free: the GUI hands over the frame it read back from the renderer.
+#include "core/analysis/caption.h"
 #include "core/analysis/heatmap.h"
 #include "core/scene/scene.h"
 #include "ui/app/app_config.h"
@@ -68,19 +69,7 @@ struct ScreenshotInfo {
 /// its side-car.
 std::string screenshot_caption(const ScreenshotInfo& info);
 
-/// At most this many caption lines under a screenshot.
-inline constexpr int kCaptionMaxLines = 4;
-
-/// `text` in lines of at most `max_chars`, each broken after its last space
-/// that fits (mid-word only when none does), at most `max_lines` of them:
-/// the last one cut with ".." when the text goes on.
-std::vector<std::string> wrap_caption(const std::string& text, int max_chars, int max_lines);
-
-/// The frame with a caption strip below it: screenshot_caption(info),
-/// lower-cased, in the 5×7 font of core's legends, wrapped to the width in
-/// up to kCaptionMaxLines lines (wrap_caption).
-RgbImage add_caption(const RgbImage& frame, const std::string& caption);
-
+// wrap_caption, add_caption and kCaptionMaxLines: core/analysis/caption.h (render's captions too).
 /// The side-car object (documented in docs/gui.md): scene, camera, size,
 /// structure and options, query choices, heatmap settings and range, every
 /// option, the caption, and the `accelviz render` and `accelviz --script`
