@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 
+#include "core/analysis/caption.h"
 #include "core/analysis/heatmap.h"
 #include "core/analysis/insight/compare_images.h"
 #include "core/query/batch.h"
@@ -235,11 +236,39 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
   RgbImage rgb_diff = colorize_difference(shown_diff, 0.0f, co.legend);
   if (!uncounted.empty())
     draw_note(rgb_diff, "n/a: " + uncounted + " counts nothing per ray, so no difference compares");
+  // Captions: which side, its structure and the options the two differ in, the scene and the metric (the
+  // images said only "A: cost" and "B: cost", not buckets=32 against 4).
+  std::string caption_a, caption_b, caption_diff;
+  {
+    const nlohmann::json da = describe_side(*side[0], metric), db = describe_side(*side[1], metric);
+    std::string differs;
+    for (const auto& [key, value] : da.items())
+      if (key != "structure" && db.contains(key) && db[key] != value)
+        differs += (differs.empty() ? "" : ", ") + key + " " + value.dump() + " -> " + db[key].dump();
+    const auto caption = [&](const nlohmann::json& d, const char* name) {
+      std::string c = std::string(name) + ": " + d["structure"].get<std::string>();
+      for (const auto& [key, value] : d.items())
+        if (key != "structure" && (!da.contains(key) || !db.contains(key) || da[key] != db[key]))
+          c += " " + key + "=" + value.dump();
+      return c + "; " + job.scene + ", " + job.metric + ", " + job.size;
+    };
+    std::erase(differs, '"');
+    caption_a = caption(da, "A");
+    caption_b = caption(db, "B");
+    std::erase(caption_a, '"');
+    std::erase(caption_b, '"');
+    caption_diff = "B - A (" + (differs.empty() ? std::string("no option differs") : differs) + "); " + job.scene +
+                   ", " + job.metric + ", " + job.size;
+    rgb[0] = add_caption(rgb[0], caption_a);
+    rgb[1] = add_caption(rgb[1], caption_b);
+    rgb_diff = add_caption(rgb_diff, caption_diff);
+  }
   write_png(paths.a, rgb[0], job.force);
   write_png(paths.b, rgb[1], job.force);
   write_png(paths.diff, rgb_diff, job.force);
 
   nlohmann::json figures = sides;
+  figures["captions"] = {{"a", caption_a}, {"b", caption_b}, {"diff", caption_diff}};
   figures["scene"] = job.scene;
   figures["metric"] = job.metric;
   figures["width"] = size.width;
