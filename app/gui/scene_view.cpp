@@ -165,12 +165,9 @@ void SceneView::upload_ray(const AppState& app) {
   }
   RayPath path = make_ray_path(insp->ray, insp->hit, built->scene->scene.bounds());
   const ReplayState r = replay_upto(insp->trace, app.replay_step());
-  for (std::uint32_t id : r.entered)
+  // The current step's node last, in the "last visit" colour (replay_box_ids).
+  for (std::uint32_t id : replay_box_ids(insp->trace, app.replay_step()))
     if (const auto b = built->nodes.box(id)) path.visited.push_back(*b);
-  // The node of the current step goes last, so it gets the "last visit"
-  // colour even when that step is a miss or a cull.
-  if (r.current_node && (r.entered.empty() || r.entered.back() != *r.current_node))
-    if (const auto b = built->nodes.box(*r.current_node)) path.visited.push_back(*b);
   // Voxel "primitives" are voxels, not triangles: nothing to highlight.
   if (built->nodes.kind() != "voxels") {
     const std::size_t n = built->scene->scene.triangles.size();

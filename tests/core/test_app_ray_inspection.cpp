@@ -125,6 +125,14 @@ TEST(AppRayInspection, ReplayWalksTheTraceInOrder) {
   EXPECT_EQ(s.tested, (std::vector<std::uint32_t>{7, 4})) << "each primitive once, in first-test order";
   s = replay_upto(t, 100);
   EXPECT_EQ(s.current_node, 5u);
+  // The boxes drawn: a missed node last while it is the current step; at the walk's end the last node
+  // entered, not the sibling culled after the hit (it read as the last box visited).
+  EXPECT_EQ(replay_box_ids(t, 1), (std::vector<std::uint32_t>{0, 2}));
+  EXPECT_EQ(replay_box_ids(t, 5), (std::vector<std::uint32_t>{0, 1}));
+  EXPECT_EQ(replay_box_ids(t, 6), (std::vector<std::uint32_t>{0, 1}));
+  VisitTrace shorter = t;
+  shorter.steps.push_back({Kd::prim_miss, 8, kInfinity, kInfinity});
+  EXPECT_EQ(replay_box_ids(shorter, 6), (std::vector<std::uint32_t>{0, 1, 5})) << "a cull stepped to is drawn";
 }
 
 TEST(AppRayInspection, JsonListsHitStepsAndShadows) {

@@ -121,6 +121,15 @@ ReplayState replay_upto(const VisitTrace& trace, std::size_t upto) {
   return s;
 }
 
+std::vector<std::uint32_t> replay_box_ids(const VisitTrace& trace, std::size_t step) {
+  const ReplayState r = replay_upto(trace, step);
+  std::vector<std::uint32_t> ids = r.entered;
+  const bool at_end = step + 1 >= trace.steps.size();
+  if (!at_end && r.current_node && (r.entered.empty() || r.entered.back() != *r.current_node))
+    ids.push_back(*r.current_node);
+  return ids;
+}
+
 nlohmann::json inspection_json(const RayInspection& r, std::size_t replay_step) {
   nlohmann::json steps = nlohmann::json::array();
   std::size_t entered = 0, prim_tests = 0;

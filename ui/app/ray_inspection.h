@@ -58,6 +58,13 @@ struct ReplayState {
 };
 ReplayState replay_upto(const VisitTrace& trace, std::size_t upto);
 
+/// The nodes whose boxes the view draws for the replay at `step`, in order,
+/// the last one in the current step's colour: those entered so far, then
+/// the current step's node when it was missed or culled, except at the
+/// trace's last step, where the last node entered stays the current one (a
+/// sibling culled after the hit, drawn last, read as the last box visited).
+std::vector<std::uint32_t> replay_box_ids(const VisitTrace& trace, std::size_t step);
+
 /// dump-ray's document: pixel, ray, hit (or null), stats, trace steps with
 /// kind/id/t_entry/t_exit (inf written as null), the shadow rays, and the
 /// replay position.
