@@ -198,6 +198,22 @@ std::vector<Triangle> floor_and_wall() {
           {{5, 0, -3}, {5, 6, -3}, {-5, 6, -3}}};
 }
 
+/// floor_and_wall seen from above and in front: its triangles, a w x h image's primary rays and their hits.
+struct FloorAndWallView {
+  std::vector<Triangle> tris = floor_and_wall();
+  std::vector<Ray> primary;
+  std::vector<Hit> hits;
+};
+
+FloorAndWallView floor_and_wall_view(int w, int h, unsigned threads) {
+  FloorAndWallView v;
+  const BruteForce accel(v.tris);
+  v.primary = primary_rays(look_at({1, 3, 9}, {0, 1, -3}, 0.9f), w, h);
+  v.hits.resize(v.primary.size());
+  trace_closest(accel, v.primary, v.hits, {}, threads);
+  return v;
+}
+
 }  // namespace
 
 TEST(RaySets, PrimaryRaysAreRowMajorFromTopLeft) {
@@ -209,11 +225,8 @@ TEST(RaySets, PrimaryRaysAreRowMajorFromTopLeft) {
 }
 
 TEST(RaySets, DiffuseRaysLeaveTheSurfaceOnTheCameraSideAndAreSeeded) {
-  const std::vector<Triangle> tris = floor_and_wall();
+  const auto [tris, primary, hits] = floor_and_wall_view(32, 24, 2u);
   const BruteForce accel(tris);
-  const std::vector<Ray> primary = primary_rays(look_at({1, 3, 9}, {0, 1, -3}, 0.9f), 32, 24);
-  std::vector<Hit> hits(primary.size());
-  trace_closest(accel, primary, hits, {}, 2u);
   const std::size_t hit_count = std::count_if(hits.begin(), hits.end(), [](const Hit& h) { return h.valid(); });
   ASSERT_GT(hit_count, 100u);
 
@@ -281,11 +294,7 @@ TEST(RaySets, SecondaryRaysOfATinySceneAreThoseOfAUnitScene) {
 }
 
 TEST(RaySets, ShadowRaysGoToLightsInFrontOfTheSurface) {
-  const std::vector<Triangle> tris = floor_and_wall();
-  const BruteForce accel(tris);
-  const std::vector<Ray> primary = primary_rays(look_at({1, 3, 9}, {0, 1, -3}, 0.9f), 16, 12);
-  std::vector<Hit> hits(primary.size());
-  trace_closest(accel, primary, hits, {}, 1u);
+  const auto [tris, primary, hits] = floor_and_wall_view(16, 12, 1u);
   Light point;
   point.position = {0, 4, 0};  // above the floor, in front of the wall
   Light below;
@@ -331,11 +340,7 @@ TEST(RaySets, ShadowRaysGoToLightsInFrontOfTheSurface) {
 // A light farther than about 1.8e19 squared its distance past float's range: its shadow rays were
 // dropped, none at all, as if it lit nothing. Up to float's largest finite distance each lit hit has one.
 TEST(RaySets, ShadowRaysReachAVeryFarLight) {
-  const std::vector<Triangle> tris = floor_and_wall();
-  const BruteForce accel(tris);
-  const std::vector<Ray> primary = primary_rays(look_at({1, 3, 9}, {0, 1, -3}, 0.9f), 16, 12);
-  std::vector<Hit> hits(primary.size());
-  trace_closest(accel, primary, hits, {}, 1u);
+  const auto [tris, primary, hits] = floor_and_wall_view(16, 12, 1u);
   Light near_light, far_light;
   near_light.position = {0.0f, 4.0f, 1.0f};
   far_light.position = glm::normalize(glm::vec3(0.0f, 4.0f, 1.0f)) * 1e38f;
