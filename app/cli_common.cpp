@@ -3,9 +3,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -120,8 +120,9 @@ Camera camera_for(const std::string& spec, const Scene& scene, const ImageSize& 
   } catch (const std::invalid_argument& e) {
     throw UsageError(std::string("--camera: ") + e.what());
   } catch (const std::range_error& e) {  // the framing camera of a scene near the float range: not a usage error
-    throw std::runtime_error(scene.source + ": " + e.what() +
-                             (has_camera_option ? " (give a camera with --camera)" : " (this command has no --camera)"));
+    throw std::runtime_error(
+        scene.source + ": " + e.what() +
+        (has_camera_option ? " (give a camera with --camera)" : " (this command has no --camera)"));
   }
 }
 
@@ -276,7 +277,8 @@ void check_output_dir(const std::string& dir, const std::string& prefix, bool fo
   const fs::path p(dir);
   if (dir.empty()) throw std::runtime_error("the output folder's name is empty");
   if (fs::exists(p, ec) && !fs::is_directory(p, ec)) throw std::runtime_error(dir + ": exists and is not a directory");
-  if (const std::string problem = unwritable_folder(p); !problem.empty()) throw std::runtime_error(dir + ": " + problem);
+  if (const std::string problem = unwritable_folder(p); !problem.empty())
+    throw std::runtime_error(dir + ": " + problem);
   if (!fs::is_directory(p, ec)) return;
   for (const auto& e : fs::directory_iterator(p, ec))
     if (is_output_file(e.path(), prefix))
@@ -316,7 +318,8 @@ void check_output_path(const std::string& path, bool force) {
   if (!force && fs::exists(p, ec)) throw std::runtime_error(path + ": exists (use --force to overwrite)");
   const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
   if (!fs::is_directory(dir, ec)) throw std::runtime_error(path + ": directory " + dir.string() + " does not exist");
-  if (const std::string problem = unwritable_folder(dir); !problem.empty()) throw std::runtime_error(path + ": " + problem);
+  if (const std::string problem = unwritable_folder(dir); !problem.empty())
+    throw std::runtime_error(path + ": " + problem);
 }
 
 std::string absolute_path(const std::string& path) {

@@ -4,8 +4,8 @@
 // the instance overlap of the frame's instance boxes).
 #include <cmath>
 #include <cstdio>
-#include <stdexcept>
 #include <memory>
+#include <stdexcept>
 
 #include "app/cli_common.h"
 #include "core/accel/tlas/tlas.h"

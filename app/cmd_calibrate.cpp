@@ -62,7 +62,8 @@ int run_calibrate(const CalibrateCliOptions& o, const GlobalOptions& global) {
     const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
     require_flattened(scene, o.scene, "calibrate --scene");
     progress.end(count_of(scene.triangles.size(), "triangle"));
-    const std::vector<Ray> rays = primary_rays(camera_for("", scene, size, /*has_camera_option=*/false), size.width, size.height);
+    const std::vector<Ray> rays =
+        primary_rays(camera_for("", scene, size, /*has_camera_option=*/false), size.width, size.height);
     progress.begin("BVH with the default and the calibrated constants");
     report = compare_calibrated_bvh(scene.triangles, rays, c, q, o.threads, o.repeat);
     progress.end();

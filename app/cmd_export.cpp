@@ -29,7 +29,9 @@ int run_export(const ExportOptions& o, const GlobalOptions& global) {
   // The result goes to stdout whatever -q says (-q silences progress only).
   // glTF animations are not written (the nodes at rest): said, not dropped silently.
   const std::string left_out =
-      scene.animations.empty() ? "" : "; not written: " + count_of(scene.animations.size(), "animation") + " (the nodes at rest)";
+      scene.animations.empty()
+          ? ""
+          : "; not written: " + count_of(scene.animations.size(), "animation") + " (the nodes at rest)";
   std::printf("wrote %s: %s, %s, %s, %s, %s%s\n", absolute_path(o.out).c_str(),
               count_of(scene.triangles.size(), "triangle").c_str(), count_of(scene.meshes.size(), "mesh").c_str(),
               count_of(scene.instances.size(), "instance").c_str(), count_of(scene.lights.size(), "light").c_str(),

@@ -52,7 +52,8 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
   require_flattened(scene, o.scene, "refit");
   progress.end(std::to_string(scene.triangles.size()) + " triangles");
   // The camera frames the rest pose; the motion is small against the scene, so it stays framed.
-  const std::vector<Ray> rays = primary_rays(camera_for("", scene, size, /*has_camera_option=*/false), size.width, size.height);
+  const std::vector<Ray> rays =
+      primary_rays(camera_for("", scene, size, /*has_camera_option=*/false), size.width, size.height);
 
   RefitDecayOptions opts;
   opts.frames = o.frames;
@@ -154,11 +155,12 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
     std::printf("%6d %8d %10.3f %10.3f %10.3f %10.3f %8.3f %16.2f %16.2f %8s\n", f.frame, f.refits_since_build,
                 f.refit_ms, f.rebuild_ms, f.sah_refit, f.sah_fresh, f.ratio, f.nodes_per_ray_refit,
                 f.nodes_per_ray_fresh, f.rebuilt ? "yes" : "");
-  std::printf("refits: of the tree in use since it was built; ratio: SAH refit / SAH fresh; nodes/ray: nodes visited "
-              "per primary ray%s\n",
-              o.rebuild_ratio > 0.0 ? "; rebuilt: the ratio passed --rebuild-ratio, so the fresh tree replaced the "
-                                      "refitted one this row measured (the next frame refits it)"
-                                    : "");
+  std::printf(
+      "refits: of the tree in use since it was built; ratio: SAH refit / SAH fresh; nodes/ray: nodes visited "
+      "per primary ray%s\n",
+      o.rebuild_ratio > 0.0 ? "; rebuilt: the ratio passed --rebuild-ratio, so the fresh tree replaced the "
+                              "refitted one this row measured (the next frame refits it)"
+                            : "");
   std::printf("rebuilds: %d; wrote %s\n", r.rebuilds, absolute_path(o.out).c_str());
   return 0;
 }

@@ -251,7 +251,8 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
   RgbImage rgb = colorize(img, co);
   // All 0 because nothing was counted, not because nothing was visited: the image says so itself.
   if (metric_needs_stats(metric) && !counters) draw_note(rgb, "n/a: " + accel->name() + " counts nothing per ray");
-  else if (const std::string why = metric_not_counted(metric, o.structure); !why.empty()) draw_note(rgb, "n/a: " + why);
+  else if (const std::string why = metric_not_counted(metric, o.structure); !why.empty())
+    draw_note(rgb, "n/a: " + why);
   return rgb;
 }
 

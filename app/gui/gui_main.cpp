@@ -772,8 +772,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       if (r && !r->error.empty()) {  // the last job failed: say so
         doc = flatten_result_json(*r, flatten_spec_of(*r));
       } else {
-        if (!flatten_prediction_)
-          throw std::runtime_error("no flatten prediction yet (run flatten IDS first)");
+        if (!flatten_prediction_) throw std::runtime_error("no flatten prediction yet (run flatten IDS first)");
         doc = flatten_result_json(*flatten_prediction_, flatten_prediction_spec_);
         // A commit of that prediction since: the merged scene it opened.
         if (r && r->kind == FlattenRequest::Kind::commit && r->committed &&

@@ -2,6 +2,14 @@
 // The one place that turns a structure name ("bvh", "brute", "embree", ...)
 // and its options into a built accelerator, for the command line, the
 // benchmarks and the GUI alike.
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
 #include "core/accel/accel.h"
 #include "core/accel/brute_force.h"
 #include "core/accel/bvh/bvh.h"
@@ -11,14 +19,6 @@
 #include "core/accel/octree/octree.h"
 #include "core/accel/tlas/tlas.h"
 #include "core/accel/voxels/voxels.h"
-
-#include <memory>
-#include <optional>
-#include <span>
-#include <string>
-#include <string_view>
-#include <utility>
-#include <vector>
 
 namespace accelviz {
 

@@ -598,9 +598,8 @@ RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
   int extra_w = 0, extra_h = 0;
   if (legend == LegendPlacement::bottom) extra_h = pad + glyph_h + pad + bar + tick + s + glyph_h + pad;
   if (legend == LegendPlacement::right)
-    extra_w =
-        std::max(pad + bar + tick + 3 * s + widest + pad,
-                 text_width(metric_short_label(image.metric, opts.structure), s) + 2 * pad);
+    extra_w = std::max(pad + bar + tick + 3 * s + widest + pad,
+                       text_width(metric_short_label(image.metric, opts.structure), s) + 2 * pad);
 
   const glm::u8vec3 panel(24, 24, 24), ink(235, 235, 235);
   RgbImage out;  // every pixel written below: the heatmap's rows on all threads, then the legend's

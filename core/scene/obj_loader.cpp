@@ -34,9 +34,9 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <span>
 #include <sstream>
 #include <string>
-#include <span>
 #include <string_view>
 #include <vector>
 
@@ -276,10 +276,10 @@ ObjScan scan_obj(const std::string& path, const std::string& text) {
     }
     // The statements of the OBJ specification (Wavefront, version 3.0) that are not read above.
     static constexpr std::string_view kKnown[] = {
-        "vt",    "vn",       "vp",       "o",          "g",         "s",     "mg",    "mtllib", "usemtl",
-        "maplib", "usemap",  "lod",      "bevel",      "c_interp",  "d_interp", "shadow_obj", "trace_obj",
-        "ctech", "stech",    "cstype",   "deg",        "bmat",      "step",  "parm",  "trim",   "hole",
-        "scrv",  "sp",       "end",      "con",        "call",      "csh"};
+        "vt",        "vn",     "vp",     "o",      "g",     "s",        "mg",       "mtllib",
+        "usemtl",    "maplib", "usemap", "lod",    "bevel", "c_interp", "d_interp", "shadow_obj",
+        "trace_obj", "ctech",  "stech",  "cstype", "deg",   "bmat",     "step",     "parm",
+        "trim",      "hole",   "scrv",   "sp",     "end",   "con",      "call",     "csh"};
     if (tok[0] == "curv" || tok[0] == "curv2" || tok[0] == "surf") {
       if (scan.free_form++ == 0) scan.first_free_form = "line " + std::to_string(line_number) + " " + quoted(tok[0]);
     } else if (std::find(std::begin(kKnown), std::end(kKnown), tok[0]) == std::end(kKnown)) {
@@ -462,8 +462,7 @@ Scene load_obj(const std::string& path) {
     // The statements it ignored may be why (`F 1 2 3` on every face line).
     std::string also;
     for (const std::string& w : scene.report.warnings)
-      if (w.find("a statement OBJ does not have") != std::string::npos || w.starts_with("free-form"))
-        also += "; " + w;
+      if (w.find("a statement OBJ does not have") != std::string::npos || w.starts_with("free-form")) also += "; " + w;
     obj_fail(path, no_triangles_message(scene.report) + also);
   }
   cap_warnings(scene.report);

@@ -544,9 +544,10 @@ TEST_F(GltfLoader, PerspectiveCameraConvertedToWorldSpace) {
 // a word; it is said, and the view's own aspect is used.
 TEST_F(GltfLoader, CameraYfovOfPiInFloatAndBadAspectRatiosAreSaid) {
   GltfBuilder b = one_triangle();
-  b.doc["cameras"] = json::array({json{{"type", "perspective"}, {"perspective", {{"yfov", 3.14159265}, {"znear", 0.1}}}},
-                                  json{{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"aspectRatio", -2.0}, {"znear", 0.1}}}},
-                                  json{{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"aspectRatio", 1e30}, {"znear", 0.1}}}}});
+  b.doc["cameras"] = json::array(
+      {json{{"type", "perspective"}, {"perspective", {{"yfov", 3.14159265}, {"znear", 0.1}}}},
+       json{{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"aspectRatio", -2.0}, {"znear", 0.1}}}},
+       json{{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"aspectRatio", 1e30}, {"znear", 0.1}}}}});
   const int c0 = b.node({{"camera", 0}, {"translation", {0, 0, 5}}});
   const int c1 = b.node({{"camera", 1}, {"translation", {0, 0, 5}}});
   const int c2 = b.node({{"camera", 2}, {"translation", {0, 0, 5}}});
@@ -796,7 +797,8 @@ TEST_F(GltfLoader, MalformedJson) {
   expect_error(path("bad.gltf"), "malformed JSON");
   // The parser stops at a NUL as at the end: junk after one was accepted. NUL padding is let be.
   write_file(dir_ / "nul.gltf", text + std::string(1, '\0') + "junk");
-  expect_error(path("nul.gltf"), "malformed JSON: a NUL byte at offset " + std::to_string(text.size()) + " with more after it");
+  expect_error(path("nul.gltf"),
+               "malformed JSON: a NUL byte at offset " + std::to_string(text.size()) + " with more after it");
   write_file(dir_ / "padded.gltf", text + std::string(3, '\0'));
   EXPECT_EQ(load_gltf(path("padded.gltf")).triangles.size(), 1u);
   write_file(dir_ / "empty.gltf", "");

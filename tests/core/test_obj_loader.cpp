@@ -152,7 +152,8 @@ TEST_F(ObjLoader, FacesOfMoreThan255VerticesKeepEveryTriangle) {
       area += 0.5 * z;
     }
     for (int i = 0; i < n; ++i) {
-      const glm::dvec3 a(m.positions[static_cast<std::size_t>(i)]), b(m.positions[static_cast<std::size_t>((i + 1) % n)]);
+      const glm::dvec3 a(m.positions[static_cast<std::size_t>(i)]),
+          b(m.positions[static_cast<std::size_t>((i + 1) % n)]);
       face_area += 0.5 * (a.x * b.y - b.x * a.y);
     }
     EXPECT_NEAR(area, face_area, 1e-9 * n);
@@ -248,8 +249,9 @@ TEST_F(ObjLoader, LinesAndPointsAreSkippedWithAWarning) {
 // says so. The statements of the specification it ignores (groups, smoothing,
 // materials, texture vertices) are not.
 TEST_F(ObjLoader, StatementsOBJDoesNotHaveAreAWarning) {
-  const Scene s = load_obj(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvn 0 0 1\ng a\ns 1\no b\n"
-                                 "usemtl m\nf 1 2 3\nF 2 4 3\nfo 1 2 4\nf2 4 3\ncstype bspline\ncurv 0 1 1 2\n"));
+  const Scene s =
+      load_obj(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvn 0 0 1\ng a\ns 1\no b\n"
+                     "usemtl m\nf 1 2 3\nF 2 4 3\nfo 1 2 4\nf2 4 3\ncstype bspline\ncurv 0 1 1 2\n"));
   EXPECT_EQ(s.triangles.size(), 1u);
   const auto has = [&](const std::string& w) {
     return std::find(s.report.warnings.begin(), s.report.warnings.end(), w) != s.report.warnings.end();
@@ -260,9 +262,10 @@ TEST_F(ObjLoader, StatementsOBJDoesNotHaveAreAWarning) {
     load_obj(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nF 1 2 3\n", "typo.obj"));
     ADD_FAILURE() << "a file of no faces loaded";
   } catch (const std::exception& e) {
-    EXPECT_NE(std::string(e.what()).find(
-                  "typo.obj: scene contains no triangles; 1 line ignored: a statement OBJ does not have (first: line 4 'F')"),
-              std::string::npos)
+    EXPECT_NE(
+        std::string(e.what()).find(
+            "typo.obj: scene contains no triangles; 1 line ignored: a statement OBJ does not have (first: line 4 'F')"),
+        std::string::npos)
         << e.what();
   }
   const Scene clean = load_obj(write("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\ng a\ns off\nmtllib\nf 1 2 3\n", "c.obj"));

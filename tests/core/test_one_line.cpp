@@ -17,8 +17,10 @@ TEST(JoinedLine, BreaksBecomeSpacesAndControlBytesQuestionMarks) {
 
 // A binary file's bytes quoted in a JSON parser's error went to the terminal raw.
 TEST(JoinedLine, BytesThatAreNotUtf8AreQuestionMarksAndUtf8IsKept) {
-  EXPECT_EQ(joined_line("K\xc3\xbc" "che \xe6\x97\xa5\xe6\x9c\xac \xf0\x9f\x90\x87.glb"),
-            "K\xc3\xbc" "che \xe6\x97\xa5\xe6\x9c\xac \xf0\x9f\x90\x87.glb");
+  EXPECT_EQ(joined_line("K\xc3\xbc"
+                        "che \xe6\x97\xa5\xe6\x9c\xac \xf0\x9f\x90\x87.glb"),
+            "K\xc3\xbc"
+            "che \xe6\x97\xa5\xe6\x9c\xac \xf0\x9f\x90\x87.glb");
   EXPECT_EQ(joined_line("got '\xff\xfe{'"), "got '??{'");
   EXPECT_EQ(joined_line("lone \x80 continuation, cut \xe6\x97"), "lone ? continuation, cut ??");
   EXPECT_EQ(joined_line("overlong \xc0\xaf \xe0\x80\xaf, surrogate \xed\xa0\x80, beyond \xf4\x90\x80\x80"),

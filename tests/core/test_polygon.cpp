@@ -66,7 +66,8 @@ TEST(Polygon, ALargerConvexFaceIsSplitInHalvesNotFanned) {
     ++degree[i];
     ++degree[j];
     ++degree[k];
-    edges += glm::length(circle[j] - circle[i]) + glm::length(circle[k] - circle[j]) + glm::length(circle[i] - circle[k]);
+    edges +=
+        glm::length(circle[j] - circle[i]) + glm::length(circle[k] - circle[j]) + glm::length(circle[i] - circle[k]);
   }
   EXPECT_EQ(std::count(degree.begin(), degree.end(), 0), 0);
   EXPECT_LE(*std::max_element(degree.begin(), degree.end()), 40);

@@ -256,7 +256,8 @@ TEST_F(RayFileTest, InvalidRays) {
   // A denormal direction (0, 0, -1e-45): the structures disagreed, a miss in some, a hit at t = inf in others.
   poke_f32(b, ray1 + 24, -1e-45f);
   spit(path("tiny_dir.rays"), b);
-  expect_error(path("tiny_dir.rays"), "ray 1: direction (0, 0, -1.4013e-45) is shorter than 1e-30: distances along it overflow float",
+  expect_error(path("tiny_dir.rays"),
+               "ray 1: direction (0, 0, -1.4013e-45) is shorter than 1e-30: distances along it overflow float",
                [&] { read_rays(path("tiny_dir.rays")); });
   poke_f32(b, ray1 + 24, -1e-29f);  // short, but its distances stay finite: taken
   spit(path("short_dir.rays"), b);

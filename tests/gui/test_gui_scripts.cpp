@@ -464,8 +464,9 @@ TEST_F(GuiScript, ScriptErrorsNameTheLineAndExitWithOne) {
 TEST_F(GuiScript, OpeningAPanelTheSceneDoesNotCallForSaysWhy) {
   RunResult r = run(std::string("open ") + kTeapot + "\nwait\nwindow open Dynamics\nquit\n");
   EXPECT_EQ(r.code, 1);
-  EXPECT_NE(r.err.find(":3: window: Dynamics is not shown now: " + std::string(kTeapot) + ": per-frame updates are off ("),
-            std::string::npos)
+  EXPECT_NE(
+      r.err.find(":3: window: Dynamics is not shown now: " + std::string(kTeapot) + ": per-frame updates are off ("),
+      std::string::npos)
       << r.err;
   r = run(std::string("open ") + kTeapot + "\nstructure kdtree\nwait\nwindow open Flatten what-if\nquit\n");
   EXPECT_EQ(r.code, 1);
@@ -477,7 +478,8 @@ TEST_F(GuiScript, OpeningAPanelTheSceneDoesNotCallForSaysWhy) {
   EXPECT_EQ(r.code, 0) << r.err;
   r = run(std::string("open ") + kTeapot + "\nwait\nplay 2\nquit\n");
   EXPECT_EQ(r.code, 1);
-  EXPECT_NE(r.err.find(":3: play: " + std::string(kTeapot) + ": per-frame updates are off"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(":3: play: " + std::string(kTeapot) + ": per-frame updates are off"), std::string::npos)
+      << r.err;
   // A panel that is shown opens as before.
   r = run("open builtin:dynamic?size=6000\nwait\nwindow open Dynamics\nwait\nquit\n");
   EXPECT_EQ(r.code, 0) << r.err;

@@ -2,19 +2,18 @@
 // Screenshot files: where they go, what they are called, the caption line
 // drawn under the picture and the JSON side-car that says how to reproduce
 // it. GL-free: the GUI hands over the frame it read back from the renderer.
-#include "core/analysis/caption.h"
-#include "core/analysis/heatmap.h"
-#include "core/scene/scene.h"
-#include "ui/app/app_config.h"
-
-#include <nlohmann/json.hpp>
-
 #include <ctime>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "core/analysis/caption.h"
+#include "core/analysis/heatmap.h"
+#include "core/scene/scene.h"
+#include "ui/app/app_config.h"
 
 namespace accelviz {
 

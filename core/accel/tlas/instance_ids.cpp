@@ -24,8 +24,7 @@ bool parse_u32(std::string_view s, std::uint32_t& out) {
 /// Digits only, but more than an id holds: said as such, not as bad syntax.
 bool too_large(std::string_view s) {
   std::uint32_t v = 0;
-  return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; }) &&
-         !parse_u32(s, v);
+  return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; }) && !parse_u32(s, v);
 }
 
 struct IdRange {
