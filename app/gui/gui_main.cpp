@@ -713,6 +713,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
                       {"visit_max", view_->boxes_visit_max()}};
       doc["tree"] = {{"swatch_max", insight_.tree_swatch_max(app_, ramp_max)},
                      {"swatch_of_boxes", ramp_max.has_value()}};
+      doc["ab_window"] = insight_.ab_window_json();
       fail_if(write_new_file(c.arg, doc.dump(2) + "\n"));
       return Status::done;
     }

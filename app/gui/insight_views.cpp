@@ -238,6 +238,26 @@ std::uint64_t InsightViews::tree_swatch_max(const AppState& app, std::optional<s
   return max;
 }
 
+void InsightViews::request_ab_compare(const AppState& app) {
+  if (!ab_.pinned || !app.current()) return;
+  ABRequest r = ab_request(app, ab_);
+  r.metric = ab_.metric == 1 ? HeatMetric::prims : ab_.metric == 2 ? HeatMetric::cost : HeatMetric::nodes;
+  ab_job_.request([r](const std::atomic<bool>& cancel) { return run_ab(r, cancel); });
+}
+
+nlohmann::json InsightViews::ab_window_json() {
+  const auto res = ab_job_.result();
+  nlohmann::json j = {{"shown", res != nullptr}, {"busy", ab_job_.busy()}};
+  if (res) {
+    j["a"] = describe_choice(res->a);
+    j["b"] = describe_choice(res->b);
+    j["metric"] = std::string(metric_name(res->image_a.metric));
+    j["total_a"] = res->figures.total_a;
+    j["total_b"] = res->figures.total_b;
+  }
+  return j;
+}
+
 void InsightViews::draw(AppState& app, const panels::PanelLayout& layout, std::optional<std::uint64_t> box_ramp_max) {
   // A/B.
   const auto ab_result = ab_job_.result();
@@ -247,11 +267,7 @@ void InsightViews::draw(AppState& app, const panels::PanelLayout& layout, std::o
     ab_.pinned = app.config().structure;
     app.set_message("pinned " + describe_choice(*ab_.pinned) + " as A");
   }
-  if (aa.compare && ab_.pinned && app.current()) {
-    ABRequest r = ab_request(app, ab_);
-    r.metric = ab_.metric == 1 ? HeatMetric::prims : ab_.metric == 2 ? HeatMetric::cost : HeatMetric::nodes;
-    ab_job_.request([r](const std::atomic<bool>& cancel) { return run_ab(r, cancel); });
-  }
+  if (aa.compare) request_ab_compare(app);
 
   // A click in the 3D view: the leaf its hit lies in becomes the selection
   // (its path opens in the tree, which scrolls to it). The ray is cast again
@@ -495,6 +511,8 @@ ScriptHost::Status InsightViews::execute(AppState& app, const ScriptCommand& c) 
       if (!ab_dump_job_.result()) throw std::runtime_error("A/B: no result");
       if (const std::string err = write_new_file(c.arg, ab_dump_job_.result()->dump(2) + "\n"); !err.empty())
         throw std::runtime_error(err);
+      // The window shows the comparison too (it stayed empty: no script command presses Compare).
+      request_ab_compare(app);
       return ScriptHost::Status::done;
     }
     default:

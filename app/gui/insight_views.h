@@ -36,7 +36,7 @@ class InsightViews {
   bool busy();
   /// The latest ray inspection's consequences (a click selects the leaf its
   /// hit lies in) are applied: the script's `wait` waits for it too.
-  bool caught_up(const AppState& app) const { return inspection_seen_ == app.inspection_version(); }
+  bool caught_up(const AppState& app) { return inspection_seen_ == app.inspection_version() && !ab_job_.busy(); }
   /// The subtree mode's node id in words: what it names in the structure
   /// shown (StructureNodes::describe) and, when it was set (typed, or
   /// selected) while another build was shown, which one: node ids are per
@@ -49,8 +49,15 @@ class InsightViews {
     box_node_seen_ = -1;
     track_box_node(app);
   }
+  /// What the A/B window shows, for dump-stats: `shown` (a comparison is
+  /// there), `busy`, and when shown its sides `a`, `b`, `metric`, `total_a`,
+  /// `total_b`.
+  nlohmann::json ab_window_json();
 
  private:
+  /// The A/B window's Compare: the pinned A against the structure shown, in
+  /// the window's metric, run in the background.
+  void request_ab_compare(const AppState& app);
   /// Selects node `id` of the structure shown (the Boxes view's subtree mode),
   /// remembering the box mode it replaces.
   void select(AppState& app, std::uint32_t id);

@@ -871,7 +871,7 @@ TEST_F(GuiScript, ABFromAScriptAndTheHeatmapsXray) {
   const RunResult r = run(std::string("open ") + kTeapot + "\nsize 480 360\ncamera " + kCamera +
                           "\nset leaf 1\nset heatmap full\nwait\npin-a\nset leaf 16\nwait\n"
                           "dump-ab " +
-                          path("leaf.json").string() + "\ndump-stats " + path("plain.json").string() +
+                          path("leaf.json").string() + "\nwait\ndump-stats " + path("plain.json").string() +
                           "\npin-a\nset xray on\nwait\ndump-stats " + path("xray.json").string() + "\ndump-ab " +
                           path("xray-ab.json").string() + "\nquit\n");
   ASSERT_EQ(r.code, 0) << r.err;
@@ -889,6 +889,14 @@ TEST_F(GuiScript, ABFromAScriptAndTheHeatmapsXray) {
   EXPECT_GT(leaf["trace_ms_b"].get<double>(), 0.0);
 
   const nlohmann::json plain = read_json(path("plain.json")), xray = read_json(path("xray.json"));
+  // The A/B window shows the comparison dump-ab made (it stayed empty), in its metric (nodes).
+  const nlohmann::json& window = plain["ab_window"];
+  ASSERT_TRUE(window["shown"].get<bool>()) << window;
+  EXPECT_EQ(window["a"], leaf["a"]);
+  EXPECT_EQ(window["b"], leaf["b"]);
+  EXPECT_EQ(window["metric"], "nodes");
+  EXPECT_EQ(window["total_a"].get<double>(), leaf["nodes"]["total_a"].get<double>());
+  EXPECT_EQ(window["total_b"].get<double>(), leaf["nodes"]["total_b"].get<double>());
   EXPECT_GT(xray["view"]["mean_prims"].get<double>(), plain["view"]["mean_prims"].get<double>());
   const nlohmann::json xab = read_json(path("xray-ab.json"));
   EXPECT_NE(xab["b"].get<std::string>().find("x-ray"), std::string::npos) << xab["b"];
