@@ -297,9 +297,10 @@ bool explainer_panel(ExplainerState& st, const SplitExplanation* e, std::uint32_
     ImGui::End();
     return changed;
   }
-  ImGui::Text("node %u: %zu primitives, decision: %s", node, e->prims, to_string(e->decision));
-  ImGui::Text("leaf cost C_isect*N = %.3f   best split = %.3f%s", e->leaf_cost, e->split_cost,
-              e->leaf_allowed ? "" : "  (too many for a leaf)");
+  ImGui::TextWrapped("node %u: %zu primitives, decision: %s", node, e->prims, to_string(e->decision));
+  // Wrapped: at the window's default width the line was cut at "(too man".
+  ImGui::TextWrapped("leaf cost C_isect*N = %.3f   best split = %.3f%s", e->leaf_cost, e->split_cost,
+                     e->leaf_allowed ? "" : "  (too many for a leaf)");
   if (e->decision == SplitDecision::unsplittable)
     ImGui::TextWrapped(
         "All centroids lie in one bucket on every axis: the SAH cannot separate them; the builder "
