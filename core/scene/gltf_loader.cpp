@@ -987,9 +987,22 @@ class GltfConverter {
     if (len > 0.0f && std::isfinite(len)) light.direction = dir / len;
     light.name = gl.name.empty() ? scene_.nodes[node].name : gl.name;
     light.position = glm::vec3(world[3]);
-    if (gl.color.size() == 3) light.color = glm::vec3(gl.color[0], gl.color[1], gl.color[2]);
-    light.intensity = float(gl.intensity);
-    light.range = gl.range > 0.0 ? float(gl.range) : 0.0f;
+    // Checked in float, as kept: a colour of 1e39 became inf, and `export` then refused the scene it
+    // had loaded without a word; a negative intensity or range is not a light's.
+    const auto finite_nonnegative = [](double v) { return v >= 0.0 && std::isfinite(static_cast<float>(v)); };
+    if (gl.color.size() == 3) {
+      if (finite_nonnegative(gl.color[0]) && finite_nonnegative(gl.color[1]) && finite_nonnegative(gl.color[2]))
+        light.color = glm::vec3(gl.color[0], gl.color[1], gl.color[2]);
+      else
+        warn(name + " has an invalid color (negative or beyond float); white is used");
+    }
+    if (finite_nonnegative(gl.intensity))
+      light.intensity = float(gl.intensity);
+    else
+      warn(name + " has an invalid intensity " + std::to_string(gl.intensity) + "; 1 is used");
+    if (gl.range < 0.0 || !std::isfinite(static_cast<float>(gl.range)))
+      warn(name + " has an invalid range " + std::to_string(gl.range) + "; unlimited is used");
+    light.range = gl.range > 0.0 && std::isfinite(static_cast<float>(gl.range)) ? float(gl.range) : 0.0f;
     scene_.lights.push_back(light);
     return int(scene_.lights.size() - 1);
   }

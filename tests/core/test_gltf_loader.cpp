@@ -565,6 +565,29 @@ TEST_F(GltfLoader, CameraYfovOfPiInFloatAndBadAspectRatiosAreSaid) {
   EXPECT_TRUE(said("camera 2 (node 3) has an invalid aspectRatio"));
 }
 
+// A light's colour of 1e39 became inf in float, and `export` then refused the scene it had loaded
+// without a word; a negative intensity or range is not a light's. Each is said and a default used.
+TEST_F(GltfLoader, LightsWithInvalidColourIntensityOrRangeAreSaid) {
+  GltfBuilder b = one_triangle();
+  b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+  b.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array(
+      {json{{"type", "point"}, {"color", {1e39, 0.5, 0.25}}, {"intensity", -5}, {"range", -1}}});
+  const int point = b.node({{"translation", {1, 2, 3}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  b.scene({0, point});
+  const Scene s = load_gltf(write_gltf(b));
+  ASSERT_EQ(s.lights.size(), 1u);
+  EXPECT_EQ(s.lights[0].color, glm::vec3(1.0f));
+  EXPECT_EQ(s.lights[0].intensity, 1.0f);
+  EXPECT_EQ(s.lights[0].range, 0.0f);
+  const auto said = [&](const std::string& part) {
+    return std::any_of(s.report.warnings.begin(), s.report.warnings.end(),
+                       [&](const std::string& w) { return w.find(part) != std::string::npos; });
+  };
+  EXPECT_TRUE(said("light 0 (node 1) has an invalid color (negative or beyond float); white is used"));
+  EXPECT_TRUE(said("light 0 (node 1) has an invalid intensity -5.000000; 1 is used"));
+  EXPECT_TRUE(said("light 0 (node 1) has an invalid range -1.000000; unlimited is used"));
+}
+
 TEST_F(GltfLoader, PunctualLightsConvertedToWorldSpace) {
   GltfBuilder b = one_triangle();
   b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
