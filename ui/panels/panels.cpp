@@ -737,6 +737,14 @@ std::optional<std::size_t> ray_panel(const RayInspection* ray, std::size_t step,
           moved = static_cast<std::size_t>(i);
         ImGui::TableSetColumnIndex(1);
         ImGui::TextUnformatted(step_kind_name(st.kind));
+        // A missed box's t entry above its t exit reads like an error: it is why the box was missed.
+        if (ImGui::IsItemHovered()) {
+          if (st.kind == VisitStep::Kind::node_missed)
+            ImGui::SetTooltip("missed: the ray's slab intervals do not overlap (t entry > t exit), or the box lies "
+                              "outside [t min, closest hit]");
+          else if (st.kind == VisitStep::Kind::node_culled)
+            ImGui::SetTooltip("culled: the box's entry lies beyond the closest hit found so far");
+        }
         ImGui::TableSetColumnIndex(2);
         ImGui::Text("%u", st.id);
         ImGui::TableSetColumnIndex(3);
