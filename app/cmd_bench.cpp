@@ -75,7 +75,8 @@ struct StructureResult {
 /// 0.1: a grid's 0.0035 on a stadium read "0.00", as if nothing were traced.
 std::string rate_text(double mrays_per_s) {
   char text[32];
-  std::snprintf(text, sizeof text, mrays_per_s > 0.0 && mrays_per_s < 0.1 ? "%.3g" : "%.2f", mrays_per_s);
+  // "%#.3g": the zeros kept (0.000500, not 0.0005, which read as one digit).
+  std::snprintf(text, sizeof text, mrays_per_s > 0.0 && mrays_per_s < 0.1 ? "%#.3g" : "%.2f", mrays_per_s);
   return text;
 }
 
