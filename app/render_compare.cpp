@@ -241,22 +241,21 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
   std::string caption_a, caption_b, caption_diff;
   {
     const nlohmann::json da = describe_side(*side[0], metric), db = describe_side(*side[1], metric);
+    // A value as the caption writes it: a string without JSON's quotes.
+    const auto text = [](const nlohmann::json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); };
     std::string differs;
     for (const auto& [key, value] : da.items())
       if (key != "structure" && db.contains(key) && db[key] != value)
-        differs += (differs.empty() ? "" : ", ") + key + " " + value.dump() + " -> " + db[key].dump();
+        differs += (differs.empty() ? "" : ", ") + key + " " + text(value) + " -> " + text(db[key]);
     const auto caption = [&](const nlohmann::json& d, const char* name) {
-      std::string c = std::string(name) + ": " + d["structure"].get<std::string>();
+      std::string c = std::string(name) + ": " + text(d["structure"]);
       for (const auto& [key, value] : d.items())
         if (key != "structure" && (!da.contains(key) || !db.contains(key) || da[key] != db[key]))
-          c += " " + key + "=" + value.dump();
+          c += " " + key + "=" + text(value);
       return c + "; " + job.scene + ", " + job.metric + ", " + job.size;
     };
-    std::erase(differs, '"');
     caption_a = caption(da, "A");
     caption_b = caption(db, "B");
-    std::erase(caption_a, '"');
-    std::erase(caption_b, '"');
     caption_diff = "B - A (" + (differs.empty() ? std::string("no option differs") : differs) + "); " + job.scene +
                    ", " + job.metric + ", " + job.size;
     rgb[0] = add_caption(rgb[0], caption_a);

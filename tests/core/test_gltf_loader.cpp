@@ -29,6 +29,12 @@ namespace {
 
 constexpr int kU8 = 5121, kU16 = 5123, kU32 = 5125, kFloat = 5126;
 
+/// Whether a loader warning of `s` contains `part`.
+bool warned(const Scene& s, const std::string& part) {
+  return std::any_of(s.report.warnings.begin(), s.report.warnings.end(),
+                     [&](const std::string& w) { return w.find(part) != std::string::npos; });
+}
+
 void put_u32(std::string& s, std::uint32_t v) {
   for (int k = 0; k < 4; ++k) s += char((v >> (8 * k)) & 0xFF);
 }
@@ -534,9 +540,7 @@ TEST_F(GltfLoader, PerspectiveCameraConvertedToWorldSpace) {
   EXPECT_FLOAT_EQ(c.aspect, 1.5f);
   EXPECT_EQ(s.nodes[std::size_t(cam)].camera, 0);
   EXPECT_EQ(s.nodes[std::size_t(ortho)].camera, -1);
-  bool warned = false;
-  for (const std::string& w : s.report.warnings) warned |= w.find("orthographic") != std::string::npos;
-  EXPECT_TRUE(warned);
+  EXPECT_TRUE(warned(s, "orthographic"));
 }
 
 // A yfov that rounds to float's pi (3.14159265) is a 180-degree view: tan(yfov/2) came out
@@ -555,14 +559,9 @@ TEST_F(GltfLoader, CameraYfovOfPiInFloatAndBadAspectRatiosAreSaid) {
   const Scene s = load_gltf(write_gltf(b));
   ASSERT_EQ(s.cameras.size(), 2u) << "the 180-degree one is skipped";
   for (const Camera& c : s.cameras) EXPECT_EQ(c.aspect, 0.0f) << "the view's own aspect";
-  const auto said = [&](const std::string& part) {
-    for (const std::string& w : s.report.warnings)
-      if (w.find(part) != std::string::npos) return true;
-    return false;
-  };
-  EXPECT_TRUE(said("camera 0 (node 1) has an invalid yfov 3.14159"));
-  EXPECT_TRUE(said("camera 1 (node 2) has an invalid aspectRatio -2.000000; the view's own is used"));
-  EXPECT_TRUE(said("camera 2 (node 3) has an invalid aspectRatio"));
+  EXPECT_TRUE(warned(s, "camera 0 (node 1) has an invalid yfov 3.14159"));
+  EXPECT_TRUE(warned(s, "camera 1 (node 2) has an invalid aspectRatio -2.000000; the view's own is used"));
+  EXPECT_TRUE(warned(s, "camera 2 (node 3) has an invalid aspectRatio"));
 }
 
 // A light's colour of 1e39 became inf in float, and `export` then refused the scene it had loaded
@@ -579,13 +578,9 @@ TEST_F(GltfLoader, LightsWithInvalidColourIntensityOrRangeAreSaid) {
   EXPECT_EQ(s.lights[0].color, glm::vec3(1.0f));
   EXPECT_EQ(s.lights[0].intensity, 1.0f);
   EXPECT_EQ(s.lights[0].range, 0.0f);
-  const auto said = [&](const std::string& part) {
-    return std::any_of(s.report.warnings.begin(), s.report.warnings.end(),
-                       [&](const std::string& w) { return w.find(part) != std::string::npos; });
-  };
-  EXPECT_TRUE(said("light 0 (node 1) has an invalid color (negative or beyond float); white is used"));
-  EXPECT_TRUE(said("light 0 (node 1) has an invalid intensity -5.000000; 1 is used"));
-  EXPECT_TRUE(said("light 0 (node 1) has an invalid range -1.000000; unlimited is used"));
+  EXPECT_TRUE(warned(s, "light 0 (node 1) has an invalid color (negative or beyond float); white is used"));
+  EXPECT_TRUE(warned(s, "light 0 (node 1) has an invalid intensity -5.000000; 1 is used"));
+  EXPECT_TRUE(warned(s, "light 0 (node 1) has an invalid range -1.000000; unlimited is used"));
 }
 
 TEST_F(GltfLoader, PunctualLightsConvertedToWorldSpace) {
