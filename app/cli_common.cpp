@@ -7,6 +7,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <iostream>
@@ -332,7 +333,21 @@ void print_json_line(const nlohmann::json& j) {
   std::cout << j.dump() << std::endl;
 }
 
-Progress::Progress(bool quiet) : quiet_(quiet), tty_(::isatty(STDERR_FILENO) == 1) {}
+namespace {
+
+/// ACCELVIZ_PROGRESS_SECONDS when it is a number above 0, else 10.
+double progress_line_seconds() {
+  const char* text = std::getenv("ACCELVIZ_PROGRESS_SECONDS");
+  if (text == nullptr || *text == '\0') return 10.0;
+  char* end = nullptr;
+  const double v = std::strtod(text, &end);
+  return (*end == '\0' && std::isfinite(v) && v > 0.0) ? v : 10.0;
+}
+
+}  // namespace
+
+Progress::Progress(bool quiet)
+    : quiet_(quiet), tty_(::isatty(STDERR_FILENO) == 1), line_seconds_(progress_line_seconds()) {}
 
 void Progress::begin(const std::string& label) {
   label_ = label;
@@ -345,16 +360,22 @@ void Progress::begin(const std::string& label) {
 }
 
 ProgressCallback Progress::callback() {
-  if (quiet_ || !tty_) return {};
-  return [this](double fraction) {
-    // A few updates a second are plenty; a thread that finds another one
-    // printing skips its update rather than wait.
+  if (quiet_) return {};
+  // A terminal: a few updates a second are plenty. Elsewhere (a pipe, a log)
+  // whole lines, far apart, so that a long step is not silent until it ends.
+  const auto interval = tty_ ? std::chrono::duration<double>(0.2) : std::chrono::duration<double>(line_seconds_);
+  return [this, interval](double fraction) {
+    // A thread that finds another one printing skips its update rather than wait.
     std::unique_lock lock(mutex_, std::try_to_lock);
     if (!lock.owns_lock()) return true;
     const auto now = Clock::now();
-    if (now - last_ < std::chrono::milliseconds(200)) return true;
+    if (now - last_ < interval) return true;
     last_ = now;
-    std::fprintf(stderr, "\r\033[K%s %3.0f%%", label_.c_str(), 100.0 * std::clamp(fraction, 0.0, 1.0));
+    const double percent = 100.0 * std::clamp(fraction, 0.0, 1.0);
+    if (tty_)
+      std::fprintf(stderr, "\r\033[K%s %3.0f%%", label_.c_str(), percent);
+    else
+      std::fprintf(stderr, "%s %.0f%%\n", label_.c_str(), percent);
     std::fflush(stderr);
     return true;
   };

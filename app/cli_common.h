@@ -152,7 +152,9 @@ void print_json_line(const nlohmann::json& j);
 // ---- progress and timing -----------------------------------------------------------
 
 /// Progress on stderr: on a terminal, one line updated in place; otherwise
-/// one line per finished step. Silent when quiet.
+/// (a pipe, a log file) one line per finished step, and for a step that runs
+/// long a "LABEL NN%" line every ACCELVIZ_PROGRESS_SECONDS seconds (default
+/// 10). Silent when quiet.
 class Progress {
  public:
   explicit Progress(bool quiet);
@@ -165,6 +167,7 @@ class Progress {
  private:
   bool quiet_;
   bool tty_;
+  double line_seconds_;  ///< not a terminal: seconds between "LABEL NN%" lines
   std::string label_;
   std::chrono::steady_clock::time_point last_;
   std::mutex mutex_;  ///< builders may report from several threads

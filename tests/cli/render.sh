@@ -65,4 +65,16 @@ h = lambda n: struct.unpack(">II", open(f"{sys.argv[1]}/{n}.png", "rb").read()[1
 assert h("c2") < h("c3") and h("c2") < h("c4"), (h("c2"), h("c3"), h("c4"))
 print("caption ok")
 PY
+
+# Progress on a pipe or in a log: no carriage returns; a step that runs longer
+# than ACCELVIZ_PROGRESS_SECONDS (default 10) prints "LABEL NN%" lines on the way.
+ACCELVIZ_PROGRESS_SECONDS=0.000001 "$accelviz" render "$scene" --size 160x120 --out "$tmp/progress.png" \
+  >/dev/null 2>"$tmp/progress.err"
+cat "$tmp/progress.err"
+grep -qE '^rendering nodes [0-9]+%$' "$tmp/progress.err" || { echo "FAIL: no progress line while rendering"; exit 1; }
+grep -qE '^rendering nodes: [0-9]+ ms$' "$tmp/progress.err" || { echo "FAIL: no end line"; exit 1; }
+if grep -q $'\r' "$tmp/progress.err"; then echo "FAIL: carriage return on a pipe"; exit 1; fi
+"$accelviz" render "$scene" --size 32x24 --out "$tmp/quick.png" >/dev/null 2>"$tmp/quick.err"
+if grep -qE '[0-9]%$' "$tmp/quick.err"; then echo "FAIL: a quick step printed progress lines"; cat "$tmp/quick.err"; exit 1; fi
+echo "progress lines ok"
 echo "render ok"
