@@ -1,5 +1,6 @@
 #include "core/geometry/polygon.h"
 
+#include <algorithm>
 #include <cmath>
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
@@ -73,34 +74,88 @@ std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(std::span<const gl
     return out;
   }
   // Ear clipping: a corner whose triangle with its neighbours turns the polygon's way and holds no
-  // other remaining corner.
-  // Walks around the ring from where the last ear was cut; a whole round without an ear (a
-  // self-intersecting outline) or a spent budget of corner checks (4 n^2: no face, however shaped,
-  // takes long) leaves the rest to the fan.
-  std::vector<std::uint32_t> rest = order;
-  std::size_t checks = 0, i = 0, since_ear = 0;
+  // other remaining corner. Only reflex (or flat) corners need checking: if a corner lies in the
+  // triangle of a convex one, so does a reflex one (Eberly, "Triangulation by Ear Clipping"); they
+  // are kept in a grid of cells, so that an ear checks the few near it. The ring is a linked list
+  // (cutting an ear is O(1)). After an ear the walk goes on past its far neighbour: a round cuts
+  // every other corner of a convex stretch, the next round the halves left, so the triangles stay
+  // small near the outline and fatten round by round (going back to the near neighbour made a fan
+  // of slivers from one corner). A whole round without an ear (a self-intersecting outline) or a
+  // spent budget of corner checks (4 n^2: no face, however shaped, takes long) leaves the rest to
+  // the fan.
+  std::vector<std::uint32_t> next(n), prev(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    next[k] = static_cast<std::uint32_t>((k + 1) % n);
+    prev[k] = static_cast<std::uint32_t>((k + n - 1) % n);
+  }
+  const auto reflex = [&](std::uint32_t b) { return cross2(p[prev[b]], p[b], p[next[b]]) <= 0.0; };
+  glm::dvec2 lo = p[0], hi = p[0];
+  for (const glm::dvec2& q : p) {
+    lo = glm::min(lo, q);
+    hi = glm::max(hi, q);
+  }
+  const int cells = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(n) / 4.0)));  // per axis
+  const glm::dvec2 extent = glm::max(hi - lo, glm::dvec2(1e-300));
+  const auto cell_of = [&](double x, double lo_, double extent_) {
+    const double c = std::floor((x - lo_) / extent_ * cells);
+    return std::clamp(std::isfinite(c) ? static_cast<int>(c) : 0, 0, cells - 1);
+  };
+  std::vector<std::vector<std::uint32_t>> grid(static_cast<std::size_t>(cells) * cells);
+  std::vector<char> listed(n, 0), removed(n, 0);  // listed: in its cell's list
+  const auto list = [&](std::uint32_t q) {
+    if (listed[q] || !reflex(q)) return;
+    listed[q] = 1;
+    grid[static_cast<std::size_t>(cell_of(p[q].y, lo.y, extent.y)) * cells + cell_of(p[q].x, lo.x, extent.x)]
+        .push_back(q);
+  };
+  for (std::uint32_t k = 0; k < n; ++k) list(k);
+  std::size_t r = n, checks = 0, since_ear = 0;
+  std::uint32_t b = 0;
   const std::size_t budget = 4 * n * n;
-  while (rest.size() > 3 && since_ear < rest.size() && checks < budget) {
-    const std::size_t r = rest.size();
-    i %= r;
-    const std::uint32_t a = rest[(i + r - 1) % r], b = rest[i], c = rest[(i + 1) % r];
+  while (r > 3 && since_ear < r && checks < budget) {
+    const std::uint32_t a = prev[b], c = next[b];
     bool ear = cross2(p[a], p[b], p[c]) > 0.0;  // reflex or flat: no ear
-    for (std::size_t k = 0; k < r && ear; ++k) {
-      ++checks;
-      const std::uint32_t q = rest[k];
-      if (q == a || q == b || q == c || p[q] == p[a] || p[q] == p[b] || p[q] == p[c]) continue;
-      ear = !(cross2(p[a], p[b], p[q]) >= 0.0 && cross2(p[b], p[c], p[q]) >= 0.0 && cross2(p[c], p[a], p[q]) >= 0.0);
+    if (ear) {
+      const glm::dvec2 e_lo = glm::min(p[a], glm::min(p[b], p[c])), e_hi = glm::max(p[a], glm::max(p[b], p[c]));
+      const int x0 = cell_of(e_lo.x, lo.x, extent.x), x1 = cell_of(e_hi.x, lo.x, extent.x);
+      const int y0 = cell_of(e_lo.y, lo.y, extent.y), y1 = cell_of(e_hi.y, lo.y, extent.y);
+      for (int y = y0; y <= y1 && ear; ++y)
+        for (int x = x0; x <= x1 && ear; ++x) {
+          std::vector<std::uint32_t>& in_cell = grid[static_cast<std::size_t>(y) * cells + x];
+          for (std::size_t k = 0; k < in_cell.size() && ear;) {
+            ++checks;
+            const std::uint32_t q = in_cell[k];
+            if (removed[q] || !reflex(q)) {  // cut, or convex now: off the list (swap with the last)
+              listed[q] = 0;
+              in_cell[k] = in_cell.back();
+              in_cell.pop_back();
+              continue;
+            }
+            ++k;
+            if (q == a || q == b || q == c || p[q] == p[a] || p[q] == p[b] || p[q] == p[c]) continue;
+            ear = !(cross2(p[a], p[b], p[q]) >= 0.0 && cross2(p[b], p[c], p[q]) >= 0.0 &&
+                    cross2(p[c], p[a], p[q]) >= 0.0);
+          }
+        }
     }
     if (!ear) {
-      ++i;
+      b = c;
       ++since_ear;
       continue;
     }
     out.push_back({a, b, c});
-    rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(i));
+    removed[b] = 1;
+    next[a] = c;
+    prev[c] = a;
+    --r;
     since_ear = 0;
-    if (i > 0) --i;  // the previous corner may have become an ear
+    list(a);  // their angles changed
+    list(c);
+    b = next[c];
   }
+  std::vector<std::uint32_t> rest;
+  rest.reserve(r);
+  for (std::size_t k = 0; k < r; ++k, b = next[b]) rest.push_back(b);
   fan(rest, out);
   return out;
 }

@@ -11,8 +11,8 @@
 //      `l`/`p` elements are counted as skipped primitives;
 //   2. tinyobjloader parses the same bytes into shapes (one per o/g group;
 //      `usemtl` does not split one) without triangulating (a face of more
-//      than 255 vertices first rewritten as pieces of at most 255:
-//      split_long_faces); a missing .mtl,
+//      than 255 vertices first rewritten as the triangles of its whole
+//      outline: split_long_faces); a missing .mtl,
 //      or one that is not a regular file of at most 64 MiB, is only a
 //      warning;
 //   3. each shape becomes one Mesh with its own compacted vertices and an
@@ -137,49 +137,50 @@ void for_each_line(const std::string& text, const F& f) {
 /// it are misread (silently wrong triangles).
 constexpr std::size_t kMaxTinyObjFace = 255;
 
-/// Writes the face of corners `refs` (vertex references as in the file) as
-/// faces of at most kMaxTinyObjFace corners: the outline cut into arcs of
-/// consecutive corners, each closed by its chord, and the polygon of the arcs'
-/// ends (itself cut the same way while it is too long). The pieces tile the
-/// face where it is convex, in n − 2 triangles together, and each stays a
-/// stretch of the outline (a fan of pieces from the first corner made every
-/// piece a thin wedge across the whole face).
-void write_face_pieces(std::span<const std::string_view> refs, std::string& out) {
-  const std::size_t n = refs.size();
-  if (n <= kMaxTinyObjFace) {
-    out += 'f';
-    for (const std::string_view r : refs) {
-      out += ' ';
-      out.append(r);
-    }
-    out += '\n';
-    return;
-  }
-  const std::size_t step = kMaxTinyObjFace - 1;  // an arc's corners: step + 1
-  std::vector<std::string_view> ends;
-  for (std::size_t i = 0; i + 1 < n; i += step) {
-    const std::size_t j = std::min(i + step, n - 1);
-    ends.push_back(refs[i]);
-    if (j - i >= 2) write_face_pieces(refs.subspan(i, j - i + 1), out);  // two corners: an edge of the ends' polygon
-  }
-  ends.push_back(refs[n - 1]);
-  write_face_pieces(ends, out);
-}
-
 /// `text` with every face of more than kMaxTinyObjFace vertices written as
-/// pieces of at most that many (write_face_pieces). Other lines are kept as
-/// they are; relative (negative) indices stay valid, as no vertex line moves.
+/// the triangles triangulate_polygon makes of its whole outline (convex:
+/// halves; concave: ear-clipped), one `f a b c` line each, at the face's
+/// place (its group and material stay). Other lines are kept as they are;
+/// relative (negative) indices stay valid, as no vertex line moves. The
+/// coordinates come from a first pass over the `v` lines (positive indices
+/// may refer forward); scan_obj has checked every line already.
 std::string split_long_faces(const std::string& text) {
-  std::string out;
-  out.reserve(text.size() + text.size() / 64);
+  std::vector<glm::vec3> positions;
   for_each_line(text, [&](std::string_view line, std::size_t) {
     const std::vector<std::string_view> tok = tokens_of(line);
+    if (tok.size() < 4 || tok[0] != "v") return;
+    double xyz[3] = {0, 0, 0};
+    for (int k = 0; k < 3; ++k) parse_coordinate(tok[1 + k], xyz[k]);
+    positions.emplace_back(float(xyz[0]), float(xyz[1]), float(xyz[2]));
+  });
+  std::string out;
+  out.reserve(text.size() + text.size() / 8);
+  std::size_t vertices_so_far = 0;
+  std::vector<glm::vec3> corners;
+  for_each_line(text, [&](std::string_view line, std::size_t) {
+    const std::vector<std::string_view> tok = tokens_of(line);
+    if (!tok.empty() && tok[0] == "v" && tok.size() >= 4) ++vertices_so_far;
     if (tok.empty() || tok[0] != "f" || tok.size() - 1 <= kMaxTinyObjFace) {
       out.append(line);
       out += '\n';
       return;
     }
-    write_face_pieces(std::span<const std::string_view>(tok).subspan(1), out);
+    const std::span<const std::string_view> refs = std::span<const std::string_view>(tok).subspan(1);
+    corners.clear();
+    for (const std::string_view ref : refs) {
+      long long v = 0;
+      parse_integer(ref.substr(0, ref.find('/')), v);
+      const long long index = v < 0 ? static_cast<long long>(vertices_so_far) + v : v - 1;
+      corners.push_back(positions[static_cast<std::size_t>(index)]);
+    }
+    for (const auto& t : triangulate_polygon(corners)) {
+      out += 'f';
+      for (const std::uint32_t c : t) {
+        out += ' ';
+        out.append(refs[c]);
+      }
+      out += '\n';
+    }
   });
   return out;
 }
