@@ -14,6 +14,7 @@
 // instrumented pass for the mean node visits and primitive tests per ray,
 // kept out of the timings. `warmup` untimed rounds (builds, passes) may come
 // before the timed ones.
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -225,6 +226,34 @@ std::vector<std::string> bench_structure_names() {
   return names;
 }
 
+/// The items of one --structure value ("bvh,kdtree"), empty ones included.
+std::vector<std::string> structure_items(const std::string& text) {
+  std::vector<std::string> items;
+  std::size_t start = 0;
+  for (std::size_t comma; (comma = text.find(',', start)) != std::string::npos; start = comma + 1)
+    items.push_back(text.substr(start, comma - start));
+  items.push_back(text.substr(start));
+  return items;
+}
+
+/// "{a,b,c}" as CLI11 lists the names an option takes.
+std::string join_names(const std::vector<std::string>& names) {
+  std::string all;
+  for (const std::string& n : names) all += (all.empty() ? "" : ",") + n;
+  return "{" + all + "}";
+}
+
+/// "" or what is wrong with one --structure value: an empty item (a typo such as "bvh,,kdtree":
+/// CLI11's own list splitting drops it without a word) or a name bench does not have.
+std::string structure_list_problem(const std::string& text) {
+  const std::vector<std::string> names = bench_structure_names();
+  for (const std::string& item : structure_items(text)) {
+    if (item.empty()) return "an empty item in '" + text + "'";
+    if (std::find(names.begin(), names.end(), item) == names.end()) return item + " not in " + join_names(names);
+  }
+  return {};
+}
+
 /// "ray I: why" for the first ray of `rays` that `accel` cannot take (Embree's
 /// limits, ray_refusals); empty when it takes every ray.
 std::string first_refused_ray(const Accelerator& accel, const std::vector<Ray>& rays) {
@@ -253,12 +282,15 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   // A structure named in --structure that refuses the scene or rays makes the
   // run exit 1 (after the others are measured); the default list's Embree does not.
   const bool named_by_user = !o.structures.empty();
+  std::vector<std::string> listed;  // each -s value split at its commas (structure_list_problem checked them)
+  for (const std::string& value : o.structures)
+    for (std::string& item : structure_items(value)) listed.push_back(std::move(item));
+  o.structures = std::move(listed);
   if (o.structures.empty())
     o.structures = kHaveEmbree ? std::vector<std::string>{"bvh", "embree"} : std::vector<std::string>{"bvh"};
   if (o.repeat < 1) throw UsageError("--repeat must be at least 1");
   // Each structure is one row: a name twice would build and time it twice.
   for (std::size_t i = 0; i < o.structures.size(); ++i) {
-    if (o.structures[i].empty()) throw UsageError("--structure: an empty name in the list");
     for (std::size_t j = 0; j < i; ++j)
       if (o.structures[j] == o.structures[i])
         throw UsageError("--structure: '" + o.structures[i] + "' is listed twice");
@@ -591,12 +623,12 @@ Command add_bench_command(CLI::App& parent, const GlobalOptions& global) {
       "(medians of repeated runs), with ratios to Embree when it is among the structures");
   sub->add_option("SCENE", o->scene, "Scene file (.gltf, .glb, .obj) or builtin:NAME[?key=value&...]")->required();
   sub->add_option("--structure,-s", o->structures,
-                  std::string("Comma-separated structures (default: bvh") + (kHaveEmbree ? ",embree" : "") + ")" +
+                  "Comma-separated structures of " + join_names(bench_structure_names()) + " (default: bvh" +
+                      (kHaveEmbree ? ",embree" : "") + ")" +
                       (kHaveEmbree ? "; embree-low, embree-medium, embree-high: Embree at that build quality "
                                      "(ratios are quoted against the plain embree row)"
                                    : ""))
-      ->delimiter(',')
-      ->check(CLI::IsMember(bench_structure_names()));
+      ->check(CLI::Validator(structure_list_problem, "NAME[,NAME...]"));
   sub->add_option("--rays", o->rays, "Ray sets: primary, diffuse, shadow or all")
       ->check(CLI::IsMember({"primary", "diffuse", "shadow", "all"}))
       ->capture_default_str();
