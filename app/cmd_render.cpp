@@ -273,12 +273,15 @@ int run_render(const RenderOptions& given, const GlobalOptions& global) {
     if (o.view != "heatmap") throw UsageError("--device gpu needs --view heatmap");
 #endif
   }
+  if (const std::string problem = order_problem(compare_side(o)); !problem.empty()) throw UsageError(problem);
   if (o.compare) {
     if (o.view != "heatmap") throw UsageError("--compare needs --view heatmap");
     CompareJob job{o.scene, o.camera, o.size, o.metric, o.colormap, o.legend, o.max, o.threads, o.out, o.force, {}, {}};
     job.max_percentile = o.max_percentile;
     job.a = compare_side(o);
     job.b = parse_compare_spec(*o.compare, job.a);
+    if (const std::string problem = order_problem(job.b); !problem.empty())
+      throw UsageError("--compare: B (" + job.b.structure + "): " + problem);
     return run_render_compare(job, global);
   }
   check_output_path(o.out, o.force);  // before any long work
@@ -363,11 +366,12 @@ Command add_render_command(CLI::App& parent, const GlobalOptions& global) {
   add_triangle_test_option(sub, o->triangle_test);
   sub->add_flag("--force,-f", o->force, "Overwrite an existing output file");
   sub->add_option("--order", o->order,
-                  "Child order of the traversal (BVH): front-to-back, back-to-front (the worst order), unordered")
+                  "Child order of the traversal: front-to-back, back-to-front (the worst order), unordered (a fixed "
+                  "order); bvh and tlas take all three, kdtree and octree front-to-back and unordered")
       ->check(CLI::IsMember({"front-to-back", "back-to-front", "unordered"}))
       ->capture_default_str();
   sub->add_flag("--xray", o->xray,
-                "Count the full traversal as if no hit ended it (BVH: no culling behind the closest hit)");
+                "Count the full traversal as if no hit ended it (no culling behind the closest hit; bvh and tlas)");
   sub->add_option("--compare", o->compare,
                   "A/B: render A (these options) and B (A with these changes, e.g. 'structure=bvh buckets=4' or "
                   "'order=unordered'; keys: structure splitter buckets leaf leaf-cap ctrav cisect embree-quality "

@@ -109,6 +109,20 @@ ComparePaths compare_paths(const std::string& out) {
   return {make("-a"), make("-b"), make("-diff")};
 }
 
+std::string order_problem(const CompareSide& side) {
+  const std::string& st = side.structure;
+  const bool every_order = st == "bvh" || st == "tlas";
+  const bool unordered_too = st == "kdtree" || st == "octree";
+  if (side.xray && !every_order)
+    return "--xray: bvh and tlas only (" + st + " counts the walk that the closest hit ends)";
+  if (side.order == "back-to-front" && !every_order)
+    return "--order back-to-front: bvh and tlas only (" + st +
+           (unordered_too ? ": front-to-back or unordered)" : " has no child order)");
+  if (side.order == "unordered" && !every_order && !unordered_too)
+    return "--order unordered: " + st + " has no child order (bvh, tlas, kdtree and octree have)";
+  return {};
+}
+
 QueryOptions query_of(const CompareSide& side) {
   QueryOptions q;
   q.triangle_test = parse_triangle_test(side.triangle_test);

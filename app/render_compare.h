@@ -19,6 +19,13 @@ struct CompareSide {
   bool xray = false;
 };
 
+/// "" or why `side`'s traversal order cannot be honoured by its structure:
+/// bvh and tlas take every --order and --xray; kdtree and octree
+/// front-to-back and unordered; the others have no child order (a grid steps
+/// its cells along the ray). Without this the option was ignored in silence
+/// (and the caption named it).
+std::string order_problem(const CompareSide& side);
+
 /// `spec` is "key=value key=value ..." (spaces or commas between pairs) over
 /// a copy of `a`. Keys: structure, splitter, buckets, leaf, leaf-cap, ctrav,
 /// cisect, embree-quality, triangle-test, order, xray (0/1). Throws

@@ -187,6 +187,10 @@ expect 2 "--camera: an empty value" -- render 'builtin:soup?size=20' --camera ""
 expect 2 "--max: an empty value" -- render 'builtin:soup?size=20' --max "" -o "$tmp/e.png"
 expect 2 "--structure: an empty value" -- robustness 'builtin:soup?size=20' -s ""
 expect 2 "--structure: an empty item in 'bvh,,kdtree'" -- verify 'builtin:soup?size=20' -s bvh,,kdtree
+# An order or x-ray the structure cannot take (it was ignored and the caption named it).
+expect 2 "--order back-to-front: bvh and tlas only (kdtree: front-to-back or unordered)" -- render 'builtin:soup?size=20' -s kdtree --order back-to-front --size 8x8 -o "$tmp/order.png"
+expect 2 "--xray: bvh and tlas only" -- render 'builtin:soup?size=20' -s octree --xray --size 8x8 -o "$tmp/order.png"
+expect 2 "--compare: B (grid): --order unordered: grid has no child order" -- render 'builtin:soup?size=20' --order unordered --compare structure=grid --size 8x8 -o "$tmp/order.png"
 # bench too (CLI11's list splitting dropped the empty item: a typo measured other structures).
 expect 2 "--structure: an empty item in 'bvh,,kdtree'" -- bench 'builtin:soup?size=20' -s bvh,,kdtree
 expect 2 "--structure: an empty item in 'bvh,'" -- bench 'builtin:soup?size=20' -s bvh,
