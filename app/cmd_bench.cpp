@@ -189,7 +189,10 @@ void count_per_ray(const Accelerator& accel, const std::vector<Ray>& rays, const
   f.occluded_fraction = hit_count / n;
 }
 
-nlohmann::json query_json(const QueryFigures& f) {
+/// The figures of one ray set; without per-ray counters (Embree) the per-ray
+/// counts are null, as sweep writes a figure a structure does not have (0
+/// read as the cheapest).
+nlohmann::json query_json(const QueryFigures& f, bool counters) {
   nlohmann::json j = {
       {"closest_mrays_1t", f.closest_1t},
       {"closest_mrays_nt", f.closest_nt},
@@ -204,6 +207,10 @@ nlohmann::json query_json(const QueryFigures& f) {
       {"hit_fraction", f.hit_fraction},
       {"occluded_fraction", f.occluded_fraction},
   };
+  if (!counters)
+    for (const char* k : {"closest_nodes_per_ray", "closest_prims_per_ray", "closest_boxes_per_ray", "any_nodes_per_ray",
+                          "any_prims_per_ray", "any_boxes_per_ray"})
+      j[k] = nullptr;
   if (f.packets) {
     j["closest_packet_mrays_1t"] = f.closest_packet_1t;
     j["any_packet_mrays_1t"] = f.any_packet_1t;
@@ -483,6 +490,11 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
         {"max_depth", r.stats.max_depth},       {"avg_leaf_depth", r.stats.avg_leaf_depth},
         {"memory_bytes", r.stats.memory_bytes}, {"sah_cost", r.stats.sah_cost},
     };
+    // A figure the structure does not have is null (Embree exposes no tree; a grid and the voxels
+    // have no SAH): a 0 read as the lowest by a script that picks the best.
+    if (r.stats.node_count == 0)
+      for (const char* k : {"nodes", "leaves", "max_depth", "avg_leaf_depth"}) s["build"][k] = nullptr;
+    if (!(r.stats.sah_cost > 0.0)) s["build"]["sah_cost"] = nullptr;
     for (const auto& [k, v] : r.stats.extra) s["build"][k] = v;
     // The constants the SAH cost is under: SAH costs compare only under the same ones.
     if (const auto c = sah_constants(r.name, so); c && r.stats.sah_cost > 0.0)
@@ -497,10 +509,10 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
           {"sah_ratio_ours_over_embree", ratio(r.stats.sah_cost, r.embree_bvh->sah_cost)},
       };
     }
-    // Embree keeps no per-ray counters: its *_per_ray figures are 0 and marked so.
+    // Embree keeps no per-ray counters: its *_per_ray figures are null and marked so.
     s["per_ray_counters"] = !r.name.starts_with("embree");
     s["rays"] = nlohmann::json::object();
-    for (const auto& [set, f] : r.queries) s["rays"][set] = query_json(f);
+    for (const auto& [set, f] : r.queries) s["rays"][set] = query_json(f, s["per_ray_counters"].get<bool>());
     j["structures"].push_back(s);
   }
   if (embree) {
