@@ -575,7 +575,8 @@ TEST_F(GuiScript, EveryScenarioSliderMovesItsFiguresTheDocumentedWay) {
   // Teapot in a stadium: as the stadium grows the grid's primitive tests per ray climb.
   EXPECT_GT(row(high("teapot-stadium"), "grid")["prims_per_ray"].get<double>(),
             row(low("teapot-stadium"), "grid")["prims_per_ray"].get<double>());
-  // One centroid / one box for all: cost per ray grows with N (nothing separates the primitives).
+  // One centroid / one box for all: cost per ray grows with N (boxes that all hold one point overlap
+  // there; with one box for all nothing separates the primitives).
   for (const char* id : {"same-centroid", "same-bounds"})
     EXPECT_GT(row(high(id), "bvh")["cost_per_ray"].get<double>(), row(low(id), "bvh")["cost_per_ray"].get<double>())
         << id;

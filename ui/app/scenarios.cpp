@@ -37,9 +37,12 @@ const std::vector<Scenario>& scenarios() {
        false,
        {"bvh"}},
       {"same-centroid",
-       "All primitives share one centroid",
-       "Centroid bounds are a single point: binning has nothing to split, every node falls back to an object "
-       "median split, and every box is the whole scene. Watch cost per ray and depth as N grows (slider).",
+       "All primitives share one centroid (their vertices' average)",
+       "The triangles' vertex averages are one point, but their boxes differ in size and centre, so the BVH "
+       "(which bins box centres) still splits them; every box holds the common point, so the boxes overlap "
+       "there and rays near it test many triangles; the K-D tree copies each reference into many cells. "
+       "Compare 'one box for all', where binning has nothing to split. Watch cost per ray and depth as N grows "
+       "(slider).",
        "triangles N",
        100.0f,
        20000.0f,

@@ -1,8 +1,10 @@
 // Degenerate inputs for builders: scenes where the usual split heuristics
 // have nothing to split on. A builder must terminate on each of them, keep
 // every primitive, and not build a deep chain of one-primitive nodes.
-//   same-centroid  every centroid is the same point: centroid bounds are a
-//                  point, so binning on centroids puts everything in one bin.
+//   same-centroid  every vertex average is the same point; the bounding
+//                  boxes' centres differ (a BVH binning box centres still
+//                  splits), but every box holds that point: boxes overlap
+//                  there, and spatial splits copy references.
 //   same-bounds    every triangle has the same bounding box: no split of
 //                  boxes separates anything.
 //   duplicates     one triangle N times: both of the above, and equal keys
