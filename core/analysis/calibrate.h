@@ -1,7 +1,8 @@
 #pragma once
 // Calibrating the SAH constants to this machine: micro-benchmarks of the
-// robust ray-box slab test and of both ray-triangle tests over arrays larger
-// than the L1 cache, each the median of repeated timed loops. The BVH's SAH
+// robust ray-box slab test and of both ray-triangle tests over arrays that
+// stay in the caches (the tests' cost, not memory's), each the median of
+// repeated timed loops. The BVH's SAH
 // charges C_trav per inner node visited, and a binary BVH visit tests both
 // children's boxes, so C_trav = 2 box tests; normalised to C_trav = 1,
 // C_isect = t_triangle / (2 t_box).
@@ -11,7 +12,7 @@
 namespace accelviz {
 
 struct CalibrateOptions {
-  std::size_t items = 1 << 16;    ///< boxes, triangles and rays in each array
+  std::size_t items = 1 << 10;    ///< boxes, triangles and rays in each array (rounded up to a power of two)
   std::size_t tests = 1 << 23;    ///< tests per timed loop
   int repeat = 5;                 ///< timed loops per figure; the median is reported
   std::uint64_t seed = 1;         ///< random boxes, triangles and rays

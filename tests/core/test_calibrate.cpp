@@ -27,6 +27,11 @@ TEST(Calibrate, FiguresArePositiveAndRatiosFinite) {
   EXPECT_LT(c.box_hit_fraction, 0.95);
   EXPECT_GT(c.triangle_hit_fraction, 0.001);
   EXPECT_LT(c.triangle_hit_fraction, 0.95);
+  // A size that is not a power of two is rounded up (indices wrap by a mask).
+  o.items = 1000;
+  const Calibration d = calibrate(o);
+  EXPECT_GT(d.ns_box, 0.0);
+  EXPECT_GT(d.box_hit_fraction, 0.05);
 }
 
 }  // namespace
