@@ -13,7 +13,9 @@ BruteForce::BruteForce(std::span<const Triangle> triangles, const BruteForceOpti
     for (const Triangle& t : tris_) boxes_.push_back(t.bounds());
   }
   stats_.build_ms = ms_since(t0);
-  stats_.memory_bytes = boxes_.size() * sizeof(Aabb);
+  // The scene's triangles it reads count (not copied), as Embree's shared buffers do.
+  stats_.memory_bytes = boxes_.size() * sizeof(Aabb) + tris_.size() * sizeof(Triangle);
+  stats_.extra["memory_triangles"] = static_cast<double>(tris_.size() * sizeof(Triangle));
   if (!opts_.bbox_early_out) {
     stats_.node_count = 0;
     stats_.leaf_count = 1;

@@ -186,7 +186,8 @@ TEST(Grid, CsrListsHoldExactlyTheOverlappingTriangles) {
         }
     EXPECT_EQ(g.build_stats().extra.at("empty_cells"), static_cast<double>(empty));
     EXPECT_EQ(g.build_stats().extra.at("references"), static_cast<double>(g.refs().size()));
-    EXPECT_EQ(g.build_stats().memory_bytes, (start.size() + g.refs().size()) * 4);
+    // The cells, the references and the triangles it copies (36 bytes each).
+    EXPECT_EQ(g.build_stats().memory_bytes, (start.size() + g.refs().size()) * 4 + s.size() * 36);
     EXPECT_EQ(g.build_stats().node_count, 210u);
   }
   // Exact overlap lists fewer references than bounds overlap.

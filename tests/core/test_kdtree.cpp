@@ -338,7 +338,8 @@ TEST(KdTree, StatsAndSahRecomputedIndependently) {
   EXPECT_NEAR(st.avg_leaf_depth, depth_sum / leaves, 1e-9);
   EXPECT_NEAR(st.sah_cost, sah / kd.bounds().half_area(), 1e-6 * st.sah_cost);
   EXPECT_EQ(st.extra.at("references"), refs);
-  EXPECT_EQ(st.memory_bytes, st.node_count * 8 + static_cast<std::uint64_t>(refs) * 4);
+  // Nodes, references and the triangles it copies (36 bytes each).
+  EXPECT_EQ(st.memory_bytes, st.node_count * 8 + static_cast<std::uint64_t>(refs) * 4 + s.size() * 36);
   EXPECT_EQ(st.extra.at("max_depth_limit"), std::lround(8 + 1.3 * std::log2(1000.0)));
   EXPECT_LE(st.max_depth, static_cast<std::uint32_t>(st.extra.at("max_depth_limit")));
   EXPECT_LT(st.sah_cost, o.cost_intersect * 1000.0 / 10.0) << "the SAH tree is far better than one leaf";

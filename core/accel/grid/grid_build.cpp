@@ -166,7 +166,9 @@ Grid::Grid(std::span<const Triangle> triangles, const GridOptions& opts, const P
   // views draw the bounds at depth 0 and the cells at depth 1).
   stats_.max_depth = ncells > 0 ? 1 : 0;
   stats_.avg_leaf_depth = ncells > 0 ? 1.0 : 0.0;
-  stats_.memory_bytes = (cell_start_.size() + refs_.size()) * sizeof(std::uint32_t);
+  // The triangles it copies count, as the BVH's triangle blocks and Embree's buffers do.
+  stats_.memory_bytes = (cell_start_.size() + refs_.size()) * sizeof(std::uint32_t) + tris_.size() * sizeof(Triangle);
+  stats_.extra["memory_triangles"] = static_cast<double>(tris_.size() * sizeof(Triangle));
   stats_.extra["cells"] = static_cast<double>(ncells);
   stats_.extra["empty_cells"] = static_cast<double>(empty);
   stats_.extra["references"] = static_cast<double>(refs_.size());

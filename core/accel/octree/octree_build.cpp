@@ -159,7 +159,10 @@ Octree::Octree(std::span<const Triangle> triangles, const OctreeOptions& opts, c
   prim_refs_.shrink_to_fit();
 
   stats_.build_ms = ms_since(t_start);
-  stats_.memory_bytes = nodes_.size() * sizeof(OctreeNode) + prim_refs_.size() * sizeof(std::uint32_t);
+  // The triangles it copies count, as the BVH's triangle blocks and Embree's buffers do.
+  stats_.memory_bytes = nodes_.size() * sizeof(OctreeNode) + prim_refs_.size() * sizeof(std::uint32_t) +
+                        tris_.size() * sizeof(Triangle);
+  stats_.extra["memory_triangles"] = static_cast<double>(tris_.size() * sizeof(Triangle));
   builder.tally_.fill(stats_, nodes_.size(), prim_refs_.size(), n, root_.half_area(), static_cast<double>(n));
   if (progress && !progress(1.0)) throw BuildCancelled();
 }
