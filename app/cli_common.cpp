@@ -55,8 +55,11 @@ void StructureCli::add_to(CLI::App* app, bool with_embree) {
       ->check(CLI::Range(1, 255))
       ->capture_default_str()
       ->group("Structure");
-  app->add_option("--leaf-cap", leaf_cap, "BVH: SAH may keep up to this many triangles in a leaf when cheaper")
+  app->add_option("--leaf-cap", leaf_cap,
+                  "BVH: SAH may keep up to this many triangles in a leaf when cheaper (at least --leaf; raised to "
+                  "--leaf when not given)")
       ->check(CLI::Range(1, 255))
+      ->each([this](const std::string&) { leaf_cap_given = true; })
       ->capture_default_str()
       ->group("Structure");
   app->add_option("--ctrav", ctrav, "SAH cost of visiting an inner node (C_trav)")
@@ -103,7 +106,11 @@ StructureOptions StructureCli::to_options(unsigned threads, bool compute_epo) co
                                           : BvhSplitter::binned_sah;
   o.bvh.buckets = buckets;
   o.bvh.max_leaf_size = leaf;
-  // The cap can never be below the always-leaf size; raise it with --leaf.
+  // The cap can never be below the always-leaf size: raised with --leaf unless given.
+  if (leaf_cap_given && leaf_cap < leaf)
+    throw UsageError("--leaf-cap " + std::to_string(leaf_cap) + " is below --leaf " + std::to_string(leaf) +
+                     " (nodes of at most --leaf triangles always become leaves; the cap is the largest leaf the SAH "
+                     "may keep)");
   o.bvh.leaf_size_cap = std::max(leaf, leaf_cap);
   o.bvh.cost_traversal = ctrav;
   o.bvh.cost_intersect = cisect;

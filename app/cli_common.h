@@ -75,6 +75,7 @@ struct StructureCli {
   int buckets = BvhOptions{}.buckets;
   int leaf = BvhOptions{}.max_leaf_size;
   int leaf_cap = BvhOptions{}.leaf_size_cap;
+  bool leaf_cap_given = false;  ///< --leaf-cap on the command line (or leaf-cap in --compare)
   int wide = BvhOptions{}.wide_width;
   float ctrav = BvhOptions{}.cost_traversal;
   float cisect = BvhOptions{}.cost_intersect;
@@ -84,7 +85,9 @@ struct StructureCli {
 
   /// Adds the options to `app`; without `with_embree` (a command that builds BVHs only) no --embree-*.
   void add_to(CLI::App* app, bool with_embree = true);
-  /// Options for the factory; `threads` is the build thread count.
+  /// Options for the factory; `threads` is the build thread count. The leaf
+  /// cap is raised to --leaf where it was not given; a --leaf-cap given below
+  /// --leaf is a UsageError (it was ignored in silence).
   StructureOptions to_options(unsigned threads, bool compute_epo) const;
 };
 

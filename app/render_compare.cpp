@@ -75,6 +75,7 @@ CompareSide parse_compare_spec(const std::string& spec, const CompareSide& a) {
       const int v = parse_number<int>(key, value);
       if (v < 1 || v > 255) throw UsageError("--compare: " + key + "=" + value + ": expected 1..255");
       (key == "leaf" ? b.structure_opts.leaf : b.structure_opts.leaf_cap) = v;
+      if (key == "leaf-cap") b.structure_opts.leaf_cap_given = true;
     } else if (key == "ctrav" || key == "cisect") {
       const float v = parse_number<float>(key, value);
       if (!(v > 0.0f) || !std::isfinite(v)) throw UsageError("--compare: " + key + "=" + value + ": expected > 0");
@@ -141,7 +142,7 @@ nlohmann::json describe_side(const CompareSide& side, HeatMetric metric) {
     d["splitter"] = side.structure_opts.splitter;
     if (side.structure_opts.splitter == "binned") d["buckets"] = side.structure_opts.buckets;
     d["leaf"] = side.structure_opts.leaf;
-    d["leaf_cap"] = side.structure_opts.leaf_cap;
+    d["leaf_cap"] = std::max(side.structure_opts.leaf, side.structure_opts.leaf_cap);  // as built
   }
   // The SAH's costs, and the cost metric's weights whatever the structure.
   if (bvh_options || metric == HeatMetric::cost) {

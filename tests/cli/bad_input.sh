@@ -187,6 +187,9 @@ expect 2 "--camera: an empty value" -- render 'builtin:soup?size=20' --camera ""
 expect 2 "--max: an empty value" -- render 'builtin:soup?size=20' --max "" -o "$tmp/e.png"
 expect 2 "--structure: an empty value" -- robustness 'builtin:soup?size=20' -s ""
 expect 2 "--structure: an empty item in 'bvh,,kdtree'" -- verify 'builtin:soup?size=20' -s bvh,,kdtree
+# A leaf cap below the always-leaf size (it was ignored); not given, it is raised to --leaf.
+expect 2 "--leaf-cap 4 is below --leaf 8" -- bench 'builtin:soup?size=20' -s bvh --leaf 8 --leaf-cap 4
+expect 2 "--leaf-cap 2 is below --leaf 4" -- render 'builtin:soup?size=20' --size 8x8 -o "$tmp/cap.png" --compare leaf-cap=2
 # An order or x-ray the structure cannot take (it was ignored and the caption named it).
 expect 2 "--order back-to-front: bvh and tlas only (kdtree: front-to-back or unordered)" -- render 'builtin:soup?size=20' -s kdtree --order back-to-front --size 8x8 -o "$tmp/order.png"
 expect 2 "--xray: bvh and tlas only" -- render 'builtin:soup?size=20' -s octree --xray --size 8x8 -o "$tmp/order.png"
