@@ -29,9 +29,12 @@ struct AnimateOptions {
 int run_animate(const AnimateOptions& o, const GlobalOptions& global) {
   if (!(o.dt > 0.0) || !std::isfinite(o.dt))
     throw UsageError("--dt: must be a finite number > 0 seconds, got " + std::to_string(o.dt));
-  if (o.rebuild_ratio != 0.0 && !(o.rebuild_ratio > 1.0 && std::isfinite(o.rebuild_ratio)))
-    throw UsageError("--rebuild-ratio: must be a finite number > 1 (or 0: always refit), got " +
-                     std::to_string(o.rebuild_ratio));
+  // refit's rule: rebuild when refit SAH / fresh SAH exceeds R, so R = 1 (rebuild on any decay) is one.
+  if (o.rebuild_ratio != 0.0 && !(o.rebuild_ratio >= 1.0 && std::isfinite(o.rebuild_ratio))) {
+    char got[32];
+    std::snprintf(got, sizeof got, "%g", o.rebuild_ratio);
+    throw UsageError(std::string("--rebuild-ratio: must be a finite number >= 1 (or 0: always refit), got ") + got);
+  }
   Progress progress(global.quiet);
   progress.begin("loading " + o.scene);
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
