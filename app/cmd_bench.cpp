@@ -208,8 +208,8 @@ nlohmann::json query_json(const QueryFigures& f, bool counters) {
       {"occluded_fraction", f.occluded_fraction},
   };
   if (!counters)
-    for (const char* k : {"closest_nodes_per_ray", "closest_prims_per_ray", "closest_boxes_per_ray", "any_nodes_per_ray",
-                          "any_prims_per_ray", "any_boxes_per_ray"})
+    for (const char* k : {"closest_nodes_per_ray", "closest_prims_per_ray", "closest_boxes_per_ray",
+                          "any_nodes_per_ray", "any_prims_per_ray", "any_boxes_per_ray"})
       j[k] = nullptr;
   if (f.packets) {
     j["closest_packet_mrays_1t"] = f.closest_packet_1t;

@@ -346,10 +346,11 @@ Command add_render_command(CLI::App& parent, const GlobalOptions& global) {
                   "visited, two-level structure)")
       ->check(CLI::IsMember({"nodes", "prims", "cost", "shaded", "depth", "instances"}))
       ->capture_default_str();
-  sub->add_option("--camera", o->camera,
-                  "View: ex,ey,ez,tx,ty,tz[,fovdeg] (eye, target, vertical fov in degrees, default 45) or gltf:N "
-                  "(the scene's N-th camera); default: the scene's first camera, else a view framing the scene (vertical fov "
-                  "0.8 rad, 45.84 degrees)");
+  sub->add_option(
+      "--camera", o->camera,
+      "View: ex,ey,ez,tx,ty,tz[,fovdeg] (eye, target, vertical fov in degrees, default 45) or gltf:N "
+      "(the scene's N-th camera); default: the scene's first camera, else a view framing the scene (vertical fov "
+      "0.8 rad, 45.84 degrees)");
   sub->add_option("--size", o->size, "Image size WxH (the legend is added below or beside it)")
       ->check(size_validator())
       ->capture_default_str();

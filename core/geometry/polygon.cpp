@@ -105,8 +105,8 @@ std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(std::span<const gl
   const auto list = [&](std::uint32_t q) {
     if (listed[q] || !reflex(q)) return;
     listed[q] = 1;
-    grid[static_cast<std::size_t>(cell_of(p[q].y, lo.y, extent.y)) * cells + cell_of(p[q].x, lo.x, extent.x)]
-        .push_back(q);
+    grid[static_cast<std::size_t>(cell_of(p[q].y, lo.y, extent.y)) * cells + cell_of(p[q].x, lo.x, extent.x)].push_back(
+        q);
   };
   for (std::uint32_t k = 0; k < n; ++k) list(k);
   std::size_t r = n, checks = 0, since_ear = 0;

@@ -160,8 +160,8 @@ Octree::Octree(std::span<const Triangle> triangles, const OctreeOptions& opts, c
 
   stats_.build_ms = ms_since(t_start);
   // The triangles it copies count, as the BVH's triangle blocks and Embree's buffers do.
-  stats_.memory_bytes = nodes_.size() * sizeof(OctreeNode) + prim_refs_.size() * sizeof(std::uint32_t) +
-                        tris_.size() * sizeof(Triangle);
+  stats_.memory_bytes =
+      nodes_.size() * sizeof(OctreeNode) + prim_refs_.size() * sizeof(std::uint32_t) + tris_.size() * sizeof(Triangle);
   stats_.extra["memory_triangles"] = static_cast<double>(tris_.size() * sizeof(Triangle));
   builder.tally_.fill(stats_, nodes_.size(), prim_refs_.size(), n, root_.half_area(), static_cast<double>(n));
   if (progress && !progress(1.0)) throw BuildCancelled();
