@@ -427,6 +427,9 @@ void tree_rows(const StructureNodes& nodes, const std::vector<std::uint64_t>* vi
   ImGuiTreeNodeFlags flags = ImGuiTreeNodeFlags_OpenOnArrow | ImGuiTreeNodeFlags_SpanAvailWidth;
   if (n->leaf) flags |= ImGuiTreeNodeFlags_Leaf | ImGuiTreeNodeFlags_NoTreePushOnOpen;
   if (id == selected) flags |= ImGuiTreeNodeFlags_Selected;
+  // The root opens on first show: with the root selected (the default, or a click on a pixel that
+  // missed) no path forces it open, and the panel showed one collapsed row.
+  if (id == 0) flags |= ImGuiTreeNodeFlags_DefaultOpen;
   if (!n->leaf && id != selected && on_path(nodes, id, selected)) ImGui::SetNextItemOpen(true, ImGuiCond_Always);
   ImGui::PushID(static_cast<int>(id));
   if (visits) {
