@@ -1,7 +1,9 @@
 // accelviz render: a per-pixel metric heatmap (nodes visited, primitive tests,
 // cost, shading, depth) of one structure, written as a PNG with a legend.
 // Also the no-subcommand demo, which renders the demo scene the same way.
+#include <algorithm>
 #include <ctime>
+#include <span>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -156,14 +158,19 @@ int run_render_raster(const RenderOptions& o, const GlobalOptions& global) {
   return 0;
 }
 
-/// Loads, builds, renders and colours; returns the image and the figures as JSON.
-RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohmann::json& figures) {
+/// One structure's heatmap, traced and not yet coloured, with its figures.
+struct TracedHeatmap {
+  MetricImage image;
+  nlohmann::json figures;
+  bool counters = true;  ///< per-ray counters (Embree keeps none)
+  std::string name;      ///< the accelerator's name
+};
+
+/// Builds o.structure over `scene` and traces its heatmap (CPU or GPU) from `camera`.
+TracedHeatmap trace_heatmap(const RenderOptions& o, const Scene& scene, const Camera& camera,
+                            const GlobalOptions& global, Progress& progress) {
   const ImageSize size = parse_size(o.size);
   const HeatMetric metric = parse_metric(o.metric).value();
-  Progress progress(global.quiet);
-
-  const Scene scene = load_scene_with_progress(o.scene, global.quiet, progress);
-  const Camera camera = camera_for(o.camera, scene, size);
   const auto t0 = Clock::now();
   const std::unique_ptr<Accelerator> accel =
       build_with_progress(o.structure, scene, o.structure_opts.to_options(o.threads, /*compute_epo=*/false), progress);
@@ -203,17 +210,8 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
     progress.end(std::to_string(static_cast<long long>(fig.render_ms)) + " ms");
   }
 
-  ColorizeOptions co;
-  co.map = parse_colormap(o.colormap).value();
-  co.max = o.max;
-  if (o.max_percentile > 0.0) {  // --max pNN: the top where NN % of the pixels' values lie below
-    const MetricImage* images[] = {&img};
-    co.max = metric_percentile(images, o.max_percentile);
-    co.scale_note = "top: " + ordinal(o.max_percentile) + " percentile";
-  }
-  co.legend = parse_legend_placement(o.legend).value();
-  co.structure = o.structure;  // the legend in its words: a grid's nodes are cells
-
+  TracedHeatmap t;
+  nlohmann::json& figures = t.figures;
   figures = {
       {"scene", o.scene},
       {"structure", o.structure},
@@ -229,7 +227,6 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
       {"rays_per_s", fig.rays_per_s},
       {"mean", fig.mean},
       {"max", fig.max},
-      {"scale_max", heatmap_scale_max(img, co.max)},
       {"colormap", o.colormap},
       {"camera",
        {{"eye", {camera.position.x, camera.position.y, camera.position.z}},
@@ -248,12 +245,131 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
   }
   figures["device"] = o.device;
   for (const auto& [key, value] : gpu_figures.items()) figures[key] = value;
-  RgbImage rgb = colorize(img, co);
+  t.image = std::move(img);
+  t.counters = counters;
+  t.name = accel->name();
+  return t;
+}
+
+/// The colour options of o (map, legend, the structure's words) with the scale's top: --max's
+/// value, or its percentile of `images`, or 0 (each image's own maximum).
+ColorizeOptions colour_options(const RenderOptions& o, std::span<const MetricImage* const> images) {
+  ColorizeOptions co;
+  co.map = parse_colormap(o.colormap).value();
+  co.max = o.max;
+  if (o.max_percentile > 0.0) {  // --max pNN: the top where NN % of the pixels' values lie below
+    co.max = metric_percentile(images, o.max_percentile);
+    co.scale_note = "top: " + ordinal(o.max_percentile) + " percentile";
+  }
+  co.legend = parse_legend_placement(o.legend).value();
+  co.structure = o.structure;  // the legend in its words: a grid's nodes are cells
+  return co;
+}
+
+/// `t` coloured under `co`, with the notes of what it cannot show; its figures get scale_max.
+RgbImage colour_heatmap(const RenderOptions& o, TracedHeatmap& t, const ColorizeOptions& co) {
+  const HeatMetric metric = parse_metric(o.metric).value();
+  t.figures["scale_max"] = heatmap_scale_max(t.image, co.max);
+  RgbImage rgb = colorize(t.image, co);
   // All 0 because nothing was counted, not because nothing was visited: the image says so itself.
-  if (metric_needs_stats(metric) && !counters) draw_note(rgb, "n/a: " + accel->name() + " counts nothing per ray");
+  if (metric_needs_stats(metric) && !t.counters) draw_note(rgb, "n/a: " + t.name + " counts nothing per ray");
   else if (const std::string why = metric_not_counted(metric, o.structure); !why.empty())
     draw_note(rgb, "n/a: " + why);
   return rgb;
+}
+
+/// Loads, builds, renders and colours; returns the image and the figures as JSON.
+RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohmann::json& figures) {
+  Progress progress(global.quiet);
+  const Scene scene = load_scene_with_progress(o.scene, global.quiet, progress);
+  const Camera camera = camera_for(o.camera, scene, parse_size(o.size));
+  TracedHeatmap t = trace_heatmap(o, scene, camera, global, progress);
+  const MetricImage* images[] = {&t.image};
+  const RgbImage rgb = colour_heatmap(o, t, colour_options(o, images));
+  figures = std::move(t.figures);
+  return rgb;
+}
+
+/// The structures of one --structure value ("bvh,kdtree,grid"); an empty item is a usage error.
+std::vector<std::string> structure_list(const std::string& text) {
+  std::vector<std::string> items;
+  std::size_t start = 0;
+  for (std::size_t comma; (comma = text.find(',', start)) != std::string::npos; start = comma + 1)
+    items.push_back(text.substr(start, comma - start));
+  items.push_back(text.substr(start));
+  const std::vector<std::string> names = structure_names();
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (items[i].empty()) throw UsageError("--structure: an empty item in '" + text + "'");
+    if (std::find(names.begin(), names.end(), items[i]) == names.end()) {
+      std::string all;
+      for (const std::string& n : names) all += (all.empty() ? "" : ",") + n;
+      throw UsageError("--structure: " + items[i] + " not in {" + all + "}");
+    }
+    for (std::size_t j = 0; j < i; ++j)
+      if (items[j] == items[i]) throw UsageError("--structure: '" + items[i] + "' is listed twice");
+  }
+  return items;
+}
+
+/// render -s A,B,...: one image per structure, DIR/NAME-A.png, ..., on one colour scale (the
+/// largest of their maxima, or --max), so that a lecture's pictures of one view compare by colour.
+int run_render_several(const RenderOptions& o, const std::vector<std::string>& structures,
+                       const GlobalOptions& global) {
+  const HeatMetric metric = parse_metric(o.metric).value();
+  if (!metric_needs_stats(metric))
+    throw UsageError("several structures: a cost metric (nodes, prims, cost or instances) shares a scale, not --metric " +
+                     o.metric);
+  if (o.view != "heatmap") throw UsageError("several structures: --view heatmap only");
+  if (o.device != "cpu") throw UsageError("several structures: --device cpu only");
+  std::vector<RenderOptions> each;
+  for (const std::string& s : structures) {
+    RenderOptions os = o;
+    os.structure = s;
+    if (const std::string problem = order_problem(compare_side(os)); !problem.empty())
+      throw UsageError(s + ": " + problem);
+    const std::filesystem::path p(o.out);
+    os.out = (p.parent_path() / (p.stem().string() + "-" + s + p.extension().string())).string();
+    check_output_path(os.out, o.force);
+    each.push_back(std::move(os));
+  }
+  Progress progress(global.quiet);
+  const Scene scene = load_scene_with_progress(o.scene, global.quiet, progress);
+  const Camera camera = camera_for(o.camera, scene, parse_size(o.size));
+  std::vector<TracedHeatmap> traced;
+  for (const RenderOptions& os : each) traced.push_back(trace_heatmap(os, scene, camera, global, progress));
+  std::vector<const MetricImage*> images;
+  for (const TracedHeatmap& t : traced) images.push_back(&t.image);
+  // One scale: --max's value or percentile (of every image's values), else the largest maximum.
+  ColorizeOptions shared = colour_options(o, images);
+  if (!(shared.max > 0.0f))
+    for (const MetricImage* img : images) shared.max = std::max(shared.max, heatmap_scale_max(*img, 0.0f));
+  nlohmann::json out = {{"scene", o.scene}, {"metric", o.metric}, {"scale_max", shared.max}};
+  out["images"] = nlohmann::json::array();
+  for (std::size_t i = 0; i < each.size(); ++i) {
+    const RenderOptions& os = each[i];
+    ColorizeOptions co = shared;
+    co.structure = os.structure;
+    co.title_prefix = os.structure + ": ";
+    std::string others;
+    for (const std::string& s : structures)
+      if (s != os.structure) others += (others.empty() ? "" : ", ") + s;
+    co.scale_note = (shared.scale_note.empty() ? "" : shared.scale_note + "; ") + "scale shared with " + others;
+    RgbImage rgb = colour_heatmap(os, traced[i], co);
+    nlohmann::json& figures = traced[i].figures;
+    if (o.caption != "none") {
+      // The single-structure command that draws the same picture: its --max is the shared top.
+      RenderOptions alone = os;
+      if (o.max_percentile > 0.0 || o.max_text.empty()) alone.max_text = short_number(shared.max);
+      figures["caption"] = o.caption == "auto" ? render_caption(alone) : o.caption;
+      rgb = add_caption(rgb, figures["caption"].get<std::string>());
+    }
+    write_png(os.out, rgb, o.force);
+    figures["out"] = absolute_path(os.out);
+    std::cout << figures["out"].get<std::string>() << "\n";
+    out["images"].push_back(figures);
+  }
+  print_json_line(out);
+  return 0;
 }
 
 int run_render(const RenderOptions& given, const GlobalOptions& global) {
@@ -272,6 +388,10 @@ int run_render(const RenderOptions& given, const GlobalOptions& global) {
     if (o.compare) throw UsageError("--device gpu: --compare traces on the CPU only");
     if (o.view != "heatmap") throw UsageError("--device gpu needs --view heatmap");
 #endif
+  }
+  if (o.structure.find(',') != std::string::npos) {
+    if (o.compare) throw UsageError("--compare: one structure for A (B names its own: structure=...)");
+    return run_render_several(o, structure_list(o.structure), global);
   }
   if (const std::string problem = order_problem(compare_side(o)); !problem.empty()) throw UsageError(problem);
   if (o.compare) {
@@ -337,8 +457,19 @@ Command add_render_command(CLI::App& parent, const GlobalOptions& global) {
                                         "(with a legend bar)");
   sub->add_option("SCENE", o->scene, "Scene file (.gltf, .glb, .obj) or builtin:NAME[?key=value&...]")->required();
   sub->add_option("--out,-o", o->out, "Output PNG file (never overwritten without --force)")->required();
-  sub->add_option("--structure,-s", o->structure, "Acceleration structure")
-      ->check(CLI::IsMember(structure_names()))
+  sub->add_option("--structure,-s", o->structure,
+                  "Acceleration structure; a comma-separated list (bvh,kdtree,grid) writes OUT-bvh.png, "
+                  "OUT-kdtree.png, ... on one colour scale (a cost metric, the heatmap view)")
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            if (text.find(',') != std::string::npos) return std::string();  // checked item by item later
+            const std::vector<std::string> names = structure_names();
+            if (std::find(names.begin(), names.end(), text) != names.end()) return std::string();
+            std::string all;
+            for (const std::string& n : names) all += (all.empty() ? "" : ",") + n;
+            return text + " not in {" + all + "}";
+          },
+          "NAME[,NAME...]"))
       ->capture_default_str();
   sub->add_option("--metric,-m", o->metric,
                   "Per-pixel metric: nodes (nodes visited), prims (triangle tests), cost (ctrav*nodes + "

@@ -193,6 +193,12 @@ expect 2 "--structure: an empty item in 'bvh,,kdtree'" -- verify 'builtin:soup?s
 # A leaf cap below the always-leaf size (it was ignored); not given, it is raised to --leaf.
 expect 2 "--leaf-cap 4 is below --leaf 8" -- bench 'builtin:soup?size=20' -s bvh --leaf 8 --leaf-cap 4
 expect 2 "--leaf-cap 2 is below --leaf 4" -- render 'builtin:soup?size=20' --size 8x8 -o "$tmp/cap.png" --compare leaf-cap=2
+# Several structures in one render: a cost metric, not with --compare, each named once.
+expect 2 "several structures: a cost metric" -- render 'builtin:soup?size=20' -s bvh,grid -m depth --size 8x8 -o "$tmp/sev.png"
+expect 2 "--compare: one structure for A" -- render 'builtin:soup?size=20' -s bvh,grid --compare buckets=4 --size 8x8 -o "$tmp/sev.png"
+expect 2 "--structure: an empty item in 'bvh,,grid'" -- render 'builtin:soup?size=20' -s bvh,,grid --size 8x8 -o "$tmp/sev.png"
+expect 2 "--structure: 'bvh' is listed twice" -- render 'builtin:soup?size=20' -s bvh,grid,bvh --size 8x8 -o "$tmp/sev.png"
+expect 2 "kdtree: --order back-to-front" -- render 'builtin:soup?size=20' -s bvh,kdtree --order back-to-front --size 8x8 -o "$tmp/sev.png"
 # An order or x-ray the structure cannot take (it was ignored and the caption named it).
 expect 2 "--order back-to-front: bvh and tlas only (kdtree: front-to-back or unordered)" -- render 'builtin:soup?size=20' -s kdtree --order back-to-front --size 8x8 -o "$tmp/order.png"
 expect 2 "--xray: bvh and tlas only" -- render 'builtin:soup?size=20' -s octree --xray --size 8x8 -o "$tmp/order.png"

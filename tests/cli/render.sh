@@ -77,4 +77,27 @@ if grep -q $'\r' "$tmp/progress.err"; then echo "FAIL: carriage return on a pipe
 "$accelviz" render "$scene" --size 32x24 --out "$tmp/quick.png" >/dev/null 2>"$tmp/quick.err"
 if grep -qE '[0-9]%$' "$tmp/quick.err"; then echo "FAIL: a quick step printed progress lines"; cat "$tmp/quick.err"; exit 1; fi
 echo "progress lines ok"
+
+# Several structures: one image each, OUT-NAME.png, on one colour scale (the largest maximum).
+out=$("$accelviz" -q render "$scene" -s bvh,kdtree,grid --size 64x48 --out "$tmp/several.png")
+for s in bvh kdtree grid; do [ -f "$tmp/several-$s.png" ] || { echo "FAIL: several-$s.png missing"; exit 1; }; done
+python3 - "$(tail -n 1 <<<"$out")" "$(head -n 3 <<<"$out")" <<'PY'
+import json, sys
+j = json.loads(sys.argv[1])
+names = [i["structure"] for i in j["images"]]
+assert names == ["bvh", "kdtree", "grid"], names
+top = max(i["max"] for i in j["images"])
+assert j["scale_max"] == top and all(i["scale_max"] == top for i in j["images"]), j
+assert all(i["caption"].endswith("--max %g" % top) for i in j["images"]), [i["caption"] for i in j["images"]]
+assert sys.argv[2].split("\n") == [i["out"] for i in j["images"]]
+print("several structures ok")
+PY
+# --max pNN: the percentile of every image's values, shared.
+"$accelviz" -q render "$scene" -s bvh,octree --size 64x48 --max p90 --out "$tmp/p90.png" | tail -n 1 |
+  python3 -c 'import json,sys; j=json.load(sys.stdin); assert 0 < j["scale_max"] < max(i["max"] for i in j["images"]), j'
+# An existing output stops the run before any is written.
+if "$accelviz" -q render "$scene" -s bvh,grid --size 32x24 --out "$tmp/several.png" 2>"$tmp/err"; then
+  echo "FAIL: several structures overwrote"; exit 1
+fi
+grep -q "several-bvh.png: exists" "$tmp/err" || { echo "FAIL: message: $(cat "$tmp/err")"; exit 1; }
 echo "render ok"
