@@ -342,7 +342,7 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
               count_of(scene.triangles.size(), "triangle").c_str(), o.structure.c_str(), rays.size(), o.rays.c_str(),
               count_of(threads, "thread").c_str(), o.repeat, o.ray_budget);
   if (kind == RayKind::shadow && synthetic) {
-    const glm::vec3 p = synthetic_light(scene.bounds()).position;
+    const glm::vec3 p = synthetic_light(scene).position;
     std::printf("the scene has no lights: shadow rays aim at a synthetic point light at (%g, %g, %g)\n", p.x, p.y, p.z);
   }
   std::printf("%-32s %10s %10s %8s %10s %10s %12s %12s", "setting", "build ms", "memory", "SAH", "nodes/ray",

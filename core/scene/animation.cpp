@@ -166,12 +166,77 @@ std::vector<Triangle> triangles_over(const Mesh& mesh, const std::vector<glm::ve
 
 }  // namespace
 
+std::vector<char> nodes_placing_instances(const Scene& scene) {
+  std::vector<char> placing(scene.nodes.size(), 0);
+  for (const Instance& inst : scene.instances)
+    for (int n = static_cast<int>(inst.node); n >= 0 && static_cast<std::size_t>(n) < scene.nodes.size() && !placing[n];
+         n = scene.nodes[n].parent)
+      placing[n] = 1;
+  return placing;
+}
+
+namespace {
+
+/// Key k's entries of a channel: [in-tangents n][values n][out-tangents n] for a cubic spline,
+/// [values n] otherwise (n: 1 for translation, rotation and scale; the target count for weights).
+/// True when every key holds `rest` (n values) and no tangent bends between keys.
+bool channel_holds(const AnimationChannel& c, std::span<const glm::vec4> rest) {
+  const std::size_t keys = c.times.size();
+  const std::size_t per_key = c.interpolation == AnimationChannel::Interpolation::cubic_spline ? 3 : 1;
+  if (keys == 0 || c.values.size() != keys * per_key * rest.size()) return false;  // malformed: assume it moves
+  const std::size_t n = rest.size(), vpart = per_key == 3 ? 1 : 0;
+  for (std::size_t k = 0; k < keys; ++k)
+    for (std::size_t part = 0; part < per_key; ++part)
+      for (std::size_t j = 0; j < n; ++j) {
+        const glm::vec4& v = c.values[(k * per_key + part) * n + j];
+        if (part == vpart ? v != rest[j] : v != glm::vec4(0.0f)) return false;
+      }
+  return true;
+}
+
+/// A channel's first value, the rest its keys would have to hold for it to never change anything.
+std::vector<glm::vec4> first_values(const AnimationChannel& c, std::size_t n) {
+  const std::size_t vpart = c.interpolation == AnimationChannel::Interpolation::cubic_spline ? 1 : 0;
+  std::vector<glm::vec4> v(n, glm::vec4(0.0f));
+  for (std::size_t j = 0; j < n && vpart * n + j < c.values.size(); ++j) v[j] = c.values[vpart * n + j];
+  return v;
+}
+
+}  // namespace
+
+bool channel_moves(const Scene& scene, const AnimationChannel& c, const std::vector<char>& placing) {
+  if (c.node < 0 || static_cast<std::size_t>(c.node) >= scene.nodes.size() || c.times.empty()) return false;
+  if (!placing[static_cast<std::size_t>(c.node)]) return false;  // no instance below it: nothing to move
+  const Node& node = scene.nodes[static_cast<std::size_t>(c.node)];
+  using P = AnimationChannel::Path;
+  if (c.path == P::weights) {
+    if (node.mesh < 0 || static_cast<std::size_t>(node.mesh) >= scene.meshes.size()) return false;
+    const Mesh& m = scene.meshes[static_cast<std::size_t>(node.mesh)];
+    if (m.morph_deltas.empty()) return false;
+    const std::size_t per_key = c.interpolation == AnimationChannel::Interpolation::cubic_spline ? 3 : 1;
+    const std::size_t n = c.values.size() / std::max<std::size_t>(1, c.times.size() * per_key);
+    std::vector<glm::vec4> rest(n, glm::vec4(0.0f));  // one weight per entry, in x
+    for (std::size_t j = 0; j < n; ++j) rest[j].x = j < m.morph_weights.size() ? m.morph_weights[j] : 0.0f;
+    return !channel_holds(c, rest);
+  }
+  // A constant channel moves the node once if its value is not the node's own (frame 0), else never.
+  const std::vector<glm::vec4> held = first_values(c, 1);
+  const glm::vec4 own = c.path == P::translation ? glm::vec4(node.translation, held[0].w)
+                        : c.path == P::scale     ? glm::vec4(node.scale, held[0].w)
+                                                 : glm::vec4(node.rotation.x, node.rotation.y, node.rotation.z,
+                                                             node.rotation.w);
+  return !channel_holds(c, held) || (!node.has_matrix && held[0] != own) || node.has_matrix;
+}
+
 std::vector<std::uint32_t> deforming_meshes(const Scene& scene) {
   std::vector<std::uint32_t> out;
   for (const MeshDeformer& d : scene.deformers)
     if (d.mesh < scene.meshes.size()) out.push_back(d.mesh);
+  const std::vector<char> placing = nodes_placing_instances(scene);
   for (std::uint32_t m = 0; m < scene.meshes.size(); ++m)
-    if (!scene.meshes[m].morph_deltas.empty() && weights_channel_of(scene, m)) out.push_back(m);
+    if (const AnimationChannel* c = scene.meshes[m].morph_deltas.empty() ? nullptr : weights_channel_of(scene, m);
+        c && channel_moves(scene, *c, placing))
+      out.push_back(m);
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
@@ -209,12 +274,18 @@ float animation_duration(const Scene& scene) {
   return d;
 }
 
-bool scene_animates(const Scene& scene) {
-  if (!scene.deformers.empty() || !deforming_meshes(scene).empty()) return true;
+std::size_t rigid_channels_moving(const Scene& scene) {
+  const std::vector<char> placing = nodes_placing_instances(scene);
+  std::size_t count = 0;
   for (const Animation& a : scene.animations)
     for (const AnimationChannel& c : a.channels)
-      if (c.node >= 0 && c.path != AnimationChannel::Path::weights && !c.times.empty()) return true;
-  return false;
+      count += c.path != AnimationChannel::Path::weights && channel_moves(scene, c, placing);
+  return count;
+}
+
+bool scene_animates(const Scene& scene) {
+  if (!scene.deformers.empty() || !deforming_meshes(scene).empty()) return true;
+  return rigid_channels_moving(scene) > 0;
 }
 
 void apply_animation(const Animation& anim, float t, std::vector<Node>& nodes, std::vector<bool>& changed) {

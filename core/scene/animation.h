@@ -35,7 +35,7 @@ std::vector<float> sample_weights(const AnimationChannel& channel, float t);
 
 /// Meshes whose shape changes over time, ascending: those a MeshDeformer
 /// moves and those with morph targets whose weights a channel drives (the
-/// channel's node references the mesh).
+/// channel's node references the mesh, and its weights change: channel_moves).
 std::vector<std::uint32_t> deforming_meshes(const Scene& scene);
 
 /// Morph weights of MESH at time T: the first `weights` channel (animations
@@ -55,8 +55,25 @@ std::vector<Triangle> posed_triangles(const Scene& scene, std::uint32_t mesh, fl
 /// Last key time over all channels of all animations (0: nothing animates).
 float animation_duration(const Scene& scene);
 
-/// True when the scene has node TRS channels, mesh deformers, or morph
-/// weights channels that drive a mesh with morph targets.
+/// For each node: 1 when it places an instance (the instance's own node or
+/// one of its ancestors), so that moving it moves geometry.
+std::vector<char> nodes_placing_instances(const Scene& scene);
+
+/// True when channel C changes what is traced: its node places an instance
+/// (nodes_placing_instances: a channel of a camera, a light, an empty node or
+/// a node outside the loaded scene moves no geometry), and its keys do not
+/// all hold one value with flat tangents that is the node's own (its rest
+/// TRS, or for weights the mesh's default weights). A constant channel whose
+/// value differs from the rest pose moves the node once; one on a node given
+/// by a matrix always counts (the animation replaces the matrix by TRS).
+bool channel_moves(const Scene& scene, const AnimationChannel& c, const std::vector<char>& placing);
+
+/// Node TRS channels that move geometry (channel_moves).
+std::size_t rigid_channels_moving(const Scene& scene);
+
+/// True when the scene has node TRS channels that move geometry, mesh
+/// deformers, or morph weights channels that change a placed mesh's shape
+/// (channel_moves): "no refit without motion".
 bool scene_animates(const Scene& scene);
 
 /// Sets the TRS of every node a channel of ANIM drives to its value at T and

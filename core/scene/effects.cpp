@@ -2,6 +2,7 @@
 #include "core/scene/effects.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -30,15 +31,17 @@ SceneEffects decide_effects(const Scene& scene, const EffectForces& forces) {
   SceneEffects fx;
   fx.shadow_rays.name = "shadow-rays";
   fx.shadow_rays.on = shadow_rays_wanted(scene, {});
-  fx.shadow_rays.reason = scene.lights.empty()
-                              ? "no lights: nothing casts a shadow"
-                              : count_of(scene.lights.size(), "light") + ": one any-hit ray per light per hit";
+  const std::size_t casting = casting_lights(scene).size(), dark = scene.lights.size() - casting;
+  const std::string dark_note =
+      dark == 0 ? "" : "; " + count_of(dark, "light") + " of intensity or colour 0 left out (they light nothing)";
+  fx.shadow_rays.reason = casting == 0 ? (scene.lights.empty() ? "no lights: nothing casts a shadow"
+                                                               : count_of(dark, "light") +
+                                                                     " but none gives light (intensity or colour 0): "
+                                                                     "nothing casts a shadow")
+                                       : count_of(casting, "light") + ": one any-hit ray per light per hit" + dark_note;
 
   fx.per_frame_updates.name = "per-frame-updates";
-  std::size_t channels = 0;
-  for (const Animation& a : scene.animations)
-    for (const AnimationChannel& c : a.channels)
-      if (c.node >= 0 && c.path != AnimationChannel::Path::weights && !c.times.empty()) ++channels;
+  const std::size_t channels = rigid_channels_moving(scene);
   fx.per_frame_updates.on = scene_animates(scene);
   if (fx.per_frame_updates.on) {
     std::string what;
@@ -48,13 +51,19 @@ SceneEffects decide_effects(const Scene& scene, const EffectForces& forces) {
       what += (what.empty() ? "" : ", ") + count_of(deforming, "deforming mesh") + " (BLAS refit or rebuild)";
     fx.per_frame_updates.reason = what;
   } else {
-    fx.per_frame_updates.reason = "nothing animates: the structure is built once";
+    std::size_t all = 0;
+    for (const Animation& a : scene.animations) all += a.channels.size();
+    fx.per_frame_updates.reason =
+        all == 0 ? "nothing animates: the structure is built once"
+                 : count_of(all, "animation channel") +
+                       " but none moves geometry (a camera, a light, an empty node or one outside the scene, or "
+                       "values that never change): the structure is built once";
   }
 
   fx.two_level.name = "two-level";
   std::vector<std::size_t> refs(scene.meshes.size(), 0);
   for (const Instance& inst : scene.instances)
-    if (inst.mesh < refs.size()) ++refs[inst.mesh];
+    if (inst.mesh < refs.size() && !scene.meshes[inst.mesh].indices.empty()) ++refs[inst.mesh];
   std::size_t shared = 0;
   for (std::size_t r : refs) shared += r > 1;
   fx.two_level.on = scene.has_instancing() || (scene.triangles.empty() && !scene.instances.empty());
@@ -72,7 +81,7 @@ SceneEffects decide_effects(const Scene& scene, const EffectForces& forces) {
   fx.textures.reason = "no view draws textures or materials: the loader skips image decoding";
 
   apply_force(fx.shadow_rays, forces.shadow_rays);
-  if (fx.shadow_rays.forced && scene.lights.empty())
+  if (fx.shadow_rays.forced && casting == 0)
     fx.shadow_rays.reason += "; they aim at a synthetic point light above the scene";
   apply_force(fx.per_frame_updates, forces.per_frame_updates);
   apply_force(fx.two_level, forces.two_level);
@@ -105,17 +114,30 @@ std::string effects_text(const SceneEffects& fx) {
   return out;
 }
 
+std::vector<Light> casting_lights(const Scene& scene) {
+  std::vector<Light> out;
+  for (const Light& l : scene.lights)
+    if (l.intensity > 0.0f && std::max({l.color.x, l.color.y, l.color.z}) > 0.0f) out.push_back(l);
+  return out;
+}
+
 bool shadow_rays_wanted(const Scene& scene, const EffectForces& forces) {
-  return !scene.lights.empty() || forces.shadow_rays;
+  return !casting_lights(scene).empty() || forces.shadow_rays;
 }
 
 std::vector<Light> shadow_lights(const Scene& scene, bool wanted) {
   if (!wanted) return {};
-  if (!scene.lights.empty()) return scene.lights;
-  return {synthetic_light(scene.bounds())};
+  std::vector<Light> lights = casting_lights(scene);
+  if (!lights.empty()) return lights;
+  return {synthetic_light(scene)};
 }
 
-Light synthetic_light(const Aabb& bounds) {
+Light synthetic_light(const Scene& scene) {
+  return synthetic_light(scene.bounds(),
+                         scene.cameras.empty() ? std::nullopt : std::optional<glm::vec3>(scene.cameras.front().position));
+}
+
+Light synthetic_light(const Aabb& bounds, std::optional<glm::vec3> eye) {
   Light light;
   light.name = "synthetic";
   light.kind = Light::Kind::point;
@@ -125,7 +147,12 @@ Light synthetic_light(const Aabb& bounds) {
   }
   float radius = 0.5f * glm::length(bounds.extent());
   if (!(radius > 0.0f)) radius = 1.0f;
-  const glm::vec3 side = glm::normalize(glm::vec3(1.0f, 0.0f, 1.4f));
+  glm::vec3 side = glm::normalize(glm::vec3(1.0f, 0.0f, 1.4f));  // the framing view's side
+  if (eye) {
+    const glm::vec3 towards(eye->x - bounds.center().x, 0.0f, eye->z - bounds.center().z);
+    const float len = glm::length(towards);
+    if (len > 0.0f && std::isfinite(len)) side = towards / len;
+  }
   light.position = bounds.center() + glm::vec3(0.0f, radius, 0.0f) + 0.5f * radius * side;
   return light;
 }

@@ -12,6 +12,7 @@
 // list; the GUI's Scene panel shows it. run_frame() is the frame loop that
 // honours the decisions and counts what it did, so tests can check them.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -53,19 +54,27 @@ bool set_force(EffectForces& forces, const std::string& name);
 /// "name  on|off  [forced]  reason" lines, for `accelviz info`.
 std::string effects_text(const SceneEffects& effects);
 
-/// Whether shadow rays are traced: the scene has lights, or the user forced
-/// them on (what decide_effects() says, without the rest of its work).
+/// The scene's lights that give light (intensity and colour above 0): a
+/// light of intensity 0 lights nothing and casts no shadow.
+std::vector<Light> casting_lights(const Scene& scene);
+
+/// Whether shadow rays are traced: the scene has a light that gives light
+/// (casting_lights), or the user forced them on (what decide_effects()
+/// says, without the rest of its work).
 bool shadow_rays_wanted(const Scene& scene, const EffectForces& forces);
 
 /// The point light shadow rays aim at in a scene without lights, wherever
 /// they are asked for (forced in the app; the shadow rays of `bench`, `rays`,
 /// `sweep` and the benchmarks): named "synthetic", above the box centre by
 /// the box's bounding radius and half that towards the default camera's
-/// side (+x, +z); at (0, 10, 0) for an empty box.
-Light synthetic_light(const Aabb& bounds);
+/// side: horizontally towards `eye` (the scene's first camera), else the
+/// framing view's side (+x, +z); at (0, 10, 0) for an empty box.
+Light synthetic_light(const Aabb& bounds, std::optional<glm::vec3> eye = std::nullopt);
+/// synthetic_light of the scene's bounds, towards its first camera if any.
+Light synthetic_light(const Scene& scene);
 
-/// The lights shadow rays aim at: the scene's own, or, in a scene without
-/// lights, synthetic_light(its bounds). Empty when WANTED is false.
+/// The lights shadow rays aim at: the scene's that give light, or, in a
+/// scene without any, synthetic_light(scene). Empty when WANTED is false.
 std::vector<Light> shadow_lights(const Scene& scene, bool wanted);
 
 /// The shadow (any-hit) ray from PRIMARY's hit H toward L: starts a little

@@ -55,8 +55,8 @@ Aabb Scene::bounds() const {
 
 bool Scene::has_instancing() const {
   std::vector<int> refs(meshes.size(), 0);
-  for (const Instance& inst : instances)
-    if (inst.mesh < refs.size() && ++refs[inst.mesh] > 1) return true;
+  for (const Instance& inst : instances)  // a mesh without triangles (points, lines) instances nothing
+    if (inst.mesh < refs.size() && !meshes[inst.mesh].indices.empty() && ++refs[inst.mesh] > 1) return true;
   return false;
 }
 

@@ -145,7 +145,7 @@ struct Scene {
   /// an instanced scene left unflattened (triangles empty), the instances'
   /// transformed mesh boxes.
   Aabb bounds() const;
-  /// True when some mesh is referenced by more than one instance.
+  /// True when some mesh with triangles is referenced by more than one instance.
   bool has_instancing() const;
   /// Triangles the instances expand to: each instance's mesh triangles, as
   /// flatten() would make them before dropping non-finite ones (so for a

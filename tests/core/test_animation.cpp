@@ -270,3 +270,117 @@ TEST(Effects, InstancedSceneBuildsEachUniqueMeshOnce) {
     EXPECT_NE(text.find(name), std::string::npos) << name;
 }
 }  // namespace unity_test_animation
+
+namespace unity_test_animation {
+namespace {
+
+/// One triangle mesh placed by node 0; node 1 empty; node 2 holds a camera; an instance on node 0.
+Scene one_placed_mesh() {
+  Scene s;
+  Mesh m;
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  m.indices = {{0, 1, 2}};
+  s.meshes.push_back(m);
+  s.nodes.resize(3);
+  s.nodes[0].mesh = 0;
+  s.nodes[0].translation = {2, 0, 0};
+  s.nodes[2].camera = 0;
+  Instance inst;
+  inst.mesh = 0;
+  inst.node = 0;
+  s.instances.push_back(inst);
+  return s;
+}
+
+Scene with_channel(Scene s, int node, AnimationChannel c) {
+  c.node = node;
+  s.animations.push_back({"a", {c}});
+  return s;
+}
+
+}  // namespace
+
+// "No refit without motion": a channel counts only where it moves geometry.
+TEST(Effects, AnimationThatMovesNoGeometryCallsForNoUpdates) {
+  const Scene s = one_placed_mesh();
+  const auto moves = [](const Scene& sc) { return decide_effects(sc).per_frame_updates.on; };
+  const AnimationChannel varying = channel(P::translation, I::linear, {0, 1}, {{0, 0, 0, 0}, {0, 1, 0, 0}});
+  EXPECT_FALSE(moves(with_channel(s, 1, varying))) << "an empty node";
+  EXPECT_FALSE(moves(with_channel(s, 2, varying))) << "a camera's node";
+  EXPECT_FALSE(moves(with_channel(s, 7, varying))) << "a node outside the scene";
+  EXPECT_TRUE(moves(with_channel(s, 0, varying)));
+  // Constant keys: at the node's own translation, nothing moves; elsewhere it moves once (frame 0).
+  EXPECT_FALSE(moves(with_channel(s, 0, channel(P::translation, I::linear, {0, 1}, {{2, 0, 0, 0}, {2, 0, 0, 0}}))));
+  EXPECT_FALSE(moves(with_channel(s, 0, channel(P::translation, I::step, {0}, {{2, 0, 0, 0}}))));
+  EXPECT_TRUE(moves(with_channel(s, 0, channel(P::translation, I::step, {0}, {{3, 0, 0, 0}}))));
+  // A cubic spline whose values hold but whose tangents bend moves between its keys.
+  const glm::vec4 z(0.0f), at(2, 0, 0, 0), bend(0, 1, 0, 0);
+  EXPECT_FALSE(moves(with_channel(s, 0, channel(P::translation, I::cubic_spline, {0, 1}, {z, at, z, z, at, z}))));
+  EXPECT_TRUE(moves(with_channel(s, 0, channel(P::translation, I::cubic_spline, {0, 1}, {z, at, bend, z, at, z}))));
+  // A parent of the placed node moves it.
+  Scene parented = s;
+  parented.nodes[1].children = {0};
+  parented.nodes[0].parent = 1;
+  EXPECT_TRUE(moves(with_channel(parented, 1, varying)));
+  // Morph weights: held at the mesh's default weights, no shape changes.
+  Scene morph = s;
+  morph.meshes[0].morph_base = morph.meshes[0].positions;
+  morph.meshes[0].morph_deltas = {{{0, 0, 0}, {0, 0, 0}, {1, 1, 0}}};
+  morph.meshes[0].morph_weights = {0.5f};
+  EXPECT_FALSE(moves(with_channel(morph, 0, channel(P::weights, I::linear, {0, 1}, {{0.5f, 0, 0, 0}, {0.5f, 0, 0, 0}}))));
+  EXPECT_TRUE(moves(with_channel(morph, 0, channel(P::weights, I::linear, {0, 1}, {{0.5f, 0, 0, 0}, {1, 0, 0, 0}}))));
+  const SceneEffects off = decide_effects(with_channel(s, 2, varying));
+  EXPECT_NE(off.per_frame_updates.reason.find("1 animation channel but none moves geometry"), std::string::npos)
+      << off.per_frame_updates.reason;
+}
+
+// "No shadow rays without lights": a light of intensity (or colour) 0 lights nothing.
+TEST(Effects, ALightThatGivesNoLightCastsNoShadow) {
+  Scene s = one_placed_mesh();
+  Light dark;
+  dark.intensity = 0.0f;
+  s.lights.push_back(dark);
+  SceneEffects fx = decide_effects(s);
+  EXPECT_FALSE(fx.shadow_rays.on);
+  EXPECT_NE(fx.shadow_rays.reason.find("none gives light"), std::string::npos) << fx.shadow_rays.reason;
+  Light lit;
+  lit.position = {0, 5, 0};
+  s.lights.push_back(lit);
+  fx = decide_effects(s);
+  EXPECT_TRUE(fx.shadow_rays.on);
+  EXPECT_NE(fx.shadow_rays.reason.find("1 light: one any-hit ray"), std::string::npos) << fx.shadow_rays.reason;
+  const std::vector<Light> aimed = shadow_lights(s, true);
+  ASSERT_EQ(aimed.size(), 1u);
+  EXPECT_EQ(aimed[0].position, lit.position);
+}
+
+// "No two-level structure without instancing": a mesh without triangles placed twice instances nothing.
+TEST(Effects, AMeshWithoutTrianglesPlacedTwiceIsNoInstancing) {
+  Scene s = one_placed_mesh();
+  s.meshes.push_back(Mesh{});  // points or lines only: no triangle
+  for (std::uint32_t node : {1u, 2u}) {
+    Instance inst;
+    inst.mesh = 1;
+    inst.node = node;
+    s.instances.push_back(inst);
+  }
+  s.flatten();
+  EXPECT_FALSE(s.has_instancing());
+  EXPECT_FALSE(decide_effects(s).two_level.on);
+}
+
+// The synthetic light stands on the default camera's side: a scene camera behind the scene (-z)
+// gets it there, so the shadow rays from what the camera sees are not all blocked by the surface.
+TEST(Effects, TheSyntheticLightStandsOnTheCamerasSide) {
+  Scene s = one_placed_mesh();
+  s.flatten();
+  const glm::vec3 c = s.bounds().center();
+  EXPECT_GT(synthetic_light(s).position.z, c.z) << "no camera: the framing view's side (+x, +z)";
+  Camera behind;
+  behind.position = c + glm::vec3(0, 0, -4);
+  s.cameras.push_back(behind);
+  EXPECT_LT(synthetic_light(s).position.z, c.z);
+  EXPECT_NEAR(synthetic_light(s).position.x, c.x, 1e-5f);
+}
+
+}  // namespace unity_test_animation
