@@ -750,6 +750,24 @@ class GltfConverter {
         node_light_.back() = light;
       }
     }
+    warn_unweighted_instances();
+  }
+
+  /// One shape per mesh: a node of a morphing mesh without weights of its own gets the weights
+  /// another node gave the mesh, not the mesh's defaults. Said once per mesh where they differ.
+  void warn_unweighted_instances() {
+    std::vector<bool> warned(scene_.meshes.size(), false);
+    for (std::size_t i = 0; i < model_.nodes.size(); ++i) {
+      const tinygltf::Node& g = model_.nodes[i];
+      if (g.mesh < 0 || !g.weights.empty()) continue;
+      const std::size_t m = std::size_t(g.mesh);
+      const auto given = mesh_default_weights_.find(m);
+      if (given == mesh_default_weights_.end() || warned[m] || given->second == scene_.meshes[m].morph_weights)
+        continue;
+      warned[m] = true;
+      warn("node " + std::to_string(i) + " has no morph weights of its own, but another node of mesh " +
+           std::to_string(m) + " has: one shape per mesh, so it takes that node's weights, not the mesh's defaults");
+    }
   }
 
   /// A node's own morph weights replace its mesh's defaults in the rest
@@ -779,6 +797,7 @@ class GltfConverter {
       return;
     }
     morph_weights_set_[std::size_t(g.mesh)] = true;
+    mesh_default_weights_[std::size_t(g.mesh)] = mesh.morph_weights;  // what a node without weights would have
     mesh.morph_weights = std::move(w);
     mesh.positions = morphed_positions(mesh, mesh.morph_weights);
   }
@@ -1057,6 +1076,41 @@ class GltfConverter {
       }
       scene_.animations.push_back(std::move(anim));
     }
+    warn_animated_nodes();
+  }
+
+  /// What an animated node cannot carry along: glTF forbids animating a node given by a matrix (the
+  /// animated TRS replaces it, so a shear in it is lost), and lights and cameras stay where the rest
+  /// pose puts them (only instances and meshes are posed per frame). Said once per node.
+  void warn_animated_nodes() {
+    std::vector<bool> seen(scene_.nodes.size(), false);
+    for (const Animation& a : scene_.animations)
+      for (const AnimationChannel& c : a.channels) {
+        if (c.path == AnimationChannel::Path::weights || c.node < 0 || seen[std::size_t(c.node)]) continue;
+        seen[std::size_t(c.node)] = true;
+        const std::string name = "node " + std::to_string(c.node);
+        if (!model_.nodes[std::size_t(c.node)].matrix.empty())
+          warn(name + " is animated but given by a matrix (glTF forbids it): the animated TRS replaces the matrix, "
+                      "so a shear in it is lost");
+        // The node and its descendants: a light or a camera among them does not follow.
+        std::vector<int> stack{c.node};
+        std::vector<bool> visited(scene_.nodes.size(), false);
+        std::string carried;
+        while (!stack.empty() && carried.empty()) {
+          const int n = stack.back();
+          stack.pop_back();
+          if (n < 0 || std::size_t(n) >= scene_.nodes.size() || visited[std::size_t(n)]) continue;
+          visited[std::size_t(n)] = true;
+          if (std::size_t(n) < node_light_.size() && node_light_[std::size_t(n)] >= 0)
+            carried = "light " + std::to_string(node_light_[std::size_t(n)]);
+          else if (model_.nodes[std::size_t(n)].camera >= 0)
+            carried = "camera " + std::to_string(model_.nodes[std::size_t(n)].camera);
+          for (const int child : scene_.nodes[std::size_t(n)].children) stack.push_back(child);
+        }
+        if (!carried.empty())
+          warn(name + " is animated and carries " + carried +
+               ": lights and cameras stay where the rest pose puts them (only meshes move per frame)");
+      }
   }
 
   /// A weights channel shapes the mesh of its node: one output per morph
@@ -1183,6 +1237,7 @@ class GltfConverter {
   std::vector<glm::mat4> local_;
   std::vector<int> node_light_;
   std::vector<bool> morph_weights_set_;  ///< per mesh: a node's weights became its rest pose
+  std::map<std::size_t, std::vector<float>> mesh_default_weights_;  ///< those meshes' own default weights
 };
 
 // --- Step 1: reading the file ----------------------------------------------

@@ -635,6 +635,53 @@ TEST_F(GltfLoader, NonFiniteKeyframeTimesAndValuesAreRefused) {
   EXPECT_EQ(load_gltf(with({0.0f, 1.0f}, {0, 0, 0, 1, 1, 1}, "fine.glb")).animations.size(), 1u);
 }
 
+// What an animated node cannot carry along is said, once per node: a light or a camera on it (or
+// below it) stays at its rest pose; a node given by a matrix (glTF forbids animating one) loses the
+// matrix to the animated TRS.
+TEST_F(GltfLoader, AnimatedNodesSayWhatDoesNotFollow) {
+  GltfBuilder b = one_triangle();
+  b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+  b.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array({json{{"type", "point"}}});
+  const int lamp = b.node({{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  const int holder = b.node({{"children", {lamp}}});
+  const int sheared = b.node({{"mesh", 0}, {"matrix", {1, 0, 0, 0, 0.5, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}}});
+  b.scene({0, holder, sheared});
+  const int times = b.floats({0.0f, 1.0f}, "SCALAR", 1);
+  const int moves = b.floats({0, 0, 0, 0, 0, -3}, "VEC3", 3);
+  b.doc["animations"] = json::array(
+      {json{{"samplers", {{{"input", times}, {"output", moves}}}},
+            {"channels",
+             {{{"sampler", 0}, {"target", {{"node", holder}, {"path", "translation"}}}},
+              {{"sampler", 0}, {"target", {{"node", sheared}, {"path", "translation"}}}},
+              {{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}}}}});
+  const Scene s = load_gltf(write_glb(b));
+  EXPECT_TRUE(warned(s, "node " + std::to_string(holder) + " is animated and carries light 0: lights and cameras "
+                        "stay where the rest pose puts them"));
+  EXPECT_TRUE(warned(s, "node " + std::to_string(sheared) + " is animated but given by a matrix (glTF forbids it)"));
+  EXPECT_FALSE(warned(s, "node 0 is animated")) << "a plain TRS mesh node moves as it should";
+}
+
+// One shape per mesh: a node of a morphing mesh without weights of its own takes another node's,
+// not the mesh's defaults; said (it was silent, and its box was another node's shape).
+TEST_F(GltfLoader, ANodeWithoutMorphWeightsBesideOneWithThemIsWarned) {
+  for (const bool weighted_first : {true, false}) {
+    SCOPED_TRACE(weighted_first);
+    GltfBuilder b;
+    const int pos = b.positions({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
+    const int lift = b.positions({{0, 0, 0}, {0, 0, 0}, {2, 2, 0}});
+    b.doc["meshes"] = json::array({json{{"primitives", json::array({json{{"attributes", {{"POSITION", pos}}},
+                                                                         {"targets", json::array({json{{"POSITION", lift}}})}}})},
+                                        {"weights", {0.0}}}});
+    const json weighted = {{"mesh", 0}, {"weights", {1.0}}}, plain = {{"mesh", 0}, {"translation", {5, 0, 0}}};
+    b.node(weighted_first ? weighted : plain);
+    b.node(weighted_first ? plain : weighted);
+    b.scene({0, 1});
+    const Scene s = load_gltf(write_glb(b, weighted_first ? "wf.glb" : "pf.glb"));
+    const std::string plain_node = weighted_first ? "node 1" : "node 0";
+    EXPECT_TRUE(warned(s, plain_node + " has no morph weights of its own, but another node of mesh 0 has"));
+  }
+}
+
 TEST_F(GltfLoader, AnimationsAreKeptAsData) {
   GltfBuilder b = one_triangle();
   const int times = b.floats({0.0f, 1.0f}, "SCALAR", 1);
