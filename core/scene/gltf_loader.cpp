@@ -991,6 +991,14 @@ class GltfConverter {
       light.kind = Light::Kind::point;
     } else if (gl.type == "spot") {
       light.kind = Light::Kind::spot;
+      const double inner = gl.spot.innerConeAngle, outer = gl.spot.outerConeAngle;
+      if (std::isfinite(inner) && std::isfinite(outer) && inner >= 0.0 && inner < outer && outer <= 1.5707963267948966) {
+        light.inner_cone = float(inner);
+        light.outer_cone = float(outer);
+      } else {
+        warn(name + " has an invalid spot cone (inner " + std::to_string(inner) + ", outer " + std::to_string(outer) +
+             "; glTF wants 0 <= inner < outer <= pi/2); the defaults are used");
+      }
     } else if (gl.type == "directional") {
       light.kind = Light::Kind::directional;
     } else {

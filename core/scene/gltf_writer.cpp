@@ -319,7 +319,7 @@ class GltfWriter {
         case Light::Kind::directional: jl["type"] = "directional"; break;
         case Light::Kind::spot:
           jl["type"] = "spot";
-          jl["spot"] = json::object();  // required for spots; cone angles keep their defaults
+          jl["spot"] = {{"innerConeAngle", light.inner_cone}, {"outerConeAngle", light.outer_cone}};
           break;
       }
       if (light.range > 0.0f) jl["range"] = light.range;

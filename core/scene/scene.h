@@ -86,6 +86,9 @@ struct Light {
   glm::vec3 color{1.0f};
   float intensity = 1.0f;
   float range = 0.0f;  ///< 0: unlimited
+  /// Spot lights' cone (KHR_lights_punctual's defaults 0 and pi/4): kept so that export writes the
+  /// cone the file had; the shadow rays aim at the light's position whatever its cone.
+  float inner_cone = 0.0f, outer_cone = 0.78539816f;
 };
 
 /// glTF animation data, kept as data (sampled by the dynamics code).

@@ -105,6 +105,8 @@ Scene sample_scene() {
   lamp.direction = {0, -1, 0};
   lamp.color = {1, 0.5f, 0};
   lamp.range = 9;
+  lamp.inner_cone = 0.1f;  // the cone is written as it was read (it was written as {}: glTF's defaults)
+  lamp.outer_cone = 0.3f;
   s.lights = {sun, lamp};
   s.flatten();
   return s;
@@ -152,6 +154,8 @@ TEST_F(GltfWriter, RoundTripGltfKeepsCamerasAndLights) {
   expect_vec3_near(back.lights[1].direction, {0, -1, 0});
   expect_vec3_near(back.lights[1].color, {1, 0.5f, 0});
   EXPECT_FLOAT_EQ(back.lights[1].range, 9.0f);
+  EXPECT_FLOAT_EQ(back.lights[1].inner_cone, 0.1f);
+  EXPECT_FLOAT_EQ(back.lights[1].outer_cone, 0.3f);
 }
 
 TEST_F(GltfWriter, RoundTripOfALoadedFileIsStable) {
