@@ -52,3 +52,24 @@ TEST(TreePanel, TheRootIsOpenWhenItIsTheSelection) {
 
 }  // namespace
 }  // namespace accelviz::unity_test_tree_panel
+
+namespace accelviz::unity_test_tree_panel {
+namespace {
+
+// A row says visits only where they were counted ("SAH 3.57%0" read as a share of 3.570).
+TEST(TreePanel, RowsSayVisitsOnlyWhereCounted) {
+  StructureNode inner;
+  inner.depth = 0;
+  inner.sah_share = 0.0357;
+  EXPECT_EQ(panels::tree_row_label(inner, 0, std::nullopt), "node 0  (depth 0, SAH 3.57%)");
+  EXPECT_EQ(panels::tree_row_label(inner, 0, 12u), "node 0  (depth 0, SAH 3.57%, visits 12)");
+  StructureNode leaf;
+  leaf.leaf = true;
+  leaf.prims = 4;
+  leaf.depth = 10;
+  leaf.sah_share = 0.001;
+  EXPECT_EQ(panels::tree_row_label(leaf, 10183, std::nullopt), "leaf 10183  (4 prims, depth 10, SAH 0.10%)");
+}
+
+}  // namespace
+}  // namespace accelviz::unity_test_tree_panel

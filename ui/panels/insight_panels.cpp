@@ -416,14 +416,8 @@ void tree_rows(const StructureNodes& nodes, const std::vector<std::uint64_t>* vi
                int budget_depth) {
   const StructureNode* n = nodes.node(id);
   if (!n) return;
-  char label[160];
   const unsigned long long vis = visits && id < visits->size() ? static_cast<unsigned long long>((*visits)[id]) : 0ull;
-  if (n->leaf)
-    std::snprintf(label, sizeof label, "leaf %u  (%u prims, depth %u, SAH %.2f%%%s%llu)", id, n->prims, n->depth,
-                  100.0 * n->sah_share, visits ? ", visits " : "", visits ? vis : 0ull);
-  else
-    std::snprintf(label, sizeof label, "node %u  (depth %u, SAH %.2f%%%s%llu)", id, n->depth, 100.0 * n->sah_share,
-                  visits ? ", visits " : "", visits ? vis : 0ull);
+  const std::string label = tree_row_label(*n, id, visits ? std::optional<std::uint64_t>(vis) : std::nullopt);
   ImGuiTreeNodeFlags flags = ImGuiTreeNodeFlags_OpenOnArrow | ImGuiTreeNodeFlags_SpanAvailWidth;
   if (n->leaf) flags |= ImGuiTreeNodeFlags_Leaf | ImGuiTreeNodeFlags_NoTreePushOnOpen;
   if (id == selected) flags |= ImGuiTreeNodeFlags_Selected;
@@ -440,7 +434,7 @@ void tree_rows(const StructureNodes& nodes, const std::vector<std::uint64_t>* vi
                        ImVec2(ImGui::GetTextLineHeight(), ImGui::GetTextLineHeight()));
     ImGui::SameLine();
   }
-  const bool open = ImGui::TreeNodeEx("n", flags, "%s", label);
+  const bool open = ImGui::TreeNodeEx("n", flags, "%s", label.c_str());
   if (ImGui::IsItemClicked() && !ImGui::IsItemToggledOpen()) clicked = id;
   if (id == selected && scroll) {
     ImGui::SetScrollHereY(0.5f);
@@ -456,6 +450,19 @@ void tree_rows(const StructureNodes& nodes, const std::vector<std::uint64_t>* vi
 }
 
 }  // namespace
+
+std::string tree_row_label(const StructureNode& n, std::uint32_t id, std::optional<std::uint64_t> visits) {
+  char label[160], visits_text[48] = "";
+  if (visits)  // none counted: no figure (it printed a bare 0 after the SAH share)
+    std::snprintf(visits_text, sizeof visits_text, ", visits %llu", static_cast<unsigned long long>(*visits));
+  if (n.leaf)
+    std::snprintf(label, sizeof label, "leaf %u  (%u prims, depth %u, SAH %.2f%%%s)", id, n.prims, n.depth,
+                  100.0 * n.sah_share, visits_text);
+  else
+    std::snprintf(label, sizeof label, "node %u  (depth %u, SAH %.2f%%%s)", id, n.depth, 100.0 * n.sah_share,
+                  visits_text);
+  return label;
+}
 
 std::optional<std::uint32_t> tree_panel(const StructureNodes* nodes, const std::vector<std::uint64_t>* visits,
                                         std::uint32_t selected, bool& scroll_to_selected, const PanelLayout& layout,

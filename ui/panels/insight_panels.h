@@ -58,6 +58,9 @@ struct ExplainerState {
 bool explainer_panel(ExplainerState& state, const SplitExplanation* e, std::uint32_t node, const std::string& note,
                      const PanelLayout& layout);
 
+/// A Tree row's text: id, prims (leaves), depth, SAH share and, where counted, visits.
+std::string tree_row_label(const StructureNode& n, std::uint32_t id, std::optional<std::uint64_t> visits);
+
 // ---- Tree view ------------------------------------------------------------------------------
 /// Collapsible tree of `nodes` (count, depth, SAH share, visits when known,
 /// with a swatch of the colour `map` gives the node's box by visits); the
