@@ -686,6 +686,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       const SavedScreenshot r = write_frame(std::filesystem::path(c.arg));
       if (!r.ok) throw std::runtime_error(r.error);
       last_screenshot_ = r.png.string();
+      app_.set_message("screenshot written: " + r.png.string() + " (+ .json)");  // as the button and F12 say
       if (!options_.quiet) std::printf("%s\n", r.png.string().c_str());
       return Status::done;
     }

@@ -12,6 +12,15 @@ namespace accelviz {
 namespace fs = std::filesystem;
 namespace {
 
+/// "K/LAST" as the Ray panel's slider reads a replay step (steps 0 to LAST; it said "K of N").
+std::string replay_step_text(std::size_t step, std::size_t steps) {
+  return std::to_string(step) + "/" + std::to_string(steps > 0 ? steps - 1 : 0);
+}
+
+}  // namespace
+
+namespace {
+
 // Single-quoted for a POSIX shell ('...' with ' written as '\'').
 std::string shell_quote(const std::string& s) {
   bool plain = !s.empty();
@@ -192,8 +201,7 @@ std::string render_command(const ScreenshotInfo& info, bool raster, const std::s
       if (ray_from_another_view(info)) cmd += " --ray-camera " + shell_quote(explicit_camera_spec(info.ray_camera));
       if (notes && info.ray_step)
         notes->push_back("raster: --ray-pixel draws the whole traversal; the window showed its replay at step " +
-                         std::to_string(*info.ray_step) + " of " + std::to_string(info.ray_steps) +
-                         " (the script's `step` brings that back)");
+                         replay_step_text(*info.ray_step, info.ray_steps) + " (the script's `step` brings that back)");
     }
   }
   return cmd + " --out " + shell_quote(out);
@@ -211,7 +219,7 @@ std::string screenshot_caption(const ScreenshotInfo& info) {
   if (info.ray_pixel && info.config.view.show_ray_path) {
     s += ", ray of pixel " + std::to_string(info.ray_pixel->first) + "," + std::to_string(info.ray_pixel->second);
     if (ray_from_another_view(info)) s += " of an earlier view";
-    if (info.ray_step) s += " at step " + std::to_string(*info.ray_step) + " of " + std::to_string(info.ray_steps);
+    if (info.ray_step) s += " at step " + replay_step_text(*info.ray_step, info.ray_steps);
   }
   return s;
 }
