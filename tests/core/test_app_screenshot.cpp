@@ -166,7 +166,7 @@ TEST(AppScreenshot, SideCarSaysHowToReproduceThePicture) {
   EXPECT_EQ(j["heatmap"]["range"][1], 39.0);
   EXPECT_EQ(j["options"].size(), option_table().size());
   EXPECT_EQ(j["ray_pixel"][0], 32);
-  EXPECT_EQ(j["caption"], screenshot_caption(info.config) + ", ray of pixel 32,24");
+  EXPECT_EQ(j["caption"], info.scene + ", " + screenshot_caption(info.config) + ", ray of pixel 32,24");
   EXPECT_EQ(j["boxes"]["drawn"], 0);
 
   const std::string cmd = j["reproduce"]["render_heatmap"];
@@ -340,7 +340,7 @@ TEST(AppScreenshot, AThinnedBoxOverlayIsSaidOnThePictureAndInTheSideCar) {
   ScreenshotInfo info = test_info();
   info.boxes_drawn = 200000;
   info.boxes_matched = 288291;
-  EXPECT_EQ(screenshot_caption(info), screenshot_caption(info.config) + ", boxes 200000 of 288291, ray of pixel 32,24");
+  EXPECT_EQ(screenshot_caption(info), info.scene + ", " + screenshot_caption(info.config) + ", boxes 200000 of 288291, ray of pixel 32,24");
   const nlohmann::json j = screenshot_sidecar(info, "shot.png");
   EXPECT_EQ(j["caption"], screenshot_caption(info));
   EXPECT_EQ(j["boxes"]["drawn"], 200000);
@@ -352,7 +352,7 @@ TEST(AppScreenshot, AThinnedBoxOverlayIsSaidOnThePictureAndInTheSideCar) {
             "draws all");
   // All drawn: nothing added.
   info.boxes_drawn = info.boxes_matched = 5000;
-  EXPECT_EQ(screenshot_caption(info), screenshot_caption(info.config) + ", ray of pixel 32,24");
+  EXPECT_EQ(screenshot_caption(info), info.scene + ", " + screenshot_caption(info.config) + ", ray of pixel 32,24");
   EXPECT_TRUE(screenshot_sidecar(info, "shot.png")["reproduce"]["notes"].empty());
 }
 
@@ -384,5 +384,23 @@ TEST(AppScreenshot, DefaultFolderFollowsXdgPictures) {
   EXPECT_EQ(default_screenshot_dir(), fs::path("/home/u/Pictures/accelviz"));
   if (old_pics) setenv("XDG_PICTURES_DIR", saved_pics.c_str(), 1);
   if (old_home) setenv("HOME", saved_home.c_str(), 1);
+}
+
+// The caption says which scene (a file by its name), the metric in the structure's words, and why a
+// metric the structure does not count reads 0 (a lecture's teapot and teapot-in-a-stadium looked alike).
+TEST(AppScreenshot, TheCaptionNamesTheSceneAndWhatTheMetricMeansHere) {
+  ScreenshotInfo info = test_info();
+  EXPECT_EQ(screenshot_caption(info).rfind("builtin:teapot?size=2000, bvh", 0), 0u) << screenshot_caption(info);
+  info.scene = "/home/u/meshes/bunny.glb";
+  EXPECT_EQ(screenshot_caption(info).rfind("bunny.glb, bvh", 0), 0u) << screenshot_caption(info);
+  EXPECT_EQ(apply_option(info.config, "metric", "nodes"), "");
+  EXPECT_EQ(apply_option(info.config, "structure", "grid"), "");
+  EXPECT_NE(screenshot_caption(info).find("heatmap nodes (cells)"), std::string::npos) << screenshot_caption(info);
+  EXPECT_EQ(apply_option(info.config, "structure", "bvh"), "");
+  EXPECT_EQ(screenshot_caption(info).find("(cells)"), std::string::npos) << screenshot_caption(info);
+  EXPECT_EQ(apply_option(info.config, "metric", "instances"), "");
+  EXPECT_NE(screenshot_caption(info).find("(n/a: only a two-level structure (tlas) enters instances)"),
+            std::string::npos)
+      << screenshot_caption(info);
 }
 }  // namespace unity_test_app_screenshot

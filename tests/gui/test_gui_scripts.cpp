@@ -208,7 +208,7 @@ TEST_F(GuiScript, ReloadShadersTakesTheFolderOrNamesTheBrokenFile) {
       std::string("open ") + kTeapot + "\nsize 320 240\ncamera " + kCamera + "\nset boxes off\nwait\n";
   const RunResult r =
       run(head + "screenshot " + path("before.png").string() + "\nreload-shaders " + path("magenta").string() +
-          "\nscreenshot " + path("after.png").string() + "\ndump-stats " + path("stats.json").string() + "\nquit\n");
+          "\ndump-stats " + path("stats.json").string() + "\nscreenshot " + path("after.png").string() + "\nquit\n");
   ASSERT_EQ(r.code, 0) << r.err;
   const RgbImage before = read_png(path("before.png").string()), after = read_png(path("after.png").string());
   const glm::u8vec3 magenta(255, 0, 255);

@@ -208,7 +208,12 @@ std::string render_command(const ScreenshotInfo& info, bool raster, const std::s
 }
 
 std::string screenshot_caption(const ScreenshotInfo& info) {
-  std::string s = screenshot_caption(info.config);
+  // Which scene first: a teapot and a teapot in a stadium look alike (a file by its name only).
+  std::string s = info.scene.starts_with("builtin:") ? info.scene : fs::path(info.scene).filename().string();
+  s += (s.empty() ? "" : ", ") + screenshot_caption(info.config);
+  if (info.config.view.heatmap != HeatmapDisplay::off)
+    if (const std::string why = metric_not_counted(info.config.view.metric, info.config.structure.name); !why.empty())
+      s += " (n/a: " + why + ")";
   if (info.boxes_drawn < info.boxes_matched)
     s += ", boxes " + std::to_string(info.boxes_drawn) + " of " + std::to_string(info.boxes_matched);
   if (info.boxes_of_region)
