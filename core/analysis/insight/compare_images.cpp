@@ -97,12 +97,16 @@ TimedClosestHits time_closest_hits(const Accelerator& accel, std::span<const Ray
   out.hits.resize(rays.size());
   std::vector<double> runs;
   const int n = std::max(passes, 1);
-  for (int k = 0; k < n; ++k) {
+  constexpr int kMostPasses = 64;
+  constexpr double kEnoughMs = 30.0;  // a short trace: more passes, so that the median is not one unlucky pass
+  double total = 0.0;
+  for (int k = 0; k < n || (total < kEnoughMs && k < kMostPasses); ++k) {
     // No callback inside a timed pass (it would be timed too): progress and a cancel between passes.
     const auto t0 = std::chrono::steady_clock::now();
     trace_closest(accel, rays, out.hits, query, BatchOptions{threads});
     runs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    if (progress && !progress(static_cast<double>(k + 1) / n)) throw BuildCancelled();
+    total += runs.back();
+    if (progress && !progress(std::min(1.0, static_cast<double>(k + 1) / n))) throw BuildCancelled();
   }
   std::sort(runs.begin(), runs.end());
   out.trace_ms = runs[runs.size() / 2];
