@@ -280,7 +280,8 @@ void Gui::handle_input(int fbw, int fbh, int ww, int wh) {
         frame->image.width > 0) {
       const int fx = std::min(frame->image.width - 1, px * frame->image.width / fbw);
       const int fy = std::min(frame->image.height - 1, py * frame->image.height / fbh);
-      panels::pixel_tooltip(fx, fy, frame->at(fx, fy), frame->image.metric, frame->complete);
+      panels::pixel_tooltip(fx, fy, frame->at(fx, fy), frame->image.metric, frame->complete,
+                            frame->request.structure ? frame->request.structure->choice.name : std::string());
     }
   }
 

@@ -55,5 +55,15 @@ TEST(StructurePanel, TlasShowsTheBvhOptionsItsLevelsAreBuiltWith) {
   EXPECT_FALSE(clicks_change_bvh_options("brute"));
 }
 
+// Panel figures keep whole numbers whole from 1e4 on (%.4g printed 20000 prim tests as "2e+04" beside
+// "prim tests 20000", and an SAH cost of 30000 as "3e+04").
+TEST(PanelFigures, LargeFiguresStayWhole) {
+  EXPECT_EQ(panels::figure_text(20000.0), "20000");
+  EXPECT_EQ(panels::figure_text(30001.4), "30001");
+  EXPECT_EQ(panels::figure_text(24.1304), "24.13");
+  EXPECT_EQ(panels::figure_text(0.5), "0.5");
+  EXPECT_EQ(panels::figure_text(2e13), "2e+13");
+}
+
 }  // namespace
 }  // namespace accelviz::unity_test_structure_panel

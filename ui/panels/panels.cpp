@@ -241,7 +241,8 @@ bool bvh_option_widgets(BvhOptions& b) {
   if (b.splitter == BvhSplitter::binned_sah)
     changed |= slider_int("Buckets", b.buckets, 2, 256, "binned SAH bucket count");
   // Not "max leaf size": leaves grow past it up to the cap where the SAH rates them cheaper.
-  if (slider_int("Always-leaf size", b.max_leaf_size, 1, 255,
+  // "Always-leaf size" was cut to "Always-leaf siz" at the panel's width.
+  if (slider_int("Always-leaf", b.max_leaf_size, 1, 255,
                  "a node with at most this many triangles is always a leaf (max_leaf_size, --leaf); larger "
                  "leaves, up to the cap below, where the SAH rates them cheaper than a split")) {
     b.leaf_size_cap = std::max(b.leaf_size_cap, b.max_leaf_size);
@@ -385,7 +386,7 @@ void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const Pa
       // Under the structure's own constants (the K-D tree's C_isect is 1.5): compare SAH costs of
       // two structures only under the same ones.
       const std::string c = sah_constants_text(built->accel->name(), built->choice.options);
-      row("SAH cost", "%.4g%s", b.sah_cost, c.empty() ? "" : ("  (" + c + ")").c_str());
+      row("SAH cost", "%s%s", figure_text(b.sah_cost).c_str(), c.empty() ? "" : ("  (" + c + ")").c_str());
     } else
       row("SAH cost", "n/a");
     if (const auto it = b.extra.find("epo"); it != b.extra.end()) row("EPO", "%.4g", it->second);
@@ -917,13 +918,24 @@ void status_bar(const std::string& message, const std::string& error, const Buil
   ImGui::End();
 }
 
-void pixel_tooltip(int x, int y, const PixelFigures& p, HeatMetric metric, bool exact) {
+std::string figure_text(double v) {
+  char text[48];
+  if (std::isfinite(v) && std::fabs(v) >= 1e4 && std::fabs(v) < 1e12)
+    std::snprintf(text, sizeof text, "%.0f", v);
+  else
+    std::snprintf(text, sizeof text, "%.4g", v);
+  return text;
+}
+
+void pixel_tooltip(int x, int y, const PixelFigures& p, HeatMetric metric, bool exact, std::string_view structure) {
   ImGui::BeginTooltip();
   ImGui::Text("pixel %d, %d%s", x, y, exact ? "" : " (coarse)");
+  const std::string name = metric == HeatMetric::nodes ? metric_short_label(metric, structure)
+                                                        : std::string(metric_name(metric));
   if (std::isnan(p.value))
-    ImGui::Text("%s: no value", std::string(metric_name(metric)).c_str());
+    ImGui::Text("%s: no value", name.c_str());
   else
-    ImGui::Text("%s: %.4g", std::string(metric_name(metric)).c_str(), p.value);
+    ImGui::Text("%s: %s", name.c_str(), figure_text(p.value).c_str());
   ImGui::Text("nodes visited %u, prim tests %u", p.nodes, p.prims);
   if (p.instances > 0) ImGui::Text("instances visited %u", p.instances);
   if (p.prim != kInvalidId)

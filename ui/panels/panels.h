@@ -104,7 +104,13 @@ void help_panel(bool& open, const PanelLayout& layout);
 void status_bar(const std::string& message, const std::string& error, const BuildProgress& progress,
                 const std::string& heatmap_status, const PanelLayout& layout);
 /// The figures of one heatmap pixel, as a tooltip at the mouse.
-void pixel_tooltip(int x, int y, const PixelFigures& p, HeatMetric metric, bool exact);
+/// The heatmap pixel under the mouse: its value (named in the structure's words: a grid's nodes are
+/// cells), its counts and its hit.
+void pixel_tooltip(int x, int y, const PixelFigures& p, HeatMetric metric, bool exact, std::string_view structure);
+
+/// A figure as panels print it: four significant digits, but whole up to 1e12 from 1e4 on (%.4g
+/// printed 20000 prim tests as "2e+04").
+std::string figure_text(double v);
 /// Opens a panel's window: on first use placed at (x, y) (x < 0: from the
 /// right edge) and sized w × h, in units the layout scales, and collapsed when
 /// `collapsed`; then ImGui::Begin(title). False when the window is collapsed
