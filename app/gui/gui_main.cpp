@@ -383,7 +383,7 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
     heatmap_status = "tracing heatmap on the GPU: " +
                      std::to_string(gpu_trace->rows > 0 ? 100 * gpu_trace->rows_done / gpu_trace->rows : 0) + "%";
   else if (app_.heatmap_busy())
-    heatmap_status = "refining heatmap";
+    heatmap_status = "refining heatmap: " + std::to_string(static_cast<int>(100.0 * app_.heatmap_progress())) + "%";
   panels::status_bar(app_.message(), app_.error(), bp, heatmap_status, layout);
 
   const std::shared_ptr<const SweepSnapshot> sweep = sweeps_.latest();

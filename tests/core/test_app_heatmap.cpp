@@ -82,8 +82,19 @@ TEST(AppHeatmap, LevelsRefineToExactlyWhatRenderComputes) {
   for (HeatMetric m : {HeatMetric::nodes, HeatMetric::depth}) {
     std::vector<std::shared_ptr<const HeatmapFrame>> frames;
     const HeatmapRequest r = request_for(built, w, h, m);
+    std::atomic<std::uint64_t> traced{0};  // the status line's percentage: every pixel's ray once
+    std::vector<std::uint64_t> traced_at_level;
     ASSERT_TRUE(trace_progressive(
-        r, 7, [] { return true; }, [&](auto f) { frames.push_back(f); }));
+        r, 7, [] { return true; },
+        [&](auto f) {
+          frames.push_back(f);
+          traced_at_level.push_back(traced.load());
+        },
+        nullptr, &traced));
+    EXPECT_EQ(traced.load(), static_cast<std::uint64_t>(w) * h);
+    ASSERT_EQ(traced_at_level.size(), 4u);
+    EXPECT_EQ(traced_at_level[0], static_cast<std::uint64_t>((w + 7) / 8) * ((h + 7) / 8));
+    EXPECT_LT(traced_at_level[2], traced_at_level[3]);
     ASSERT_EQ(frames.size(), 4u);
     EXPECT_EQ(frames[0]->stride, 8);
     EXPECT_EQ(frames[3]->stride, 1);

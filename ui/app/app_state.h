@@ -83,6 +83,8 @@ class AppState {
   BuildWorker::Status build_status() const { return builds_.status(); }
   /// The CPU worker or the GPU job is tracing the current view.
   bool heatmap_busy() const { return heatmaps_.busy() || gpu_heatmap_progress().has_value(); }
+  /// The CPU heatmap job's share of its rays traced (0 to 1).
+  double heatmap_progress() const { return heatmaps_.progress(); }
 
   /// With a GPU job set (the GUI installs one over its GL context:
   /// app/gui/gpu_heatmap.h) and the View's heatmap-gpu on, the heatmap of a

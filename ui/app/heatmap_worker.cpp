@@ -132,7 +132,7 @@ std::shared_ptr<HeatmapFrame> HeatmapFramePool::take(int stride) {
 
 bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::function<bool()>& keep_going,
                        const std::function<void(std::shared_ptr<const HeatmapFrame>)>& publish,
-                       HeatmapFramePool* pool) {
+                       HeatmapFramePool* pool, std::atomic<std::uint64_t>* traced) {
   const HeatmapOptions& o = r.options;
   const int w = o.width, h = o.height;
   if (w <= 0 || h <= 0 || !r.structure || !r.structure->accel) return true;
@@ -194,6 +194,7 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
         row_hits.resize(row_rays.size());
         row_stats.assign(row_rays.size(), RayStats{});
         accel.closest_hits(row_rays, row_hits, o.query, row_stats);
+        if (traced) traced->fetch_add(row_rays.size(), std::memory_order_relaxed);
         for (std::size_t k = 0; k < row_rays.size(); ++k) {
           const Ray& ray = row_rays[k];
           const Hit& hit = row_hits[k];
@@ -239,7 +240,11 @@ bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::fun
 HeatmapWorker::HeatmapWorker()
     : worker_([this](const HeatmapRequest& r, std::uint64_t id, const std::function<bool()>& keep_going,
                      const std::function<void(std::shared_ptr<const HeatmapFrame>)>& publish) {
-        trace_progressive(r, id, keep_going, publish, &pool_);
+        traced_.store(0, std::memory_order_relaxed);
+        job_rays_.store(static_cast<std::uint64_t>(std::max(0, r.options.width)) *
+                            static_cast<std::uint64_t>(std::max(0, r.options.height)),
+                        std::memory_order_relaxed);
+        trace_progressive(r, id, keep_going, publish, &pool_, &traced_);
       }) {}
 
 }  // namespace accelviz

@@ -9,6 +9,7 @@
 //
 // Rays are core's primary_ray(camera, x, y, W, H): pixel centres, row 0 at
 // the top, the same convention as `accelviz render` and the GL camera.
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -133,9 +134,12 @@ class HeatmapFramePool {
 /// row, from all tracing threads at once, so it must be thread-safe. The
 /// worker's engine, exposed for tests. With a `pool`, the levels' frames
 /// come from it (the worker's jobs reuse the frames of the jobs before).
+/// With `traced`, the primary rays traced so far are added to it as rows
+/// finish (a job traces width × height rays over all its levels), for the
+/// status line's percentage.
 bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::function<bool()>& keep_going,
                        const std::function<void(std::shared_ptr<const HeatmapFrame>)>& publish,
-                       HeatmapFramePool* pool = nullptr);
+                       HeatmapFramePool* pool = nullptr, std::atomic<std::uint64_t>* traced = nullptr);
 
 /// The summary of fully traced pixels (every pixel counted once), as the
 /// worker computes it for its frames; used by the GPU path too.
@@ -156,9 +160,15 @@ class HeatmapWorker {
   /// A job is queued or running.
   bool busy() const { return worker_.busy(); }
   std::uint64_t latest_request() const { return worker_.latest_request(); }
+  /// The running job's share of its rays traced, 0 to 1 (a long trace said only "refining").
+  double progress() const {
+    const std::uint64_t total = job_rays_.load(std::memory_order_relaxed);
+    return total > 0 ? std::min(1.0, static_cast<double>(traced_.load(std::memory_order_relaxed)) / total) : 0.0;
+  }
 
  private:
   HeatmapFramePool pool_;  ///< the worker thread's only
+  std::atomic<std::uint64_t> traced_{0}, job_rays_{0};  ///< the running job's rays traced, and all of them
   /// A superseded job's levels are never shown (the default store rule).
   LatestJobWorker<HeatmapRequest, std::shared_ptr<const HeatmapFrame>> worker_;
 };
