@@ -406,6 +406,12 @@ void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const Pa
     ImGui::TextDisabled("tracing...");
   } else {
     const HeatmapSummary& s = view->summary;
+    // After a switch the view still shows the structure before until the new one's first level is
+    // traced: say whose figures these are (they read as the new structure's under its heading).
+    if (view->request.structure && view->request.structure.get() != built)
+      ImGui::TextColored(ImVec4(1.0f, 0.78f, 0.35f, 1.0f), "of %s, the structure before: %s",
+                         view->request.structure->choice.name.c_str(),
+                         built ? "the new one's view is being traced" : "no structure now");
     if (ImGui::BeginTable("view", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV)) {
       ImGui::TableSetupColumn("name", ImGuiTableColumnFlags_WidthFixed);
       ImGui::TableSetupColumn("value", ImGuiTableColumnFlags_WidthStretch);
@@ -929,7 +935,9 @@ std::string figure_text(double v) {
 
 void pixel_tooltip(int x, int y, const PixelFigures& p, HeatMetric metric, bool exact, std::string_view structure) {
   ImGui::BeginTooltip();
-  ImGui::Text("pixel %d, %d%s", x, y, exact ? "" : " (coarse)");
+  // Whose figures: after a switch the view shows the structure before until the new one is traced.
+  ImGui::Text("pixel %d, %d%s%s%s", x, y, exact ? "" : " (coarse)", structure.empty() ? "" : ", ",
+              std::string(structure).c_str());
   const std::string name = metric == HeatMetric::nodes ? metric_short_label(metric, structure)
                                                         : std::string(metric_name(metric));
   if (std::isnan(p.value))
