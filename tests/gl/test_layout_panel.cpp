@@ -132,6 +132,32 @@ TEST(PanelLayout, ColumnsAndCollapsedInsightWindowsStayApartAndFollowAResize) {
   ui.expect_tidy(1280, 720);
 }
 
+// A window narrower than designed for (a 1024×768 projector) on first use: the insight windows and the
+// Ray panel take the strip left between the columns, so nothing covers the Stats or View panels (the
+// insight title bars lay over Stats, the Ray panel over the View panel's controls).
+TEST(PanelLayout, ANarrowWindowFirstOpensWithoutOverlaps) {
+  Ui ui;
+  ui.flatten.collapsed_at_start = true;
+  for (int i = 0; i < 3; ++i) ui.frame(1024, 768);
+  ui.expect_tidy(1024, 768);
+  EXPECT_FLOAT_EQ(panels::middle_width(panels::PanelLayout{1.0f, 1024, 768}), 222.0f);
+  EXPECT_FLOAT_EQ(panels::middle_width(panels::PanelLayout{1.0f, 1280, 800}), 470.0f);
+}
+
+// Made narrower after opening (a script's `size 1024 768`, a window dragged onto a projector): the
+// strip's windows narrow with it, and take their width back when the window grows again.
+TEST(PanelLayout, ANarrowedWindowNarrowsTheMiddleStrip) {
+  Ui ui;
+  ui.flatten.collapsed_at_start = true;
+  for (int i = 0; i < 3; ++i) ui.frame(1280, 800);
+  const float ray_width = rect_of("Ray").x1 - rect_of("Ray").x0;
+  for (int i = 0; i < 3; ++i) ui.frame(1024, 768);
+  ui.expect_tidy(1024, 768);
+  for (int i = 0; i < 3; ++i) ui.frame(1280, 800);
+  ui.expect_tidy(1280, 800);
+  EXPECT_FLOAT_EQ(rect_of("Ray").x1 - rect_of("Ray").x0, ray_width);
+}
+
 // Resizes in a row (one frame each, as a window drag gives) and back again
 // keep the layout tidy, and a window first drawn after a resize (the Flatten
 // what-if appears with a tlas) joins the stack in its place.

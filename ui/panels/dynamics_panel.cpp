@@ -53,7 +53,7 @@ std::optional<std::pair<std::string, bool>> scene_effects_section(const SceneEff
 
 void dynamics_panel(DynamicsPlayer& player, const DynamicsSnapshot* snap, bool busy, const PanelLayout& layout) {
   const float s = layout.scale;
-  if (!begin_panel("Dynamics", layout, 360, 470, 470, 300)) return;
+  if (!begin_panel("Dynamics", layout, 360, 470, middle_width(layout), 300)) return;
   if (ImGui::Button(player.playing ? "Pause" : "Play")) player.playing = !player.playing;
   ImGui::SameLine();
   ImGui::SetNextItemWidth(90.0f * s);

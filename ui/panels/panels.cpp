@@ -38,9 +38,20 @@ constexpr float kReferenceHeight = 800.0f;  ///< the window height the layout wa
 constexpr float kMiddleX = 356.0f;          ///< the left edge of the strip between the columns
 constexpr float kMiddleWidth = 470.0f;      ///< its width in a 1280-wide window, less a margin
 
+constexpr float kRightColumn = 438.0f;      ///< the right column's left edge, from the window's right edge
+
 float vertical_factor(const PanelLayout& l) {
   return std::clamp(l.height / (kReferenceHeight * l.scale), 0.5f, 4.0f);
 }
+
+}  // namespace
+
+float middle_width(const PanelLayout& l) {
+  const float room = l.width / l.scale - kMiddleX - kRightColumn - 8.0f;
+  return std::clamp(room, 160.0f, kMiddleWidth);
+}
+
+namespace {
 
 void place(const PanelLayout& l, float x, float y, float w, float h) {
   const float s = l.scale, f = vertical_factor(l);
@@ -64,8 +75,11 @@ void follow_display(const PanelLayout& l, int slot) {
   ImGuiStorage* st = ImGui::GetStateStorage();
   const ImGuiID kw = ImGui::GetID("##display_w"), kh = ImGui::GetID("##display_h");
   const ImGuiID kx = ImGui::GetID("##pos_x"), ky = ImGui::GetID("##pos_y");
+  const ImGuiID kn = ImGui::GetID("##natural_w"), ks = ImGui::GetID("##set_w");
   const float w0 = st->GetFloat(kw, 0.0f), h0 = st->GetFloat(kh, 0.0f);
   ImGuiWindow* w = ImGui::GetCurrentWindow();
+  // The width the panel wants: its first one, or the user's since (not one a resize below set).
+  if (w->SizeFull.x != st->GetFloat(ks, -1.0f)) st->SetFloat(kn, w->SizeFull.x);
   if (w0 > 0.0f && h0 > 0.0f && (w0 != l.width || h0 != l.height)) {
     // Where it was in the last frame: ImGui has already pulled a window the
     // smaller display would hide back into it (pos.y = height - 19), which
@@ -73,7 +87,16 @@ void follow_display(const PanelLayout& l, int slot) {
     // size set in the frame before (two resizes in a row) shows there already.
     ImVec2 pos(st->GetFloat(kx, w->Pos.x), st->GetFloat(ky, w->Pos.y));
     ImVec2 size = w->SizeFull;
-    if (pos.x + size.x * 0.5f > w0 * 0.5f) pos.x += l.width - w0;
+    if (pos.x + size.x * 0.5f > w0 * 0.5f) {
+      pos.x += l.width - w0;
+    } else {
+      // Left of the right column: as wide as it wants where there is room, narrower where there is not
+      // (a window made narrower than 1280: the insight windows and the Ray panel covered the column).
+      const float room = l.width - (kRightColumn + 8.0f) * l.scale - pos.x;
+      const float natural = st->GetFloat(kn, size.x);
+      size.x = std::max(std::min(natural, 160.0f * l.scale), std::min(natural, room));
+      st->SetFloat(ks, size.x);
+    }
     const float f = l.height / h0;
     pos.y = slot >= 0 ? stacked_y(l, slot) : pos.y * f;
     ImGui::SetWindowPos(pos);
@@ -359,7 +382,7 @@ bool structure_panel(StructureChoice& choice, const BuildProgress& progress, boo
 // ---- Stats ---------------------------------------------------------------------------------
 
 void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const PanelLayout& layout) {
-  if (!begin_panel("Stats", layout, -438, 8, 320, 340)) return;
+  if (!begin_panel("Stats", layout, -kRightColumn, 8, 320, 340)) return;
   if (!built) {
     ImGui::TextDisabled("no structure yet");
     ImGui::End();
@@ -449,7 +472,7 @@ void stats_panel(const BuiltStructure* built, const HeatmapFrame* view, const Pa
 
 bool view_panel(ViewSettings& v, const ViewInfo& info, const PanelLayout& layout, QueryOptions* query) {
   bool changed = false;
-  if (!begin_panel("View", layout, -438, 356, 320, 404)) return false;
+  if (!begin_panel("View", layout, -kRightColumn, 356, 320, 404)) return false;
   changed |= checkbox("Mesh", v.show_mesh);
   ImGui::SameLine();
   changed |= checkbox("Wireframe", v.show_wireframe);
@@ -654,7 +677,7 @@ std::optional<std::size_t> ray_panel(const RayInspection* ray, std::size_t step,
                                      const PanelLayout& layout) {
   std::optional<std::size_t> moved;
   // Along the bottom edge, between the left and right columns.
-  if (!begin_panel("Ray", layout, kMiddleX, 530, kMiddleWidth, 230)) return moved;
+  if (!begin_panel("Ray", layout, kMiddleX, 530, middle_width(layout), 230)) return moved;
   if (!ray) {
     ImGui::TextWrapped("Click the 3D view (without dragging) to cast that pixel's ray.");
     ImGui::End();
@@ -879,7 +902,7 @@ bool covered_by_window(float x0, float y0, float x1, float y1) {
 bool begin_stacked_panel(const char* title, const PanelLayout& layout, int slot, float w, float h, bool collapsed) {
   const float s = layout.scale, f = vertical_factor(layout);
   ImGui::SetNextWindowPos(ImVec2(kMiddleX * s, stacked_y(layout, slot)), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(std::min(w, kMiddleWidth) * s, h * s * f), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(std::min(w, middle_width(layout)) * s, h * s * f), ImGuiCond_FirstUseEver);
   return begin_placed(title, layout, collapsed, slot);
 }
 

@@ -108,6 +108,11 @@ void status_bar(const std::string& message, const std::string& error, const Buil
 /// cells), its counts and its hit.
 void pixel_tooltip(int x, int y, const PixelFigures& p, HeatMetric metric, bool exact, std::string_view structure);
 
+/// The width, in layout units, of the strip between the left and right columns where the insight
+/// windows, the Ray and the Dynamics panels first open: 470 in a window 1280 wide or more, narrower
+/// in a narrower one (a 1024-wide projector: 222) so that they do not cover the columns; at least 160.
+float middle_width(const PanelLayout& layout);
+
 /// A figure as panels print it: four significant digits, but whole up to 1e12 from 1e4 on (%.4g
 /// printed 20000 prim tests as "2e+04").
 std::string figure_text(double v);
