@@ -1433,8 +1433,27 @@ Scene load_gltf(const std::string& path) {
   Scene scene;
   scene.source = path;
   scene.report.warnings = json_warnings;
-  for (const std::string& line : lines_of(warn)) scene.report.warnings.push_back(line);
-  for (const std::string& line : lines_of(err)) scene.report.warnings.push_back(line);  // non-fatal notes
+  // tinygltf says an unreadable image in two lines, its file's problem and "Failed to load external
+  // 'uri' for image[N] name = []": one warning in our words.
+  std::vector<std::string> notes = lines_of(warn);
+  for (const std::string& line : lines_of(err)) notes.push_back(line);  // non-fatal notes
+  for (std::size_t i = 0; i < notes.size(); ++i) {
+    const std::string& line = notes[i];
+    constexpr std::string_view kFailed = "Failed to load external 'uri' for image[";
+    if (line.starts_with(kFailed) && !scene.report.warnings.empty() && i > 0 &&
+        scene.report.warnings.back() == notes[i - 1]) {
+      const std::string image = line.substr(kFailed.size(), line.find(']') - kFailed.size());
+      std::string what = notes[i - 1];
+      for (const std::string_view prefix : {"File not found : ", "File read error : "})
+        if (what.starts_with(prefix)) what = what.substr(prefix.size());
+      if (notes[i - 1].starts_with("File not found : ")) what = "'" + what + "' not found";
+      if (const std::size_t sep = what.find(" : "); sep != std::string::npos) what.replace(sep, 3, ": ");
+      scene.report.warnings.back() =
+          "image " + image + ": " + what + " (images are never decoded: no traced triangle changes)";
+      continue;
+    }
+    scene.report.warnings.push_back(line);
+  }
   GltfConverter(path, model, scene).run();
   return scene;
 }

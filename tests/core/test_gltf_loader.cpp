@@ -638,6 +638,24 @@ TEST_F(GltfLoader, NonFiniteKeyframeTimesAndValuesAreRefused) {
 // What an animated node cannot carry along is said, once per node: a light or a camera on it (or
 // below it) stays at its rest pose; a node given by a matrix (glTF forbids animating one) loses the
 // matrix to the animated TRS.
+// An image that cannot be read is one warning in our words (tinygltf said it in two lines, its own
+// "Failed to load external 'uri' for image[0] name = []" the second).
+TEST_F(GltfLoader, AnUnreadableImageIsOneWarning) {
+  GltfBuilder b = one_triangle();
+  b.doc["images"] = json::array({json{{"uri", "nothere.png"}}});
+  const Scene missing = load_gltf(write_glb(b, "missing_image.glb"));
+  ASSERT_EQ(missing.report.warnings.size(), 1u) << missing.report.warnings.front();
+  EXPECT_EQ(missing.report.warnings[0],
+            "image 0: 'nothere.png' not found (images are never decoded: no traced triangle changes)");
+  fs::create_directories(dir_ / "adir.png");
+  b.doc["images"] = json::array({json{{"uri", "adir.png"}}});
+  const Scene folder = load_gltf(write_glb(b, "folder_image.glb"));
+  ASSERT_EQ(folder.report.warnings.size(), 1u) << folder.report.warnings.front();
+  EXPECT_TRUE(warned(folder, "image 0: ")) << folder.report.warnings[0];
+  EXPECT_TRUE(warned(folder, "adir.png: is a directory, not a file")) << folder.report.warnings[0];
+  EXPECT_EQ(missing.triangles.size(), 1u);
+}
+
 TEST_F(GltfLoader, AnimatedNodesSayWhatDoesNotFollow) {
   GltfBuilder b = one_triangle();
   b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
