@@ -149,6 +149,12 @@ void write_output_text(const std::filesystem::path& path, const std::string& tex
 /// Absolute, normalised form of a path for messages.
 std::string absolute_path(const std::string& path);
 
+/// The items of a comma-separated option value, empty ones included ("a,,b" has three: an empty
+/// item is a typo to refuse, which CLI11's own list splitting drops in silence).
+std::vector<std::string> comma_items(const std::string& text);
+/// "{a,b,c}", as CLI11 lists the values an option takes.
+std::string braced_names(const std::vector<std::string>& names);
+
 /// One-line JSON on stdout.
 void print_json_line(const nlohmann::json& j);
 

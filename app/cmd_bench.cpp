@@ -233,30 +233,13 @@ std::vector<std::string> bench_structure_names() {
   return names;
 }
 
-/// The items of one --structure value ("bvh,kdtree"), empty ones included.
-std::vector<std::string> structure_items(const std::string& text) {
-  std::vector<std::string> items;
-  std::size_t start = 0;
-  for (std::size_t comma; (comma = text.find(',', start)) != std::string::npos; start = comma + 1)
-    items.push_back(text.substr(start, comma - start));
-  items.push_back(text.substr(start));
-  return items;
-}
-
-/// "{a,b,c}" as CLI11 lists the names an option takes.
-std::string join_names(const std::vector<std::string>& names) {
-  std::string all;
-  for (const std::string& n : names) all += (all.empty() ? "" : ",") + n;
-  return "{" + all + "}";
-}
-
 /// "" or what is wrong with one --structure value: an empty item (a typo such as "bvh,,kdtree":
 /// CLI11's own list splitting drops it without a word) or a name bench does not have.
 std::string structure_list_problem(const std::string& text) {
   const std::vector<std::string> names = bench_structure_names();
-  for (const std::string& item : structure_items(text)) {
+  for (const std::string& item : comma_items(text)) {
     if (item.empty()) return "an empty item in '" + text + "'";
-    if (std::find(names.begin(), names.end(), item) == names.end()) return item + " not in " + join_names(names);
+    if (std::find(names.begin(), names.end(), item) == names.end()) return item + " not in " + braced_names(names);
   }
   return {};
 }
@@ -291,7 +274,7 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   const bool named_by_user = !o.structures.empty();
   std::vector<std::string> listed;  // each -s value split at its commas (structure_list_problem checked them)
   for (const std::string& value : o.structures)
-    for (std::string& item : structure_items(value)) listed.push_back(std::move(item));
+    for (std::string& item : comma_items(value)) listed.push_back(std::move(item));
   o.structures = std::move(listed);
   if (o.structures.empty())
     o.structures = kHaveEmbree ? std::vector<std::string>{"bvh", "embree"} : std::vector<std::string>{"bvh"};
@@ -635,7 +618,7 @@ Command add_bench_command(CLI::App& parent, const GlobalOptions& global) {
       "(medians of repeated runs), with ratios to Embree when it is among the structures");
   sub->add_option("SCENE", o->scene, "Scene file (.gltf, .glb, .obj) or builtin:NAME[?key=value&...]")->required();
   sub->add_option("--structure,-s", o->structures,
-                  "Comma-separated structures of " + join_names(bench_structure_names()) + " (default: bvh" +
+                  "Comma-separated structures of " + braced_names(bench_structure_names()) + " (default: bvh" +
                       (kHaveEmbree ? ",embree" : "") + ")" +
                       (kHaveEmbree ? "; embree-low, embree-medium, embree-high: Embree at that build quality "
                                      "(ratios are quoted against the plain embree row)"

@@ -292,19 +292,11 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
 
 /// The structures of one --structure value ("bvh,kdtree,grid"); an empty item is a usage error.
 std::vector<std::string> structure_list(const std::string& text) {
-  std::vector<std::string> items;
-  std::size_t start = 0;
-  for (std::size_t comma; (comma = text.find(',', start)) != std::string::npos; start = comma + 1)
-    items.push_back(text.substr(start, comma - start));
-  items.push_back(text.substr(start));
-  const std::vector<std::string> names = structure_names();
+  const std::vector<std::string> items = comma_items(text), names = structure_names();
   for (std::size_t i = 0; i < items.size(); ++i) {
     if (items[i].empty()) throw UsageError("--structure: an empty item in '" + text + "'");
-    if (std::find(names.begin(), names.end(), items[i]) == names.end()) {
-      std::string all;
-      for (const std::string& n : names) all += (all.empty() ? "" : ",") + n;
-      throw UsageError("--structure: " + items[i] + " not in {" + all + "}");
-    }
+    if (std::find(names.begin(), names.end(), items[i]) == names.end())
+      throw UsageError("--structure: " + items[i] + " not in " + braced_names(names));
     for (std::size_t j = 0; j < i; ++j)
       if (items[j] == items[i]) throw UsageError("--structure: '" + items[i] + "' is listed twice");
   }
@@ -465,9 +457,7 @@ Command add_render_command(CLI::App& parent, const GlobalOptions& global) {
             if (text.find(',') != std::string::npos) return std::string();  // checked item by item later
             const std::vector<std::string> names = structure_names();
             if (std::find(names.begin(), names.end(), text) != names.end()) return std::string();
-            std::string all;
-            for (const std::string& n : names) all += (all.empty() ? "" : ",") + n;
-            return text + " not in {" + all + "}";
+            return text + " not in " + braced_names(names);
           },
           "NAME[,NAME...]"))
       ->capture_default_str();

@@ -225,7 +225,7 @@ bool channel_moves(const Scene& scene, const AnimationChannel& c, const std::vec
                         : c.path == P::scale     ? glm::vec4(node.scale, held[0].w)
                                                  : glm::vec4(node.rotation.x, node.rotation.y, node.rotation.z,
                                                              node.rotation.w);
-  return !channel_holds(c, held) || (!node.has_matrix && held[0] != own) || node.has_matrix;
+  return !channel_holds(c, held) || node.has_matrix || held[0] != own;
 }
 
 std::vector<std::uint32_t> deforming_meshes(const Scene& scene) {
