@@ -341,7 +341,7 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
     if (want_diffuse) sets.push_back({"diffuse", diffuse_rays(scene.triangles, sets[0].rays, hits, o.seed)});
     if (want_shadow) {
       const std::vector<Light> lights = shadow_lights(scene, true);
-      if (scene.lights.empty()) {  // a stand-in, reported in the output
+      if (casting_lights(scene).empty()) {  // a stand-in (no light, or none that gives light), reported
         synthetic_light = true;
         synthetic_position = lights[0].position;
       }
@@ -351,9 +351,10 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   if (o.rays != "all" && o.rays != "primary") sets.erase(sets.begin());
   if (synthetic_light && !global.quiet)
     std::fprintf(stderr,
-                 "accelviz: %s has no lights: shadow rays aim at a synthetic point light at (%g, %g, %g) "
+                 "accelviz: %s has no lights%s: shadow rays aim at a synthetic point light at (%g, %g, %g) "
                  "(benchmark only)\n",
-                 o.scene.c_str(), synthetic_position->x, synthetic_position->y, synthetic_position->z);
+                 o.scene.c_str(), scene.lights.empty() ? "" : " that give light (intensity or colour 0)",
+                 synthetic_position->x, synthetic_position->y, synthetic_position->z);
 
   // ---- builds: each round builds every structure once, in turn ----
   const std::size_t count = o.structures.size();

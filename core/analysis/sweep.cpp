@@ -612,7 +612,7 @@ std::vector<Ray> sweep_ray_set(const Scene& scene, const Camera& camera, int wid
   std::vector<Hit> hits(primary.size());
   trace_closest(bvh, primary, hits, QueryOptions{}, resolve_threads(threads));
   if (kind == RayKind::diffuse) return diffuse_rays(scene.triangles, primary, hits, seed);
-  if (synthetic_light) *synthetic_light = scene.lights.empty();
+  if (synthetic_light) *synthetic_light = casting_lights(scene).empty();
   return shadow_rays(scene.triangles, primary, hits, shadow_lights(scene, true));
 }
 

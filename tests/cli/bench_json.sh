@@ -130,3 +130,26 @@ tokens = sys.argv[1].split()[1:5]
 assert all(float(x) > 0 for x in tokens), sys.argv[1]
 assert all(float(x) >= 0.1 or len(x.replace(".", "").lstrip("0")) >= 2 for x in tokens), sys.argv[1]
 print("bench slow rates ok")' "$row"
+
+# A scene whose only light gives no light (intensity 0): no shadow ray aims at it; the shadow set aims
+# at the synthetic stand-in and says so, as for a scene without lights.
+python3 - "$tmp/dark.gltf" <<'PY'
+import base64, json, struct, sys
+pos = struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0)
+doc = {"asset": {"version": "2.0"}, "extensionsUsed": ["KHR_lights_punctual"],
+       "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 0}]}},
+       "buffers": [{"byteLength": len(pos), "uri": "data:application/octet-stream;base64," + base64.b64encode(pos).decode()}],
+       "bufferViews": [{"buffer": 0, "byteLength": len(pos)}],
+       "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}],
+       "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+       "nodes": [{"mesh": 0}, {"translation": [0.2, 0.2, 3], "extensions": {"KHR_lights_punctual": {"light": 0}}}],
+       "scenes": [{"nodes": [0, 1]}], "scene": 0}
+open(sys.argv[1], "w").write(json.dumps(doc))
+PY
+"$accelviz" bench "$tmp/dark.gltf" -s bvh --rays shadow --size 8x8 --repeat 1 --json 2>"$tmp/dark.err" |
+  python3 -c 'import json, sys; s = json.load(sys.stdin)["ray_sets"]["shadow"]; assert s["synthetic_light"] is True, s'
+grep -q "has no lights that give light (intensity or colour 0): shadow rays aim at a synthetic point light" "$tmp/dark.err" ||
+  { echo "FAIL: the stand-in light is not said: $(cat "$tmp/dark.err")"; exit 1; }
+"$accelviz" -q info "$tmp/dark.gltf" | grep -q "shadow-rays *off .*none gives light" ||
+  { echo "FAIL: info: $("$accelviz" -q info "$tmp/dark.gltf" | grep shadow)"; exit 1; }
+echo "dark light ok"
