@@ -329,12 +329,19 @@ int run_render_several(const RenderOptions& o, const std::vector<std::string>& s
   const Camera camera = camera_for(o.camera, scene, parse_size(o.size));
   std::vector<TracedHeatmap> traced;
   for (const RenderOptions& os : each) traced.push_back(trace_heatmap(os, scene, camera, global, progress));
+  // One scale over the images that count something: a structure that counts nothing per ray (embree;
+  // the voxels' prims) is all 0, and its zeros pulled a shared percentile down (p90: 10 read 2).
   std::vector<const MetricImage*> images;
-  for (const TracedHeatmap& t : traced) images.push_back(&t.image);
-  // One scale: --max's value or percentile (of every image's values), else the largest maximum.
+  for (std::size_t i = 0; i < traced.size(); ++i)
+    if (traced[i].counters && metric_not_counted(metric, each[i].structure).empty()) images.push_back(&traced[i].image);
+  // --max's value, or its percentile of those images' values together, else their largest maximum.
   ColorizeOptions shared = colour_options(o, images);
-  if (!(shared.max > 0.0f))
+  if (o.max_percentile > 0.0) {
+    shared.max = heatmap_scale_max(ValueRange{0.0f, shared.max}, 0.0f);  // all 0: a top of 1, as --compare
+  } else if (!(shared.max > 0.0f)) {
     for (const MetricImage* img : images) shared.max = std::max(shared.max, heatmap_scale_max(*img, 0.0f));
+    if (!(shared.max > 0.0f)) shared.max = 1.0f;  // nothing counted anywhere
+  }
   nlohmann::json out = {{"scene", o.scene}, {"metric", o.metric}, {"scale_max", shared.max}};
   out["images"] = nlohmann::json::array();
   for (std::size_t i = 0; i < each.size(); ++i) {
@@ -392,6 +399,13 @@ int run_render(const RenderOptions& given, const GlobalOptions& global) {
     job.max_percentile = o.max_percentile;
     job.a = compare_side(o);
     job.b = parse_compare_spec(*o.compare, job.a);
+    // Options that do not fit together, said for the side they belong to.
+    (void)job.a.structure_opts.to_options(1, false);
+    try {
+      (void)job.b.structure_opts.to_options(1, false);
+    } catch (const UsageError& e) {
+      throw UsageError(std::string("--compare: B: ") + e.what());
+    }
     if (const std::string problem = order_problem(job.b); !problem.empty())
       throw UsageError("--compare: B (" + job.b.structure + "): " + problem);
     return run_render_compare(job, global);

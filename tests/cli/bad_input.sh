@@ -192,7 +192,7 @@ expect 2 "--structure: an empty value" -- robustness 'builtin:soup?size=20' -s "
 expect 2 "--structure: an empty item in 'bvh,,kdtree'" -- verify 'builtin:soup?size=20' -s bvh,,kdtree
 # A leaf cap below the always-leaf size (it was ignored); not given, it is raised to --leaf.
 expect 2 "--leaf-cap 4 is below --leaf 8" -- bench 'builtin:soup?size=20' -s bvh --leaf 8 --leaf-cap 4
-expect 2 "--leaf-cap 2 is below --leaf 4" -- render 'builtin:soup?size=20' --size 8x8 -o "$tmp/cap.png" --compare leaf-cap=2
+expect 2 "--compare: B: --leaf-cap 2 is below --leaf 4" -- render 'builtin:soup?size=20' --size 8x8 -o "$tmp/cap.png" --compare leaf-cap=2
 # Several structures in one render: a cost metric, not with --compare, each named once.
 expect 2 "several structures: a cost metric" -- render 'builtin:soup?size=20' -s bvh,grid -m depth --size 8x8 -o "$tmp/sev.png"
 expect 2 "--compare: one structure for A" -- render 'builtin:soup?size=20' -s bvh,grid --compare buckets=4 --size 8x8 -o "$tmp/sev.png"
