@@ -992,7 +992,9 @@ class GltfConverter {
     } else if (gl.type == "spot") {
       light.kind = Light::Kind::spot;
       const double inner = gl.spot.innerConeAngle, outer = gl.spot.outerConeAngle;
-      if (std::isfinite(inner) && std::isfinite(outer) && inner >= 0.0 && inner < outer && outer <= 1.5707963267948966) {
+      // pi/2 as a float (what export writes back) lies a hair above pi/2 as a double: allowed.
+      if (std::isfinite(inner) && std::isfinite(outer) && inner >= 0.0 && inner < outer &&
+          outer <= double(float(1.5707963267948966))) {
         light.inner_cone = float(inner);
         light.outer_cone = float(outer);
       } else {

@@ -319,7 +319,9 @@ class GltfWriter {
         case Light::Kind::directional: jl["type"] = "directional"; break;
         case Light::Kind::spot:
           jl["type"] = "spot";
-          jl["spot"] = {{"innerConeAngle", light.inner_cone}, {"outerConeAngle", light.outer_cone}};
+          // Written as doubles no wider than glTF's pi/2 (the float pi/2 lies a hair above it).
+          jl["spot"] = {{"innerConeAngle", std::min(double(light.inner_cone), 1.5707963267948966)},
+                        {"outerConeAngle", std::min(double(light.outer_cone), 1.5707963267948966)}};
           break;
       }
       if (light.range > 0.0f) jl["range"] = light.range;

@@ -156,6 +156,16 @@ TEST_F(GltfWriter, RoundTripGltfKeepsCamerasAndLights) {
   EXPECT_FLOAT_EQ(back.lights[1].range, 9.0f);
   EXPECT_FLOAT_EQ(back.lights[1].inner_cone, 0.1f);
   EXPECT_FLOAT_EQ(back.lights[1].outer_cone, 0.3f);
+  // The widest cone glTF allows, pi/2, survives a round trip (as a float it lies above pi/2 as a double).
+  Scene wide = original;
+  wide.lights[1].inner_cone = 1.5f;
+  wide.lights[1].outer_cone = 1.5707963267948966f;
+  write_gltf(wide, path("wide_cone.gltf"), false);
+  const Scene wide_back = load_gltf(path("wide_cone.gltf"));
+  ASSERT_EQ(wide_back.lights.size(), 2u);
+  EXPECT_FLOAT_EQ(wide_back.lights[1].outer_cone, 1.5707963267948966f);
+  EXPECT_FLOAT_EQ(wide_back.lights[1].inner_cone, 1.5f);
+  EXPECT_TRUE(wide_back.report.warnings.empty()) << wide_back.report.warnings.front();
 }
 
 TEST_F(GltfWriter, RoundTripOfALoadedFileIsStable) {
