@@ -21,6 +21,7 @@
 #include <optional>
 
 #include "app/cli_common.h"
+#include "core/analysis/heatmap.h"
 #include "core/query/batch.h"
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
@@ -192,7 +193,7 @@ void count_per_ray(const Accelerator& accel, const std::vector<Ray>& rays, const
 /// The figures of one ray set; without per-ray counters (Embree) the per-ray
 /// counts are null, as sweep writes a figure a structure does not have (0
 /// read as the cheapest).
-nlohmann::json query_json(const QueryFigures& f, bool counters) {
+nlohmann::json query_json(const QueryFigures& f, bool counters, bool prims_counted) {
   nlohmann::json j = {
       {"closest_mrays_1t", f.closest_1t},
       {"closest_mrays_nt", f.closest_nt},
@@ -211,6 +212,8 @@ nlohmann::json query_json(const QueryFigures& f, bool counters) {
     for (const char* k : {"closest_nodes_per_ray", "closest_prims_per_ray", "closest_boxes_per_ray",
                           "any_nodes_per_ray", "any_prims_per_ray", "any_boxes_per_ray"})
       j[k] = nullptr;
+  if (!prims_counted)  // the voxels test no triangles (a hit is a voxel)
+    for (const char* k : {"closest_prims_per_ray", "any_prims_per_ray"}) j[k] = nullptr;
   if (f.packets) {
     j["closest_packet_mrays_1t"] = f.closest_packet_1t;
     j["any_packet_mrays_1t"] = f.any_packet_1t;
@@ -496,7 +499,9 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
     // Embree keeps no per-ray counters: its *_per_ray figures are null and marked so.
     s["per_ray_counters"] = !r.name.starts_with("embree");
     s["rays"] = nlohmann::json::object();
-    for (const auto& [set, f] : r.queries) s["rays"][set] = query_json(f, s["per_ray_counters"].get<bool>());
+    for (const auto& [set, f] : r.queries)
+      s["rays"][set] = query_json(f, s["per_ray_counters"].get<bool>(),
+                                  metric_not_counted(HeatMetric::prims, r.name).empty());
     j["structures"].push_back(s);
   }
   if (embree) {

@@ -153,3 +153,7 @@ grep -q "has no lights that give light (intensity or colour 0): shadow rays aim 
 "$accelviz" -q info "$tmp/dark.gltf" | grep -q "shadow-rays *off .*none gives light" ||
   { echo "FAIL: info: $("$accelviz" -q info "$tmp/dark.gltf" | grep shadow)"; exit 1; }
 echo "dark light ok"
+# The voxels test no triangles: their prims per ray are null, their nodes counted.
+"$accelviz" -q bench 'builtin:teapot?size=300' -s voxels --rays primary --size 8x8 --repeat 1 --json |
+  python3 -c 'import json, sys; q = json.load(sys.stdin)["structures"][0]["rays"]["primary"]; assert q["closest_prims_per_ray"] is None and q["any_prims_per_ray"] is None and q["closest_nodes_per_ray"] > 0, q'
+echo "voxels prims null ok"
