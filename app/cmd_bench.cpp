@@ -500,8 +500,8 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
     s["per_ray_counters"] = !r.name.starts_with("embree");
     s["rays"] = nlohmann::json::object();
     for (const auto& [set, f] : r.queries)
-      s["rays"][set] = query_json(f, s["per_ray_counters"].get<bool>(),
-                                  metric_not_counted(HeatMetric::prims, r.name).empty());
+      s["rays"][set] =
+          query_json(f, s["per_ray_counters"].get<bool>(), metric_not_counted(HeatMetric::prims, r.name).empty());
     j["structures"].push_back(s);
   }
   if (embree) {

@@ -61,10 +61,9 @@ int run_rays(const RaysOptions& o, const GlobalOptions& global) {
       if (casting_lights(scene).empty()) {  // no light, or none that gives light
         const glm::vec3 p = lights[0].position;
         if (!global.quiet)
-          std::fprintf(stderr,
-                       "accelviz: %s has no lights%s: shadow rays aim at a synthetic point light at (%g, %g, %g)\n",
-                       o.scene.c_str(), scene.lights.empty() ? "" : " that give light (intensity or colour 0)", p.x,
-                       p.y, p.z);
+          std::fprintf(
+              stderr, "accelviz: %s has no lights%s: shadow rays aim at a synthetic point light at (%g, %g, %g)\n",
+              o.scene.c_str(), scene.lights.empty() ? "" : " that give light (intensity or colour 0)", p.x, p.y, p.z);
         j["synthetic_light"] = {p.x, p.y, p.z};
       }
       rays = shadow_rays(scene.triangles, rays, hits, lights);

@@ -3,11 +3,11 @@
 // Also the no-subcommand demo, which renders the demo scene the same way.
 #include <algorithm>
 #include <ctime>
-#include <span>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <span>
 
 #include "app/cli_common.h"
 #include "app/render_compare.h"
@@ -272,7 +272,8 @@ RgbImage colour_heatmap(const RenderOptions& o, TracedHeatmap& t, const Colorize
   t.figures["scale_max"] = heatmap_scale_max(t.image, co.max);
   RgbImage rgb = colorize(t.image, co);
   // All 0 because nothing was counted, not because nothing was visited: the image says so itself.
-  if (metric_needs_stats(metric) && !t.counters) draw_note(rgb, "n/a: " + t.name + " counts nothing per ray");
+  if (metric_needs_stats(metric) && !t.counters)
+    draw_note(rgb, "n/a: " + t.name + " counts nothing per ray");
   else if (const std::string why = metric_not_counted(metric, o.structure); !why.empty())
     draw_note(rgb, "n/a: " + why);
   return rgb;
@@ -309,8 +310,8 @@ int run_render_several(const RenderOptions& o, const std::vector<std::string>& s
                        const GlobalOptions& global) {
   const HeatMetric metric = parse_metric(o.metric).value();
   if (!metric_needs_stats(metric))
-    throw UsageError("several structures: a cost metric (nodes, prims, cost or instances) shares a scale, not --metric " +
-                     o.metric);
+    throw UsageError(
+        "several structures: a cost metric (nodes, prims, cost or instances) shares a scale, not --metric " + o.metric);
   if (o.view != "heatmap") throw UsageError("several structures: --view heatmap only");
   if (o.device != "cpu") throw UsageError("several structures: --device cpu only");
   std::vector<RenderOptions> each;

@@ -222,9 +222,9 @@ bool channel_moves(const Scene& scene, const AnimationChannel& c, const std::vec
   // A constant channel moves the node once if its value is not the node's own (frame 0), else never.
   const std::vector<glm::vec4> held = first_values(c, 1);
   const glm::vec4 own = c.path == P::translation ? glm::vec4(node.translation, held[0].w)
-                        : c.path == P::scale     ? glm::vec4(node.scale, held[0].w)
-                                                 : glm::vec4(node.rotation.x, node.rotation.y, node.rotation.z,
-                                                             node.rotation.w);
+                        : c.path == P::scale
+                            ? glm::vec4(node.scale, held[0].w)
+                            : glm::vec4(node.rotation.x, node.rotation.y, node.rotation.z, node.rotation.w);
   return !channel_holds(c, held) || node.has_matrix || held[0] != own;
 }
 

@@ -133,8 +133,8 @@ std::vector<Light> shadow_lights(const Scene& scene, bool wanted) {
 }
 
 Light synthetic_light(const Scene& scene) {
-  return synthetic_light(scene.bounds(),
-                         scene.cameras.empty() ? std::nullopt : std::optional<glm::vec3>(scene.cameras.front().position));
+  return synthetic_light(
+      scene.bounds(), scene.cameras.empty() ? std::nullopt : std::optional<glm::vec3>(scene.cameras.front().position));
 }
 
 Light synthetic_light(const Aabb& bounds, std::optional<glm::vec3> eye) {

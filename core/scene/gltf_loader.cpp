@@ -1100,8 +1100,9 @@ class GltfConverter {
         seen[std::size_t(c.node)] = true;
         const std::string name = "node " + std::to_string(c.node);
         if (!model_.nodes[std::size_t(c.node)].matrix.empty())
-          warn(name + " is animated but given by a matrix (glTF forbids it): the animated TRS replaces the matrix, "
-                      "so a shear in it is lost");
+          warn(name +
+               " is animated but given by a matrix (glTF forbids it): the animated TRS replaces the matrix, "
+               "so a shear in it is lost");
         // The node and its descendants: a light or a camera among them does not follow.
         std::vector<int> stack{c.node};
         std::vector<bool> visited(scene_.nodes.size(), false);

@@ -327,7 +327,8 @@ TEST(Effects, AnimationThatMovesNoGeometryCallsForNoUpdates) {
   morph.meshes[0].morph_base = morph.meshes[0].positions;
   morph.meshes[0].morph_deltas = {{{0, 0, 0}, {0, 0, 0}, {1, 1, 0}}};
   morph.meshes[0].morph_weights = {0.5f};
-  EXPECT_FALSE(moves(with_channel(morph, 0, channel(P::weights, I::linear, {0, 1}, {{0.5f, 0, 0, 0}, {0.5f, 0, 0, 0}}))));
+  EXPECT_FALSE(
+      moves(with_channel(morph, 0, channel(P::weights, I::linear, {0, 1}, {{0.5f, 0, 0, 0}, {0.5f, 0, 0, 0}}))));
   EXPECT_TRUE(moves(with_channel(morph, 0, channel(P::weights, I::linear, {0, 1}, {{0.5f, 0, 0, 0}, {1, 0, 0, 0}}))));
   const SceneEffects off = decide_effects(with_channel(s, 2, varying));
   EXPECT_NE(off.per_frame_updates.reason.find("1 animation channel but none moves geometry"), std::string::npos)

@@ -311,8 +311,7 @@ TEST(AppScreenshot, ARayReplayStepIsReplayedAndSaid) {
   EXPECT_NE(script.find("\"click 32 24\",\"step 3\",\"screenshot "), std::string::npos) << script;
   EXPECT_NE(screenshot_caption(info).find(", ray of pixel 32,24 at step 3/9"), std::string::npos)
       << screenshot_caption(info);
-  EXPECT_NE(j["reproduce"]["notes"].dump().find("replay at step 3/9"), std::string::npos)
-      << j["reproduce"]["notes"];
+  EXPECT_NE(j["reproduce"]["notes"].dump().find("replay at step 3/9"), std::string::npos) << j["reproduce"]["notes"];
 }
 
 // Boxes the Predicted vs measured view drew (a region's entered nodes,
@@ -340,7 +339,8 @@ TEST(AppScreenshot, AThinnedBoxOverlayIsSaidOnThePictureAndInTheSideCar) {
   ScreenshotInfo info = test_info();
   info.boxes_drawn = 200000;
   info.boxes_matched = 288291;
-  EXPECT_EQ(screenshot_caption(info), info.scene + ", " + screenshot_caption(info.config) + ", boxes 200000 of 288291, ray of pixel 32,24");
+  EXPECT_EQ(screenshot_caption(info),
+            info.scene + ", " + screenshot_caption(info.config) + ", boxes 200000 of 288291, ray of pixel 32,24");
   const nlohmann::json j = screenshot_sidecar(info, "shot.png");
   EXPECT_EQ(j["caption"], screenshot_caption(info));
   EXPECT_EQ(j["boxes"]["drawn"], 200000);

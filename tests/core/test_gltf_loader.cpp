@@ -666,15 +666,15 @@ TEST_F(GltfLoader, AnimatedNodesSayWhatDoesNotFollow) {
   b.scene({0, holder, sheared});
   const int times = b.floats({0.0f, 1.0f}, "SCALAR", 1);
   const int moves = b.floats({0, 0, 0, 0, 0, -3}, "VEC3", 3);
-  b.doc["animations"] = json::array(
-      {json{{"samplers", {{{"input", times}, {"output", moves}}}},
-            {"channels",
-             {{{"sampler", 0}, {"target", {{"node", holder}, {"path", "translation"}}}},
-              {{"sampler", 0}, {"target", {{"node", sheared}, {"path", "translation"}}}},
-              {{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}}}}});
+  b.doc["animations"] = json::array({json{{"samplers", {{{"input", times}, {"output", moves}}}},
+                                          {"channels",
+                                           {{{"sampler", 0}, {"target", {{"node", holder}, {"path", "translation"}}}},
+                                            {{"sampler", 0}, {"target", {{"node", sheared}, {"path", "translation"}}}},
+                                            {{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}}}}});
   const Scene s = load_gltf(write_glb(b));
-  EXPECT_TRUE(warned(s, "node " + std::to_string(holder) + " is animated and carries light 0: lights and cameras "
-                        "stay where the rest pose puts them"));
+  EXPECT_TRUE(warned(s, "node " + std::to_string(holder) +
+                            " is animated and carries light 0: lights and cameras "
+                            "stay where the rest pose puts them"));
   EXPECT_TRUE(warned(s, "node " + std::to_string(sheared) + " is animated but given by a matrix (glTF forbids it)"));
   EXPECT_FALSE(warned(s, "node 0 is animated")) << "a plain TRS mesh node moves as it should";
 }
@@ -687,9 +687,10 @@ TEST_F(GltfLoader, ANodeWithoutMorphWeightsBesideOneWithThemIsWarned) {
     GltfBuilder b;
     const int pos = b.positions({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
     const int lift = b.positions({{0, 0, 0}, {0, 0, 0}, {2, 2, 0}});
-    b.doc["meshes"] = json::array({json{{"primitives", json::array({json{{"attributes", {{"POSITION", pos}}},
-                                                                         {"targets", json::array({json{{"POSITION", lift}}})}}})},
-                                        {"weights", {0.0}}}});
+    b.doc["meshes"] =
+        json::array({json{{"primitives", json::array({json{{"attributes", {{"POSITION", pos}}},
+                                                           {"targets", json::array({json{{"POSITION", lift}}})}}})},
+                          {"weights", {0.0}}}});
     const json weighted = {{"mesh", 0}, {"weights", {1.0}}}, plain = {{"mesh", 0}, {"translation", {5, 0, 0}}};
     b.node(weighted_first ? weighted : plain);
     b.node(weighted_first ? plain : weighted);

@@ -24,8 +24,8 @@ int rows_shown(const StructureNodes& nodes, std::uint32_t selected) {
   bool scroll = false;
   for (int i = 0; i < 2; ++i) {
     ui.begin_frame(ImVec2(-100, -100), false);
-    panels::tree_panel(&nodes, nullptr, selected, scroll, panels::PanelLayout{1.0f, 1600, 1000}, ColorMap::viridis,
-                       0, false);
+    panels::tree_panel(&nodes, nullptr, selected, scroll, panels::PanelLayout{1.0f, 1600, 1000}, ColorMap::viridis, 0,
+                       false);
     ImGui::Render();
   }
   const ImGuiWindow* w = ImGui::FindWindowByName("Tree");

@@ -493,7 +493,8 @@ std::string screenshot_caption(const AppConfig& config) {
     s += ", heatmap " + std::string(metric_name(config.view.metric));
     // In the structure's words where they differ, as the legend says (a grid's nodes are cells).
     const std::string word = metric_short_label(config.view.metric, config.structure.name);
-    if (config.view.metric == HeatMetric::nodes && word != metric_short_label(config.view.metric)) s += " (" + word + ")";
+    if (config.view.metric == HeatMetric::nodes && word != metric_short_label(config.view.metric))
+      s += " (" + word + ")";
     if (config.view.metric != HeatMetric::shaded)  // grey shading: no colour map, no scale
       s += " " + std::string(colormap_name(config.view.colormap)) + " scale " + option_value(config, "scale");
     if (config.view.heatmap == HeatmapDisplay::blend) s += " blend " + option_value(config, "opacity");

@@ -131,8 +131,8 @@ std::shared_ptr<HeatmapFrame> HeatmapFramePool::take(int stride) {
 }
 
 bool trace_progressive(const HeatmapRequest& r, std::uint64_t id, const std::function<bool()>& keep_going,
-                       const std::function<void(std::shared_ptr<const HeatmapFrame>)>& publish,
-                       HeatmapFramePool* pool, std::atomic<std::uint64_t>* traced) {
+                       const std::function<void(std::shared_ptr<const HeatmapFrame>)>& publish, HeatmapFramePool* pool,
+                       std::atomic<std::uint64_t>* traced) {
   const HeatmapOptions& o = r.options;
   const int w = o.width, h = o.height;
   if (w <= 0 || h <= 0 || !r.structure || !r.structure->accel) return true;

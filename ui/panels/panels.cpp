@@ -38,7 +38,7 @@ constexpr float kReferenceHeight = 800.0f;  ///< the window height the layout wa
 constexpr float kMiddleX = 356.0f;          ///< the left edge of the strip between the columns
 constexpr float kMiddleWidth = 470.0f;      ///< its width in a 1280-wide window, less a margin
 
-constexpr float kRightColumn = 438.0f;      ///< the right column's left edge, from the window's right edge
+constexpr float kRightColumn = 438.0f;  ///< the right column's left edge, from the window's right edge
 
 float vertical_factor(const PanelLayout& l) {
   return std::clamp(l.height / (kReferenceHeight * l.scale), 0.5f, 4.0f);
@@ -961,8 +961,8 @@ void pixel_tooltip(int x, int y, const PixelFigures& p, HeatMetric metric, bool 
   // Whose figures: after a switch the view shows the structure before until the new one is traced.
   ImGui::Text("pixel %d, %d%s%s%s", x, y, exact ? "" : " (coarse)", structure.empty() ? "" : ", ",
               std::string(structure).c_str());
-  const std::string name = metric == HeatMetric::nodes ? metric_short_label(metric, structure)
-                                                        : std::string(metric_name(metric));
+  const std::string name =
+      metric == HeatMetric::nodes ? metric_short_label(metric, structure) : std::string(metric_name(metric));
   if (std::isnan(p.value))
     ImGui::Text("%s: no value", name.c_str());
   else
