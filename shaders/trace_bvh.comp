@@ -196,6 +196,26 @@ bool watertight_double(uint k, float tmin, float tmax, out float t_out) {
   return true;
 }
 
+// watertight_sheared_double: steps 6 and 7 in double on the float-sheared coordinates, so that a
+// shared edge is decided as the neighbour's float test decides it (the fresh double shear above did
+// not: holes at tiny hit distances).
+bool watertight_sheared_double(float ax, float ay, float bx, float by, float cx, float cy, float az, float bz,
+                               float cz, float tmin, float tmax, out float t_out) {
+  precise double U = double(cx) * double(by) - double(cy) * double(bx);
+  precise double V = double(ax) * double(cy) - double(ay) * double(cx);
+  precise double W = double(bx) * double(ay) - double(by) * double(ax);
+  if ((U < 0.0LF || V < 0.0LF || W < 0.0LF) && (U > 0.0LF || V > 0.0LF || W > 0.0LF)) return false;
+  precise double det = (U + V) + W;
+  if (det == 0.0LF || !finite_d(det)) return false;
+  precise double T = (U * double(az) + V * double(bz)) + W * double(cz);
+  precise double t = T / det;
+  if (!(t >= double(tmin) && t <= double(tmax))) return false;
+  float tf = float(t);
+  if (!(tf >= tmin && tf <= tmax)) tf = t < double(tmin) ? tmin : tmax;
+  t_out = tf;
+  return true;
+}
+
 // intersect_watertight (the inline twin in the BVH gives the same results)
 bool watertight(uint k, float tmin, float tmax, out float t_out) {
   precise vec3 A = vert(k, 0) - g_origin;
@@ -210,8 +230,16 @@ bool watertight(uint k, float tmin, float tmax, out float t_out) {
   precise float U = cx * by - cy * bx;
   precise float V = ax * cy - ay * cx;
   precise float W = bx * ay - by * ax;
+  precise float az = g_sz * A[g_kz];
+  precise float bz = g_sz * B[g_kz];
+  precise float cz = g_sz * C[g_kz];
   precise float sum = (U + V) + W;
-  if (!finite_f(sum)) return watertight_double(k, tmin, tmax, t_out);
+  if (!finite_f(sum)) {
+    if (finite_f(ax) && finite_f(ay) && finite_f(bx) && finite_f(by) && finite_f(cx) && finite_f(cy) && finite_f(az) &&
+        finite_f(bz) && finite_f(cz))
+      return watertight_sheared_double(ax, ay, bx, by, cx, cy, az, bz, cz, tmin, tmax, t_out);
+    return watertight_double(k, tmin, tmax, t_out);
+  }
   if (U == 0.0 || V == 0.0 || W == 0.0) {
     // Products of floats are exact in double; one rounding to double, one to float.
     precise double dU = double(cx) * double(by) - double(cy) * double(bx);
@@ -222,17 +250,19 @@ bool watertight(uint k, float tmin, float tmax, out float t_out) {
     W = float(dW);
     // Below about 1e-22 the products underflow float altogether: the whole test in double.
     if ((U == 0.0 && dU != 0.0LF) || (V == 0.0 && dV != 0.0LF) || (W == 0.0 && dW != 0.0LF))
-      return watertight_double(k, tmin, tmax, t_out);
+      return watertight_sheared_double(ax, ay, bx, by, cx, cy, az, bz, cz, tmin, tmax, t_out);
   }
   if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
   precise float det = (U + V) + W;
   if (det == 0.0) return false;
-  if (abs(det) < kWatertightLowRange) return watertight_double(k, tmin, tmax, t_out);
-  precise float az = g_sz * A[g_kz];
-  precise float bz = g_sz * B[g_kz];
-  precise float cz = g_sz * C[g_kz];
+  if (abs(det) < kWatertightLowRange)
+    return watertight_sheared_double(ax, ay, bx, by, cx, cy, az, bz, cz, tmin, tmax, t_out);
   precise float T = (U * az + V * bz) + W * cz;
-  if (!finite_f(T) || (abs(T) < kWatertightLowRange && T != 0.0)) return watertight_double(k, tmin, tmax, t_out);
+  if (!finite_f(T) || (abs(T) < kWatertightLowRange && T != 0.0)) {
+    if (finite_f(az) && finite_f(bz) && finite_f(cz))
+      return watertight_sheared_double(ax, ay, bx, by, cx, cy, az, bz, cz, tmin, tmax, t_out);
+    return watertight_double(k, tmin, tmax, t_out);
+  }
   // watertight_accept
   precise float lo_s = tmin * det;
   precise float hi_s = tmax * det;

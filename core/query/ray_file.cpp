@@ -137,6 +137,14 @@ std::vector<Ray> read_rays(const std::string& path) {
       fail(path, where + text + ": distances along it overflow float");
     }
     if (std::isnan(tmin) || std::isnan(tmax)) fail(path, where + "NaN in tmin/tmax");
+    // Behind the origin the structures disagreed (a hit at t = -1 in some, t = +1 or a miss in others):
+    // a ray covers t >= 0 from its origin; a segment behind it is a ray from a point further back.
+    if (tmin < 0.0f) {
+      char text[160];
+      std::snprintf(text, sizeof text, "tmin %g is negative (rays start at their origin: move the origin back instead)",
+                    static_cast<double>(tmin));
+      fail(path, where + text);
+    }
     if (tmin > tmax)
       fail(path, where + "tmin > tmax (" + std::to_string(tmin) + " > " + std::to_string(tmax) + ")");
     rays.emplace_back(o, d, tmin, from_file_t(tmax));

@@ -117,13 +117,12 @@ done
 help="$("$accelviz" render --help)"  # into a variable: `grep -q` on a pipe could end it early (pipefail)
 if grep -q embree <<<"$help"; then
   python3 -c "import struct,sys; open(sys.argv[1],'wb').write(b'RAYS'+struct.pack('<IQ',1,2)+struct.pack('<8f',0,0,-5,0,0,0,1,9)+struct.pack('<8f',0,0,-5,-100,0,0,1,9))" "$tmp/negtmin.rays"
-  expect 1 "$tmp/negtmin.rays: ray 1: embree cannot trace a ray whose tmin -100 is not >= 0" -- \
+  # A negative tmin is refused by the ray file for every structure (they disagreed behind the origin).
+  expect 1 "$tmp/negtmin.rays: ray 1: tmin -100 is negative (rays start at their origin" -- \
     trace 'builtin:soup?size=10' -s embree --rays "$tmp/negtmin.rays" --out "$tmp/e.hits"
-  expect 1 "$tmp/negtmin.rays: ray 1: embree" -- \
-    trace 'builtin:soup?size=10' -s embree --any --rays "$tmp/negtmin.rays" --out "$tmp/e.occl"
-  [ ! -e "$tmp/e.hits" ] && [ ! -e "$tmp/e.occl" ] || { echo "FAIL: embree wrote hits for rays it refused"; fail=1; }
-  "$accelviz" -q trace 'builtin:soup?size=10' -s bvh --rays "$tmp/negtmin.rays" --out "$tmp/b.hits" >/dev/null ||
-    { echo "FAIL: the bvh refused a ray with tmin < 0"; fail=1; }
+  expect 1 "$tmp/negtmin.rays: ray 1: tmin -100 is negative" -- \
+    trace 'builtin:soup?size=10' -s bvh --any --rays "$tmp/negtmin.rays" --out "$tmp/e.occl"
+  [ ! -e "$tmp/e.hits" ] && [ ! -e "$tmp/e.occl" ] || { echo "FAIL: hits written for rays refused"; fail=1; }
   expect 1 "embree: cannot trace a ray whose origin (2e+18, 1, 1)" -- \
     render 'builtin:soup?size=10' -s embree --size 8x6 --camera 2e18,1,1,0,0,0 --out "$tmp/e.png"
   printf 'v 0 0 0\nv 1e19 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\n' >"$tmp/far.obj"

@@ -241,6 +241,8 @@ TEST_F(RayFileTest, InvalidRays) {
       {"inf_origin", ray1 + 0, kInfinity, "ray 1: infinite origin"},
       {"nan_tmax", ray1 + 28, std::nanf(""), "ray 1: NaN in tmin/tmax"},
       {"tmin_gt_tmax", ray1 + 12, 1e31f, "ray 1: tmin > tmax"},
+      // Behind the origin the structures disagreed (t = -1, t = +1 or a miss): refused.
+      {"negative_tmin", ray1 + 12, -1.0f, "ray 1: tmin -1 is negative (rays start at their origin"},
   };
   for (const Case& c : cases) {
     std::vector<std::uint8_t> b = base;
