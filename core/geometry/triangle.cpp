@@ -8,46 +8,10 @@ namespace accelviz {
 
 namespace {
 
-// The whole watertight test in double precision, for triangles whose float
-// edge functions overflow or underflow (coordinates near 1e20 or 1e-20): the
-// float products would be inf/NaN or flush to zero there. Shared vertices are
-// still sheared by one and the same computation, so neighbouring triangles
-// stay consistent with each other.
-bool intersect_watertight_double(const Ray& ray, const WatertightRay& wr, const Triangle& tri, float tmin, float tmax,
-                                 Hit& hit) {
-  const glm::dvec3 o(ray.origin), d(ray.direction);
-  const double sx = d[wr.kx] / d[wr.kz], sy = d[wr.ky] / d[wr.kz], sz = 1.0 / d[wr.kz];
-  const glm::dvec3 A = glm::dvec3(tri.v0) - o, B = glm::dvec3(tri.v1) - o, C = glm::dvec3(tri.v2) - o;
-  const double ax = A[wr.kx] - sx * A[wr.kz], ay = A[wr.ky] - sy * A[wr.kz];
-  const double bx = B[wr.kx] - sx * B[wr.kz], by = B[wr.ky] - sy * B[wr.kz];
-  const double cx = C[wr.kx] - sx * C[wr.kz], cy = C[wr.ky] - sy * C[wr.kz];
+// Steps 6 and 7 of the watertight test (inside test, distance) on sheared coordinates in double.
+bool watertight_steps_in_double(double ax, double ay, double bx, double by, double cx, double cy, double az, double bz,
+                                double cz, float tmin, float tmax, Hit& hit) {
   const double U = cx * by - cy * bx, V = ax * cy - ay * cx, W = bx * ay - by * ax;
-  if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
-  const double det = U + V + W;
-  if (det == 0.0 || !std::isfinite(det)) return false;
-  const double T = U * (sz * A[wr.kz]) + V * (sz * B[wr.kz]) + W * (sz * C[wr.kz]);
-  const double t = T / det;
-  if (!(t >= tmin && t <= tmax)) return false;
-  hit.t = static_cast<float>(t);
-  if (!(hit.t >= tmin && hit.t <= tmax)) hit.t = t < tmin ? tmin : tmax;  // keep the float t inside the interval
-  hit.u = static_cast<float>(V / det);
-  hit.v = static_cast<float>(W / det);
-  return true;
-}
-
-// Steps 6 and 7 of the watertight test in double, on the coordinates the float test sheared: the
-// product of two floats is exact in double, so each edge function's sign is the exact one, which
-// the float test also reads wherever it reads a sign (rounding keeps a sign or gives 0), and two
-// triangles that share an edge share its sheared vertices and read opposite signs. For a candidate
-// whose float figures leave float's range (edge functions or T under 1e-30 or beyond 3e38). The
-// whole test redone from a fresh double shear (intersect_watertight_double) decided such an edge
-// on other coordinates than the neighbour's float test: a closed cube of half-size 1e-12, traced
-// with unit directions through its shared vertices and edges, let 27 of 1,116 rays through.
-bool watertight_sheared_double(float ax, float ay, float bx, float by, float cx, float cy, float az, float bz, float cz,
-                               float tmin, float tmax, Hit& hit) {
-  const double U = static_cast<double>(cx) * by - static_cast<double>(cy) * bx;
-  const double V = static_cast<double>(ax) * cy - static_cast<double>(ay) * cx;
-  const double W = static_cast<double>(bx) * ay - static_cast<double>(by) * ax;
   if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
   const double det = U + V + W;
   if (det == 0.0 || !std::isfinite(det)) return false;
@@ -59,6 +23,32 @@ bool watertight_sheared_double(float ax, float ay, float bx, float by, float cx,
   hit.u = static_cast<float>(V / det);
   hit.v = static_cast<float>(W / det);
   return true;
+}
+
+// The whole watertight test in double precision, for triangles whose sheared float coordinates
+// overflow (coordinates near 3e38). Shared vertices are still sheared by one and the same
+// computation, so neighbouring triangles stay consistent with each other.
+bool intersect_watertight_double(const Ray& ray, const WatertightRay& wr, const Triangle& tri, float tmin, float tmax,
+                                 Hit& hit) {
+  const glm::dvec3 o(ray.origin), d(ray.direction);
+  const double sx = d[wr.kx] / d[wr.kz], sy = d[wr.ky] / d[wr.kz], sz = 1.0 / d[wr.kz];
+  const glm::dvec3 A = glm::dvec3(tri.v0) - o, B = glm::dvec3(tri.v1) - o, C = glm::dvec3(tri.v2) - o;
+  return watertight_steps_in_double(A[wr.kx] - sx * A[wr.kz], A[wr.ky] - sy * A[wr.kz], B[wr.kx] - sx * B[wr.kz],
+                                    B[wr.ky] - sy * B[wr.kz], C[wr.kx] - sx * C[wr.kz], C[wr.ky] - sy * C[wr.kz],
+                                    sz * A[wr.kz], sz * B[wr.kz], sz * C[wr.kz], tmin, tmax, hit);
+}
+
+// Steps 6 and 7 in double on the coordinates the float test sheared, for a candidate whose float
+// figures leave float's range (edge functions or T under 1e-30, or beyond 3e38). The product of two
+// floats is exact in double, so each edge function's sign is the exact one, which the float test
+// also reads wherever it reads a sign (rounding keeps a sign or gives 0); two triangles that share
+// an edge share its sheared vertices and read opposite signs. Redone from a fresh double shear
+// (intersect_watertight_double), such an edge was decided on other coordinates than the
+// neighbour's float test: a closed cube of half-size 1e-12, traced with unit directions through its
+// shared vertices and edges, let 27 of 1,116 rays through.
+bool watertight_sheared_double(float ax, float ay, float bx, float by, float cx, float cy, float az, float bz, float cz,
+                               float tmin, float tmax, Hit& hit) {
+  return watertight_steps_in_double(ax, ay, bx, by, cx, cy, az, bz, cz, tmin, tmax, hit);
 }
 
 bool finite6(float a, float b, float c, float d, float e, float f) {
