@@ -351,6 +351,19 @@ std::string braced_names(const std::vector<std::string>& names) {
   return "{" + all + "}";
 }
 
+std::string name_list_problem(const std::string& text, const std::vector<std::string>& names) {
+  const std::vector<std::string> items = comma_items(text);
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (items[i].empty()) return "an empty item in '" + text + "'";
+    if (std::find(names.begin(), names.end(), items[i]) == names.end())
+      return items[i] + " not in " + braced_names(names);
+    if (std::find(items.begin(), items.begin() + static_cast<std::ptrdiff_t>(i), items[i]) !=
+        items.begin() + static_cast<std::ptrdiff_t>(i))
+      return "'" + items[i] + "' is listed twice";
+  }
+  return {};
+}
+
 void print_json_line(const nlohmann::json& j) {
   std::cout << j.dump() << std::endl;
 }

@@ -154,6 +154,9 @@ std::string absolute_path(const std::string& path);
 std::vector<std::string> comma_items(const std::string& text);
 /// "{a,b,c}", as CLI11 lists the values an option takes.
 std::string braced_names(const std::vector<std::string>& names);
+/// "" or what is wrong with a comma-separated list of `names` (a CLI11 validator's answer): an
+/// empty item, a name not among them, or one listed twice.
+std::string name_list_problem(const std::string& text, const std::vector<std::string>& names);
 
 /// One-line JSON on stdout.
 void print_json_line(const nlohmann::json& j);

@@ -236,17 +236,6 @@ std::vector<std::string> bench_structure_names() {
   return names;
 }
 
-/// "" or what is wrong with one --structure value: an empty item (a typo such as "bvh,,kdtree":
-/// CLI11's own list splitting drops it without a word) or a name bench does not have.
-std::string structure_list_problem(const std::string& text) {
-  const std::vector<std::string> names = bench_structure_names();
-  for (const std::string& item : comma_items(text)) {
-    if (item.empty()) return "an empty item in '" + text + "'";
-    if (std::find(names.begin(), names.end(), item) == names.end()) return item + " not in " + braced_names(names);
-  }
-  return {};
-}
-
 /// "ray I: why" for the first ray of `rays` that `accel` cannot take (Embree's
 /// limits, ray_refusals); empty when it takes every ray.
 std::string first_refused_ray(const Accelerator& accel, const std::vector<Ray>& rays) {
@@ -275,7 +264,7 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   // A structure named in --structure that refuses the scene or rays makes the
   // run exit 1 (after the others are measured); the default list's Embree does not.
   const bool named_by_user = !o.structures.empty();
-  std::vector<std::string> listed;  // each -s value split at its commas (structure_list_problem checked them)
+  std::vector<std::string> listed;  // each -s value split at its commas (name_list_problem checked them)
   for (const std::string& value : o.structures)
     for (std::string& item : comma_items(value)) listed.push_back(std::move(item));
   o.structures = std::move(listed);
@@ -629,7 +618,8 @@ Command add_bench_command(CLI::App& parent, const GlobalOptions& global) {
                       (kHaveEmbree ? "; embree-low, embree-medium, embree-high: Embree at that build quality "
                                      "(ratios are quoted against the plain embree row)"
                                    : ""))
-      ->check(CLI::Validator(structure_list_problem, "NAME[,NAME...]"));
+      ->check(CLI::Validator([](std::string& text) { return name_list_problem(text, bench_structure_names()); },
+                             "NAME[,NAME...]"));
   sub->add_option("--rays", o->rays, "Ray sets: primary, diffuse, shadow or all")
       ->check(CLI::IsMember({"primary", "diffuse", "shadow", "all"}))
       ->capture_default_str();

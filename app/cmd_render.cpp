@@ -291,19 +291,6 @@ RgbImage render_job(const RenderOptions& o, const GlobalOptions& global, nlohman
   return rgb;
 }
 
-/// The structures of one --structure value ("bvh,kdtree,grid"); an empty item is a usage error.
-std::vector<std::string> structure_list(const std::string& text) {
-  const std::vector<std::string> items = comma_items(text), names = structure_names();
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    if (items[i].empty()) throw UsageError("--structure: an empty item in '" + text + "'");
-    if (std::find(names.begin(), names.end(), items[i]) == names.end())
-      throw UsageError("--structure: " + items[i] + " not in " + braced_names(names));
-    for (std::size_t j = 0; j < i; ++j)
-      if (items[j] == items[i]) throw UsageError("--structure: '" + items[i] + "' is listed twice");
-  }
-  return items;
-}
-
 /// render -s A,B,...: one image per structure, DIR/NAME-A.png, ..., on one colour scale (the
 /// largest of their maxima, or --max), so that a lecture's pictures of one view compare by colour.
 int run_render_several(const RenderOptions& o, const std::vector<std::string>& structures,
@@ -391,7 +378,7 @@ int run_render(const RenderOptions& given, const GlobalOptions& global) {
   }
   if (o.structure.find(',') != std::string::npos) {
     if (o.compare) throw UsageError("--compare: one structure for A (B names its own: structure=...)");
-    return run_render_several(o, structure_list(o.structure), global);
+    return run_render_several(o, comma_items(o.structure), global);  // checked when parsed
   }
   if (const std::string problem = order_problem(compare_side(o)); !problem.empty()) throw UsageError(problem);
   if (o.compare) {
@@ -467,14 +454,8 @@ Command add_render_command(CLI::App& parent, const GlobalOptions& global) {
   sub->add_option("--structure,-s", o->structure,
                   "Acceleration structure; a comma-separated list (bvh,kdtree,grid) writes OUT-bvh.png, "
                   "OUT-kdtree.png, ... on one colour scale (a cost metric, the heatmap view)")
-      ->check(CLI::Validator(
-          [](std::string& text) {
-            if (text.find(',') != std::string::npos) return std::string();  // checked item by item later
-            const std::vector<std::string> names = structure_names();
-            if (std::find(names.begin(), names.end(), text) != names.end()) return std::string();
-            return text + " not in " + braced_names(names);
-          },
-          "NAME[,NAME...]"))
+      ->check(CLI::Validator([](std::string& text) { return name_list_problem(text, structure_names()); },
+                             "NAME[,NAME...]"))
       ->capture_default_str();
   sub->add_option("--metric,-m", o->metric,
                   "Per-pixel metric: nodes (nodes visited), prims (triangle tests), cost (ctrav*nodes + "
