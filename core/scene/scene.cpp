@@ -53,10 +53,27 @@ Aabb Scene::bounds() const {
   return b;
 }
 
+static bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+/// Whether flatten() keeps one of MESH's triangles: one without a NaN or infinite vertex.
+static bool has_finite_triangle(const Mesh& mesh) {
+  for (const glm::uvec3& t : mesh.indices)
+    if (finite3(mesh.positions[t.x]) && finite3(mesh.positions[t.y]) && finite3(mesh.positions[t.z])) return true;
+  return false;
+}
+
 bool Scene::has_instancing() const {
+  // A mesh without triangles (points, lines) instances nothing, nor one whose triangles the
+  // flattening drops. refs: -1 for such a mesh, else the instances seen so far.
   std::vector<int> refs(meshes.size(), 0);
-  for (const Instance& inst : instances)  // a mesh without triangles (points, lines) instances nothing
-    if (inst.mesh < refs.size() && !meshes[inst.mesh].indices.empty() && ++refs[inst.mesh] > 1) return true;
+  for (const Instance& inst : instances) {
+    if (inst.mesh >= refs.size() || refs[inst.mesh] < 0) continue;
+    if (refs[inst.mesh] == 0 && !has_finite_triangle(meshes[inst.mesh])) {
+      refs[inst.mesh] = -1;
+      continue;
+    }
+    if (++refs[inst.mesh] > 1) return true;
+  }
   return false;
 }
 
@@ -100,8 +117,6 @@ std::string triangle_count_text(const Scene& scene) {
   if (scene.has_instancing()) return std::to_string(scene.triangles.size()) + " (from " + unique() + ")";
   return std::to_string(scene.triangles.size());
 }
-
-static bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 void Scene::flatten() {
   triangles.clear();

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/accel/bvh/bvh.h"
@@ -355,19 +356,31 @@ TEST(Effects, ALightThatGivesNoLightCastsNoShadow) {
   EXPECT_EQ(aimed[0].position, lit.position);
 }
 
-// "No two-level structure without instancing": a mesh without triangles placed twice instances nothing.
+// "No two-level structure without instancing": a mesh without triangles placed twice instances
+// nothing, nor does one whose every triangle the flattening drops (a NaN vertex in each).
 TEST(Effects, AMeshWithoutTrianglesPlacedTwiceIsNoInstancing) {
-  Scene s = one_placed_mesh();
-  s.meshes.push_back(Mesh{});  // points or lines only: no triangle
-  for (std::uint32_t node : {1u, 2u}) {
-    Instance inst;
-    inst.mesh = 1;
-    inst.node = node;
-    s.instances.push_back(inst);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  Mesh all_nan;
+  all_nan.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {nan, 0, 0}};
+  all_nan.indices = {{0, 1, 3}, {3, 2, 1}};
+  for (const Mesh& placed : {Mesh{} /* points or lines only */, all_nan}) {
+    Scene s = one_placed_mesh();
+    s.meshes.push_back(placed);
+    for (std::uint32_t node : {1u, 2u}) {
+      Instance inst;
+      inst.mesh = 1;
+      inst.node = node;
+      s.instances.push_back(inst);
+    }
+    s.flatten();
+    EXPECT_FALSE(s.has_instancing()) << placed.indices.size() << " triangles";
+    EXPECT_FALSE(decide_effects(s).two_level.on);
+    // One finite triangle is enough for instancing.
+    s.meshes[1].indices.push_back({0, 1, 2});
+    s.meshes[1].positions.resize(std::max<std::size_t>(s.meshes[1].positions.size(), 3));
+    s.flatten();
+    EXPECT_TRUE(s.has_instancing());
   }
-  s.flatten();
-  EXPECT_FALSE(s.has_instancing());
-  EXPECT_FALSE(decide_effects(s).two_level.on);
 }
 
 // The synthetic light stands on the default camera's side: a scene camera behind the scene (-z)

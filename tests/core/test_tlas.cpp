@@ -397,6 +397,36 @@ TEST(Tlas, StatsCountBothLevels) {
   EXPECT_EQ(saw_hit, h.valid());
 }
 
+// max_depth and avg_leaf_depth are the two-level tree's as rays walk it: a BLAS root one level below
+// the TLAS leaf that holds its instance, each placed BLAS's leaves counted once per instance.
+TEST(Tlas, LeafDepthsSpanBothLevels) {
+  const Scene s = make_instanced_scene(60, 2);
+  const Tlas two(s);
+  ASSERT_GT(two.tlas_nodes().size(), 1u);
+  double sum = 0.0, leaves = 0.0;
+  std::uint32_t deepest = 0;
+  const auto walk = [&](std::span<const BvhNode> nodes, std::uint32_t i, std::uint32_t depth, const auto& at_leaf,
+                        const auto& self) -> void {
+    if (nodes[i].is_leaf()) return at_leaf(nodes[i], depth);
+    self(nodes, nodes[i].index, depth + 1, at_leaf, self);
+    self(nodes, nodes[i].index + 1, depth + 1, at_leaf, self);
+  };
+  walk(two.tlas_nodes(), 0, 0, [&](const BvhNode& leaf, std::uint32_t d) {
+    for (std::uint32_t k = leaf.index; k < leaf.index + leaf.count; ++k) {
+      const Bvh& b = two.blas(two.instances()[two.tlas_instance_order()[k]].blas);
+      walk(b.nodes(), 0, d + 1, [&](const BvhNode&, std::uint32_t e) {
+        sum += e;
+        leaves += 1.0;
+        deepest = std::max(deepest, e);
+      }, walk);
+    }
+  }, walk);
+  ASSERT_GT(leaves, 0.0);
+  EXPECT_NEAR(two.build_stats().avg_leaf_depth, sum / leaves, 1e-9 * sum / leaves);
+  EXPECT_GE(two.build_stats().max_depth, deepest) << "the deepest TLAS leaf plus the deepest BLAS: an upper bound";
+  EXPECT_GT(two.build_stats().avg_leaf_depth, 1.0);
+}
+
 TEST(Tlas, FactoryBuildsFromTheSceneOrOneInstance) {
   const Scene s = make_instanced_scene(20, 4);
   StructureOptions so;
