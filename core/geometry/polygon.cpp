@@ -38,6 +38,59 @@ void split_convex(std::uint32_t n, std::vector<std::array<std::uint32_t, 3>>& ou
   }
 }
 
+/// Flat corners one triangle of a convex face's cut takes as a fan; more keep the halving.
+constexpr std::size_t kMaxFannedFlatCorners = 8;
+
+/// A triangle (x, y, z) of the polygon's winding whose sides x→y, y→z and z→x carry the flat
+/// corners FLAT[0], FLAT[1] and FLAT[2] (each in outline order, strictly between the side's ends),
+/// as triangles without a zero-area one: the side with flat corners fanned from the opposite
+/// corner, and the fan's first and last triangles, whose other sides are the triangle's, each
+/// fanned again from the flat corner they hold over that side's flat corners. One triangle more
+/// per flat corner; every outline edge is used as it is (no crack beside a neighbouring face).
+/// Over kMaxFannedFlatCorners the fans' slivers would each span the triangle (boxes that overlap
+/// for every structure), so such a triangle and its flat corners are halved as a convex polygon
+/// (split_convex): zero-area triangles along the straight sides, each in a small box.
+void fan_sides(std::array<std::uint32_t, 3> t, std::array<std::span<const std::uint32_t>, 3> flat,
+               std::vector<std::array<std::uint32_t, 3>>& out) {
+  const std::size_t flats = flat[0].size() + flat[1].size() + flat[2].size();
+  if (flats == 0) {
+    out.push_back(t);
+    return;
+  }
+  if (flats > kMaxFannedFlatCorners) {
+    std::vector<std::uint32_t> corners;  // the triangle's outline with its flat corners
+    for (int s = 0; s < 3; ++s) {
+      corners.push_back(t[s]);
+      corners.insert(corners.end(), flat[s].begin(), flat[s].end());
+    }
+    const std::size_t first = out.size();
+    split_convex(static_cast<std::uint32_t>(corners.size()), out);
+    for (std::size_t k = first; k < out.size(); ++k)
+      for (std::uint32_t& i : out[k]) i = corners[i];
+    return;
+  }
+  while (flat[0].empty()) {  // rotate: the side x→y carries flat corners
+    std::rotate(t.begin(), t.begin() + 1, t.end());
+    std::rotate(flat.begin(), flat.begin() + 1, flat.end());
+  }
+  const auto [x, y, z] = t;
+  const std::span<const std::uint32_t> f = flat[0];
+  // The fan from z over x, f..., y; its first triangle (z, x, f0) holds side z→x, its last
+  // (z, fk, y) side y→z: each fanned again from its flat corner when that side carries any.
+  const auto over = [&](std::uint32_t apex, std::uint32_t from, std::span<const std::uint32_t> mid,
+                        std::uint32_t to) {
+    std::uint32_t prev = from;
+    for (const std::uint32_t q : mid) {
+      out.push_back({apex, prev, q});
+      prev = q;
+    }
+    out.push_back({apex, prev, to});
+  };
+  over(f.front(), z, flat[2], x);  // (z, x, f0) as (f0, z, ..., x)
+  for (std::size_t k = 0; k + 1 < f.size(); ++k) out.push_back({z, f[k], f[k + 1]});
+  over(f.back(), y, flat[1], z);  // (z, fk, y) as (fk, y, ..., z)
+}
+
 }  // namespace
 
 std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(std::span<const glm::vec3> corners) {
@@ -67,6 +120,49 @@ std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(std::span<const gl
   bool convex = true;
   for (std::size_t i = 0; i < n && convex; ++i) convex = cross2(p[i], p[(i + 1) % n], p[(i + 2) % n]) >= 0.0;
   if (convex) {
+    // Flat corners (on the straight line from one neighbour to the other, going on: a T-junction
+    // of the mesh) would make zero-area triangles in the fan or the halving; the strictly convex
+    // polygon of the other corners is cut instead, and each flat corner fanned in from the
+    // triangle on its side (fan_sides). A corner that turns back or repeats its neighbour keeps
+    // the cut below: no triangulation of it is free of a zero-area triangle.
+    std::vector<char> flat(n, 0);
+    bool any_flat = false, back = false;
+    for (std::size_t i = 0; i < n; ++i) {
+      const glm::dvec2 &a = p[(i + n - 1) % n], &b = p[i], &c = p[(i + 1) % n];
+      if (cross2(a, b, c) != 0.0) continue;
+      flat[i] = glm::dot(b - a, c - b) > 0.0;
+      any_flat = any_flat || flat[i];
+      back = back || !flat[i];
+    }
+    std::vector<std::uint32_t> strict;  // the strictly convex corners, in order
+    for (std::uint32_t i = 0; i < n; ++i)
+      if (!flat[i]) strict.push_back(i);
+    if (any_flat && !back && strict.size() >= 3) {
+      const std::size_t s = strict.size();
+      std::vector<std::array<std::uint32_t, 3>> cut;  // indices into `strict`
+      if (s == 4) {
+        std::vector<std::uint32_t> four{0, 1, 2, 3};
+        fan(four, cut);
+      } else if (s == 3) {
+        cut.push_back({0, 1, 2});
+      } else {
+        split_convex(static_cast<std::uint32_t>(s), cut);
+      }
+      // The flat corners on the side from strict[k] to strict[k + 1]: order[first[k], first[k + 1])
+      // with the outline rotated to start at strict[0].
+      std::vector<std::uint32_t> ring(n);
+      for (std::size_t i = 0; i < n; ++i) ring[i] = static_cast<std::uint32_t>((strict[0] + i) % n);
+      std::vector<std::size_t> at(s + 1);  // strict[k]'s position in ring
+      for (std::size_t k = 0; k < s; ++k) at[k] = (strict[k] + n - strict[0]) % n;
+      at[s] = n;
+      const auto side = [&](std::uint32_t from, std::uint32_t to) -> std::span<const std::uint32_t> {
+        if ((from + 1) % s != to) return {};  // a chord, not a side of the polygon
+        return std::span<const std::uint32_t>(ring).subspan(at[from] + 1, at[from + 1] - at[from] - 1);
+      };
+      for (const auto& [i, j, k] : cut)
+        fan_sides({strict[i], strict[j], strict[k]}, {side(i, j), side(j, k), side(k, i)}, out);
+      return out;
+    }
     if (n == 4)
       fan(order, out);  // a quad: the diagonal 0-2 the loaders always made
     else

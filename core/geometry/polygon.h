@@ -10,7 +10,9 @@ namespace accelviz {
 
 /// n − 2 triangles over the polygon's corners (indices into `corners`, in the
 /// polygon's winding). A convex quad (or a polygon with no usable plane) is
-/// fan-triangulated from its first corner: (0, k, k+1); a convex polygon of
+/// fan-triangulated from its first corner: (0, k, k+1) (flat corners, on the straight line
+/// between their neighbours, are fanned in from the triangles of the other corners' cut, so no
+/// triangle has zero area, up to 8 per triangle: polygon.cpp fan_sides); a convex polygon of
 /// five or more corners is cut by (0, t, 2t), t = (n+1)/3, and each arc left
 /// by (first, middle, last) and its halves the same way, so that a
 /// many-cornered face is not n − 2 slivers from one corner (fatter

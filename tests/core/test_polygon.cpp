@@ -94,6 +94,57 @@ TEST(Polygon, AConcaveCombIsCoveredExactlyOnceInItsOwnWinding) {
   EXPECT_NEAR(covered(comb, cw), shoelace(comb), 1e-6 * std::abs(shoelace(comb)));
 }
 
+// A convex face with flat corners (a T-junction's vertex on a straight side: a rectangle with a
+// point on one side is the commonest pentagon of CAD exports) gives n - 2 triangles, none of zero
+// area, tiling it exactly once in its winding, every outline edge used by one triangle as it is
+// (no crack beside the neighbouring faces' triangles); the halving made (0, 1, 2) of three
+// corners on one line. Over 8 flat corners on one triangle's sides the halving stays (a fan of
+// slivers across the face would be worse): still n - 2 triangles tiling it once.
+TEST(Polygon, FlatCornersOfAConvexFaceMakeNoZeroAreaTriangle) {
+  // A rectangle (or a triangle) with `per_side[s]` corners spread along side s.
+  const auto outline = [](std::vector<glm::vec3> strict, std::vector<int> per_side) {
+    std::vector<glm::vec3> out;
+    for (std::size_t s = 0; s < strict.size(); ++s) {
+      const glm::vec3 a = strict[s], b = strict[(s + 1) % strict.size()];
+      out.push_back(a);
+      for (int k = 1; k <= per_side[s]; ++k) out.push_back(a + (b - a) * (float(k) / float(per_side[s] + 1)));
+    }
+    return out;
+  };
+  const std::vector<glm::vec3> rect = {{0, 0, 0}, {8, 0, 0}, {8, 4, 0}, {0, 4, 0}};
+  const std::vector<glm::vec3> tri = {{0, 0, 0}, {8, 0, 0}, {0, 8, 0}};
+  const std::vector<std::pair<std::vector<glm::vec3>, std::vector<int>>> cases = {
+      {rect, {1, 0, 0, 0}}, {rect, {0, 0, 0, 1}}, {rect, {1, 1, 0, 0}}, {rect, {3, 0, 5, 0}},
+      {rect, {2, 1, 3, 2}}, {rect, {100, 60, 100, 60}}, {tri, {1, 0, 0}}, {tri, {1, 1, 1}},
+      {tri, {3, 2, 3}}, {tri, {0, 0, 4}}, {tri, {30, 0, 0}}};
+  for (const auto& [strict, per_side] : cases) {
+    for (int start = 0; start < 3; ++start) {  // the outline starting at a strict or a flat corner
+      std::vector<glm::vec3> p = outline(strict, per_side);
+      std::rotate(p.begin(), p.begin() + start, p.end());
+      const std::size_t n = p.size();
+      const auto tris = triangulate_polygon(p);
+      ASSERT_EQ(tris.size(), n - 2) << n << " corners, start " << start;
+      EXPECT_NEAR(covered(p, tris), shoelace(p), 1e-6 * shoelace(p));  // `covered` sums float cross products
+      std::vector<int> used(n, 0);  // outline edge i -> i + 1, by the triangles' edges
+      const bool fanned = n - strict.size() <= 8;
+      for (const auto& t : tris) {
+        const float area = glm::cross(p[t[1]] - p[t[0]], p[t[2]] - p[t[0]]).z;
+        if (fanned)
+          EXPECT_GT(area, 0.0f) << n << " corners, start " << start << ": (" << t[0] << ", " << t[1] << ", " << t[2]
+                                << ")";
+        else
+          EXPECT_GE(area, 0.0f);
+        for (int e = 0; e < 3; ++e)
+          if ((t[e] + 1) % n == t[(e + 1) % 3]) ++used[t[e]];
+      }
+      EXPECT_EQ(std::count(used.begin(), used.end(), 1), static_cast<std::ptrdiff_t>(n)) << n << " corners";
+    }
+  }
+  // A corner that turns back keeps the cut: n - 2 triangles all the same.
+  const std::vector<glm::vec3> spike = {{0, 0, 0}, {4, 0, 0}, {2, 0, 0}, {2, 2, 0}, {0, 2, 0}};
+  EXPECT_EQ(triangulate_polygon(spike).size(), 3u);
+}
+
 TEST(Polygon, DegenerateOutlinesStillGiveNMinusTwoTriangles) {
   const std::vector<glm::vec3> line = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}};  // no plane: fanned
   EXPECT_EQ(triangulate_polygon(line).size(), 2u);
