@@ -15,6 +15,7 @@
 #include "core/accel/tlas/tlas.h"
 #include "core/query/camera.h"
 #include "core/util/one_line.h"
+#include "tests/support/refusing_accelerator.h"
 #include "ui/app/app_state.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
@@ -278,6 +279,24 @@ namespace {
 // instances a mesh more than once opens as the two-level structure (the
 // effects list says "two-level on" for it); a scene without instancing then
 // goes back to the structure the app left; a structure the user picks is kept.
+using accelviz::testing::RefusingAccelerator;
+
+// The heatmap, a click's pick and a ray inspection over a structure that refuses the view's rays:
+// the exceptions ended the program (the heatmap's on its worker thread); now the status line says
+// why, the window settles (a script's `wait` returns), and nothing is inspected.
+TEST(AppBuildWorker, AStructureThatRefusesTheRaysIsSaidNotFatal) {
+  AppState app(AppSettings{}, fake_loader(),
+               [](std::span<const Triangle>, const StructureChoice&, const ProgressCallback&) {
+                 return std::unique_ptr<Accelerator>(std::make_unique<RefusingAccelerator>());
+               });
+  app.open_scene("builtin:anything");
+  ASSERT_TRUE(pump(app, [&] { return app.settled() && app.current(); }));
+  EXPECT_EQ(app.error(), "heatmap not traced: refusing: cannot trace this ray");
+  EXPECT_FALSE(app.pick(10, 10).has_value());
+  EXPECT_EQ(app.cast_ray(10, 10), "pixel 10,10 not inspected: refusing: cannot trace this ray");
+  EXPECT_FALSE(app.inspection().has_value());
+}
+
 TEST(AppBuildWorker, AnOpenedScenesInstancingChoosesTheLevel) {
   AppSettings settings;
   settings.config.structure.name = "kdtree";

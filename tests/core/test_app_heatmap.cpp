@@ -11,6 +11,7 @@
 #include "core/accel/factory.h"
 #include "core/query/camera.h"
 #include "core/scene/load.h"
+#include "tests/support/refusing_accelerator.h"
 #include "ui/app/heatmap_worker.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
@@ -252,5 +253,34 @@ TEST(AppHeatmap, WorkerEndsOnTheNewestRequest) {
   EXPECT_TRUE(f->complete);
   EXPECT_EQ(f->image.width, 52);
   EXPECT_EQ(worker.latest_request(), last);
+}
+
+using accelviz::testing::RefusingAccelerator;
+
+// A query that throws on the worker thread ended the program (std::terminate): the worker keeps the
+// failure and its message for the status line, publishes no frame for that job, and goes on to
+// trace the next request.
+TEST(AppHeatmap, AWorkerWhoseStructureThrowsSaysWhyAndGoesOn) {
+  const auto good = teapot_bvh();
+  auto refusing = std::make_shared<BuiltStructure>(*good);
+  refusing->accel = std::make_shared<RefusingAccelerator>();
+  HeatmapWorker worker;
+  const std::uint64_t failed = worker.request(request_for(refusing, 32, 24, HeatMetric::nodes));
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  while (worker.failure().first != failed && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(1ms);
+  EXPECT_EQ(worker.failure().first, failed);
+  EXPECT_EQ(worker.failure().second, "refusing: cannot trace this ray");
+  EXPECT_FALSE(worker.latest() && worker.latest()->complete);
+  const std::uint64_t next = worker.request(request_for(good, 32, 24, HeatMetric::nodes));
+  std::shared_ptr<const HeatmapFrame> f;
+  while (std::chrono::steady_clock::now() < deadline) {
+    f = worker.latest();
+    if (f && f->id == next && f->complete && !worker.busy()) break;
+    std::this_thread::sleep_for(1ms);
+  }
+  ASSERT_TRUE(f);
+  EXPECT_EQ(f->id, next);
+  EXPECT_EQ(worker.failure().first, failed) << "the failure stays the last one's until another job fails";
 }
 }  // namespace unity_test_app_heatmap

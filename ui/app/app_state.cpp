@@ -245,6 +245,11 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
     shown_on_gpu_ = false;
     u.heatmap_changed = true;
   }
+  if (const auto [failed, why] = heatmaps_.failure();
+      failed != 0 && failed != heatmap_failure_shown_ && failed == heatmaps_.latest_request()) {
+    heatmap_failure_shown_ = failed;
+    set_error("heatmap not traced: " + why);
+  }
   last_gpu_step_ms_ = step_ms;
   return u;
 }
@@ -275,6 +280,7 @@ bool AppState::settled() const {
   if (!current_ || view_w_ <= 0 || view_h_ <= 0) return true;
   if (!heatmap_requested_ || !(*heatmap_requested_ == heatmap_key(view_w_, view_h_))) return false;
   if (heatmap_on_gpu_) return gpu_frame_shown_;
+  if (heatmaps_.failure().first == heatmaps_.latest_request() && !heatmaps_.busy()) return true;  // failed: said
   return heatmap_ && heatmap_->id == heatmaps_.latest_request() && heatmap_->complete;
 }
 
@@ -329,6 +335,7 @@ void AppState::set_camera_spec(const std::string& spec) {
 std::optional<glm::vec3> AppState::pick(int x, int y) const {
   if (!current_ || x < 0 || y < 0 || x >= view_w_ || y >= view_h_) return std::nullopt;
   const Ray ray = primary_ray(camera(), x, y, view_w_, view_h_);
+  if (!current_->accel->ray_problem(ray).empty()) return std::nullopt;  // Embree's reach: its query would throw
   const Hit hit = current_->accel->closest_hit(ray, config().structure.query);
   if (!hit.valid()) return std::nullopt;
   return ray.at(hit.t);
@@ -339,7 +346,12 @@ std::string AppState::cast_ray(int x, int y) {
   if (x < 0 || y < 0 || x >= view_w_ || y >= view_h_)
     return "pixel " + std::to_string(x) + "," + std::to_string(y) + " is outside the " + std::to_string(view_w_) + "x" +
            std::to_string(view_h_) + " view";
-  inspection_ = inspect_pixel(*current_, camera(), x, y, view_w_, view_h_, config().structure.query);
+  try {
+    inspection_ = inspect_pixel(*current_, camera(), x, y, view_w_, view_h_, config().structure.query);
+  } catch (const std::exception& e) {  // a structure that refuses the ray (Embree's reach)
+    clear_inspection();
+    return "pixel " + std::to_string(x) + "," + std::to_string(y) + " not inspected: " + e.what();
+  }
   inspected_query_ = config().structure.query;
   ++inspection_version_;
   inspection_recast_ = false;
@@ -349,7 +361,13 @@ std::string AppState::cast_ray(int x, int y) {
 
 void AppState::recast() {
   if (!inspection_ || !current_) return;
-  inspection_ = inspect_ray(*current_, *inspection_, config().structure.query);
+  try {
+    inspection_ = inspect_ray(*current_, *inspection_, config().structure.query);
+  } catch (const std::exception& e) {  // the new structure refuses the inspected ray (Embree's reach)
+    clear_inspection();
+    set_error(std::string("inspected ray dropped: ") + e.what());
+    return;
+  }
   inspected_query_ = config().structure.query;
   ++inspection_version_;
   inspection_recast_ = true;

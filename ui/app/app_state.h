@@ -191,6 +191,7 @@ class AppState {
   std::shared_ptr<const BuiltStructure> rest_;  ///< the last build (current_ unless a frame is shown)
   std::shared_ptr<const HeatmapFrame> heatmap_;
   std::optional<HeatmapKey> heatmap_requested_;
+  std::uint64_t heatmap_failure_shown_ = 0;  ///< the failed heatmap job whose error is on the status line
   GpuHeatmapJob* gpu_job_ = nullptr;
   std::string gpu_note_;
   // The current view is traced by gpu_job_; its frame is complete and shown;

@@ -244,7 +244,12 @@ HeatmapWorker::HeatmapWorker()
         job_rays_.store(static_cast<std::uint64_t>(std::max(0, r.options.width)) *
                             static_cast<std::uint64_t>(std::max(0, r.options.height)),
                         std::memory_order_relaxed);
-        trace_progressive(r, id, keep_going, publish, &pool_, &traced_);
+        try {
+          trace_progressive(r, id, keep_going, publish, &pool_, &traced_);
+        } catch (const std::exception& e) {  // on this thread it would end the program
+          std::lock_guard lock(failure_mutex_);
+          failure_ = {id, e.what()};
+        }
       }) {}
 
 }  // namespace accelviz

@@ -12,7 +12,9 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <span>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -160,6 +162,12 @@ class HeatmapWorker {
   /// A job is queued or running.
   bool busy() const { return worker_.busy(); }
   std::uint64_t latest_request() const { return worker_.latest_request(); }
+  /// The last job that failed (0: none yet) and why: a structure's query threw (Embree refuses
+  /// rays beyond its reach), so that job publishes no further level.
+  std::pair<std::uint64_t, std::string> failure() const {
+    std::lock_guard lock(failure_mutex_);
+    return failure_;
+  }
   /// The running job's share of its rays traced, 0 to 1 (a long trace said only "refining").
   double progress() const {
     const std::uint64_t total = job_rays_.load(std::memory_order_relaxed);
@@ -169,6 +177,8 @@ class HeatmapWorker {
  private:
   HeatmapFramePool pool_;  ///< the worker thread's only
   std::atomic<std::uint64_t> traced_{0}, job_rays_{0};  ///< the running job's rays traced, and all of them
+  mutable std::mutex failure_mutex_;
+  std::pair<std::uint64_t, std::string> failure_{0, ""};
   /// A superseded job's levels are never shown (the default store rule).
   LatestJobWorker<HeatmapRequest, std::shared_ptr<const HeatmapFrame>> worker_;
 };
