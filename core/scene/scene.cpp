@@ -79,7 +79,8 @@ bool Scene::has_instancing() const {
 
 std::uint64_t Scene::instanced_triangle_count() const {
   std::uint64_t total = 0;
-  for (const Instance& inst : instances) total += meshes[inst.mesh].indices.size();
+  for (const Instance& inst : instances)
+    if (inst.mesh < meshes.size()) total += meshes[inst.mesh].indices.size();
   return total;
 }
 

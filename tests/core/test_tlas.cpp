@@ -470,6 +470,58 @@ TEST(Tlas, SingularTransformIsRefused) {
   }
 }
 
+// A tiny mirrored instance (scale -1e-16, 1e-16, 1e-16) flips its normals as a large one does: its
+// float determinant (-1e-48) flushed to -0, so it counted as not mirrored and the two-level hit's
+// normal pointed the other way from the flattened triangle's.
+TEST(Tlas, ATinyMirroredInstanceIsMirrored) {
+  Scene s;
+  Mesh m;
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  m.indices = {{0, 1, 2}};
+  s.meshes.push_back(m);
+  Instance inst;
+  inst.mesh = 0;
+  inst.transform = glm::scale(glm::mat4(1.0f), glm::vec3(-1e-16f, 1e-16f, 1e-16f));
+  s.instances.push_back(inst);
+  s.flatten();
+  ASSERT_EQ(s.triangles.size(), 1u);
+  const Tlas two(s);
+  ASSERT_EQ(two.instances().size(), 1u);
+  EXPECT_TRUE(two.instances()[0].mirrored);
+  const Bvh flat(s.triangles);
+  const Ray r({-0.25e-16f, 0.25e-16f, 1.0f}, {0, 0, -1}, 0.0f, kInfinity);
+  const Hit a = two.closest_hit(r, QueryOptions{}), b = flat.closest_hit(r, QueryOptions{});
+  ASSERT_TRUE(a.valid());
+  ASSERT_TRUE(b.valid());
+  EXPECT_GT(glm::dot(a.ng, b.ng), 0.99f) << "two-level (" << a.ng.x << ", " << a.ng.y << ", " << a.ng.z
+                                         << ") against flattened (" << b.ng.x << ", " << b.ng.y << ", " << b.ng.z
+                                         << ")";
+}
+
+// A hit names its world triangle with 32 bits: a scene of 2^32 or more instanced triangles is refused
+// in one line before any BLAS is built (the ids wrapped, and a hit could read as a miss).
+TEST(Tlas, MoreInstancedTrianglesThanHitIdsIsRefused) {
+  Scene s;
+  Mesh m;
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  m.indices.assign(std::size_t{1} << 20, glm::uvec3(0, 1, 2));
+  s.meshes.push_back(std::move(m));
+  for (int i = 0; i < 4096; ++i) {  // 2^32 instanced triangles
+    Instance inst;
+    inst.mesh = 0;
+    inst.transform = glm::translate(glm::mat4(1.0f), glm::vec3(2.0f * i, 0, 0));
+    s.instances.push_back(inst);
+  }
+  try {
+    Tlas t(s);
+    ADD_FAILURE() << "built";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "tlas: 4294967296 instanced triangles, more than the 4294967294 world triangle ids a hit can name "
+              "(32-bit)");
+  }
+}
+
 // A scale of 0 on every axis (glTF's way to hide a node, often animated) is
 // no singular transform to refuse: the instance has no surface and is left out
 // of the top level; `animate` stopped at the frame a scale reached 0. The

@@ -215,6 +215,28 @@ TEST(FlattenWhatIf, BadSelectionsAreRefused) {
       EXPECT_NE(std::string(e.what()).find("flatten:"), std::string::npos) << e.what();
     }
   }
+  // More triangles than one flattened mesh may hold (its vertex indices are 32-bit; the merge wrapped
+  // them past 1.43e9 triangles): refused in one line before anything is copied.
+  Scene big;
+  Mesh m;
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  m.indices.assign(std::size_t{1} << 20, glm::uvec3(0, 1, 2));
+  big.meshes.push_back(std::move(m));
+  std::vector<std::uint32_t> all;
+  for (std::uint32_t i = 0; i < 257; ++i) {
+    Instance inst;
+    inst.mesh = 0;
+    big.instances.push_back(inst);
+    all.push_back(i);
+  }
+  try {
+    flatten_instances(big, all);
+    ADD_FAILURE() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "flatten: the selected instances hold 269484032 triangles, more than the 268435456 (2^28) one "
+              "flattened mesh may hold");
+  }
 }
 
 }  // namespace unity_test_tlas_overlap

@@ -70,7 +70,7 @@ class KdBuilder {
     const double area = box.half_area();
 
     Split split;
-    if (static_cast<int>(n) > opts_.max_leaf_size && depth < max_depth_ && area > 0.0) split = find_split(cb, box, area);
+    if (n > static_cast<std::size_t>(opts_.max_leaf_size) && depth < max_depth_ && area > 0.0) split = find_split(cb, box, area);
     if (split.axis < 0 || split.cost >= static_cast<double>(opts_.cost_intersect) * static_cast<double>(n)) {
       make_leaf(index, prims, box, depth, weight);
       return;
@@ -132,6 +132,8 @@ class KdBuilder {
   void make_leaf(std::uint32_t index, const std::vector<std::uint32_t>& prims, const Aabb& box, int depth,
                  double weight) {
     if (prims.size() >= (1u << 30)) throw std::length_error("kdtree: leaf with more than 2^30 primitives");
+    // Leaves address their references with 32 bits; split triangles are referenced on both sides.
+    if (refs_.size() + prims.size() > 0xFFFFFFFFull) throw std::length_error("kdtree: more than 2^32-1 references");
     nodes_[index] = KdNode::leaf(static_cast<std::uint32_t>(refs_.size()), static_cast<std::uint32_t>(prims.size()));
     refs_.insert(refs_.end(), prims.begin(), prims.end());
     tally_.leaf(prims.size(), depth,

@@ -21,6 +21,17 @@ FlattenedScene flatten_instances(const Scene& scene, std::span<const std::uint32
     if (merged[id]) throw std::invalid_argument("flatten: instance " + std::to_string(id) + " listed twice");
     merged[id] = 1;
   }
+  // One mesh of merged world triangles, three 32-bit-indexed vertices each: refused beyond the
+  // glTF loader's limit on world triangles (2^28, about 9.6 GB of them) rather than run out of
+  // memory or wrap the indices.
+  std::uint64_t to_merge = 0;
+  for (std::size_t i = 0; i < scene.instances.size(); ++i)
+    if (merged[i] && scene.instances[i].mesh < scene.meshes.size())
+      to_merge += scene.meshes[scene.instances[i].mesh].indices.size();
+  if (constexpr std::uint64_t kMaxMerged = std::uint64_t{1} << 28; to_merge > kMaxMerged)
+    throw std::invalid_argument("flatten: the selected instances hold " + std::to_string(to_merge) +
+                                " triangles, more than the " + std::to_string(kMaxMerged) +
+                                " (2^28) one flattened mesh may hold");
   FlattenedScene result;
   result.scene = scene;
   Scene& out = result.scene;

@@ -105,6 +105,12 @@ Tlas::Tlas(const Scene& scene, const TlasOptions& opts, const ProgressCallback& 
   const auto t0 = Clock::now();
   validate(opts_.blas);
   validate(opts_.tlas);
+  // A hit names its world triangle with 32 bits (kInvalidId: a miss); beyond that the ids wrapped
+  // and a hit could read as a miss. Checked before any BLAS is built.
+  if (const std::uint64_t n = scene.instanced_triangle_count(); n >= kInvalidId)
+    throw std::invalid_argument("tlas: " + std::to_string(n) +
+                                " instanced triangles, more than the 4294967294 world triangle ids a hit can name "
+                                "(32-bit)");
   build_blas_list(scene, progress);
   // Instances, with the world primitive ids flattening gives (or would give).
   std::vector<std::uint64_t> kept(blas_.size());
@@ -209,12 +215,12 @@ void Tlas::set_instance_transform(TlasInstance& inst, const glm::mat4& to_world)
     inst.world_bounds = Aabb{};
     return;
   }
-  const float det = glm::determinant(glm::mat3(to_world));
-  // The inverse in double: nearly singular transforms (a 1e-4 squash) keep
-  // their digits.
+  // The inverse and the determinant's sign in double: nearly singular transforms (a 1e-4 squash)
+  // keep their digits, and a tiny mirrored one (scale -1e-16, 1e-16, 1e-16: a float determinant of
+  // -1e-48 flushes to -0) still flips its normals.
   const glm::dmat4 inv = glm::inverse(glm::dmat4(to_world));
   inst.to_object = glm::mat4(inv);
-  inst.mirrored = det < 0.0f;
+  inst.mirrored = glm::determinant(glm::dmat3(glm::mat3(to_world))) < 0.0;
   inst.normal_to_world = glm::mat3(glm::transpose(glm::dmat3(inv))) * (inst.mirrored ? -1.0f : 1.0f);
   update_world_bounds(inst);
 }
