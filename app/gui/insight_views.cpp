@@ -232,10 +232,13 @@ void InsightViews::drop_stale_selection(AppState& app) {
 std::uint64_t InsightViews::tree_swatch_max(const AppState& app, std::optional<std::uint64_t> box_ramp_max) {
   if (box_ramp_max) return *box_ramp_max;
   const auto shown = shown_insight(app);
-  std::uint64_t max = 0;
-  if (shown)
-    for (const std::uint64_t v : shown->visits) max = std::max(max, v);
-  return max;
+  if (!shown) return 0;
+  if (shown != swatch_of_) {
+    swatch_of_ = shown;
+    swatch_max_ = 0;
+    for (const std::uint64_t v : shown->visits) swatch_max_ = std::max(swatch_max_, v);
+  }
+  return swatch_max_;
 }
 
 void InsightViews::request_ab_compare(const AppState& app) {
@@ -307,9 +310,10 @@ void InsightViews::draw(AppState& app, const panels::PanelLayout& layout, std::o
   }
   if (shown) draw_labels(app, *shown, layout);
 
-  // Explainer.
+  // Explainer: the explanation bins the selected node's triangles (all of them at the root), so
+  // only while its window is expanded (a collapsed one cost every build that work on this thread).
   std::string note;
-  const SplitExplanation* e = explanation(app, note);
+  const SplitExplanation* e = explainer_.open ? explanation(app, note) : nullptr;
   panels::explainer_panel(explainer_, e, explained_node_, note, layout);
 
   // Tree.

@@ -107,6 +107,9 @@ class InsightViews {
   AsyncJob<nlohmann::json> ab_dump_job_;
   bool script_ab_requested_ = false;
   panels::ExplainerState explainer_;
+  /// The largest visit count of this insight (tree_swatch_max: once per insight, not per frame).
+  std::shared_ptr<const ViewInsight> swatch_of_;
+  std::uint64_t swatch_max_ = 0;
   panels::ScenarioPanelState scenario_;
   ScenarioJob scenario_job_;
   bool script_insight_requested_ = false;

@@ -143,6 +143,36 @@ TEST(AppStructureNodes, GridCellsAreTheGridsOwn) {
   EXPECT_EQ(matched({BoxMode::depth, 3, 3, 0}), 0u);
 }
 
+// prims_below (the node labels' and the View panel's "primitives below", computed once per build; the
+// labels walked the whole tree per frame) equals the leaves' sum over each node's subtree, the voxel
+// octree's too, whose root is its last node.
+TEST(AppStructureNodes, PrimitivesBelowSumTheSubtreesLeaves) {
+  for (const char* name : {"bvh", "kdtree", "octree", "voxels"}) {
+    SCOPED_TRACE(name);
+    const auto accel = build_accelerator(name, teapot().triangles, StructureOptions{});
+    const StructureNodes t = StructureNodes::of(*accel);
+    ASSERT_GT(t.size(), 1u);
+    const auto below = [&](std::uint32_t id, const auto& self) -> std::uint64_t {
+      const StructureNode& n = *t.node(id);
+      if (n.leaf) return n.prims;
+      std::uint64_t sum = 0;
+      for (const std::uint32_t c : t.children(id)) sum += self(c, self);
+      return sum;
+    };
+    std::size_t roots = 0;
+    for (std::uint32_t id = 0; id < t.size(); ++id) {
+      EXPECT_EQ(t.node(id)->prims_below, below(id, below)) << id;
+      if (t.node(id)->parent == 0xFFFFFFFFu && !t.node(id)->leaf) {
+        ++roots;
+        if (std::string(name) != "voxels") {  // voxels reference no triangles
+          EXPECT_GE(t.node(id)->prims_below, teapot().triangles.size()) << "the root holds every triangle";
+        }
+      }
+    }
+    EXPECT_GE(roots, 1u);
+  }
+}
+
 // The View panel's line for a node id: what the id names in the structure
 // shown (inner node, leaf, grid cell), and an id past the end said as such.
 TEST(AppStructureNodes, DescribeSaysWhatAnIdNamesHere) {

@@ -33,28 +33,6 @@ std::vector<glm::vec4> visit_colors(std::span<const NodeBox> boxes, std::span<co
   return out;
 }
 
-namespace {
-
-// Primitives under a node: its own for a leaf, else the sum over its subtree.
-std::uint64_t prims_under(const StructureNodes& nodes, std::uint32_t id) {
-  std::uint64_t sum = 0;
-  std::vector<std::uint32_t> stack{id};
-  while (!stack.empty()) {
-    const std::uint32_t n = stack.back();
-    stack.pop_back();
-    const StructureNode* s = nodes.node(n);
-    if (!s) continue;
-    if (s->leaf) {
-      sum += s->prims;
-      continue;
-    }
-    for (const std::uint32_t c : nodes.children(n)) stack.push_back(c);
-  }
-  return sum;
-}
-
-}  // namespace
-
 std::vector<NodeLabel> node_labels(const StructureNodes& nodes, std::span<const std::uint64_t> visits,
                                    std::span<const HotNode> hot, std::size_t top_n,
                                    std::optional<std::uint32_t> selected) {
@@ -69,7 +47,7 @@ std::vector<NodeLabel> node_labels(const StructureNodes& nodes, std::span<const 
     l.anchor = glm::vec3(c.x, n->bounds.hi.y, c.z);
     char text[96];
     std::snprintf(text, sizeof text, "#%u d%u p%llu v%llu", id, n->depth,
-                  static_cast<unsigned long long>(n->leaf ? n->prims : prims_under(nodes, id)),
+                  static_cast<unsigned long long>(n->prims_below),
                   static_cast<unsigned long long>(id < visits.size() ? visits[id] : 0));
     l.text = text;
     out.push_back(std::move(l));

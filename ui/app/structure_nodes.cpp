@@ -223,6 +223,20 @@ void StructureNodes::finish(float c_trav, float c_isect) {
   for (std::uint32_t i = 0; i < nodes_.size(); ++i)
     if (nodes_[i].parent < nodes_.size()) children_[fill[nodes_[i].parent]++] = i;
 
+  // Primitives below each node: children before their parents, in the reverse of a breadth-first
+  // order from the roots (a child's id is not always above its parent's: the voxel octree's root
+  // comes last).
+  std::vector<std::uint32_t> order;
+  order.reserve(nodes_.size());
+  for (std::uint32_t i = 0; i < nodes_.size(); ++i) {
+    nodes_[i].prims_below = nodes_[i].leaf ? nodes_[i].prims : 0;
+    if (nodes_[i].parent >= nodes_.size()) order.push_back(i);
+  }
+  for (std::size_t k = 0; k < order.size(); ++k)
+    for (std::uint32_t c = child_start_[order[k]]; c < child_start_[order[k] + 1]; ++c) order.push_back(children_[c]);
+  for (std::size_t k = order.size(); k-- > 0;)
+    if (const std::uint32_t p = nodes_[order[k]].parent; p < nodes_.size()) nodes_[p].prims_below += nodes_[order[k]].prims_below;
+
   max_depth_ = 0;
   double total = 0.0;
   const float root_area = nodes_.empty() ? 0.0f : nodes_.front().bounds.surface_area();
@@ -278,23 +292,14 @@ std::string StructureNodes::describe(std::uint32_t id) const {
   const StructureNode& node = nodes_[id];
   if (node.leaf)
     return name + ": a leaf at depth " + std::to_string(node.depth) + ", " + count_of(node.prims, "primitive");
-  // Primitives referenced by the leaves below (a primitive in two leaves counts twice).
-  std::uint64_t below = 0;
-  std::vector<std::uint32_t> stack{id};
-  while (!stack.empty()) {
-    const std::uint32_t i = stack.back();
-    stack.pop_back();
-    if (nodes_[i].leaf) below += nodes_[i].prims;
-    for (std::uint32_t c : children(i)) stack.push_back(c);
-  }
   const std::size_t kids = children(id).size();
   return name + ": depth " + std::to_string(node.depth) + ", " + std::to_string(kids) +
-         (kids == 1 ? " child, " : " children, ") + count_of(below, "primitive") + " below";
+         (kids == 1 ? " child, " : " children, ") + count_of(node.prims_below, "primitive") + " below";
 }
 
-std::vector<std::uint32_t> StructureNodes::children(std::uint32_t id) const {
+std::span<const std::uint32_t> StructureNodes::children(std::uint32_t id) const {
   if (id >= nodes_.size() || child_start_.empty()) return {};
-  return {children_.begin() + child_start_[id], children_.begin() + child_start_[id + 1]};
+  return std::span<const std::uint32_t>(children_).subspan(child_start_[id], child_start_[id + 1] - child_start_[id]);
 }
 
 template <class F>

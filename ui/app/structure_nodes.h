@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,8 @@ struct StructureNode {
   std::uint32_t depth = 0;
   std::uint32_t parent = 0xFFFFFFFFu;  ///< none for the root
   std::uint32_t prims = 0;             ///< leaves: primitives referenced
+  /// Primitives referenced by the leaves below (a leaf: its prims; one in two leaves counts twice).
+  std::uint64_t prims_below = 0;
   bool leaf = false;
   float sah_share = 0.0f;                ///< this node's part of the SAH cost, all nodes summing to 1
   std::uint32_t instance = 0xFFFFFFFFu;  ///< two-level: the instance whose world box this leaf is (none otherwise)
@@ -76,7 +79,7 @@ class StructureNodes {
   Selection select(const NodeSelection& sel, std::size_t limit) const;
 
   /// The children of a tree node, in id order.
-  std::vector<std::uint32_t> children(std::uint32_t id) const;
+  std::span<const std::uint32_t> children(std::uint32_t id) const;
 
   /// What id names in this table, one line for the View panel's subtree
   /// mode: "node 57: depth 4, 2 children, 1234 primitives below", "node 9:

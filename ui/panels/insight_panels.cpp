@@ -287,7 +287,8 @@ InsightAction insight_panel(InsightPanelState& st, const ViewInsight* v, const R
 bool explainer_panel(ExplainerState& st, const SplitExplanation* e, std::uint32_t node, const std::string& note,
                      const PanelLayout& layout) {
   bool changed = false;
-  if (!begin_stacked_panel("SAH explainer", layout, 2, 520.0f, 460.0f)) return false;
+  st.open = begin_stacked_panel("SAH explainer", layout, 2, 520.0f, 460.0f);
+  if (!st.open) return false;
   changed = ImGui::SliderInt("buckets B", &st.buckets, 2, 64, "%d", ImGuiSliderFlags_AlwaysClamp);
   ImGui::Combo("axis", &st.axis, "x\0y\0z\0");
   ImGui::SameLine();

@@ -51,8 +51,9 @@ InsightAction insight_panel(InsightPanelState& state, const ViewInsight* insight
 
 // ---- Binned-SAH explainer -------------------------------------------------------------------
 struct ExplainerState {
-  int buckets = 32;  ///< the build's default (BvhOptions::buckets)
-  int axis = -1;     ///< -1: the chosen axis
+  int buckets = 32;   ///< the build's default (BvhOptions::buckets)
+  int axis = -1;      ///< -1: the chosen axis
+  bool open = false;  ///< the window was expanded last frame (the explanation is computed only then)
 };
 /// Returns true when the bucket count changed (re-explain).
 bool explainer_panel(ExplainerState& state, const SplitExplanation* e, std::uint32_t node, const std::string& note,

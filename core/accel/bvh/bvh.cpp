@@ -194,10 +194,17 @@ void Bvh::refit(std::span<const Triangle> moved) {
 }
 
 std::vector<Triangle> Bvh::copy_leaf_triangles() const {
-  std::vector<Triangle> out(prim_indices_.size());
+  return copy_leaf_triangles(0, static_cast<std::uint32_t>(prim_indices_.size()));
+}
+
+std::vector<Triangle> Bvh::copy_leaf_triangles(std::uint32_t first, std::uint32_t last) const {
+  last = std::min(last, static_cast<std::uint32_t>(prim_indices_.size()));
+  if (first >= last) return {};
+  std::vector<Triangle> out(last - first);
   for (const bvh_detail::TriBlock4& b : blocks_)
     for (std::uint32_t l = 0; l < 4; ++l)
-      if (b.pos[l] != bvh_detail::kTri4Empty) out[b.pos[l]] = bvh_detail::tri4_triangle(b, l);
+      if (b.pos[l] != bvh_detail::kTri4Empty && b.pos[l] >= first && b.pos[l] < last)
+        out[b.pos[l] - first] = bvh_detail::tri4_triangle(b, l);
   return out;
 }
 

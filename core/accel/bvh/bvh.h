@@ -124,6 +124,8 @@ class Bvh final : public Accelerator {
   /// A copy of the triangles in leaf order: [k] is scene triangle
   /// prim_indices()[k] (O(triangles); the tree keeps them only as blocks).
   std::vector<Triangle> copy_leaf_triangles() const;
+  /// Leaf-order positions [first, last) of copy_leaf_triangles() only (a subtree's triangles).
+  std::vector<Triangle> copy_leaf_triangles(std::uint32_t first, std::uint32_t last) const;
   const BvhOptions& options() const { return opts_; }
 
   /// After the vertices moved (same triangle count, same order as at build):

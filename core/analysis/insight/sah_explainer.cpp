@@ -124,8 +124,8 @@ SplitExplanation explain_bvh_node(const Bvh& bvh, std::uint32_t node, const BvhO
       stack.push_back(n.index + 1);
     }
   }
-  const std::vector<Triangle> leaf_tris = bvh.copy_leaf_triangles();
-  const auto tris = std::span<const Triangle>(leaf_tris).subspan(first, last - first);
+  const std::vector<Triangle> leaf_tris = bvh.copy_leaf_triangles(first, last);
+  const std::span<const Triangle> tris(leaf_tris);
   std::vector<Aabb> bounds(tris.size());
   std::vector<glm::vec3> centroids(tris.size());
   for (std::size_t i = 0; i < tris.size(); ++i) {
