@@ -18,6 +18,7 @@
 #include "core/analysis/heatmap.h"
 #include "core/query/camera.h"
 #include "core/scene/load.h"
+#include "core/util/output_file.h"
 #ifdef ACCELVIZ_HAVE_UI
 #include "ui/gl/headless.h"
 #include "ui/render/gpu_trace.h"
@@ -429,13 +430,12 @@ std::string write_unique_demo_png(const RgbImage& rgb) {
   std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &tm);
   for (int k = 0; k < 1000; ++k) {
     const std::string name = std::string("accelviz-demo-") + stamp + (k == 0 ? "" : "-" + std::to_string(k)) + ".png";
-    std::error_code ec;
-    if (fs::exists(name, ec)) continue;
+    if (name_taken(name)) continue;  // a dangling link too: the write refuses it
     try {
       write_png(name, rgb, /*overwrite=*/false);
       return name;
     } catch (const std::runtime_error&) {
-      if (fs::exists(name, ec)) continue;  // another process took the name in between
+      if (name_taken(name)) continue;  // another process took the name in between
       throw;
     }
   }

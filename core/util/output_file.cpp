@@ -129,4 +129,9 @@ OutputWrite write_output_file(const std::string& path, std::initializer_list<std
   return fail(std::string("cannot create: ") + std::strerror(err));
 }
 
+bool name_taken(const std::string& path) {
+  std::error_code ec;
+  return fs::exists(fs::symlink_status(path, ec));
+}
+
 }  // namespace accelviz

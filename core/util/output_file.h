@@ -28,4 +28,9 @@ struct OutputWrite {
 /// for I/O problems: the caller words them as its own error type.
 OutputWrite write_output_file(const std::string& path, std::initializer_list<std::string_view> parts, bool overwrite);
 
+/// Whether something has the name `path` (a file, folder, or symbolic link: a dangling link too),
+/// as write_output_file without `overwrite` sees it. For callers choosing a free name: a plain
+/// exists() is false for a dangling link, which the write then refuses.
+bool name_taken(const std::string& path);
+
 }  // namespace accelviz

@@ -18,4 +18,16 @@ b=$(sed -n 2p <<<"$second")
 [ "$a" != "$b" ] || { echo "FAIL: same name twice"; exit 1; }
 [ "$(ls "$tmp" | wc -l)" -eq 2 ] || { echo "FAIL: expected two files"; ls "$tmp"; exit 1; }
 head -c 8 "$a" | od -An -c | grep -q 'P   N   G' || { echo "FAIL: not a PNG"; exit 1; }
+
+# Dangling symbolic links with the names of the next seconds take those names too (the demo
+# gave up with "exists (use --force to overwrite)", an option it does not have).
+mkdir links && cd links
+now=$(date +%s)
+for s in $(seq 0 20); do
+  ln -s /nonexistent/accelviz-test "accelviz-demo-$(date -d "@$((now + s))" +%Y%m%d-%H%M%S).png"
+done
+third=$("$accelviz" -q) || { echo "FAIL: demo beside dangling links"; exit 1; }
+c=$(sed -n 2p <<<"$third")
+[ -f "$c" ] && [ ! -L "$c" ] || { echo "FAIL: $c is not a new file"; exit 1; }
+grep -q -- '-1\.png$' <<<"$c" || { echo "FAIL: expected the -1 name beside a link: $c"; exit 1; }
 echo "demo ok"

@@ -64,6 +64,15 @@ TEST(AppScreenshot, NamesAreTimeStampedAndSkipTakenStems) {
   // A side-car alone also takes the stem: the pair stays together.
   std::ofstream(dir.path() / ("accelviz-" + stamp + "-2.json")) << "{}";
   EXPECT_EQ(unique_screenshot_paths(dir.path(), stamp).png, dir.path() / ("accelviz-" + stamp + "-3.png"));
+  // A dangling symbolic link takes its name too: the write refuses it, and save_screenshot retried the
+  // same name 1,000 times (70 s on the window's thread) before "no free screenshot name".
+  std::filesystem::create_symlink("/nonexistent/accelviz-test", dir.path() / ("accelviz-" + stamp + "-3.png"));
+  EXPECT_EQ(unique_screenshot_paths(dir.path(), stamp).png, dir.path() / ("accelviz-" + stamp + "-4.png"));
+  const RgbImage frame(4, 2, {128, 128, 128});
+  ScreenshotInfo info;
+  const SavedScreenshot saved = save_screenshot(dir.path(), frame, info, t);
+  EXPECT_TRUE(saved.ok) << saved.error;
+  EXPECT_EQ(saved.png, dir.path() / ("accelviz-" + stamp + "-4.png"));
 }
 
 TEST(AppScreenshot, SavingTwiceInTheSameSecondNeverOverwrites) {

@@ -65,7 +65,7 @@ SavedScreenshot write_pair(const ScreenshotPaths& paths, const RgbImage& frame, 
   // Both names are checked before anything is written, so a refused pair
   // leaves no half behind; the exclusive creates below catch a late race.
   for (const fs::path& p : {paths.png, paths.json})
-    if (fs::exists(p, ec)) {
+    if (accelviz::name_taken(p.string())) {
       *name_taken = true;
       r.error = p.string() + ": exists (not overwritten)";
       return r;
@@ -115,7 +115,7 @@ ScreenshotPaths unique_screenshot_paths(const fs::path& dir, const std::string& 
     }
     ScreenshotPaths p{dir / (stem + ".png"), dir / (stem + ".json")};
     std::error_code ec;
-    if (!fs::exists(p.png, ec) && !fs::exists(p.json, ec)) return p;
+    if (!name_taken(p.png.string()) && !name_taken(p.json.string())) return p;
   }
 }
 
