@@ -12,6 +12,7 @@ struct GuiOptions {
   std::optional<std::string> scene;   ///< file or builtin spec to open (else the last scene, else the demo)
   std::optional<std::string> script;  ///< --script FILE: run its commands, then quit
   bool use_settings = true;           ///< read and write settings and layout (off for scripts and tests)
+  bool save_settings = true;          ///< off when the settings file is unusable and no copy of it was kept
   bool quiet = false;                 ///< no status lines on stderr (errors are always printed)
 };
 

@@ -206,7 +206,7 @@ void Gui::report_errors() {
 }
 
 void Gui::save_settings_now() {
-  if (!options_.use_settings) return;
+  if (!options_.use_settings || !options_.save_settings) return;
   int w = 0, h = 0;
   glfwGetWindowSize(window_->window(), &w, &h);
   if (w >= 100 && h >= 100) {
@@ -1030,6 +1030,7 @@ int run_gui(const GuiOptions& options) {
     LoadedSettings loaded = load_settings(settings_file(config_dir()));
     settings = std::move(loaded.settings);
     settings_error = std::move(loaded.error);
+    o.save_settings = !loaded.leave_file;
   }
   Gui gui(o, std::move(settings), std::move(runner), settings_error);
   if (script_opens_first && !o.scene) gui.skip_initial_open();

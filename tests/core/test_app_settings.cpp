@@ -130,9 +130,38 @@ TEST(AppSettings, AFifoFolderOrHugeFileIsReportedNotRead) {
        {std::pair{"fifo.json", "is not a regular file"}, std::pair{"dir.json", "is a directory, not a file"},
         std::pair{"huge.json", "is larger than 1048576 bytes"}}) {
     const LoadedSettings loaded = load_settings(dir.path() / name);
-    EXPECT_EQ(loaded.error, (dir.path() / name).string() + ": " + problem + " (using defaults)");
+    EXPECT_EQ(loaded.error, (dir.path() / name).string() + ": " + problem +
+                                " (using defaults; the file is left as it is: settings are not saved this session)");
+    EXPECT_TRUE(loaded.leave_file) << "not read, so not copied: a save would replace it";
     EXPECT_EQ(loaded.settings.last_scene, "");
   }
+}
+
+// A malformed file whose copy cannot be made (here a folder has the name .bad, and another .bad-2;
+// a full disk fails them all) is copied to the next free name; where none takes it, the file is left
+// as it is and not saved over (the defaults replaced it: the recent list and folders were lost).
+TEST(AppSettings, AMalformedFileIsNeverSavedOverWithoutACopy) {
+  TempDir dir("settings");
+  const fs::path file = dir.path() / "settings.json";
+  write_file(file, "{\"options\": {\"buckets\": \"1\"}}");
+  fs::create_directories(dir.path() / "settings.json.bad");
+  fs::create_directories(dir.path() / "settings.json.bad-2");
+  LoadedSettings loaded = load_settings(file);
+  EXPECT_FALSE(loaded.leave_file) << loaded.error;
+  EXPECT_NE(loaded.error.find("the file is kept as " + file.string() + ".bad-3)"), std::string::npos) << loaded.error;
+  EXPECT_EQ(read_file(dir.path() / "settings.json.bad-3"), "{\"options\": {\"buckets\": \"1\"}}");
+  // Every name a folder: no copy, the file left alone.
+  for (int k = 3; k <= 1000; ++k) {
+    fs::remove(dir.path() / ("settings.json.bad-" + std::to_string(k)));
+    fs::create_directories(dir.path() / ("settings.json.bad-" + std::to_string(k)));
+  }
+  loaded = load_settings(file);
+  EXPECT_TRUE(loaded.leave_file);
+  EXPECT_NE(loaded.error.find("(using defaults; no copy kept: " + file.string() +
+                              ".bad: is a directory, so the file is left as it is: settings are not "
+                              "saved this session)"),
+            std::string::npos)
+      << loaded.error;
 }
 
 TEST(AppSettings, AtomicWriteReplacesWholeFilesAndLeavesNoTemporary) {

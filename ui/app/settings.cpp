@@ -127,7 +127,11 @@ LoadedSettings load_settings(const std::filesystem::path& file) {
   // app's start and a huge file would be read whole.
   std::string text;
   if (const std::string problem = read_text_file(file.string(), kMaxSettingsBytes, text); !problem.empty()) {
-    if (problem != "no such file") out.error = file.string() + ": " + problem + " (using defaults)";
+    if (problem != "no such file") {
+      // Not read, so not copied: a save would replace what the user has there.
+      out.leave_file = true;
+      out.error = file.string() + ": " + problem + " (using defaults; the file is left as it is: settings are not saved this session)";
+    }
     return out;
   }
   try {
@@ -138,16 +142,25 @@ LoadedSettings load_settings(const std::filesystem::path& file) {
     out.settings = AppSettings{};
     // The defaults replace the file at the next save: its recent list, folders and window size
     // would be lost for one bad value, so a copy is kept first under a fresh name.
-    std::string kept;
-    for (int k = 1; k <= 1000 && kept.empty(); ++k) {
+    // Up to 1,000 names, each taken or failing (a folder has the name); a full disk fails them all,
+    // so the failures stop at 20.
+    std::string kept, first_problem;
+    for (int k = 1, failures = 0; k <= 1000 && kept.empty() && failures < 20; ++k) {
       const std::filesystem::path copy = file.string() + (k == 1 ? ".bad" : ".bad-" + std::to_string(k));
       const OutputWrite w = write_output_file(copy.string(), {text}, /*overwrite=*/false);
-      if (w.ok())
+      if (w.ok()) {
         kept = "the file is kept as " + copy.string();
-      else if (!w.exists)
-        kept = "no copy kept: " + copy.string() + ": " + w.problem;
+      } else if (!w.exists) {
+        ++failures;
+        if (first_problem.empty()) first_problem = copy.string() + ": " + w.problem;
+      }
     }
-    out.error = file.string() + ": " + what + " (using defaults; " + (kept.empty() ? "no copy kept" : kept) + ")";
+    out.leave_file = kept.empty();
+    out.error = file.string() + ": " + what + " (using defaults; " +
+                (kept.empty() ? "no copy kept" + (first_problem.empty() ? std::string() : ": " + first_problem) +
+                                    ", so the file is left as it is: settings are not saved this session"
+                              : kept) +
+                ")";
   }
   return out;
 }

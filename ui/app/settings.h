@@ -56,13 +56,18 @@ AppSettings settings_from_json(const nlohmann::json& j);
 struct LoadedSettings {
   AppSettings settings;  ///< defaults when the file is missing or unusable
   std::string error;     ///< one line when the file exists but was unusable ("" otherwise)
+  /// The file is unusable and no copy of it could be kept (a full disk, a folder where the copy
+  /// goes, a file over kMaxSettingsBytes): saving would lose it, so the session must not write it.
+  bool leave_file = false;
 };
 /// Largest settings file read (and imgui.ini): both are a few KB.
 inline constexpr std::uintmax_t kMaxSettingsBytes = std::uintmax_t{1} << 20;
 
 /// Reads `file`. A missing file gives defaults without an error; a
 /// malformed one, or one that is not a regular file of at most
-/// kMaxSettingsBytes, gives defaults and "<file>: <problem> (using defaults)".
+/// kMaxSettingsBytes, gives defaults and "<file>: <problem> (using defaults)". A malformed file is
+/// first copied to FILE.bad (or .bad-2, ...: the first free name that takes the copy); where no copy
+/// is kept, `leave_file` is set and the message says the file is left as it is.
 LoadedSettings load_settings(const std::filesystem::path& file);
 
 /// Writes `content` to `file` atomically: core's write_output_file (a fresh
