@@ -695,11 +695,9 @@ std::string png_name_problem(const std::string& path) {
   return lower_extension(path) == ".png" ? std::string() : path + ": a PNG file's name must end in .png";
 }
 
-void write_png(const std::string& path, const RgbImage& img, bool overwrite) {
+std::string encode_png(const RgbImage& img, const std::string& path) {
   if (const std::string problem = png_name_problem(path); !problem.empty()) throw std::runtime_error(problem);
   if (img.width <= 0 || img.height <= 0) throw std::runtime_error(path + ": cannot write an empty image");
-  // Encoded in memory, then written through a temporary beside the file
-  // (write_output_file): a failed write never costs the file that was there.
   std::string bytes;
   const int encoded = stbi_write_png_to_func(
       [](void* context, void* data, int size) {
@@ -707,6 +705,13 @@ void write_png(const std::string& path, const RgbImage& img, bool overwrite) {
       },
       &bytes, img.width, img.height, 3, img.pixels.data(), img.width * 3);
   if (!encoded) throw std::runtime_error(path + ": the PNG could not be encoded");
+  return bytes;
+}
+
+void write_png(const std::string& path, const RgbImage& img, bool overwrite) {
+  // Encoded in memory, then written through a temporary beside the file
+  // (write_output_file): a failed write never costs the file that was there.
+  const std::string bytes = encode_png(img, path);
   const OutputWrite w = write_output_file(path, {bytes}, overwrite);
   if (w.exists) throw FileExistsError(path + ": exists (use --force to overwrite)");
   if (!w.ok()) throw std::runtime_error(path + ": " + w.problem);

@@ -248,6 +248,12 @@ class FileExistsError : public std::runtime_error {
 /// <reason>". Throws std::runtime_error.
 void write_png(const std::string& path, const RgbImage& img, bool overwrite = false);
 
+/// The PNG file's bytes of `img`, for a file named `path` (for a set of files
+/// written all or nothing: write_output_files, OutputFolder). Throws
+/// std::runtime_error as write_png does for a name not ending in .png, an
+/// empty image or a failed encoding.
+std::string encode_png(const RgbImage& img, const std::string& path);
+
 /// Reads any image stb_image understands as 8-bit RGB. Throws std::runtime_error "<file>: <reason>".
 RgbImage read_png(const std::string& path);
 

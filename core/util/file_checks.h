@@ -4,6 +4,9 @@
 // and one that is a directory or a device reads as garbage or without end; an
 // output that is a FIFO blocks its writer, and a failed write or a rename
 // would remove or replace a device node.
+#include <limits.h>  // NAME_MAX
+#include <unistd.h>  // pathconf
+
 #include <cctype>
 #include <cstdint>
 #include <filesystem>
@@ -61,11 +64,32 @@ inline std::string lower_extension(const std::string& path) {
   return ext;
 }
 
+/// "" when every name along `path` fits the file system, else the problem,
+/// without the path: "a name in it is N bytes long; the file system takes at
+/// most M (NAME_MAX)". The limit is that of the nearest folder on the path
+/// that exists (pathconf). Checked before long work: creating the file
+/// failed with "File name too long" only after it.
+inline std::string name_length_problem(const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path p(path);
+  std::error_code ec;
+  fs::path dir = p.parent_path();
+  while (!dir.empty() && !fs::is_directory(dir, ec) && dir != dir.parent_path()) dir = dir.parent_path();
+  long max = ::pathconf(dir.empty() ? "." : dir.c_str(), _PC_NAME_MAX);
+  if (max <= 0) max = NAME_MAX;  // no limit said: the usual one
+  for (const fs::path& part : p)
+    if (part.native().size() > static_cast<std::size_t>(max))
+      return "a name in it is " + std::to_string(part.native().size()) + " bytes long; the file system takes at most " +
+             std::to_string(max);
+  return {};
+}
+
 /// "" when `path` may be created or overwritten as a file: nothing is there,
 /// or a regular file is (a symbolic link counts as what it names); else the
-/// problem, without the path: "is a directory" or "is not a regular file (a
-/// FIFO, device or socket)".
+/// problem, without the path: name_length_problem's, "is a directory" or "is
+/// not a regular file (a FIFO, device or socket)".
 inline std::string output_path_problem(const std::string& path) {
+  if (std::string problem = name_length_problem(path); !problem.empty()) return problem;
   std::error_code ec;
   const std::filesystem::file_status st = std::filesystem::status(path, ec);
   if (ec || !std::filesystem::exists(st) || std::filesystem::is_regular_file(st)) return {};
