@@ -257,15 +257,6 @@ std::unique_ptr<Accelerator> build_with_progress(const std::string& structure, c
 
 namespace {
 
-bool is_output_file(const fs::path& p, const std::string& prefix) {
-  const std::string n = p.filename().string();
-  return n == prefix + ".csv" || n == prefix + ".json" || (n.rfind(prefix + "-", 0) == 0 && p.extension() == ".png");
-}
-
-}  // namespace
-
-namespace {
-
 /// Why files cannot be made in the folder `dir`, or its nearest existing
 /// parent where it does not exist yet ("" when they can): checked before
 /// the work, which ran to its end before the write failed (a read-only folder).
@@ -280,42 +271,34 @@ std::string unwritable_folder(const fs::path& dir) {
 
 }  // namespace
 
-void check_output_dir(const std::string& dir, const std::string& prefix, bool force) {
-  std::error_code ec;
-  const fs::path p(dir);
+void check_output_dir(const std::string& dir, const OutputDirFiles& files, bool force) {
   if (dir.empty()) throw std::runtime_error("the output folder's name is empty");
-  if (fs::exists(p, ec) && !fs::is_directory(p, ec)) throw std::runtime_error(dir + ": exists and is not a directory");
-  if (const std::string problem = unwritable_folder(p); !problem.empty())
+  if (const std::string problem = name_length_problem(dir); !problem.empty())
     throw std::runtime_error(dir + ": " + problem);
-  if (!fs::is_directory(p, ec)) return;
-  for (const auto& e : fs::directory_iterator(p, ec))
-    if (is_output_file(e.path(), prefix))
-      // Not even --force replaces a FIFO, device or socket (or a folder) by such a name.
-      if (const std::string problem = output_path_problem(e.path().string()); !problem.empty())
-        throw std::runtime_error(e.path().string() + ": " + problem);
-  if (force) return;
-  for (const auto& e : fs::directory_iterator(p, ec))
-    if (is_output_file(e.path(), prefix))
-      throw std::runtime_error(dir + ": already holds " + prefix + " files (use --force to overwrite)");
-}
-
-void write_output_text(const fs::path& path, const std::string& text) {
-  const OutputWrite w = write_output_file(path.string(), {text}, /*overwrite=*/true);
-  if (!w.ok()) throw std::runtime_error(path.string() + ": " + w.problem);
-}
-
-void prepare_output_dir(const std::string& dir, const std::string& prefix, bool force) {
-  check_output_dir(dir, prefix, force);  // again: the folder may have changed during the work
-  std::error_code ec;
-  const fs::path p(dir);
-  if (fs::is_directory(p, ec)) {
-    std::vector<fs::path> stale;
-    for (const auto& e : fs::directory_iterator(p, ec))
-      if (is_output_file(e.path(), prefix)) stale.push_back(e.path());
-    for (const fs::path& f : stale) fs::remove(f, ec);
-    return;
+  bool holds = false;
+  if (const std::string problem = OutputFolder::problem(dir, files.names, force, &holds); !problem.empty()) {
+    if (holds) throw std::runtime_error(dir + ": already holds " + files.label + " files (use --force to overwrite)");
+    throw std::runtime_error(dir + ": " + problem);  // "DIR: sweep.csv: is not a regular file (...)"
   }
-  if (!fs::create_directories(p, ec) || ec) throw std::runtime_error(dir + ": cannot create directory");
+  if (const std::string problem = unwritable_folder(dir); !problem.empty())
+    throw std::runtime_error(dir + ": " + problem);
+}
+
+OutputDirWriter::OutputDirWriter(const std::string& dir, const OutputDirFiles& files, bool force)
+    : label_(files.label), folder_(dir, files.names, force) {
+  check_output_dir(dir, files, force);  // again: the folder may have changed during the work
+  if (const OutputWrite w = folder_.open(); !w.ok()) throw std::runtime_error(w.path + ": " + w.problem);
+}
+
+void OutputDirWriter::add(const std::string& name, const std::string& bytes) {
+  if (const OutputWrite w = folder_.add(name, {bytes}); !w.ok()) throw std::runtime_error(w.path + ": " + w.problem);
+}
+
+void OutputDirWriter::commit() {
+  if (const OutputWrite w = folder_.commit(); !w.ok()) throw std::runtime_error(w.path + ": " + w.problem);
+  for (const std::string& left : folder_.stale_left())
+    std::fprintf(stderr, "accelviz: warning: could not remove an earlier run's %s file: %s\n", label_.c_str(),
+                 left.c_str());
 }
 
 void check_output_path(const std::string& path, bool force) {

@@ -15,6 +15,7 @@
 #include "core/scene/scene.h"
 #include "core/util/image_size.h"
 #include "core/util/one_line.h"  // count_of: "1 thread", "2 threads"
+#include "core/util/output_file.h"
 #include "core/util/timing.h"
 
 namespace accelviz::cli {
@@ -131,20 +132,38 @@ void require_flattened(const Scene& scene, const std::string& spec, const char* 
 /// or its directory does not exist: "<path>: exists (use --force to overwrite)".
 void check_output_path(const std::string& path, bool force);
 
-/// An output folder for a command's files, the files its `prefix` names:
-/// PREFIX.csv, PREFIX.json, PREFIX-*.png. check_output_dir, before any work:
-/// refused (one line) when `dir` is not a folder, or holds such files and
-/// `force` is off; nothing changes on disk. prepare_output_dir, once the
-/// results are ready to write: removes those files (stale charts of an
-/// earlier run would mislead) and creates the folder. So a run that fails
-/// leaves what was there, and no empty folder.
-void check_output_dir(const std::string& dir, const std::string& prefix, bool force);
-void prepare_output_dir(const std::string& dir, const std::string& prefix, bool force);
+/// The files a command writes into its output folder (sweep, refit): what
+/// messages call them ("sweep files") and every name any of its runs can
+/// write, built by its naming scheme. Only these names are refused, replaced
+/// or removed: a file of the user's own in the folder is never touched.
+struct OutputDirFiles {
+  std::string label;
+  std::vector<std::string> names;
+};
 
-/// Writes one of those files (a folder prepare_output_dir made ready) through
-/// core's write_output_file: a temporary beside it, then its name. Throws
-/// std::runtime_error "<path>: <problem>".
-void write_output_text(const std::filesystem::path& path, const std::string& text);
+/// Before any work: refused (one line) when `dir` is not a folder, cannot be
+/// written in, or holds one of the files and `force` is off ("DIR: already
+/// holds sweep files (use --force to overwrite)"); nothing changes on disk.
+void check_output_dir(const std::string& dir, const OutputDirFiles& files, bool force);
+
+/// Once the results are ready: the folder's files, written all or nothing
+/// (core's OutputFolder). The constructor checks the folder again (it may
+/// have changed during the work) and creates it where missing; add() writes
+/// each file to a temporary in the folder; commit() gives them their names
+/// only once all were written, then removes the files of an earlier run that
+/// this one did not write (stale charts would mislead). A run that fails
+/// (throws, std::runtime_error "<path>: <problem>") leaves the folder as it
+/// was: the old results, no temporary, and no folder it created.
+class OutputDirWriter {
+ public:
+  OutputDirWriter(const std::string& dir, const OutputDirFiles& files, bool force);
+  void add(const std::string& name, const std::string& bytes);
+  void commit();
+
+ private:
+  std::string label_;
+  OutputFolder folder_;
+};
 
 /// Absolute, normalised form of a path for messages.
 std::string absolute_path(const std::string& path);

@@ -36,6 +36,11 @@ struct RefitCliOptions {
   StructureCli structure_opts;
 };
 
+/// Every name refit writes in its folder: the only files of the folder it refuses, replaces or removes.
+OutputDirFiles refit_files() {
+  return {"refit", {"refit.csv", "refit.json", "refit-sah.png", "refit-nodes.png", "refit-ms.png"}};
+}
+
 int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
   const ImageSize size = parse_size(o.size);
   if (!(o.amplitude >= 0) || !std::isfinite(o.amplitude))
@@ -43,8 +48,8 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
   if (!std::isfinite(o.frame_step)) throw UsageError("--frame-step must be a finite number");
   if (!(o.rebuild_ratio == 0 || (o.rebuild_ratio >= 1 && std::isfinite(o.rebuild_ratio))))
     throw UsageError("--rebuild-ratio must be 0 (never) or a finite number >= 1");
-  check_output_dir(o.out, "refit", o.force);  // refused before any work; created when the results are ready
-  const fs::path dir(o.out);
+  const OutputDirFiles files = refit_files();
+  check_output_dir(o.out, files, o.force);  // refused before any work; created when the results are ready
 
   Progress progress(global.quiet);
   progress.begin("loading " + o.scene);
@@ -91,8 +96,9 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
                       {"prims_per_ray_fresh", f.prims_per_ray_fresh},
                       {"rebuilt", f.rebuilt}});
   }
-  prepare_output_dir(o.out, "refit", o.force);
-  write_output_text(dir / "refit.csv", csv.str());
+  // All written to temporaries in DIR first; they take their names only once every one was written.
+  OutputDirWriter out(o.out, files, o.force);
+  out.add("refit.csv", csv.str());
   const nlohmann::json j = {{"scene", o.scene},
                             {"triangles", scene.triangles.size()},
                             {"frames", o.frames},
@@ -106,7 +112,7 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
                             {"seed", o.seed},
                             {"rebuilds", r.rebuilds},
                             {"per_frame", frames}};
-  write_output_text(dir / "refit.json", j.dump(2) + "\n");
+  out.add("refit.json", j.dump(2) + "\n");
 
   ChartSeries refit{"refitted", {}, {}, {}, {214, 39, 40}, true, true, 2};
   ChartSeries fresh{"fresh build", {}, {}, {}, {31, 119, 180}, true, true, 2};
@@ -122,17 +128,21 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
     ms_refit.x.push_back(x), ms_refit.y.push_back(f.refit_ms);
     ms_build.x.push_back(x), ms_build.y.push_back(f.rebuild_ms);
   }
+  const auto chart = [&](const std::string& name, const RgbImage& img) {
+    out.add(name, encode_png(img, (fs::path(o.out) / name).string()));
+  };
   ChartOptions c;
   c.x_label = "frame";
   c.title = "sah cost: refit vs fresh build (" + o.motion + " motion)";
   c.y_label = "sah cost";
-  write_png((dir / "refit-sah.png").string(), draw_chart(c, {refit, fresh}), true);
+  chart("refit-sah.png", draw_chart(c, {refit, fresh}));
   c.title = "nodes visited per ray";
   c.y_label = "nodes/ray";
-  write_png((dir / "refit-nodes.png").string(), draw_chart(c, {nodes_refit, nodes_fresh}), true);
+  chart("refit-nodes.png", draw_chart(c, {nodes_refit, nodes_fresh}));
   c.title = "refit vs rebuild time";
   c.y_label = "ms";
-  write_png((dir / "refit-ms.png").string(), draw_chart(c, {ms_refit, ms_build}), true);
+  chart("refit-ms.png", draw_chart(c, {ms_refit, ms_build}));
+  out.commit();
 
   // ---- text ----
   std::printf("scene %s: %s; %s, amplitude %g of the diagonal; %s\n", o.scene.c_str(),
@@ -186,7 +196,9 @@ Command add_refit_command(CLI::App& parent, const GlobalOptions& global) {
   add_threads_option(sub, o->threads, "Build and trace threads (0: all)");
   sub->add_option("--seed", o->seed, "Seed of the motion")->capture_default_str();
   sub->add_option("--out,-o", o->out, "Output directory (created if missing)")->required();
-  sub->add_flag("--force,-f", o->force, "Overwrite the refit files of an earlier run in DIR");
+  sub->add_flag("--force,-f", o->force,
+                "Replace the refit files of an earlier run in DIR (only the names refit writes; the new set is "
+                "written whole first)");
   o->structure_opts.add_to(sub, /*with_embree=*/false);  // it builds BVHs only
   return {sub, [o, &global] { return run_refit(*o, global); }};
 }

@@ -98,6 +98,27 @@ const Figure kFigures[] = {
     {"total_ms", "total ms for the ray budget", [](const SweepResult& r, double b) { return r.total_ms(b); }},
 };
 
+/// The structures sweep takes.
+const std::vector<std::string> kSweepStructures = {"bvh", "kdtree", "grid", "octree", "voxels"};
+
+/// A figure's chart against one parameter: sweep-FIGURE-vs-PARAM.png.
+std::string sweep_chart_name(std::string_view figure, std::string_view param) {
+  return "sweep-" + std::string(figure) + "-vs-" + std::string(param) + ".png";
+}
+
+/// Every name a sweep writes in its folder (any structure, any parameter):
+/// the only files of the folder it refuses, replaces or removes.
+OutputDirFiles sweep_files() {
+  OutputDirFiles files{"sweep", {"sweep.csv", "sweep.json", "sweep-pareto.png"}};
+  for (const std::string& structure : kSweepStructures)
+    for (const std::string& param : sweep_param_names(structure))
+      for (const Figure& f : kFigures)
+        if (const std::string name = sweep_chart_name(f.key, param);
+            std::find(files.names.begin(), files.names.end(), name) == files.names.end())
+          files.names.push_back(name);
+  return files;
+}
+
 /// (a) build time against trace time for the budget, Pareto front joined and labelled.
 RgbImage pareto_chart(const std::vector<SweepResult>& results, const std::vector<std::size_t>& front, double budget,
                       const std::string& scene, bool leaks) {
@@ -226,7 +247,8 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
   }
   const ImageSize size = parse_size(o.size);
   const RayKind kind = *parse_ray_kind(o.rays);
-  check_output_dir(o.out, "sweep", o.force);  // refused before any work; created when the results are ready
+  const OutputDirFiles files = sweep_files();
+  check_output_dir(o.out, files, o.force);  // refused before any work; created when the results are ready
   const unsigned threads = resolve_threads(o.threads);
   Progress progress(global.quiet);
 
@@ -281,9 +303,9 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
   if (o.ray_budget != 1e6 && o.ray_budget != 1e9) budgets.push_back(o.ray_budget);
 
   // ---- files ----
-  prepare_output_dir(o.out, "sweep", o.force);
-  const fs::path dir(o.out);
-  write_output_text(dir / "sweep.csv", sweep_csv(results, o.ray_budget));
+  // All written to temporaries in DIR first; they take their names only once every one was written.
+  OutputDirWriter out(o.out, files, o.force);
+  out.add("sweep.csv", sweep_csv(results, o.ray_budget));
   nlohmann::json j;
   const std::string cmdline = command_line();
   j["machine"] = {{"cpu_model", cpu_model()},
@@ -321,11 +343,11 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
   }
   const TimingScatter scatter = timing_scatter(results);
   j["timing_scatter"] = {{"rays_per_s", scatter.rays_per_s}, {"build_ms", scatter.build_ms}};
-  write_output_text(dir / "sweep.json", j.dump(2) + "\n");
+  out.add("sweep.json", j.dump(2) + "\n");
 
   std::vector<std::string> charts;
   auto chart = [&](const std::string& name, const RgbImage& img) {
-    write_png((dir / name).string(), img, true);
+    out.add(name, encode_png(img, (fs::path(o.out) / name).string()));
     charts.push_back(name);
   };
   chart("sweep-pareto.png", pareto_chart(results, front, o.ray_budget, o.scene, !probes.empty()));
@@ -333,9 +355,9 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
     for (const Figure& f : kFigures) {
       if (f.key == std::string("sah_cost") && o.structure != "bvh" && o.structure != "kdtree" && o.structure != "octree")
         continue;  // grids and voxels report no SAH cost
-      chart("sweep-" + std::string(f.key) + "-vs-" + params[p].name + ".png",
-            figure_chart(results, params, p, f, o.ray_budget));
+      chart(sweep_chart_name(f.key, params[p].name), figure_chart(results, params, p, f, o.ray_budget));
     }
+  out.commit();
 
   // ---- text ----
   std::printf("scene %s: %s; %s, %zu %s rays; %s; medians of %d; ray budget %g\n", o.scene.c_str(),
@@ -411,7 +433,7 @@ Command add_sweep_command(CLI::App& parent, const GlobalOptions& global) {
                "setting, the Pareto front, CSV/JSON and charts");
   sub->add_option("SCENE", o->scene, "Scene file (.gltf, .glb, .obj) or builtin:NAME[?key=value&...]")->required();
   sub->add_option("--structure,-s", o->structure, "Structure to sweep: bvh, kdtree, grid, octree, voxels")
-      ->check(CLI::IsMember({"bvh", "kdtree", "grid", "octree", "voxels"}))
+      ->check(CLI::IsMember(kSweepStructures))
       ->capture_default_str();
   sub->add_option("--param,-p", o->params,
                   "NAME=V1,V2,... (repeatable; the cartesian product is swept). bvh: buckets (2..256 or exact), "
@@ -440,7 +462,9 @@ Command add_sweep_command(CLI::App& parent, const GlobalOptions& global) {
       ->check(CLI::Range(0, 10000000))
       ->capture_default_str();
   sub->add_option("--out,-o", o->out, "Output directory (created if missing)")->required();
-  sub->add_flag("--force,-f", o->force, "Overwrite the sweep files of an earlier run in DIR");
+  sub->add_flag("--force,-f", o->force,
+                "Replace the sweep files of an earlier run in DIR (only the names sweep writes; the new set is "
+                "written whole first)");
   return {sub, [o, &global] { return run_sweep_command(*o, global); }};
 }
 
