@@ -301,6 +301,12 @@ void OutputDirWriter::commit() {
                  left.c_str());
 }
 
+void write_output_set(const std::vector<OutputBytes>& files, bool force) {
+  const OutputWrite w = write_output_files(files, force);
+  if (w.exists) throw std::runtime_error(w.path + ": exists (use --force to overwrite)");
+  if (!w.ok()) throw std::runtime_error(w.path + ": " + w.problem);
+}
+
 void check_output_path(const std::string& path, bool force) {
   std::error_code ec;
   const fs::path p(path);

@@ -165,6 +165,12 @@ class OutputDirWriter {
   OutputFolder folder_;
 };
 
+/// Writes several files (render -s a,b's images, --compare's trio) all or
+/// nothing (core's write_output_files): all temporaries first, then the
+/// names. Throws std::runtime_error "<path>: exists (use --force to
+/// overwrite)" or "<path>: <problem>"; then no file has changed.
+void write_output_set(const std::vector<OutputBytes>& files, bool force);
+
 /// Absolute, normalised form of a path for messages.
 std::string absolute_path(const std::string& path);
 

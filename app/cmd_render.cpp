@@ -333,6 +333,7 @@ int run_render_several(const RenderOptions& o, const std::vector<std::string>& s
   }
   nlohmann::json out = {{"scene", o.scene}, {"metric", o.metric}, {"scale_max", shared.max}};
   out["images"] = nlohmann::json::array();
+  std::vector<OutputBytes> files;  // written all or nothing once every image is ready
   for (std::size_t i = 0; i < each.size(); ++i) {
     const RenderOptions& os = each[i];
     ColorizeOptions co = shared;
@@ -351,11 +352,12 @@ int run_render_several(const RenderOptions& o, const std::vector<std::string>& s
       figures["caption"] = o.caption == "auto" ? render_caption(alone) : o.caption;
       rgb = add_caption(rgb, figures["caption"].get<std::string>());
     }
-    write_png(os.out, rgb, o.force);
+    files.push_back({os.out, encode_png(rgb, os.out)});
     figures["out"] = absolute_path(os.out);
-    std::cout << figures["out"].get<std::string>() << "\n";
     out["images"].push_back(figures);
   }
+  write_output_set(files, o.force);
+  for (const nlohmann::json& figures : out["images"]) std::cout << figures["out"].get<std::string>() << "\n";
   print_json_line(out);
   return 0;
 }

@@ -277,9 +277,11 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
     rgb[1] = add_caption(rgb[1], caption_b);
     rgb_diff = add_caption(rgb_diff, caption_diff);
   }
-  write_png(paths.a, rgb[0], job.force);
-  write_png(paths.b, rgb[1], job.force);
-  write_png(paths.diff, rgb_diff, job.force);
+  // The trio all or nothing: a failure on the second image left a mixed old and new set.
+  write_output_set({{paths.a, encode_png(rgb[0], paths.a)},
+                    {paths.b, encode_png(rgb[1], paths.b)},
+                    {paths.diff, encode_png(rgb_diff, paths.diff)}},
+                   job.force);
 
   nlohmann::json figures = sides;
   figures["captions"] = {{"a", caption_a}, {"b", caption_b}, {"diff", caption_diff}};

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Nothing the user made is lost when a write fails part-way: sweep's and
-# refit's DIR are written all or nothing (a write that fails here: a
-# file-size limit, as a full disk would);
+# refit's DIR, render -s a,b's images and --compare's trio are written all or
+# nothing (a write that fails here: a file-size limit, as a full disk would);
 # --force replaces only the names the command writes; a replaced file keeps
 # its permission bits; a name the file system takes is written, one it does
 # not is refused before the work.
@@ -62,7 +62,54 @@ limited 4 "${rf[@]}" --seed 2 --out "$out" --force > /dev/null 2>&1 && fail "ref
 "$bin" -q "${rf[@]}" --seed 2 --out "$out" --force > /dev/null
 [ "$(cat "$out/refit-mine.png")" = mine ] || fail "--force removed the user's refit-mine.png"
 
+# ---- render -s a,b and --compare: all or nothing, paths printed after ----
+# A limit between two images' sizes: the first written fits, the next does not. The sizes come from a
+# probe run of the same images; where they do not allow it, the check cannot be made here.
+# first_fits_kib FIRST OTHERS...: the KiB FIRST needs when one of OTHERS needs more, else 0.
+first_fits_kib() {
+  local first="$1" kib
+  shift
+  kib=$((($(stat -c %s "$first") + 1023) / 1024))
+  for f in "$@"; do
+    [ "$(stat -c %s "$f")" -gt $((kib * 1024)) ] && { echo "$kib"; return; }
+  done
+  echo 0
+}
+# Brute force's image is one colour (every ray tests every triangle): a small PNG beside the BVH's.
 r=(render 'builtin:teapot?size=400' --size 160x120 -m prims --caption none --threads 1)
+mkdir "$tmp/probe" "$tmp/several"
+"$bin" -q "${r[@]}" -s brute,bvh --colormap inferno -o "$tmp/probe/T.png" > "$tmp/stdout"
+[ "$(wc -l < "$tmp/stdout")" -eq 3 ] || fail "render -s brute,bvh printed: $(cat "$tmp/stdout")"
+pair=(brute bvh)
+if [ "$(stat -c %s "$tmp/probe/T-brute.png")" -gt "$(stat -c %s "$tmp/probe/T-bvh.png")" ]; then pair=(bvh brute); fi
+kib=$(first_fits_kib "$tmp/probe/T-${pair[0]}.png" "$tmp/probe/T-${pair[1]}.png")
+if [ "$kib" -gt 0 ]; then
+  "$bin" -q "${r[@]}" -s brute,bvh -o "$tmp/several/T.png" > /dev/null
+  before="$(listing "$tmp/several")"
+  limited "$kib" "${r[@]}" -s "${pair[0]},${pair[1]}" --colormap inferno -o "$tmp/several/T.png" -f \
+    > "$tmp/stdout" 2> "$tmp/stderr" && fail "render -s wrote past the file-size limit"
+  [ "$before" = "$(listing "$tmp/several")" ] || fail "a failed render -s ${pair[0]},${pair[1]} left a mixed set"
+  [ ! -s "$tmp/stdout" ] || fail "a failed render -s printed paths: $(cat "$tmp/stdout")"
+  [ "$(ls -A "$tmp/several" | wc -l)" -eq 2 ] || fail "temporaries left: $(ls -A "$tmp/several")"
+else
+  echo "skip: render -s: the two images' sizes round to the same KiB"
+fi
+
+mkdir "$tmp/cmp"
+"$bin" -q "${r[@]}" -s brute --compare structure=bvh --colormap inferno -o "$tmp/probe/C.png" > /dev/null
+kib=$(first_fits_kib "$tmp/probe/C-a.png" "$tmp/probe/C-b.png" "$tmp/probe/C-diff.png")
+if [ "$kib" -gt 0 ]; then
+  "$bin" -q "${r[@]}" -s brute --compare structure=bvh -o "$tmp/cmp/C.png" > /dev/null
+  before="$(listing "$tmp/cmp")"
+  limited "$kib" "${r[@]}" -s brute --compare structure=bvh --colormap inferno -o "$tmp/cmp/C.png" -f \
+    > "$tmp/stdout" 2> "$tmp/stderr" && fail "render --compare wrote past the file-size limit"
+  [ "$before" = "$(listing "$tmp/cmp")" ] || fail "a failed render --compare left a mixed set"
+  [ ! -s "$tmp/stdout" ] || fail "a failed render --compare printed paths: $(cat "$tmp/stdout")"
+  [ "$(ls -A "$tmp/cmp" | wc -l)" -eq 3 ] || fail "temporaries left: $(ls -A "$tmp/cmp")"
+else
+  echo "skip: render --compare: image A is not smaller than B or the difference"
+fi
+
 # ---- a replaced file keeps its permission bits ----
 "$bin" -q "${r[@]}" -o "$tmp/private.png" > /dev/null
 chmod 600 "$tmp/private.png"
