@@ -26,12 +26,46 @@
 #   HEADLINE_SOUP     the soup's scene (default builtin:soup?size=10000000; "" skips it)
 #   HEADLINE_THREADS  thread counts (default "1 2")
 #   HEADLINE_REPEAT   runs per figure of the meshes (default 5); the soup's is 3 unless this is lower
+#   HEADLINE_FORCE    1: replace the results of an earlier run in OUT_DIR. Without it an OUT_DIR that
+#                     holds any (N-robust.json, N-fast.json, N-default.json, table.md) is refused before
+#                     the first run, and nothing in it changes.
+#
+# Each result is written to a temporary in OUT_DIR and takes its name only when its run succeeded: a
+# run that fails leaves the earlier result (if any) as it was.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${1:-$root/build/release/app/accelviz}"
 out="${2:-$(mktemp -d /tmp/accelviz-headline-XXXXXX)}"
 [ -x "$bin" ] || { echo "headline: $bin: not an executable (build first, or pass the accelviz binary)" >&2; exit 2; }
+force="${HEADLINE_FORCE:-0}"
+case "$force" in 0 | 1) ;; *) echo "headline: HEADLINE_FORCE=$force: expected 0 or 1" >&2; exit 2 ;; esac
+if [ "$force" != 1 ] && [ -d "$out" ]; then
+  for f in "$out"/table.md "$out"/[0-9]*-robust.json "$out"/[0-9]*-fast.json "$out"/[0-9]*-default.json; do
+    if [ -e "$f" ] || [ -L "$f" ]; then
+      echo "headline: $out already holds results ($(basename "$f")); set HEADLINE_FORCE=1 to replace them" >&2
+      exit 2
+    fi
+  done
+fi
 mkdir -p "$out"
+mode="$(printf '%o' $((0666 & ~0$(umask))))"  # what `>` gave a new file (mktemp's are 0600)
+pending=""  # the temporary being written, removed when the script stops before it took its name
+trap '[ -z "$pending" ] || rm -f -- "$pending"' EXIT
+
+keep() {  # TMP NAME: the finished temporary takes NAME in $out (without HEADLINE_FORCE, only a free name)
+  chmod "$mode" -- "$1"
+  if [ "$force" = 1 ]; then
+    mv -f -- "$1" "$out/$2"
+  elif [ -e "$out/$2" ] || [ -L "$out/$2" ]; then  # appeared during the runs
+    echo "headline: $out/$2: exists (set HEADLINE_FORCE=1 to replace it)" >&2
+    exit 1
+  else
+    # A hard link takes only a free name; a file system without them: mv's no-clobber.
+    ln -- "$1" "$out/$2" 2>/dev/null || mv -n -- "$1" "$out/$2"
+    rm -f -- "$1"
+  fi
+  pending=""
+}
 assets="${ACCELVIZ_ASSETS:-$root/../shared/assets}"
 meshes="${HEADLINE_MESHES-$assets/bunny.glb $assets/dragon.glb $assets/kitchen_partial.glb}"
 soup="${HEADLINE_SOUP-builtin:soup?size=10000000}"
@@ -43,7 +77,9 @@ run() {  # FILE ARGS...: one bench run, its JSON kept
   local file="$1"
   shift
   echo "headline: accelviz -q bench $*" >&2
-  "$bin" -q bench "$@" --json > "$out/$file"
+  pending="$(mktemp "$out/.headline-XXXXXX.tmp")"
+  "$bin" -q bench "$@" --json > "$pending"
+  keep "$pending" "$file"
 }
 
 i=0
@@ -70,7 +106,8 @@ if [ -n "$soup" ]; then
   done
 fi
 
-python3 - "$out" "${rows[@]}" > "$out/table.md" <<'PY'
+pending="$(mktemp "$out/.headline-XXXXXX.tmp")"
+python3 - "$out" "${rows[@]}" > "$pending" <<'PY'
 import json, os, sys
 
 out, rows = sys.argv[1], sys.argv[2:]
@@ -97,5 +134,6 @@ for row in rows:
     name = os.path.splitext(os.path.basename(j["scene"]))[0] if not j["scene"].startswith("builtin:") else j["scene"]
     print(f"| {name} | {mode} | {j['threads']} | {build} | {sah} | {mem} | " + " | ".join(cells) + " |")
 PY
+keep "$pending" table.md
 cat "$out/table.md"
 echo "headline: the runs' JSON and table.md are in $out" >&2

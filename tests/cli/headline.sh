@@ -10,6 +10,26 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
+# Earlier results are never lost: an OUT_DIR that holds some is refused before the first run unless
+# HEADLINE_FORCE=1 (`> "$out/$file"` emptied them as the run began), and a run that fails leaves the earlier
+# result as it was (it was left empty). Neither needs Embree: the refusal comes first, the scene fails.
+mkdir "$tmp/earlier"
+echo mine > "$tmp/earlier/1-robust.json"
+echo table > "$tmp/earlier/table.md"
+rc=0
+HEADLINE_MESHES='builtin:nosuchscene' HEADLINE_SOUP='' HEADLINE_THREADS=1 HEADLINE_REPEAT=1 \
+  bash "$src/bench/headline.sh" "$accelviz" "$tmp/earlier" > /dev/null 2> "$tmp/stderr.txt" || rc=$?
+[ "$rc" -eq 2 ] || fail "an OUT_DIR holding results: exit $rc, expected 2: $(cat "$tmp/stderr.txt")"
+grep -q "already holds results.*HEADLINE_FORCE=1" "$tmp/stderr.txt" || fail "the refusal says: $(cat "$tmp/stderr.txt")"
+[ "$(cat "$tmp/earlier/1-robust.json")" = mine ] || fail "a refused run changed an earlier result"
+rc=0
+HEADLINE_FORCE=1 HEADLINE_MESHES='builtin:nosuchscene' HEADLINE_SOUP='' HEADLINE_THREADS=1 HEADLINE_REPEAT=1 \
+  bash "$src/bench/headline.sh" "$accelviz" "$tmp/earlier" > /dev/null 2> "$tmp/stderr.txt" || rc=$?
+[ "$rc" -ne 0 ] || fail "a failed bench run did not fail the script"
+[ "$(cat "$tmp/earlier/1-robust.json")" = mine ] || fail "a failed run cost the earlier result"
+[ "$(cat "$tmp/earlier/table.md")" = table ] || fail "a failed run cost the earlier table"
+[ "$(ls -A "$tmp/earlier" | wc -l)" -eq 2 ] || fail "a failed run left files behind: $(ls -A "$tmp/earlier")"
+
 "$accelviz" bench --help > "$tmp/help.txt"
 if ! grep -q embree-medium "$tmp/help.txt"; then
   echo "headline: built without Embree, nothing to compare"
@@ -19,6 +39,9 @@ HEADLINE_MESHES='builtin:teapot?size=800' HEADLINE_SOUP='builtin:soup?size=2000'
   HEADLINE_REPEAT=1 bash "$src/bench/headline.sh" "$accelviz" "$tmp/out" > "$tmp/stdout.md" 2> "$tmp/stderr.txt"
 cmp -s "$tmp/stdout.md" "$tmp/out/table.md" || fail "the table printed is not table.md"
 [ "$(ls "$tmp/out"/*.json | wc -l)" -eq 10 ] || fail "expected 10 bench runs: $(ls "$tmp/out")"
+[ "$(ls -A "$tmp/out" | wc -l)" -eq 11 ] || fail "expected the runs and table.md only: $(ls -A "$tmp/out")"
+[ "$(stat -c %a "$tmp/out/table.md")" = "$(printf '%o' $((0666 & ~0$(umask))))" ] ||
+  fail "table.md has mode $(stat -c %a "$tmp/out/table.md"), not the umask's"
 grep -q -- "--embree-robust" "$tmp/stderr.txt" || fail "the commands are not echoed"
 python3 - "$tmp/out/table.md" <<'PY'
 import sys
