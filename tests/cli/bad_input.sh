@@ -156,7 +156,7 @@ for kind in png rays hits; do
   grep -q "write failed: File too large" "$tmp/stderr" || { echo "FAIL: $kind: $(cat "$tmp/stderr")"; fail=1; }
   [ "$(cat "$old")" = ORIGINAL ] || { echo "FAIL: a failed $kind write lost the old file"; fail=1; }
 done
-leftovers=$(find "$tmp" -name '.*.tmp-*')
+leftovers=$(find "$tmp" -name '.accelviz-*.tmp')
 [ -z "$leftovers" ] || { echo "FAIL: temporaries left behind: $leftovers"; fail=1; }
 
 # A scene near the float range cannot be framed: one line naming the scene
