@@ -29,6 +29,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
@@ -41,6 +42,26 @@ namespace accelviz {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// SIGTERM, SIGHUP (a logout) and SIGINT ask the window to close as its close button does, so the
+// settings and layout are saved on the way out (a kill skipped that: the changes since the last
+// scene opened were lost). The main loop wakes at least every 0.25 s and sees the flag. A signal
+// repeated is the same request (`timeout` sends SIGTERM to the program and then to its process
+// group: a handler reset on the first let the second end the program before the saves); SIGKILL
+// ends it at once.
+volatile std::sig_atomic_t g_quit_signal = 0;
+
+extern "C" void on_quit_signal(int sig) {
+  g_quit_signal = sig;
+}
+
+void catch_quit_signals() {
+  struct sigaction sa {};
+  sa.sa_handler = &on_quit_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  for (const int sig : {SIGTERM, SIGHUP, SIGINT}) sigaction(sig, &sa, nullptr);
+}
 
 // Dropped file names arrive in a GLFW callback; they are queued here and
 // opened by the main loop (one window, so one queue).
@@ -901,7 +922,7 @@ int Gui::run() {
   }
 
   GLFWwindow* win = window_->window();
-  while (!quit_ && !glfwWindowShouldClose(win)) {
+  while (!quit_ && !glfwWindowShouldClose(win) && g_quit_signal == 0) {
     // Idle (nothing building, tracing or scripted): sleep until input
     // arrives; otherwise keep frames coming so results show up promptly.
     // One more frame after the workers go quiet picks up their last result.
@@ -989,7 +1010,8 @@ int Gui::run() {
   if (options_.use_settings)
     if (const std::string e = imgui_->save_layout(true); !e.empty()) std::fprintf(stderr, "accelviz: %s\n", e.c_str());
   report_errors();
-  return exit_code_;
+  // Ended by a signal: the status a shell expects of one (128 + its number), after the saves.
+  return g_quit_signal != 0 ? 128 + static_cast<int>(g_quit_signal) : exit_code_;
 }
 
 }  // namespace
@@ -1032,6 +1054,7 @@ int run_gui(const GuiOptions& options) {
     settings_error = std::move(loaded.error);
     o.save_settings = !loaded.leave_file;
   }
+  catch_quit_signals();
   Gui gui(o, std::move(settings), std::move(runner), settings_error);
   if (script_opens_first && !o.scene) gui.skip_initial_open();
   return gui.run();

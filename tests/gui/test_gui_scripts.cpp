@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <csignal>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -1028,4 +1029,21 @@ TEST_F(GuiScript, InstancesMetricAndFlattenWhatIfCommit) {
   EXPECT_EQ(committed["committed"], after["scene"]);
   committed.erase("committed");
   EXPECT_EQ(committed, what);
+}
+
+// A window ended by SIGTERM (a kill, a logout's SIGHUP, Ctrl-C) closes as its close button does: the
+// settings and the layout are saved on the way out (imgui.ini is written only at exit in a run this
+// short), and the status is 128 + 15. Killed outright, the changes since the last scene opened were lost.
+TEST_F(GuiScript, ATerminatedWindowSavesItsSettingsAndLayout) {
+  const fs::path config = dir_ / "interactive-config";
+  const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+  const std::string cmd = "XDG_CONFIG_HOME='" + config.string() + "' timeout --preserve-status -s TERM 8 '" +
+                          ACCELVIZ_BIN + "' 'builtin:teapot?size=300' > '" + out.string() + "' 2> '" + err.string() +
+                          "'";
+  const int status = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(status)) << read_file(err);
+  EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM) << read_file(err);
+  EXPECT_TRUE(fs::exists(config / "accelviz" / "imgui.ini")) << "the layout saved at exit; stderr: " << read_file(err);
+  const nlohmann::json settings = read_json(config / "accelviz" / "settings.json");
+  EXPECT_EQ(settings["last_scene"], "builtin:teapot?size=300");
 }
