@@ -131,6 +131,13 @@ class Device {
   RTCDevice get() const { return device_; }
   std::int64_t bytes() const { return bytes_.load(); }
 
+  /// Forgets a reported error (a build cancelled on purpose).
+  void clear() {
+    rtcGetDeviceError(device_);
+    std::lock_guard lock(mutex_);
+    message_.clear();
+  }
+
   /// Throws with Embree's own message when an error was reported.
   void check(const char* step) {
     const RTCError code = rtcGetDeviceError(device_);
@@ -333,7 +340,8 @@ std::string EmbreeAccelerator::ray_problem(const Ray& ray) const {
          "accelviz's own structures trace it)";
 }
 
-EmbreeAccelerator::EmbreeAccelerator(std::span<const Triangle> triangles, const EmbreeOptions& opts)
+EmbreeAccelerator::EmbreeAccelerator(std::span<const Triangle> triangles, const EmbreeOptions& opts,
+                                     const ProgressCallback& progress)
     : impl_(std::make_unique<Impl>(opts.threads, opts.isa)) {
   // Our checks first, outside Embree's build time.
   const std::size_t n = triangles.size();
@@ -390,8 +398,31 @@ EmbreeAccelerator::EmbreeAccelerator(std::span<const Triangle> triangles, const 
     rtcReleaseGeometry(geom);
     dev.check("triangle geometry");
   }
+  // Embree's progress, forwarded (its build threads call the monitor: one at a time here); false
+  // cancels the build, which then reports RTC_ERROR_CANCELLED.
+  struct Monitor {
+    const ProgressCallback* progress;
+    std::mutex mutex;
+    bool cancelled = false;
+    static bool call(void* ptr, double fraction) {
+      auto* m = static_cast<Monitor*>(ptr);
+      std::lock_guard lock(m->mutex);
+      if (!m->cancelled && !(*m->progress)(std::clamp(fraction, 0.0, 1.0))) m->cancelled = true;
+      return !m->cancelled;
+    }
+  } monitor{&progress};
+  if (progress) {
+    if (!progress(0.0)) throw BuildCancelled();
+    rtcSetSceneProgressMonitorFunction(impl_->scene, &Monitor::call, &monitor);
+  }
   rtcCommitScene(impl_->scene);
+  if (progress) rtcSetSceneProgressMonitorFunction(impl_->scene, nullptr, nullptr);
+  if (monitor.cancelled) {
+    dev.clear();
+    throw BuildCancelled();
+  }
   dev.check("rtcCommitScene");
+  if (progress) progress(1.0);
 
   stats_.build_ms = ms_since(t0);
   stats_.memory_bytes = static_cast<std::uint64_t>(std::max<std::int64_t>(0, dev.bytes())) +

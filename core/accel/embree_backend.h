@@ -70,7 +70,10 @@ class EmbreeAccelerator final : public Accelerator {
   /// Throws std::runtime_error ("embree: ...") when Embree reports an error,
   /// and when a triangle has a vertex coordinate beyond ±1.844e18, which
   /// Embree's build would silently leave out (the other structures keep it).
-  EmbreeAccelerator(std::span<const Triangle> triangles, const EmbreeOptions& opts = {});
+  /// PROGRESS (may be empty) hears Embree's own build progress (its scene progress monitor, calls
+  /// serialised); false cancels the build: BuildCancelled.
+  EmbreeAccelerator(std::span<const Triangle> triangles, const EmbreeOptions& opts = {},
+                    const ProgressCallback& progress = {});
   ~EmbreeAccelerator() override;
   EmbreeAccelerator(const EmbreeAccelerator&) = delete;
   EmbreeAccelerator& operator=(const EmbreeAccelerator&) = delete;

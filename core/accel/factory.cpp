@@ -75,12 +75,8 @@ std::unique_ptr<Accelerator> build_accelerator(std::string_view name, std::span<
 #ifdef ACCELVIZ_HAVE_EMBREE
     EmbreeOptions eo = opts.embree;
     if (eo.threads == 0) eo.threads = opts.threads;
-    // Embree's scene build cannot report progress through our callback; a
-    // cancel is honoured before it starts.
-    if (progress && !progress(0.0)) throw BuildCancelled();
-    auto accel = std::make_unique<EmbreeAccelerator>(triangles, eo);
-    if (progress) progress(1.0);
-    return accel;
+    // Embree's own build progress (its scene progress monitor) reaches `progress`; false cancels.
+    return std::make_unique<EmbreeAccelerator>(triangles, eo, progress);
 #else
     throw std::invalid_argument("structure 'embree': this build has no Embree backend (configure with "
                                 "-DACCELVIZ_WITH_EMBREE=ON and libembree-dev installed)");

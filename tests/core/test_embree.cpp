@@ -256,6 +256,34 @@ TEST(EmbreeOracle, SharedMeshesClosestAndAnyHitAgreeWithTheBvh) {
   if (tested == 0) GTEST_SKIP() << "no mesh of " << ACCELVIZ_SHARED_ASSETS << " present";
 }
 
+// Embree's build reports its progress to ours (its scene progress monitor), and a false from ours
+// cancels it: BuildCancelled (the factory said 0 % then 100 %, and a Cancel waited for the build).
+TEST(Embree, TheBuildReportsProgressAndCanBeCancelled) {
+  const std::vector<Triangle> tris = random_soup(200000, 5);
+  std::vector<double> heard;
+  const EmbreeAccelerator built(tris, EmbreeOptions{}, [&](double f) {
+    heard.push_back(f);
+    return true;
+  });
+  ASSERT_GE(heard.size(), 3u);
+  EXPECT_EQ(heard.front(), 0.0);
+  EXPECT_EQ(heard.back(), 1.0);
+  EXPECT_TRUE(std::any_of(heard.begin(), heard.end(), [](double f) { return f > 0.0 && f < 1.0; }))
+      << "Embree's own steps between 0 and 1";
+  for (const double f : heard) {
+    EXPECT_GE(f, 0.0);
+    EXPECT_LE(f, 1.0);
+  }
+  int calls = 0;
+  EXPECT_THROW(EmbreeAccelerator(tris, EmbreeOptions{}, [&](double f) { return ++calls < 2 || f <= 0.0; }),
+               BuildCancelled);
+  EXPECT_GE(calls, 2);
+  // A build after the cancelled one is whole: it answers as the first.
+  const EmbreeAccelerator again(tris);
+  for (const Ray& r : {Ray({0, 0, -5}, {0, 0, 1}), Ray({-5, 0.1f, 0.2f}, {1, 0, 0})})
+    EXPECT_EQ(again.closest_hit(r, {}).prim, built.closest_hit(r, {}).prim);
+}
+
 TEST(Embree, LeavesRayStatsAtZero) {
   // ... and says so: the views show n/a, not 0 nodes (Accelerator::inspectable()).
   const std::vector<Triangle> tris = random_soup(100, 3);
