@@ -91,6 +91,19 @@ TEST(AppScreenshot, SavingTwiceInTheSameSecondNeverOverwrites) {
   EXPECT_EQ(b.png.stem().string(), a.png.stem().string() + "-2");
 }
 
+// The PNG and its side-car are written both or neither: a side-car that cannot be written (here its
+// name is one byte over the file system's 255, the PNG's fits) left the PNG behind, and a script's
+// rerun was then refused by it.
+TEST(AppScreenshot, APictureWhoseSideCarFailsLeavesNothing) {
+  TempDir dir("shots");
+  const fs::path png = dir.path() / (std::string(251, 'x') + ".png");  // 255 bytes; the .json 256
+  const SavedScreenshot r = save_screenshot_as(png, test_frame(16, 8), test_info());
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.error.find(std::string(251, 'x') + ".json"), std::string::npos) << r.error;
+  EXPECT_FALSE(fs::exists(png)) << "no PNG without its side-car";
+  EXPECT_TRUE(fs::is_empty(dir.path())) << "no temporary left";
+}
+
 TEST(AppScreenshot, ExplicitPathRefusesExistingFiles) {
   TempDir dir("shots");
   const fs::path png = dir.path() / "figure.png";

@@ -34,14 +34,6 @@ std::string shell_quote(const std::string& s) {
   return q + "'";
 }
 
-// Creates `path` exclusively and writes `text`; "" or one line of error
-// (EEXIST is reported as "exists (not overwritten)").
-std::string write_text_exclusive(const fs::path& path, const std::string& text) {
-  const OutputWrite w = write_output_file(path.string(), {text}, /*overwrite=*/false);
-  if (w.exists) return path.string() + ": exists (not overwritten)";
-  return w.ok() ? std::string() : path.string() + ": " + w.problem;
-}
-
 std::string heatmap_display_name(HeatmapDisplay d) {
   switch (d) {
     case HeatmapDisplay::off:
@@ -54,37 +46,37 @@ std::string heatmap_display_name(HeatmapDisplay d) {
   return "off";
 }
 
-// Writes PNG then side-car, both exclusively; on EEXIST the caller moves on.
+// Writes the PNG and its side-car as one set (write_output_files): both or neither, each name
+// taken exclusively; on a taken name the caller moves on. A side-car that failed (a full disk) left
+// the PNG behind, and a script's rerun was then refused by it.
 SavedScreenshot write_pair(const ScreenshotPaths& paths, const RgbImage& frame, const ScreenshotInfo& info,
                            bool* name_taken) {
   SavedScreenshot r;
   r.png = paths.png;
   r.json = paths.json;
   *name_taken = false;
-  std::error_code ec;
-  // Both names are checked before anything is written, so a refused pair
-  // leaves no half behind; the exclusive creates below catch a late race.
+  // Both names are checked before the work, so a taken one costs no encoding; the exclusive
+  // creates below catch a late race.
   for (const fs::path& p : {paths.png, paths.json})
     if (accelviz::name_taken(p.string())) {
       *name_taken = true;
       r.error = p.string() + ": exists (not overwritten)";
       return r;
     }
+  std::string png;
   try {
-    write_png(paths.png.string(), add_caption(frame, screenshot_caption(info)), /*overwrite=*/false);
-  } catch (const FileExistsError&) {
-    // core's message for an existing file speaks of --force; say it the GUI's way.
-    *name_taken = true;
-    r.error = paths.png.string() + ": exists (not overwritten)";
-    return r;
+    png = encode_png(add_caption(frame, screenshot_caption(info)), paths.png.string());
   } catch (const std::exception& e) {
     r.error = e.what();
     return r;
   }
-  const std::string error = write_text_exclusive(paths.json, screenshot_sidecar(info, paths.png).dump(2) + "\n");
-  if (!error.empty()) {
-    r.error = error;
-    return r;  // the PNG stays: it is the user's picture, and it was new
+  const OutputWrite w = write_output_files(
+      {{paths.png.string(), std::move(png)}, {paths.json.string(), screenshot_sidecar(info, paths.png).dump(2) + "\n"}},
+      /*overwrite=*/false);
+  if (!w.ok()) {
+    *name_taken = w.exists;
+    r.error = w.path + ": " + (w.exists ? std::string("exists (not overwritten)") : w.problem);
+    return r;
   }
   r.ok = true;
   return r;
