@@ -692,7 +692,12 @@ RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
 // ---- PNG I/O ---------------------------------------------------------------------
 
 std::string png_name_problem(const std::string& path) {
-  return lower_extension(path) == ".png" ? std::string() : path + ": a PNG file's name must end in .png";
+  if (lower_extension(path) == ".png") return {};
+  // ".png" alone is a hidden file's name without an extension: the name before .png is missing.
+  std::string probe(1, 'x');  // appended, not "x" + name: GCC 12's -Wrestrict false positive
+  probe += std::filesystem::path(path).filename().string();
+  if (lower_extension(probe) == ".png") return path + ": a PNG file needs a name before .png";
+  return path + ": a PNG file's name must end in .png";
 }
 
 std::string encode_png(const RgbImage& img, const std::string& path) {

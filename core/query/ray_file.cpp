@@ -123,30 +123,31 @@ std::vector<Ray> read_rays(const std::string& path) {
     const float tmin = get_f32(p + 12);
     const glm::vec3 d(get_f32(p + 16), get_f32(p + 20), get_f32(p + 24));
     const float tmax = get_f32(p + 28);
-    const std::string where = "ray " + std::to_string(i) + ": ";
-    if (std::isnan(o.x) || std::isnan(o.y) || std::isnan(o.z)) fail(path, where + "NaN in origin");
-    if (std::isnan(d.x) || std::isnan(d.y) || std::isnan(d.z)) fail(path, where + "NaN in direction");
-    if (std::isinf(o.x) || std::isinf(o.y) || std::isinf(o.z)) fail(path, where + "infinite origin");
-    if (std::isinf(d.x) || std::isinf(d.y) || std::isinf(d.z)) fail(path, where + "infinite direction");
-    if (d.x == 0.0f && d.y == 0.0f && d.z == 0.0f) fail(path, where + "zero direction");
+    // Built only for a message: every valid record paid for the string.
+    const auto where = [i] { return "ray " + std::to_string(i) + ": "; };
+    if (std::isnan(o.x) || std::isnan(o.y) || std::isnan(o.z)) fail(path, where() + "NaN in origin");
+    if (std::isnan(d.x) || std::isnan(d.y) || std::isnan(d.z)) fail(path, where() + "NaN in direction");
+    if (std::isinf(o.x) || std::isinf(o.y) || std::isinf(o.z)) fail(path, where() + "infinite origin");
+    if (std::isinf(d.x) || std::isinf(d.y) || std::isinf(d.z)) fail(path, where() + "infinite direction");
+    if (d.x == 0.0f && d.y == 0.0f && d.z == 0.0f) fail(path, where() + "zero direction");
     // Distances along a direction this short overflow float (t = distance / length): the structures
     // disagreed on such a ray, a miss in some and a hit at t = inf in others.
     if (std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)}) < kMinRayDirection) {
       char text[128];
       std::snprintf(text, sizeof text, "direction (%g, %g, %g) is shorter than %g", d.x, d.y, d.z, kMinRayDirection);
-      fail(path, where + text + ": distances along it overflow float");
+      fail(path, where() + text + ": distances along it overflow float");
     }
-    if (std::isnan(tmin) || std::isnan(tmax)) fail(path, where + "NaN in tmin/tmax");
+    if (std::isnan(tmin) || std::isnan(tmax)) fail(path, where() + "NaN in tmin/tmax");
     // Behind the origin the structures disagreed (a hit at t = -1 in some, t = +1 or a miss in others):
     // a ray covers t >= 0 from its origin; a segment behind it is a ray from a point further back.
     if (tmin < 0.0f) {
       char text[160];
       std::snprintf(text, sizeof text, "tmin %g is negative (rays start at their origin: move the origin back instead)",
                     static_cast<double>(tmin));
-      fail(path, where + text);
+      fail(path, where() + text);
     }
     if (tmin > tmax)
-      fail(path, where + "tmin > tmax (" + std::to_string(tmin) + " > " + std::to_string(tmax) + ")");
+      fail(path, where() + "tmin > tmax (" + std::to_string(tmin) + " > " + std::to_string(tmax) + ")");
     rays.emplace_back(o, d, tmin, from_file_t(tmax));
   }
   return rays;
@@ -160,11 +161,11 @@ std::vector<HitRecord> read_hits(const std::string& path) {
   for (std::uint64_t i = 0; i < count; ++i) {
     const std::uint8_t* p = payload.data() + i * kHitRecordBytes;
     HitRecord h{get_u32(p), get_f32(p + 4)};
-    const std::string where = "hit " + std::to_string(i) + ": ";
-    if (std::isnan(h.t)) fail(path, where + "NaN t");
+    const auto where = [i] { return "hit " + std::to_string(i) + ": "; };
+    if (std::isnan(h.t)) fail(path, where() + "NaN t");
     const bool miss_t = h.t >= kRayFileUnbounded;
     if (h.valid() == miss_t)
-      fail(path, where + (h.valid() ? "a primitive id with the miss t 1e30" : "the miss id 0xFFFFFFFF with a finite t"));
+      fail(path, where() + (h.valid() ? "a primitive id with the miss t 1e30" : "the miss id 0xFFFFFFFF with a finite t"));
     h.t = from_file_t(h.t);
     hits.push_back(h);
   }

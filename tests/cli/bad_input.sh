@@ -105,6 +105,7 @@ expect 1 "only 'tlas' can hold this scene" -- calibrate --scene "$island" --repe
 
 # A PNG under another format's name (or none): refused before any work, nothing written.
 expect 2 "$tmp/heat.jpg: a PNG file's name must end in .png" -- render 'builtin:soup?size=10' --out "$tmp/heat.jpg"
+expect 2 "$tmp/.png: a PNG file needs a name before .png" -- render 'builtin:soup?size=10' --out "$tmp/.png"
 expect 2 "$tmp/heat: a PNG file's name must end in .png" -- render 'builtin:soup?size=10' --out "$tmp/heat" \
   --compare 'buckets=4'
 for f in heat.jpg heat heat-a heat-b heat-diff; do
