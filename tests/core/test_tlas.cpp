@@ -498,6 +498,49 @@ TEST(Tlas, ATinyMirroredInstanceIsMirrored) {
                                          << ")";
 }
 
+// The ray carried into an instance's space keeps its aim (instance_ray): from far away along an axis
+// (1e8: the float rotation of the origin lost the units that aim at a 2-unit cube, and the instance
+// was missed from there on, every other structure hitting), and into a tiny instance (1e-30: a 1e9
+// direction became infinite in its space, and the BLAS said a hit at t = 0).
+TEST(Tlas, FarOriginsAndExtremeScalesKeepTheirAim) {
+  Mesh cube;
+  cube.positions = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}};
+  cube.indices = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                  {3, 7, 6}, {3, 6, 2}, {0, 4, 7}, {0, 7, 3}, {1, 2, 6}, {1, 6, 5}};
+  const auto scene_with = [&](const glm::mat4& m) {
+    Scene s;
+    s.meshes.push_back(cube);
+    Instance inst;
+    inst.mesh = 0;
+    inst.transform = m;
+    s.instances.push_back(inst);
+    s.flatten();
+    return s;
+  };
+  const auto agree = [](const Accelerator& a, const Accelerator& b, const Ray& r, const std::string& what) {
+    const Hit x = a.closest_hit(r, QueryOptions{}), y = b.closest_hit(r, QueryOptions{});
+    ASSERT_TRUE(y.valid()) << what << ": the flattened BVH hits";
+    EXPECT_TRUE(x.valid()) << what;
+    if (!x.valid()) return;
+    EXPECT_NEAR(x.t, y.t, 1e-5 * y.t) << what;
+    EXPECT_TRUE(a.any_hit(r, QueryOptions{})) << what;
+  };
+  const Scene rotated = scene_with(glm::rotate(glm::mat4(1.0f), glm::radians(30.0f), glm::vec3(0, 1, 0)));
+  const Tlas two(rotated);
+  const Bvh flat(rotated.triangles);
+  for (const float far : {1e3f, 3e7f, 1e8f, 1e12f, 1e14f})
+    for (const glm::vec2 aim : {glm::vec2(0.1f, 0.1f), glm::vec2(-0.7f, 0.4f), glm::vec2(0.5f, -0.9f)}) {
+      agree(two, flat, Ray({aim.x, aim.y, -far}, {0, 0, 1}), "from z = -" + std::to_string(far));
+      agree(two, flat, Ray({far, aim.x, aim.y}, {-1, 0, 0}), "from x = " + std::to_string(far));
+    }
+  const Scene tiny = scene_with(glm::scale(glm::mat4(1.0f), glm::vec3(1e-30f)));
+  const Tlas small(tiny);
+  const Bvh small_flat(tiny.triangles);
+  agree(small, small_flat, Ray({-1.0f, 3e-31f, 2e-31f}, {1e9f, 0, 0}), "a 1e9 direction into a 1e-30 instance");
+  const Hit h = small.closest_hit(Ray({-1.0f, 3e-31f, 2e-31f}, {1e9f, 0, 0}), QueryOptions{});
+  EXPECT_GT(h.t, 0.0f) << "not a hit at the origin";
+}
+
 // A hit names its world triangle with 32 bits: a scene of 2^32 or more instanced triangles is refused
 // in one line before any BLAS is built (the ids wrapped, and a hit could read as a miss).
 TEST(Tlas, MoreInstancedTrianglesThanHitIdsIsRefused) {

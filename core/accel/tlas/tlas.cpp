@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -325,9 +326,74 @@ struct Counters {
 
 }  // namespace
 
-template <bool AnyHit>
+/// A world ray carried into an instance's space: world t = shift + scale · local t.
+struct InstanceRay {
+  Ray ray;
+  double shift = 0.0;
+  double scale = 1.0;
+  float world_t(float local_t) const {
+    return shift == 0.0 && scale == 1.0 ? local_t : static_cast<float>(shift + scale * static_cast<double>(local_t));
+  }
+};
+
+/// RAY's stretch [ray.tmin, tmax] in INST's space, so that far origins and extreme transforms keep
+/// their aim (before, the origin went through the float inverse as it was, and t kept its meaning):
+///  - an origin more than 1024 of the instance's world diagonals from the coordinate origin is first
+///    moved along the ray (in double) to one diagonal before the instance's world box: a rotation
+///    mixed the far coordinate (1e8) into the others in float, whose spacing there (8) outweighed
+///    the few units that aim at the instance, and whole instances were missed. Only while double
+///    places the moved origin to a small part of a diagonal (|origin| below 2^48 diagonals, e.g.
+///    5e14 for a 2-unit cube); beyond that the ray goes in as it is;
+///  - an object-space direction beyond 2^±40 is scaled by a power of two: a 1e-30 instance made a
+///    1e9 direction infinite, and the BLAS reported hits at t = 0.
+/// Ordinary rays take neither step and the same arithmetic as before (the product in double, then
+/// rounded, differs from the float product by at most a rounding).
+InstanceRay instance_ray(const TlasInstance& inst, const Ray& ray, float tmax) {
+  InstanceRay r;
+  glm::dvec3 o(ray.origin);
+  const glm::dvec3 d(ray.direction);
+  double tmin = ray.tmin, tmax_d = tmax;
+  const glm::vec3 extent = inst.world_bounds.extent();
+  const double diag = glm::length(glm::dvec3(extent));
+  const double far = std::max({std::abs(o.x), std::abs(o.y), std::abs(o.z)});
+  SlabInterval iv;
+  if (far > 1024.0 * diag && far < 0x1p48 * diag && intersect_slab(inst.world_bounds, ray.origin, ray.inv_dir, ray.tmin, tmax, iv)) {
+    const double shift = static_cast<double>(iv.t_entry) - diag / glm::length(d);
+    if (shift > 0.0) {
+      r.shift = shift;
+      o += shift * d;
+      tmin = std::max(0.0, tmin - shift);  // before the shift lies nothing of the instance
+      tmax_d -= shift;
+    }
+  }
+  const glm::dmat4 to_object(inst.to_object);
+  const glm::dvec3 lo = glm::dvec3(to_object * glm::dvec4(o, 1.0));
+  glm::dvec3 ld = glm::dmat3(to_object) * d;
+  const double m = std::max({std::abs(ld.x), std::abs(ld.y), std::abs(ld.z)});
+  if (m > 0x1p40 || (m > 0.0 && m < 0x1p-40)) {
+    int e = 0;
+    std::frexp(m, &e);
+    // ld·s has its largest component in [0.5, 1); a point lo + u·(ld·s) is lo + (u·s)·ld, so world
+    // t = shift + s·u and the stretch in u is the stretch in t over s.
+    const double s = std::ldexp(1.0, -e);
+    ld *= s;
+    r.scale = s;
+    tmin /= s;
+    tmax_d /= s;
+  }
+  const auto to_float = [](double t) {
+    return t >= static_cast<double>(std::numeric_limits<float>::max()) ? kInfinity : static_cast<float>(t);
+  };
+  r.ray = Ray(glm::vec3(lo), glm::vec3(ld), to_float(tmin), to_float(tmax_d));
+  return r;
+}
+
+/// The two-level walk. Collect false (no counter asked for: the fast path) makes every counter
+/// pointer below a null the compiler knows, so no counting branch is left in that instance.
+template <bool AnyHit, bool Collect>
 static Hit traverse_two_level(const Tlas& t, std::span<const BvhNode> nodes, std::span<const std::uint32_t> prims,
-                              const Ray& ray, const QueryOptions& qo, const Counters& c) {
+                              const Ray& ray, const QueryOptions& qo, const Counters& counters) {
+  const Counters c = Collect ? counters : Counters{nullptr, nullptr, nullptr};
   Hit best;
   if (nodes.empty()) return best;
   float tmax = ray.tmax;
@@ -361,10 +427,9 @@ static Hit traverse_two_level(const Tlas& t, std::span<const BvhNode> nodes, std
     for (std::uint32_t k = node.index; k < node.index + node.count; ++k) {
       const std::uint32_t id = prims[k];
       const TlasInstance& inst = instances[id];
-      // Into object space: t keeps its meaning (direction not renormalised).
-      const glm::vec3 o(inst.to_object * glm::vec4(ray.origin, 1.0f));
-      const glm::vec3 d(glm::mat3(inst.to_object) * ray.direction);
-      const Ray local(o, d, ray.tmin, tmax);
+      // Into object space (instance_ray: far origins moved near, extreme directions scaled).
+      const InstanceRay ir = instance_ray(inst, ray, tmax);
+      const Ray& local = ir.ray;
       const Bvh& blas = t.blas(inst.blas);
       RayStats ls;
       RayStats* lsp = c.any() ? &ls : nullptr;
@@ -394,8 +459,10 @@ static Hit traverse_two_level(const Tlas& t, std::span<const BvhNode> nodes, std
           for (VisitStep s : lt.steps)
             if (s.kind == VisitStep::Kind::prim_hit || s.kind == VisitStep::Kind::prim_miss) {
               s.id = static_cast<std::uint32_t>(inst.first_prim + s.id);
+              if (std::isfinite(s.t_entry)) s.t_entry = ir.world_t(s.t_entry);  // a hit's t, in world units
               c.trace->steps.push_back(s);
             }
+        if (h.valid()) h.t = ir.world_t(h.t);
         if (h.valid() && h.t <= tmax) {
           tmax = h.t;
           h.prim = static_cast<std::uint32_t>(inst.first_prim + h.prim);
@@ -412,16 +479,22 @@ static Hit traverse_two_level(const Tlas& t, std::span<const BvhNode> nodes, std
 }
 
 Hit Tlas::closest_hit(const Ray& ray, const QueryOptions& opts, RayStats* stats, VisitTrace* trace) const {
-  return traverse_two_level<false>(*this, tlas_nodes_, tlas_prims_, ray, opts, Counters{stats, nullptr, trace});
+  const Counters c{stats, nullptr, trace};
+  return c.any() ? traverse_two_level<false, true>(*this, tlas_nodes_, tlas_prims_, ray, opts, c)
+                 : traverse_two_level<false, false>(*this, tlas_nodes_, tlas_prims_, ray, opts, c);
 }
 
 bool Tlas::any_hit(const Ray& ray, const QueryOptions& opts, RayStats* stats) const {
-  return traverse_two_level<true>(*this, tlas_nodes_, tlas_prims_, ray, opts, Counters{stats, nullptr, nullptr})
+  const Counters c{stats, nullptr, nullptr};
+  return (c.any() ? traverse_two_level<true, true>(*this, tlas_nodes_, tlas_prims_, ray, opts, c)
+                  : traverse_two_level<true, false>(*this, tlas_nodes_, tlas_prims_, ray, opts, c))
       .valid();
 }
 
 Hit Tlas::closest_hit_two_level(const Ray& ray, const QueryOptions& opts, TwoLevelRayStats* stats) const {
-  return traverse_two_level<false>(*this, tlas_nodes_, tlas_prims_, ray, opts, Counters{nullptr, stats, nullptr});
+  const Counters c{nullptr, stats, nullptr};
+  return c.any() ? traverse_two_level<false, true>(*this, tlas_nodes_, tlas_prims_, ray, opts, c)
+                 : traverse_two_level<false, false>(*this, tlas_nodes_, tlas_prims_, ray, opts, c);
 }
 
 TlasUpdateStats Tlas::update_transforms(std::span<const glm::mat4> to_world) {
