@@ -213,6 +213,37 @@ TEST(Grid, RaysStartingInsideAndOutside) {
   EXPECT_FALSE(g.any_hit(Ray({5, 0, 0}, {-1, 0, 0}, 0.0f, 2.0f), {}));
 }
 
+// Named case: axis-aligned rays from far away (3e7 .. 1e12 scene sizes) find what brute force finds,
+// at the same float t up to its rounding there. The float entry t there is rounded by whole units, which put the entry point
+// and the first cell at the grid's far side: every such ray missed.
+TEST(Grid, RaysFromFarAwayEnterAtTheRightCell) {
+  const Scene s = soup(4, 400, 0.1f);
+  GridOptions o;
+  o.resolution = {8, 8, 8};
+  const Grid g(s, o);
+  const BruteForce bf(s);
+  Rng rng{9};
+  int hits = 0;
+  for (const float far : {3e7f, 1e9f, 1e12f})
+    for (int i = 0; i < 200; ++i) {
+      const glm::vec3 p = rng.in_box(glm::vec3(-1), glm::vec3(1));
+      const int axis = i % 3;
+      glm::vec3 origin = p, dir(0.0f);
+      origin[axis] = (i % 2 ? far : -far);
+      dir[axis] = i % 2 ? -1.0f : 1.0f;
+      const Ray r(origin, dir);
+      const Hit a = g.closest_hit(r, {}), b = bf.closest_hit(r, {});
+      ASSERT_EQ(a.valid(), b.valid()) << far << " ray " << i;
+      if (!b.valid()) continue;
+      ++hits;
+      // Within a few float steps of t there (2 at 3e7): which of two triangles that close float
+      // cannot order is a near tie.
+      EXPECT_NEAR(a.t, b.t, 4e-7 * b.t) << far << " ray " << i;
+      EXPECT_TRUE(g.any_hit(r, {})) << far << " ray " << i;
+    }
+  EXPECT_GT(hits, 100) << "the rays must mostly hit for the check to mean anything";
+}
+
 // Named case: rays through cell edges and corners exactly, and along cell
 // planes. On a 4^3 grid over [0, 4]^3 the cell planes are the integers;
 // rays along the body diagonal pass through every cell corner on their way,

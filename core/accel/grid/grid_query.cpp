@@ -2,6 +2,7 @@
 // next boundary distances recomputed from the cell index at every step
 // (instead of accumulated by adding t_delta) so that rounding does not
 // drift along long rays.
+#include <algorithm>
 #include <type_traits>
 
 #include "core/accel/grid/grid.h"
@@ -24,11 +25,21 @@ Hit Grid::traverse(const Ray& ray, const QueryOptions& qo, RayStats* stats, Visi
   // 2. Starting cell, step direction and the distance to the next boundary
   //    per axis. An axis with a ±0 direction component (inverse infinite) or
   //    a single cell is never stepped along: its next boundary is at +inf.
-  const glm::vec3 entry = ray.origin + iv.t_entry * ray.direction;
+  //    The entry point in double, from the slab distances in double: the float entry t of a far
+  //    origin (3e7 away) is rounded by whole units, which put the entry point, and the first cell,
+  //    cells away (at the grid's far side: every ray from there missed).
+  double t0 = ray.tmin;
+  for (int a = 0; a < 3; ++a)
+    if (ray.direction[a] != 0.0f) {
+      const double lo = (static_cast<double>(bounds_.lo[a]) - ray.origin[a]) / ray.direction[a];
+      const double hi = (static_cast<double>(bounds_.hi[a]) - ray.origin[a]) / ray.direction[a];
+      t0 = std::max(t0, std::min(lo, hi));
+    }
+  const glm::dvec3 entry = glm::dvec3(ray.origin) + t0 * glm::dvec3(ray.direction);
   int idx[3], step[3];
   float t_next[3];
   for (int a = 0; a < 3; ++a) {
-    idx[a] = cell_of(entry[a], a);
+    idx[a] = cell_of(static_cast<float>(entry[a]), a);
     if (std::isinf(ray.inv_dir[a]) || res_[a] == 1) {
       step[a] = 0;
       t_next[a] = kInfinity;
