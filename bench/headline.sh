@@ -26,9 +26,11 @@
 #   HEADLINE_SOUP     the soup's scene (default builtin:soup?size=10000000; "" skips it)
 #   HEADLINE_THREADS  thread counts (default "1 2")
 #   HEADLINE_REPEAT   runs per figure of the meshes (default 5); the soup's is 3 unless this is lower
-#   HEADLINE_FORCE    1: replace the results of an earlier run in OUT_DIR. Without it an OUT_DIR that
-#                     holds any (N-robust.json, N-fast.json, N-default.json, table.md) is refused before
-#                     the first run, and nothing in it changes.
+#   HEADLINE_FORCE    1: write over the results of an earlier run in OUT_DIR, name by name (the names
+#                     this run writes; an earlier run's other N-*.json stay, beside a table.md of this
+#                     run only). Without it an OUT_DIR that holds any (N-robust.json, N-fast.json,
+#                     N-default.json, table.md) is refused before the first run, and nothing in it
+#                     changes.
 #
 # Each result is written to a temporary in OUT_DIR and takes its name only when its run succeeded: a
 # run that fails leaves the earlier result (if any) as it was.

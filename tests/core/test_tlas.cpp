@@ -560,7 +560,7 @@ TEST(Tlas, MoreInstancedTrianglesThanHitIdsIsRefused) {
     ADD_FAILURE() << "built";
   } catch (const std::invalid_argument& e) {
     EXPECT_EQ(std::string(e.what()),
-              "tlas: 4294967296 instanced triangles, more than the 4294967294 world triangle ids a hit can name "
+              "tlas: 4294967296 instanced triangles, more than the 4294967295 world triangle ids a hit can name "
               "(32-bit)");
   }
 }

@@ -108,9 +108,9 @@ Tlas::Tlas(const Scene& scene, const TlasOptions& opts, const ProgressCallback& 
   validate(opts_.tlas);
   // A hit names its world triangle with 32 bits (kInvalidId: a miss); beyond that the ids wrapped
   // and a hit could read as a miss. Checked before any BLAS is built.
-  if (const std::uint64_t n = scene.instanced_triangle_count(); n >= kInvalidId)
+  if (const std::uint64_t n = scene.instanced_triangle_count(); n > kInvalidId)  // ids 0 .. n - 1 < kInvalidId
     throw std::invalid_argument("tlas: " + std::to_string(n) +
-                                " instanced triangles, more than the 4294967294 world triangle ids a hit can name "
+                                " instanced triangles, more than the 4294967295 world triangle ids a hit can name "
                                 "(32-bit)");
   build_blas_list(scene, progress);
   // Instances, with the world primitive ids flattening gives (or would give).
