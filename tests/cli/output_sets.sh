@@ -75,6 +75,17 @@ first_fits_kib() {
   done
   echo 0
 }
+# failed_set_leaves WHAT DIR N KIB ARGS...: accelviz ARGS -f under a KIB KiB limit fails, and leaves
+# DIR's N files as they were, no temporary, and no path printed.
+failed_set_leaves() {
+  local what="$1" dir="$2" n="$3" kib="$4" before
+  shift 4
+  before="$(listing "$dir")"
+  limited "$kib" "$@" -f > "$tmp/stdout" 2> "$tmp/stderr" && fail "$what wrote past the file-size limit"
+  [ "$before" = "$(listing "$dir")" ] || fail "a failed $what left a mixed set"
+  [ ! -s "$tmp/stdout" ] || fail "a failed $what printed paths: $(cat "$tmp/stdout")"
+  [ "$(ls -A "$dir" | wc -l)" -eq "$n" ] || fail "temporaries left: $(ls -A "$dir")"
+}
 # Brute force's image is one colour (every ray tests every triangle): a small PNG beside the BVH's.
 r=(render 'builtin:teapot?size=400' --size 160x120 -m prims --caption none --threads 1)
 mkdir "$tmp/probe" "$tmp/several"
@@ -85,12 +96,8 @@ if [ "$(stat -c %s "$tmp/probe/T-brute.png")" -gt "$(stat -c %s "$tmp/probe/T-bv
 kib=$(first_fits_kib "$tmp/probe/T-${pair[0]}.png" "$tmp/probe/T-${pair[1]}.png")
 if [ "$kib" -gt 0 ]; then
   "$bin" -q "${r[@]}" -s brute,bvh -o "$tmp/several/T.png" > /dev/null
-  before="$(listing "$tmp/several")"
-  limited "$kib" "${r[@]}" -s "${pair[0]},${pair[1]}" --colormap inferno -o "$tmp/several/T.png" -f \
-    > "$tmp/stdout" 2> "$tmp/stderr" && fail "render -s wrote past the file-size limit"
-  [ "$before" = "$(listing "$tmp/several")" ] || fail "a failed render -s ${pair[0]},${pair[1]} left a mixed set"
-  [ ! -s "$tmp/stdout" ] || fail "a failed render -s printed paths: $(cat "$tmp/stdout")"
-  [ "$(ls -A "$tmp/several" | wc -l)" -eq 2 ] || fail "temporaries left: $(ls -A "$tmp/several")"
+  failed_set_leaves "render -s ${pair[0]},${pair[1]}" "$tmp/several" 2 "$kib" \
+    "${r[@]}" -s "${pair[0]},${pair[1]}" --colormap inferno -o "$tmp/several/T.png"
 else
   echo "skip: render -s: the two images' sizes round to the same KiB"
 fi
@@ -100,12 +107,8 @@ mkdir "$tmp/cmp"
 kib=$(first_fits_kib "$tmp/probe/C-a.png" "$tmp/probe/C-b.png" "$tmp/probe/C-diff.png")
 if [ "$kib" -gt 0 ]; then
   "$bin" -q "${r[@]}" -s brute --compare structure=bvh -o "$tmp/cmp/C.png" > /dev/null
-  before="$(listing "$tmp/cmp")"
-  limited "$kib" "${r[@]}" -s brute --compare structure=bvh --colormap inferno -o "$tmp/cmp/C.png" -f \
-    > "$tmp/stdout" 2> "$tmp/stderr" && fail "render --compare wrote past the file-size limit"
-  [ "$before" = "$(listing "$tmp/cmp")" ] || fail "a failed render --compare left a mixed set"
-  [ ! -s "$tmp/stdout" ] || fail "a failed render --compare printed paths: $(cat "$tmp/stdout")"
-  [ "$(ls -A "$tmp/cmp" | wc -l)" -eq 3 ] || fail "temporaries left: $(ls -A "$tmp/cmp")"
+  failed_set_leaves "render --compare" "$tmp/cmp" 3 "$kib" \
+    "${r[@]}" -s brute --compare structure=bvh --colormap inferno -o "$tmp/cmp/C.png"
 else
   echo "skip: render --compare: image A is not smaller than B or the difference"
 fi
