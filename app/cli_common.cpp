@@ -271,8 +271,19 @@ std::string unwritable_folder(const fs::path& dir) {
 
 }  // namespace
 
+/// "" unless `path` is a symbolic link whose target does not exist: then the problem, said before the
+/// work (a write through it failed only after the work, "cannot create directory" without a reason).
+static std::string dangling_link_problem(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::is_symlink(fs::symlink_status(path, ec)) || fs::exists(path, ec)) return {};
+  const fs::path target = fs::read_symlink(path, ec);
+  return "is a symbolic link to " + target.string() + ", which does not exist";
+}
+
 void check_output_dir(const std::string& dir, const OutputDirFiles& files, bool force) {
   if (dir.empty()) throw std::runtime_error("the output folder's name is empty");
+  if (const std::string problem = dangling_link_problem(dir); !problem.empty())
+    throw std::runtime_error(dir + ": " + problem);
   if (const std::string problem = name_length_problem(dir); !problem.empty())
     throw std::runtime_error(dir + ": " + problem);
   bool holds = false;
@@ -313,6 +324,15 @@ void check_output_path(const std::string& path, bool force) {
   if (const std::string problem = output_path_problem(path); !problem.empty())
     throw std::runtime_error(path + ": " + problem);
   if (!force && fs::exists(p, ec)) throw std::runtime_error(path + ": exists (use --force to overwrite)");
+  // With --force a symbolic link is written through: the file it names must be able to exist.
+  if (force && fs::is_symlink(fs::symlink_status(p, ec))) {
+    fs::path target = fs::read_symlink(p, ec);
+    if (!ec && target.is_relative()) target = (p.has_parent_path() ? p.parent_path() : fs::path(".")) / target;
+    const fs::path target_dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+    if (!ec && !fs::is_directory(target_dir, ec))
+      throw std::runtime_error(path + ": is a symbolic link to " + target.string() + ", whose directory " +
+                               target_dir.string() + " does not exist");
+  }
   const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
   if (!fs::is_directory(dir, ec)) throw std::runtime_error(path + ": directory " + dir.string() + " does not exist");
   if (const std::string problem = unwritable_folder(dir); !problem.empty())

@@ -178,6 +178,15 @@ expect 1 "$tmp/UP.GLB: exists (use --force to overwrite)" -- export 'builtin:sou
 "$accelviz" -q export 'builtin:soup?size=20' "$tmp/UP.GLB" -f >/dev/null || { echo "FAIL: export -f"; fail=1; }
 expect 2 "$tmp/.glb: the output's name must end in .glb or .gltf" -- export 'builtin:soup?size=20' "$tmp/.glb"
 expect 2 "$tmp/x.obj: the output's name must end in .glb or .gltf" -- export 'builtin:soup?size=20' "$tmp/x.obj"
+
+# Written through a symbolic link (-f) into a folder that does not exist, or into an output folder
+# that is a dangling link: said before the work (the writes failed after it, one without a reason).
+ln -s "$tmp/no-such-dir/x.png" "$tmp/through.png"
+expect 1 "$tmp/through.png: is a symbolic link to $tmp/no-such-dir/x.png, whose directory $tmp/no-such-dir does not exist" \
+  -- render 'builtin:soup?size=10' --size 8x8 -o "$tmp/through.png" -f
+ln -s "$tmp/no-such-dir" "$tmp/dangling-dir"
+expect 1 "$tmp/dangling-dir: is a symbolic link to $tmp/no-such-dir, which does not exist" \
+  -- sweep 'builtin:soup?size=10' --param buckets=2,4 --size 8x8 --repeat 1 --out "$tmp/dangling-dir"
 [ ! -e "$tmp/.glb" ] && [ ! -e "$tmp/x.obj" ] || { echo "FAIL: export wrote under a refused name"; fail=1; }
 
 # Missing output directory.
