@@ -248,7 +248,8 @@ AppState::FrameUpdate AppState::update(int view_width, int view_height) {
   if (const auto [failed, why] = heatmaps_.failure();
       failed != 0 && failed != heatmap_failure_shown_ && failed == heatmaps_.latest_request()) {
     heatmap_failure_shown_ = failed;
-    set_error("heatmap not traced: " + why);
+    // Said once while it stays the same (each camera move is a new job that fails the same way).
+    if (std::string e = "heatmap not traced: " + why; e != error_) set_error(std::move(e));
   }
   last_gpu_step_ms_ = step_ms;
   return u;
