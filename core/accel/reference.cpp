@@ -40,9 +40,17 @@ ReferenceTriangleHit intersect_reference(const Ray& ray, const Triangle& tri, do
   // 3. Edge functions (signed areas), exact enough in double, with the size
   //    of the rounding a float evaluation could put on each.
   const double e[3] = {x[2] * y[1] - y[2] * x[1], x[0] * y[2] - y[0] * x[2], x[1] * y[0] - y[1] * x[0]};
-  const double tol[3] = {kEdgeRoundingScale * (mx[2] * my[1] + my[2] * mx[1]),
-                         kEdgeRoundingScale * (mx[0] * my[2] + my[0] * mx[2]),
-                         kEdgeRoundingScale * (mx[1] * my[0] + my[1] * mx[0])};
+  // The float test's shear constants sx, sy underflow (a denormal direction component beside a
+  // large one): an absolute rounding of up to float's smallest step, times |p_z|, on each sheared
+  // coordinate, which the relative term above does not cover (every float structure was condemned
+  // on such rays). u[i] bounds it; in e = x_a y_b - y_a x_b it adds u_a my_b + mx_a u_b + ...
+  double u[3];
+  for (int i = 0; i < 3; ++i)
+    u[i] = static_cast<double>(std::numeric_limits<float>::denorm_min()) * std::abs(p[i][kz]);
+  const auto under = [&](int a, int b) { return u[a] * (my[b] + mx[b]) + u[b] * (mx[a] + my[a]) + 2.0 * u[a] * u[b]; };
+  const double tol[3] = {kEdgeRoundingScale * (mx[2] * my[1] + my[2] * mx[1]) + under(2, 1),
+                         kEdgeRoundingScale * (mx[0] * my[2] + my[0] * mx[2]) + under(0, 2),
+                         kEdgeRoundingScale * (mx[1] * my[0] + my[1] * mx[0]) + under(1, 0)};
   const bool neg = e[0] < 0.0 || e[1] < 0.0 || e[2] < 0.0;
   const bool pos = e[0] > 0.0 || e[1] > 0.0 || e[2] > 0.0;
   const double det = e[0] + e[1] + e[2];

@@ -108,6 +108,24 @@ TEST(Classifier, HitWhereReferenceMissesClearlyIsMismatch) {
   EXPECT_EQ(classify_closest(tris, ray, ref, got), Verdict::mismatched_prim);
 }
 
+// A direction with denormal components (1.4e-45 beside -1000): the float test's shear constants
+// (d.x / d.y, d.z / d.y) underflow to 0, so it walks exactly along the mesh's outer edge at z = 0 and
+// hits; the reference, in double, puts the ray 4e-50 outside it. Underflow is an absolute rounding
+// the relative tolerance did not cover: every float structure, brute force too, was condemned
+// (found by an audit on a lattice of 1/8 squares).
+TEST(Classifier, DenormalDirectionComponentsRoundAsTheFloatTestDoes) {
+  const std::vector<Triangle> tris = {{{0, 0.25f, 0}, {0.125f, 0.25f, 0}, {0, 0.25f, 0.125f}}};
+  const Ray ray({0.03125f, 0.28125f, 0.0f}, {1.4e-45f, -1000.0f, -1.4e-45f});
+  ASSERT_GT(ray.direction.x, 0.0f) << "the denormal survives";
+  const BruteForce brute(tris);
+  const Hit got = brute.closest_hit(ray, {});
+  ASSERT_TRUE(got.valid()) << "the float test hits on the edge";
+  const ReferenceHit ref = ReferenceTracer(tris).closest_hit(ray);
+  const Verdict v = classify_closest(tris, ray, ref, got);
+  EXPECT_TRUE(v == Verdict::match || v == Verdict::near_tie) << to_string(v);
+  EXPECT_NE(classify_any(ref, true), Verdict::mismatched_prim) << "the any hit too";
+}
+
 TEST(Classifier, AnyHit) {
   ReferenceHit miss;
   EXPECT_EQ(classify_any(miss, false), Verdict::match);
