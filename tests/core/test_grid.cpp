@@ -213,7 +213,7 @@ TEST(Grid, RaysStartingInsideAndOutside) {
   EXPECT_FALSE(g.any_hit(Ray({5, 0, 0}, {-1, 0, 0}, 0.0f, 2.0f), {}));
 }
 
-// Named case: axis-aligned rays from far away (3e7 .. 1e12 scene sizes) find what brute force finds,
+// Named case: axis-aligned rays from far away (3e7 .. 1e25 scene sizes) find what brute force finds,
 // at the same float t up to its rounding there. The float entry t there is rounded by whole units, which put the entry point
 // and the first cell at the grid's far side: every such ray missed.
 TEST(Grid, RaysFromFarAwayEnterAtTheRightCell) {
@@ -224,13 +224,17 @@ TEST(Grid, RaysFromFarAwayEnterAtTheRightCell) {
   const BruteForce bf(s);
   Rng rng{9};
   int hits = 0;
-  for (const float far : {3e7f, 1e9f, 1e12f})
+  // Exactly along an axis, and nearly (a lateral component of 1e-28 of the axial one: the entry
+  // t's of the two faces then round equal, and the face was picked by them, the far one). From 1e16
+  // on, o + t·d loses the entry coordinate even in double: the entry face's own coordinate is used.
+  for (const float far : {3e7f, 1e9f, 1e12f, 1e16f, 1e20f, 1e25f})
     for (int i = 0; i < 200; ++i) {
       const glm::vec3 p = rng.in_box(glm::vec3(-1), glm::vec3(1));
       const int axis = i % 3;
       glm::vec3 origin = p, dir(0.0f);
       origin[axis] = (i % 2 ? far : -far);
-      dir[axis] = i % 2 ? -1.0f : 1.0f;
+      dir[axis] = (i % 2 ? -1.0f : 1.0f) * (i % 5 == 0 ? 1e-3f : 1.0f);
+      if (i % 4 == 0) dir[(axis + 1) % 3] = 1e-28f * (i % 8 == 0 ? 1.0f : -1.0f);
       const Ray r(origin, dir);
       const Hit a = g.closest_hit(r, {}), b = bf.closest_hit(r, {});
       ASSERT_EQ(a.valid(), b.valid()) << far << " ray " << i;

@@ -539,6 +539,44 @@ TEST(Tlas, FarOriginsAndExtremeScalesKeepTheirAim) {
   agree(small, small_flat, Ray({-1.0f, 3e-31f, 2e-31f}, {1e9f, 0, 0}), "a 1e9 direction into a 1e-30 instance");
   const Hit h = small.closest_hit(Ray({-1.0f, 3e-31f, 2e-31f}, {1e9f, 0, 0}), QueryOptions{});
   EXPECT_GT(h.t, 0.0f) << "not a hit at the origin";
+
+  // A triangle far from the coordinate origin (3e15) under the identity: the ray's own float origin is
+  // exact, and one moved near the triangle and rounded there (float's spacing 2.7e8, the triangle's
+  // size) lost the aim (an audit's case: every other structure hit).
+  Mesh far_tri;
+  far_tri.positions = {{2999997075292160.0f, -2000001853030400.0f, 999998846140416.0f},
+                       {2999997343727616.0f, -2000001853030400.0f, 999998913249280.0f},
+                       {2999997343727616.0f, -2000001987248128.0f, 999998711922688.0f}};
+  far_tri.indices = {{0, 1, 2}};
+  Scene far_scene;
+  far_scene.meshes.push_back(far_tri);
+  far_scene.instances.push_back(Instance{});
+  far_scene.flatten();
+  agree(Tlas(far_scene), Bvh(far_scene.triangles),
+        Ray({2997817647824896.0f, -2004741752094720.0f, 996452411113472.0f},
+            {0.0003455208789091557f, 0.0007513753371313214f, 0.0005621836171485484f}),
+        "a triangle at 3e15 from 1.7e4 of its sizes away");
+  // Near-axis rays from 6.3e8 onto a unit-sized triangle, with direction lengths 1e3 to 1e10: the
+  // float slab entry's rounding there exceeded the diagonal kept before the box, and the moved origin
+  // went past the triangle for some lengths (1e3, 1e10) and not others.
+  Mesh unit_tri;
+  unit_tri.positions = {{-0.4577852487564087f, -0.898190975189209f, -0.25532540678977966f},
+                        {-0.5581909418106079f, -0.6353254318237305f, -0.41778525710105896f},
+                        {-0.2953253984451294f, -0.797785222530365f, -0.5181909799575806f}};
+  unit_tri.indices = {{0, 1, 2}};
+  Scene near_scene;
+  near_scene.meshes.push_back(unit_tri);
+  near_scene.instances.push_back(Instance{});
+  near_scene.flatten();
+  const Tlas near_two(near_scene);
+  const Bvh near_flat(near_scene.triangles);
+  for (const float length : {1e3f, 1e5f, 1e7f, 1e8f, 1e10f})
+    agree(near_two, near_flat, Ray({629530304.0f, -0.7966833114624023f, -0.4705464243888855f}, {-length, 0, 0}),
+          "an axis ray from 6.3e8, direction length " + std::to_string(length));
+  agree(near_two, near_flat,
+        Ray({629530304.0f, -0.7966833114624023f, -0.4705464243888855f},
+            {-1e10f, 4.2847162262660277e-08f, 5.367832844882514e-09f}),
+        "a near-axis ray from 6.3e8");
 }
 
 // A hit names its world triangle with 32 bits: a scene of 2^32 or more instanced triangles is refused

@@ -28,14 +28,23 @@ Hit Grid::traverse(const Ray& ray, const QueryOptions& qo, RayStats* stats, Visi
   //    The entry point in double, from the slab distances in double: the float entry t of a far
   //    origin (3e7 away) is rounded by whole units, which put the entry point, and the first cell,
   //    cells away (at the grid's far side: every ray from there missed).
+  //    On the axis whose face the ray enters through, the entry coordinate is that face itself:
+  //    o + t·d, in double too, lost it from 1e16 away (double's spacing there is 2).
   double t0 = ray.tmin;
+  int face_axis = -1;
+  float face = 0.0f;
   for (int a = 0; a < 3; ++a)
     if (ray.direction[a] != 0.0f) {
       const double lo = (static_cast<double>(bounds_.lo[a]) - ray.origin[a]) / ray.direction[a];
       const double hi = (static_cast<double>(bounds_.hi[a]) - ray.origin[a]) / ray.direction[a];
-      t0 = std::max(t0, std::min(lo, hi));
+      if (std::min(lo, hi) > t0) {
+        t0 = std::min(lo, hi);
+        face_axis = a;
+        face = ray.direction[a] > 0.0f ? bounds_.lo[a] : bounds_.hi[a];  // not by the t's: they may round equal
+      }
     }
-  const glm::dvec3 entry = glm::dvec3(ray.origin) + t0 * glm::dvec3(ray.direction);
+  glm::dvec3 entry = glm::dvec3(ray.origin) + t0 * glm::dvec3(ray.direction);
+  if (face_axis >= 0) entry[face_axis] = face;
   int idx[3], step[3];
   float t_next[3];
   for (int a = 0; a < 3; ++a) {
@@ -69,8 +78,12 @@ Hit Grid::traverse(const Ray& ray, const QueryOptions& qo, RayStats* stats, Visi
     if (prims.test(refs_.data() + begin, end - begin)) return prims.result();
     // 4. Done when the closest candidate lies within this cell's range (a
     //    candidate beyond it may still be beaten in a later cell), or when
-    //    the ray leaves the grid or its segment.
-    if (prims.tmax() <= t_exit || t_exit >= t_end) break;
+    //    the ray leaves its segment; leaving the grid is the index check
+    //    below. Past the segment's end, not at it: far from the origin float
+    //    t rounds whole cells to one value, and a cell whose exit read equal
+    //    to the end stopped the walk at the first cell (hits beyond it are
+    //    refused by the triangle tests anyway).
+    if (prims.tmax() <= t_exit || t_exit > t_end) break;
     const int a = t_next[0] <= t_next[1] ? (t_next[0] <= t_next[2] ? 0 : 2) : (t_next[1] <= t_next[2] ? 1 : 2);
     idx[a] += step[a];
     if (step[a] == 0 || idx[a] < 0 || idx[a] >= res_[a]) break;

@@ -336,47 +336,62 @@ struct InstanceRay {
   }
 };
 
-/// RAY's stretch [ray.tmin, tmax] in INST's space, so that far origins and extreme transforms keep
-/// their aim (before, the origin went through the float inverse as it was, and t kept its meaning):
-///  - an origin more than 1024 of the instance's world diagonals from the coordinate origin is first
-///    moved along the ray (in double) to one diagonal before the instance's world box: a rotation
-///    mixed the far coordinate (1e8) into the others in float, whose spacing there (8) outweighed
-///    the few units that aim at the instance, and whole instances were missed. Only while double
-///    places the moved origin to a small part of a diagonal (|origin| below 2^48 diagonals, e.g.
-///    5e14 for a 2-unit cube); beyond that the ray goes in as it is;
+/// RAY's stretch [ray.tmin, tmax] in INST's space (BOX: its BLAS root's box, in that space), so that
+/// far origins and extreme transforms keep their aim. The origin and direction go through the
+/// inverse in double (the float product rounded each step) and are then rounded to float once:
+///  - an object-space origin that rounding would move by a sizeable part of the instance (a rotation
+///    mixes a far coordinate, 1e8, into the others, and float's spacing there, 8, outweighed the
+///    few units that aim at a 2-unit cube: whole instances were missed) is first moved along the
+///    ray, in double, to one box diagonal before BOX. Only where that brings it at least 1024 times
+///    nearer the object-space origin: an instance that lies far from it (a triangle at 3e15) has
+///    the same float spacing near it as the ray's own origin, and a moved origin rounded there
+///    lost the aim the exact one had. The entry distance is the double slab test's on BOX, whose
+///    rounding is a few parts in 1e16 of t (the float slab test's, at 1e10 diagonals away, was
+///    more than the diagonal: the origin went past the instance);
 ///  - an object-space direction beyond 2^±40 is scaled by a power of two: a 1e-30 instance made a
 ///    1e9 direction infinite, and the BLAS reported hits at t = 0.
-/// Ordinary rays take neither step and the same arithmetic as before (the product in double, then
-/// rounded, differs from the float product by at most a rounding).
-InstanceRay instance_ray(const TlasInstance& inst, const Ray& ray, float tmax) {
+/// t is the same number in both spaces (the direction is not renormalised) but for these two steps:
+/// world t = shift + scale · local t.
+InstanceRay instance_ray(const TlasInstance& inst, const Aabb& box, const Ray& ray, float tmax) {
   InstanceRay r;
-  glm::dvec3 o(ray.origin);
-  const glm::dvec3 d(ray.direction);
+  const glm::dmat4 to_object(inst.to_object);
+  glm::dvec3 o = glm::dvec3(to_object * glm::dvec4(glm::dvec3(ray.origin), 1.0));
+  glm::dvec3 d = glm::dmat3(to_object) * glm::dvec3(ray.direction);
   double tmin = ray.tmin, tmax_d = tmax;
-  const glm::vec3 extent = inst.world_bounds.extent();
-  const double diag = glm::length(glm::dvec3(extent));
-  const double far = std::max({std::abs(o.x), std::abs(o.y), std::abs(o.z)});
-  SlabInterval iv;
-  if (far > 1024.0 * diag && far < 0x1p48 * diag && intersect_slab(inst.world_bounds, ray.origin, ray.inv_dir, ray.tmin, tmax, iv)) {
-    const double shift = static_cast<double>(iv.t_entry) - diag / glm::length(d);
-    if (shift > 0.0) {
-      r.shift = shift;
-      o += shift * d;
-      tmin = std::max(0.0, tmin - shift);  // before the shift lies nothing of the instance
-      tmax_d -= shift;
+  const auto largest = [](const glm::dvec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); };
+  const double diag = glm::length(glm::dvec3(box.extent()));
+  const double far = largest(o);
+  if (!box.is_empty() && far > 1024.0 * diag && far < 0x1p48 * diag) {
+    // The double slab test on BOX: the entry distance along the ray.
+    double t0 = tmin, t1 = tmax_d;
+    for (int a = 0; a < 3; ++a) {
+      if (d[a] == 0.0) {
+        if (o[a] < box.lo[a] || o[a] > box.hi[a]) t0 = t1 + 1.0;  // parallel, outside: no entry
+        continue;
+      }
+      const double n = (static_cast<double>(box.lo[a]) - o[a]) / d[a], f = (static_cast<double>(box.hi[a]) - o[a]) / d[a];
+      t0 = std::max(t0, std::min(n, f));
+      t1 = std::min(t1, std::max(n, f));
+    }
+    const double shift = t0 - diag / glm::length(d);
+    if (t0 <= t1 && shift > 0.0) {
+      const glm::dvec3 moved = o + shift * d;
+      if (largest(moved) * 1024.0 < far) {  // nearer the object-space origin: float resolves it
+        r.shift = shift;
+        o = moved;
+        tmin = std::max(0.0, tmin - shift);  // before the shift lies nothing of the instance
+        tmax_d -= shift;
+      }
     }
   }
-  const glm::dmat4 to_object(inst.to_object);
-  const glm::dvec3 lo = glm::dvec3(to_object * glm::dvec4(o, 1.0));
-  glm::dvec3 ld = glm::dmat3(to_object) * d;
-  const double m = std::max({std::abs(ld.x), std::abs(ld.y), std::abs(ld.z)});
+  const double m = largest(d);
   if (m > 0x1p40 || (m > 0.0 && m < 0x1p-40)) {
     int e = 0;
     std::frexp(m, &e);
-    // ld·s has its largest component in [0.5, 1); a point lo + u·(ld·s) is lo + (u·s)·ld, so world
+    // d·s has its largest component in [0.5, 1); a point o + u·(d·s) is o + (u·s)·d, so world
     // t = shift + s·u and the stretch in u is the stretch in t over s.
     const double s = std::ldexp(1.0, -e);
-    ld *= s;
+    d *= s;
     r.scale = s;
     tmin /= s;
     tmax_d /= s;
@@ -384,7 +399,7 @@ InstanceRay instance_ray(const TlasInstance& inst, const Ray& ray, float tmax) {
   const auto to_float = [](double t) {
     return t >= static_cast<double>(std::numeric_limits<float>::max()) ? kInfinity : static_cast<float>(t);
   };
-  r.ray = Ray(glm::vec3(lo), glm::vec3(ld), to_float(tmin), to_float(tmax_d));
+  r.ray = Ray(glm::vec3(o), glm::vec3(d), to_float(tmin), to_float(tmax_d));
   return r;
 }
 
@@ -428,9 +443,9 @@ static Hit traverse_two_level(const Tlas& t, std::span<const BvhNode> nodes, std
       const std::uint32_t id = prims[k];
       const TlasInstance& inst = instances[id];
       // Into object space (instance_ray: far origins moved near, extreme directions scaled).
-      const InstanceRay ir = instance_ray(inst, ray, tmax);
-      const Ray& local = ir.ray;
       const Bvh& blas = t.blas(inst.blas);
+      const InstanceRay ir = instance_ray(inst, blas.nodes().empty() ? Aabb{} : blas.nodes()[0].bounds, ray, tmax);
+      const Ray& local = ir.ray;
       RayStats ls;
       RayStats* lsp = c.any() ? &ls : nullptr;
       if (c.ts) ++c.ts->instances_visited;
