@@ -45,8 +45,7 @@ ReferenceTriangleHit intersect_reference(const Ray& ray, const Triangle& tri, do
   // coordinate, which the relative term above does not cover (every float structure was condemned
   // on such rays). u[i] bounds it; in e = x_a y_b - y_a x_b it adds u_a my_b + mx_a u_b + ...
   double u[3];
-  for (int i = 0; i < 3; ++i)
-    u[i] = static_cast<double>(std::numeric_limits<float>::denorm_min()) * std::abs(p[i][kz]);
+  for (int i = 0; i < 3; ++i) u[i] = static_cast<double>(std::numeric_limits<float>::denorm_min()) * std::abs(p[i][kz]);
   const auto under = [&](int a, int b) { return u[a] * (my[b] + mx[b]) + u[b] * (mx[a] + my[a]) + 2.0 * u[a] * u[b]; };
   const double tol[3] = {kEdgeRoundingScale * (mx[2] * my[1] + my[2] * mx[1]) + under(2, 1),
                          kEdgeRoundingScale * (mx[0] * my[2] + my[0] * mx[2]) + under(0, 2),

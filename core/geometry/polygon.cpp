@@ -77,8 +77,7 @@ void fan_sides(std::array<std::uint32_t, 3> t, std::array<std::span<const std::u
   const std::span<const std::uint32_t> f = flat[0];
   // The fan from z over x, f..., y; its first triangle (z, x, f0) holds side z→x, its last
   // (z, fk, y) side y→z: each fanned again from its flat corner when that side carries any.
-  const auto over = [&](std::uint32_t apex, std::uint32_t from, std::span<const std::uint32_t> mid,
-                        std::uint32_t to) {
+  const auto over = [&](std::uint32_t apex, std::uint32_t from, std::span<const std::uint32_t> mid, std::uint32_t to) {
     std::uint32_t prev = from;
     for (const std::uint32_t q : mid) {
       out.push_back({apex, prev, q});

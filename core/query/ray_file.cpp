@@ -146,8 +146,7 @@ std::vector<Ray> read_rays(const std::string& path) {
                     static_cast<double>(tmin));
       fail(path, where() + text);
     }
-    if (tmin > tmax)
-      fail(path, where() + "tmin > tmax (" + std::to_string(tmin) + " > " + std::to_string(tmax) + ")");
+    if (tmin > tmax) fail(path, where() + "tmin > tmax (" + std::to_string(tmin) + " > " + std::to_string(tmax) + ")");
     rays.emplace_back(o, d, tmin, from_file_t(tmax));
   }
   return rays;
@@ -165,7 +164,8 @@ std::vector<HitRecord> read_hits(const std::string& path) {
     if (std::isnan(h.t)) fail(path, where() + "NaN t");
     const bool miss_t = h.t >= kRayFileUnbounded;
     if (h.valid() == miss_t)
-      fail(path, where() + (h.valid() ? "a primitive id with the miss t 1e30" : "the miss id 0xFFFFFFFF with a finite t"));
+      fail(path,
+           where() + (h.valid() ? "a primitive id with the miss t 1e30" : "the miss id 0xFFFFFFFF with a finite t"));
     h.t = from_file_t(h.t);
     hits.push_back(h);
   }

@@ -53,7 +53,9 @@ Aabb Scene::bounds() const {
   return b;
 }
 
-static bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+static bool finite3(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 /// Whether flatten() keeps one of MESH's triangles: one without a NaN or infinite vertex.
 static bool has_finite_triangle(const Mesh& mesh) {

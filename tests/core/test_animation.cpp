@@ -9,8 +9,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <limits>
 #include <glm/gtc/matrix_transform.hpp>
+#include <limits>
 
 #include "core/accel/bvh/bvh.h"
 #include "core/accel/tlas/tlas.h"

@@ -214,8 +214,8 @@ TEST(Grid, RaysStartingInsideAndOutside) {
 }
 
 // Named case: axis-aligned rays from far away (3e7 .. 1e25 scene sizes) find what brute force finds,
-// at the same float t up to its rounding there. The float entry t there is rounded by whole units, which put the entry point
-// and the first cell at the grid's far side: every such ray missed.
+// at the same float t up to its rounding there. The float entry t there is rounded by whole units, which put the entry
+// point and the first cell at the grid's far side: every such ray missed.
 TEST(Grid, RaysFromFarAwayEnterAtTheRightCell) {
   const Scene s = soup(4, 400, 0.1f);
   GridOptions o;

@@ -114,9 +114,9 @@ TEST(Polygon, FlatCornersOfAConvexFaceMakeNoZeroAreaTriangle) {
   const std::vector<glm::vec3> rect = {{0, 0, 0}, {8, 0, 0}, {8, 4, 0}, {0, 4, 0}};
   const std::vector<glm::vec3> tri = {{0, 0, 0}, {8, 0, 0}, {0, 8, 0}};
   const std::vector<std::pair<std::vector<glm::vec3>, std::vector<int>>> cases = {
-      {rect, {1, 0, 0, 0}}, {rect, {0, 0, 0, 1}}, {rect, {1, 1, 0, 0}}, {rect, {3, 0, 5, 0}},
-      {rect, {2, 1, 3, 2}}, {rect, {100, 60, 100, 60}}, {tri, {1, 0, 0}}, {tri, {1, 1, 1}},
-      {tri, {3, 2, 3}}, {tri, {0, 0, 4}}, {tri, {30, 0, 0}}};
+      {rect, {1, 0, 0, 0}}, {rect, {0, 0, 0, 1}},       {rect, {1, 1, 0, 0}}, {rect, {3, 0, 5, 0}},
+      {rect, {2, 1, 3, 2}}, {rect, {100, 60, 100, 60}}, {tri, {1, 0, 0}},     {tri, {1, 1, 1}},
+      {tri, {3, 2, 3}},     {tri, {0, 0, 4}},           {tri, {30, 0, 0}}};
   for (const auto& [strict, per_side] : cases) {
     for (int start = 0; start < 3; ++start) {  // the outline starting at a strict or a flat corner
       std::vector<glm::vec3> p = outline(strict, per_side);

@@ -411,16 +411,22 @@ TEST(Tlas, LeafDepthsSpanBothLevels) {
     self(nodes, nodes[i].index, depth + 1, at_leaf, self);
     self(nodes, nodes[i].index + 1, depth + 1, at_leaf, self);
   };
-  walk(two.tlas_nodes(), 0, 0, [&](const BvhNode& leaf, std::uint32_t d) {
-    for (std::uint32_t k = leaf.index; k < leaf.index + leaf.count; ++k) {
-      const Bvh& b = two.blas(two.instances()[two.tlas_instance_order()[k]].blas);
-      walk(b.nodes(), 0, d + 1, [&](const BvhNode&, std::uint32_t e) {
-        sum += e;
-        leaves += 1.0;
-        deepest = std::max(deepest, e);
-      }, walk);
-    }
-  }, walk);
+  walk(
+      two.tlas_nodes(), 0, 0,
+      [&](const BvhNode& leaf, std::uint32_t d) {
+        for (std::uint32_t k = leaf.index; k < leaf.index + leaf.count; ++k) {
+          const Bvh& b = two.blas(two.instances()[two.tlas_instance_order()[k]].blas);
+          walk(
+              b.nodes(), 0, d + 1,
+              [&](const BvhNode&, std::uint32_t e) {
+                sum += e;
+                leaves += 1.0;
+                deepest = std::max(deepest, e);
+              },
+              walk);
+        }
+      },
+      walk);
   ASSERT_GT(leaves, 0.0);
   EXPECT_NEAR(two.build_stats().avg_leaf_depth, sum / leaves, 1e-9 * sum / leaves);
   EXPECT_GE(two.build_stats().max_depth, deepest) << "the deepest TLAS leaf plus the deepest BLAS: an upper bound";

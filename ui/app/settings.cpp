@@ -130,7 +130,8 @@ LoadedSettings load_settings(const std::filesystem::path& file) {
     if (problem != "no such file") {
       // Not read, so not copied: a save would replace what the user has there.
       out.leave_file = true;
-      out.error = file.string() + ": " + problem + " (using defaults; the file is left as it is: settings are not saved this session)";
+      out.error = file.string() + ": " + problem +
+                  " (using defaults; the file is left as it is: settings are not saved this session)";
     }
     return out;
   }

@@ -235,7 +235,8 @@ void StructureNodes::finish(float c_trav, float c_isect) {
   for (std::size_t k = 0; k < order.size(); ++k)
     for (std::uint32_t c = child_start_[order[k]]; c < child_start_[order[k] + 1]; ++c) order.push_back(children_[c]);
   for (std::size_t k = order.size(); k-- > 0;)
-    if (const std::uint32_t p = nodes_[order[k]].parent; p < nodes_.size()) nodes_[p].prims_below += nodes_[order[k]].prims_below;
+    if (const std::uint32_t p = nodes_[order[k]].parent; p < nodes_.size())
+      nodes_[p].prims_below += nodes_[order[k]].prims_below;
 
   max_depth_ = 0;
   double total = 0.0;

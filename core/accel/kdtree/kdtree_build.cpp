@@ -70,7 +70,8 @@ class KdBuilder {
     const double area = box.half_area();
 
     Split split;
-    if (n > static_cast<std::size_t>(opts_.max_leaf_size) && depth < max_depth_ && area > 0.0) split = find_split(cb, box, area);
+    if (n > static_cast<std::size_t>(opts_.max_leaf_size) && depth < max_depth_ && area > 0.0)
+      split = find_split(cb, box, area);
     if (split.axis < 0 || split.cost >= static_cast<double>(opts_.cost_intersect) * static_cast<double>(n)) {
       make_leaf(index, prims, box, depth, weight);
       return;

@@ -369,7 +369,8 @@ InstanceRay instance_ray(const TlasInstance& inst, const Aabb& box, const Ray& r
         if (o[a] < box.lo[a] || o[a] > box.hi[a]) t0 = t1 + 1.0;  // parallel, outside: no entry
         continue;
       }
-      const double n = (static_cast<double>(box.lo[a]) - o[a]) / d[a], f = (static_cast<double>(box.hi[a]) - o[a]) / d[a];
+      const double n = (static_cast<double>(box.lo[a]) - o[a]) / d[a],
+                   f = (static_cast<double>(box.hi[a]) - o[a]) / d[a];
       t0 = std::max(t0, std::min(n, f));
       t1 = std::min(t1, std::max(n, f));
     }
