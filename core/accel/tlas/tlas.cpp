@@ -364,9 +364,10 @@ InstanceRay instance_ray(const TlasInstance& inst, const Aabb& box, const Ray& r
   if (!box.is_empty() && far > 1024.0 * diag && far < 0x1p48 * diag) {
     // The double slab test on BOX: the entry distance along the ray.
     double t0 = tmin, t1 = tmax_d;
+    bool parallel_outside = false;
     for (int a = 0; a < 3; ++a) {
       if (d[a] == 0.0) {
-        if (o[a] < box.lo[a] || o[a] > box.hi[a]) t0 = t1 + 1.0;  // parallel, outside: no entry
+        parallel_outside = parallel_outside || o[a] < box.lo[a] || o[a] > box.hi[a];
         continue;
       }
       const double n = (static_cast<double>(box.lo[a]) - o[a]) / d[a],
@@ -375,7 +376,7 @@ InstanceRay instance_ray(const TlasInstance& inst, const Aabb& box, const Ray& r
       t1 = std::min(t1, std::max(n, f));
     }
     const double shift = t0 - diag / glm::length(d);
-    if (t0 <= t1 && shift > 0.0) {
+    if (!parallel_outside && t0 <= t1 && shift > 0.0 && std::isfinite(shift)) {
       const glm::dvec3 moved = o + shift * d;
       if (largest(moved) * 1024.0 < far) {  // nearer the object-space origin: float resolves it
         r.shift = shift;
