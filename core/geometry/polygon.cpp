@@ -147,8 +147,8 @@ std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(std::span<const gl
       } else {
         split_convex(static_cast<std::uint32_t>(s), cut);
       }
-      // The flat corners on the side from strict[k] to strict[k + 1]: order[first[k], first[k + 1])
-      // with the outline rotated to start at strict[0].
+      // The flat corners on the side from strict[k] to strict[k + 1]: ring(at[k], at[k + 1]), the
+      // outline rotated to start at strict[0], at[k] being strict[k]'s place in it.
       std::vector<std::uint32_t> ring(n);
       for (std::size_t i = 0; i < n; ++i) ring[i] = static_cast<std::uint32_t>((strict[0] + i) % n);
       std::vector<std::size_t> at(s + 1);  // strict[k]'s position in ring
