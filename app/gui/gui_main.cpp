@@ -910,6 +910,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
 }
 
 int Gui::run() {
+  catch_quit_signals();  // once the window is open: the headless demo (no window) keeps Ctrl-C's default
   // What to show first: the file given, else (with settings) the last
   // scene, else the demo. A script that starts with `open` loads nothing
   // before it.
@@ -1054,7 +1055,6 @@ int run_gui(const GuiOptions& options) {
     settings_error = std::move(loaded.error);
     o.save_settings = !loaded.leave_file;
   }
-  catch_quit_signals();
   Gui gui(o, std::move(settings), std::move(runner), settings_error);
   if (script_opens_first && !o.scene) gui.skip_initial_open();
   return gui.run();
