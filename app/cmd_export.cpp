@@ -22,6 +22,8 @@ struct ExportOptions {
 int run_export(const ExportOptions& o, const GlobalOptions& global) {
   const std::string ext = lower_extension(o.out);
   const bool binary = ext == ".glb";
+  if (const std::string bare = bare_extension(o.out); bare == ".glb" || bare == ".gltf")
+    throw UsageError(o.out + ": a glTF file needs a name before " + bare);
   if (!binary && ext != ".gltf") throw UsageError(o.out + ": the output's name must end in .glb or .gltf");
   check_output_path(o.out, o.force);
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);

@@ -693,10 +693,7 @@ RgbImage colorize(const MetricImage& image, const ColorizeOptions& opts) {
 
 std::string png_name_problem(const std::string& path) {
   if (lower_extension(path) == ".png") return {};
-  // ".png" alone is a hidden file's name without an extension: the name before .png is missing.
-  std::string probe(1, 'x');  // appended, not "x" + name: GCC 12's -Wrestrict false positive
-  probe += std::filesystem::path(path).filename().string();
-  if (lower_extension(probe) == ".png") return path + ": a PNG file needs a name before .png";
+  if (bare_extension(path) == ".png") return path + ": a PNG file needs a name before .png";
   return path + ": a PNG file's name must end in .png";
 }
 

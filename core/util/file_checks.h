@@ -64,6 +64,16 @@ inline std::string lower_extension(const std::string& path) {
   return ext;
 }
 
+/// The extension, in lower case, when `path`'s file name is nothing else (".png", ".GLB": a hidden
+/// file's name, which has no extension of its own, so the name before the extension is missing);
+/// else "".
+inline std::string bare_extension(const std::string& path) {
+  std::string probe(1, 'x');  // appended, not "x" + name: GCC 12's -Wrestrict false positive
+  probe += std::filesystem::path(path).filename().string();
+  const std::string ext = lower_extension(probe);
+  return ext.size() + 1 == probe.size() ? ext : std::string();
+}
+
 /// "" when every name along `path` fits the file system, else the problem,
 /// without the path: "a name in it is N bytes long; the file system takes at
 /// most M (NAME_MAX)". The limit is that of the nearest folder on the path

@@ -176,7 +176,7 @@ expect 1 "would stand beyond the float range (this command has no --camera)" -- 
 "$accelviz" -q export 'builtin:soup?size=20' "$tmp/UP.GLB" >/dev/null || { echo "FAIL: export to .GLB"; fail=1; }
 expect 1 "$tmp/UP.GLB: exists (use --force to overwrite)" -- export 'builtin:soup?size=20' "$tmp/UP.GLB"
 "$accelviz" -q export 'builtin:soup?size=20' "$tmp/UP.GLB" -f >/dev/null || { echo "FAIL: export -f"; fail=1; }
-expect 2 "$tmp/.glb: the output's name must end in .glb or .gltf" -- export 'builtin:soup?size=20' "$tmp/.glb"
+expect 2 "$tmp/.glb: a glTF file needs a name before .glb" -- export 'builtin:soup?size=20' "$tmp/.glb"
 expect 2 "$tmp/x.obj: the output's name must end in .glb or .gltf" -- export 'builtin:soup?size=20' "$tmp/x.obj"
 
 # Written through a symbolic link (-f) into a folder that does not exist, or into an output folder
