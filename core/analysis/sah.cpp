@@ -36,22 +36,12 @@ double bvh_sah_cost(std::span<const BvhNode> nodes, double cost_traversal, doubl
 TreeShape bvh_tree_shape(std::span<const BvhNode> nodes) {
   TreeShape s;
   if (nodes.empty()) return s;
-  // Children always follow their parent in the array, so one forward sweep
-  // propagates depths.
-  HugePageVector<std::uint32_t> depth(nodes.size(), 0);  // fresh pages: cheaper as huge ones (huge_page_allocator.h)
   double depth_sum = 0.0;
-  for (std::size_t i = 0; i < nodes.size(); ++i) {
-    const BvhNode& n = nodes[i];
-    if (n.count == 0) {
-      if (n.index <= i || n.index + 1 >= nodes.size()) continue;  // malformed: not a tree this builder makes
-      depth[n.index] = depth[i] + 1;
-      depth[n.index + 1] = depth[i] + 1;
-    } else {
-      ++s.leaf_count;
-      depth_sum += depth[i];
-      if (depth[i] > s.max_depth) s.max_depth = depth[i];
-    }
-  }
+  for_each_leaf_depth(nodes, [&](std::size_t, std::uint32_t depth) {
+    ++s.leaf_count;
+    depth_sum += depth;
+    if (depth > s.max_depth) s.max_depth = depth;
+  });
   s.avg_leaf_depth = s.leaf_count > 0 ? depth_sum / static_cast<double>(s.leaf_count) : 0.0;
   return s;
 }

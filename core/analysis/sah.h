@@ -32,4 +32,21 @@ struct TreeShape {
 };
 TreeShape bvh_tree_shape(std::span<const BvhNode> nodes);
 
+/// Calls f(i, depth) for every leaf i of `nodes` (root at 0, depth 0), in array order. Children
+/// always follow their parent in the array, so one forward sweep propagates depths; an inner node
+/// whose children do not (a malformed array, not a tree this builder makes) is skipped.
+template <class F>
+void for_each_leaf_depth(std::span<const BvhNode> nodes, F&& f) {
+  HugePageVector<std::uint32_t> depth(nodes.size(), 0);  // fresh pages: cheaper as huge ones (huge_page_allocator.h)
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    const BvhNode& n = nodes[i];
+    if (n.count > 0) {
+      f(i, depth[i]);
+    } else if (n.index > i && n.index + 1 < nodes.size()) {
+      depth[n.index] = depth[i] + 1;
+      depth[n.index + 1] = depth[i] + 1;
+    }
+  }
+}
+
 }  // namespace accelviz

@@ -403,9 +403,7 @@ std::string glb_bytes(const std::string& path, std::string json_text, const std:
 }  // namespace
 
 void write_gltf(const Scene& scene, const std::string& path, bool binary, bool overwrite) {
-  std::error_code ec;
-  if (!overwrite && fs::exists(fs::symlink_status(path, ec)))
-    throw SceneError(path + ": exists (use --force to overwrite)");
+  if (!overwrite && name_taken(path)) throw SceneError(path + ": exists (use --force to overwrite)");
   if (const std::string problem = output_path_problem(path); !problem.empty()) throw SceneError(path + ": " + problem);
 
   GltfWriter writer(scene, path);

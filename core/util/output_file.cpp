@@ -210,8 +210,7 @@ OutputWrite OutputFileSet::commit() {
     const int err = errno;
     if (err == EEXIST) return fail(s, "exists", true);
     if (!no_hard_links(err)) return fail(s, errno_text("cannot create: ", err));
-    std::error_code ec;
-    if (fs::exists(fs::symlink_status(s.target, ec))) return fail(s, "exists", true);
+    if (name_taken(s.target)) return fail(s, "exists", true);
     if (::rename(s.tmp.c_str(), s.target.c_str()) != 0) return fail(s, errno_text("cannot create: ", errno));
     undo[i].placed = true;
   }
@@ -255,7 +254,7 @@ std::string OutputFolder::problem(const std::string& dir, const std::vector<std:
       return name + ": " + problem;
   if (overwrite) return "";
   for (const std::string& name : known)
-    if (fs::exists(fs::symlink_status(p / name, ec))) {
+    if (name_taken((p / name).string())) {
       if (holds) *holds = true;
       return "holds " + name;
     }
@@ -316,7 +315,7 @@ OutputWrite OutputFolder::commit() {
   for (const std::string& name : known_) {
     if (std::find(written_.begin(), written_.end(), name) != written_.end()) continue;
     const fs::path f = fs::path(dir_) / name;
-    if (!fs::exists(fs::symlink_status(f, ec))) continue;
+    if (!name_taken(f.string())) continue;
     if (!fs::remove(f, ec) || ec) stale_left_.push_back(f.string() + (ec ? ": " + ec.message() : std::string()));
   }
   return r;

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "core/accel/tlas/tlas_overlap.h"
+#include "core/analysis/sah.h"
 #include "core/util/timing.h"
 
 namespace accelviz {
@@ -260,20 +261,15 @@ double Tlas::build_top() {
   // Mean leaf depth of the two-level tree as rays walk it: each instance's BLAS leaves sit one level
   // below its TLAS leaf (as in max_depth), weighted by how many leaves each placed BLAS has.
   {
-    std::vector<std::uint32_t> depth(tlas_nodes_.size(), 0);  // children follow their parent
     double sum = 0.0, leaves = 0.0;
-    for (std::size_t i = 0; i < tlas_nodes_.size(); ++i) {
+    for_each_leaf_depth(tlas_nodes_, [&](std::size_t i, std::uint32_t depth) {
       const BvhNode& n = tlas_nodes_[i];
-      if (!n.is_leaf()) {
-        depth[n.index] = depth[n.index + 1] = depth[i] + 1;
-        continue;
-      }
       for (std::uint32_t k = n.index; k < n.index + n.count; ++k) {
         const BuildStats& b = blas_[instances_[tlas_prims_[k]].blas]->build_stats();
-        sum += static_cast<double>(b.leaf_count) * (depth[i] + 1 + b.avg_leaf_depth);
+        sum += static_cast<double>(b.leaf_count) * (depth + 1 + b.avg_leaf_depth);
         leaves += static_cast<double>(b.leaf_count);
       }
-    }
+    });
     stats_.avg_leaf_depth = leaves > 0.0 ? sum / leaves : 0.0;
   }
   // Expected cost per ray: TLAS nodes by area, then each instance's BLAS SAH
