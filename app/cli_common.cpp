@@ -345,6 +345,13 @@ std::string absolute_path(const std::string& path) {
   return ec ? path : abs.lexically_normal().string();
 }
 
+std::string path_line(const std::string& path) {
+  std::string line = path;
+  for (char& c : line)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7F) c = '?';
+  return line;
+}
+
 std::vector<std::string> comma_items(const std::string& text) {
   std::vector<std::string> items;
   std::size_t start = 0;

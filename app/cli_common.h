@@ -174,6 +174,11 @@ void write_output_set(const std::vector<OutputBytes>& files, bool force);
 /// Absolute, normalised form of a path for messages.
 std::string absolute_path(const std::string& path);
 
+/// `path` as a line of stdout: each control byte (a newline, an ESC) shown as
+/// '?', so that the line stays one line a script can read (the JSON that
+/// follows holds the name exactly).
+std::string path_line(const std::string& path);
+
 /// The items of a comma-separated option value, empty ones included ("a,,b" has three: an empty
 /// item is a typo to refuse, which CLI11's own list splitting drops in silence).
 std::vector<std::string> comma_items(const std::string& text);

@@ -34,7 +34,7 @@ int run_export(const ExportOptions& o, const GlobalOptions& global) {
       scene.animations.empty()
           ? ""
           : "; not written: " + count_of(scene.animations.size(), "animation") + " (the nodes at rest)";
-  std::printf("wrote %s: %s, %s, %s, %s, %s%s\n", absolute_path(o.out).c_str(),
+  std::printf("wrote %s: %s, %s, %s, %s, %s%s\n", path_line(absolute_path(o.out)).c_str(),
               count_of(scene.triangles.size(), "triangle").c_str(), count_of(scene.meshes.size(), "mesh").c_str(),
               count_of(scene.instances.size(), "instance").c_str(), count_of(scene.lights.size(), "light").c_str(),
               count_of(scene.cameras.size(), "camera").c_str(), left_out.c_str());

@@ -171,7 +171,7 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
       o.rebuild_ratio > 0.0 ? "; rebuilt: the ratio passed --rebuild-ratio, so the fresh tree replaced the "
                               "refitted one this row measured (the next frame refits it)"
                             : "");
-  std::printf("rebuilds: %d; wrote %s\n", r.rebuilds, absolute_path(o.out).c_str());
+  std::printf("rebuilds: %d; wrote %s\n", r.rebuilds, path_line(absolute_path(o.out)).c_str());
   return 0;
 }
 

@@ -154,7 +154,7 @@ int run_render_raster(const RenderOptions& o, const GlobalOptions& global) {
   progress.end();
   const std::string abs = absolute_path(o.out);
   figures["out"] = abs;
-  std::cout << abs << "\n";
+  std::cout << path_line(abs) << "\n";
   print_json_line(figures);
   return 0;
 }
@@ -357,7 +357,7 @@ int run_render_several(const RenderOptions& o, const std::vector<std::string>& s
     out["images"].push_back(figures);
   }
   write_output_set(files, o.force);
-  for (const nlohmann::json& figures : out["images"]) std::cout << figures["out"].get<std::string>() << "\n";
+  for (const nlohmann::json& figures : out["images"]) std::cout << path_line(figures["out"].get<std::string>()) << "\n";
   print_json_line(out);
   return 0;
 }
@@ -417,7 +417,7 @@ int run_render(const RenderOptions& given, const GlobalOptions& global) {
   write_png(o.out, rgb, o.force);
   const std::string abs = absolute_path(o.out);
   figures["out"] = abs;
-  std::cout << abs << "\n";
+  std::cout << path_line(abs) << "\n";
   print_json_line(figures);
   return 0;
 }
@@ -546,7 +546,7 @@ int run_demo(const GlobalOptions& global) {
   figures["caption"] = render_caption(o);  // the command that draws the same picture
   const std::string abs = absolute_path(write_unique_demo_png(rgb));
   figures["out"] = abs;
-  std::cout << "No display: rendered the demo heatmap to " << abs << "\n" << abs << "\n";
+  std::cout << "No display: rendered the demo heatmap to " << path_line(abs) << "\n" << path_line(abs) << "\n";
   print_json_line(figures);
   return 0;
 }

@@ -308,7 +308,9 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
           ? nlohmann::json(sides["b"]["trace_ms"].get<double>() / sides["a"]["trace_ms"].get<double>())
           : nlohmann::json(nullptr);
   figures["out"] = {{"a", absolute_path(paths.a)}, {"b", absolute_path(paths.b)}, {"diff", absolute_path(paths.diff)}};
-  std::cout << absolute_path(paths.a) << "\n" << absolute_path(paths.b) << "\n" << absolute_path(paths.diff) << "\n";
+  std::cout << path_line(absolute_path(paths.a)) << "\n"
+            << path_line(absolute_path(paths.b)) << "\n"
+            << path_line(absolute_path(paths.diff)) << "\n";
   print_json_line(figures);
   return 0;
 }

@@ -4,8 +4,9 @@
 // and one that is a directory or a device reads as garbage or without end; an
 // output that is a FIFO blocks its writer, and a failed write or a rename
 // would remove or replace a device node.
-#include <limits.h>  // NAME_MAX
-#include <unistd.h>  // pathconf
+#include <limits.h>    // NAME_MAX
+#include <sys/stat.h>  // stat, fstat
+#include <unistd.h>    // pathconf
 
 #include <cctype>
 #include <cstdint>
@@ -96,13 +97,26 @@ inline std::string name_length_problem(const std::string& path) {
 
 /// "" when `path` may be created or overwritten as a file: nothing is there,
 /// or a regular file is (a symbolic link counts as what it names); else the
-/// problem, without the path: name_length_problem's, "is a directory" or "is
-/// not a regular file (a FIFO, device or socket)".
+/// problem, without the path: name_length_problem's, "is a directory", "is
+/// not a regular file (a FIFO, device or socket)", or, for the regular file
+/// this process's standard output or error goes to (`-o /dev/stdout -f >
+/// out.hits`, or the file's own name), "is this program's standard output":
+/// the rename replaced that file, and what the program printed there before
+/// and after went to the old one, lost.
 inline std::string output_path_problem(const std::string& path) {
   if (std::string problem = name_length_problem(path); !problem.empty()) return problem;
   std::error_code ec;
   const std::filesystem::file_status st = std::filesystem::status(path, ec);
-  if (ec || !std::filesystem::exists(st) || std::filesystem::is_regular_file(st)) return {};
+  if (ec || !std::filesystem::exists(st)) return {};
+  if (std::filesystem::is_regular_file(st)) {
+    struct stat file {}, stream {};
+    if (::stat(path.c_str(), &file) == 0)
+      for (const int fd : {1, 2})
+        if (::fstat(fd, &stream) == 0 && stream.st_dev == file.st_dev && stream.st_ino == file.st_ino)
+          return fd == 1 ? "is this program's standard output (name a file of its own)"
+                         : "is this program's standard error (name a file of its own)";
+    return {};
+  }
   if (std::filesystem::is_directory(st)) return "is a directory";
   return "is not a regular file (a FIFO, device or socket)";
 }

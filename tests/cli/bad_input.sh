@@ -159,6 +159,17 @@ for kind in png rays hits; do
 done
 leftovers=$(find "$tmp" -name '.accelviz-*.tmp')
 [ -z "$leftovers" ] || { echo "FAIL: temporaries left behind: $leftovers"; fail=1; }
+# A newline in an output's name: the path printed stays one line (a '?' for the newline), the
+# JSON after it holds the name exactly; it split the line, and a script read half a path.
+"$accelviz" -q render 'builtin:soup?size=10' --size 8x8 -o "$tmp/a"$'\n'"b.png" >"$tmp/stdout" ||
+  { echo "FAIL: render to a name with a newline"; fail=1; }
+[ "$(wc -l <"$tmp/stdout")" -eq 2 ] && [ "$(head -n 1 "$tmp/stdout")" = "$tmp/a?b.png" ] &&
+  grep -qF "\"out\":\"$tmp/a\\nb.png\"" "$tmp/stdout" ||
+  { echo "FAIL: the path printed for a name with a newline: $(cat "$tmp/stdout")"; fail=1; }
+# The file standard output goes to is not replaced: `-o /dev/stdout -f > out` renamed a new file
+# over it, and what was printed there, before and after, went to the old one.
+expect 1 "/dev/stdout: is this program's standard output" -- \
+  trace 'builtin:soup?size=10' --rays "$tmp/keep.rays" -f --out /dev/stdout
 
 # A scene near the float range cannot be framed: one line naming the scene
 # (it was reported as a --camera usage error), nothing written.

@@ -2,6 +2,7 @@
 // tool goes through. Nothing the user had is lost: an existing file is kept
 // unless overwriting is asked for, a failed write keeps the old file, and
 // nothing already beside the target (a link, a FIFO, a leftover) is followed.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
@@ -9,6 +10,7 @@
 
 #include <algorithm>
 #include <csignal>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -110,6 +112,31 @@ TEST_F(OutputFile, AFifoOrAFolderAsTheTargetIsRefused) {
     EXPECT_EQ(write_output_file(path("folder.png"), {"x"}, overwrite).problem, "is a directory");
   }
   EXPECT_TRUE(others({"pipe.png", "folder.png"}).empty());
+}
+
+// `trace -o /dev/stdout -f > out.hits` replaced out.hits by rename: the
+// program's later output went to the old, unlinked file, lost.
+TEST_F(OutputFile, TheFileStandardOutputGoesToIsRefused) {
+  write_file(path("out.hits"), "printed before");
+  const int fd = ::open(path("out.hits").c_str(), O_WRONLY | O_APPEND);
+  ASSERT_GE(fd, 0);
+  std::fflush(stdout);
+  const int saved = ::dup(1);
+  ASSERT_GE(saved, 0);
+  ASSERT_EQ(::dup2(fd, 1), 1);
+  ::close(fd);
+  const std::string by_name = output_path_problem(path("out.hits"));
+  const std::string by_link = output_path_problem("/dev/stdout");
+  const OutputWrite w = write_output_file(path("out.hits"), {"hits"}, true);
+  ::dup2(saved, 1);
+  ::close(saved);
+  EXPECT_EQ(by_name, "is this program's standard output (name a file of its own)");
+  EXPECT_EQ(by_link, by_name);
+  EXPECT_EQ(w.problem, by_name);
+  EXPECT_EQ(read_file(path("out.hits")), "printed before");
+  // Once standard output goes elsewhere, the same name is an ordinary file to replace.
+  EXPECT_TRUE(output_path_problem(path("out.hits")).empty());
+  EXPECT_TRUE(others({"out.hits"}).empty());
 }
 
 TEST_F(OutputFile, AMissingFolderIsNamed) {
