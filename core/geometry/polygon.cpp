@@ -90,6 +90,126 @@ void fan_sides(std::array<std::uint32_t, 3> t, std::array<std::span<const std::u
   over(f.back(), y, flat[1], z);  // (z, fk, y) as (fk, y, ..., z)
 }
 
+/// The reflex (and flat) corners of a polygon being ear-clipped, in rows of equal height and, within
+/// a row, sorted by x, so that an ear's test looks only at the corners in the x range its triangle
+/// spans in each row it crosses. A corner that turns convex leaves at once: its place is skipped by
+/// a union-find over the places (path halving), so a row's corners cut or turned convex are never
+/// walked again (the grid of cells this replaces kept them until met, and a comb's spine, a line of
+/// 50,000 flat corners, filled a few cells). A corner that rounding turns reflex after the start
+/// (exactly, a convex corner stays convex as ears are cut) goes to a short list checked by every ear.
+class ReflexRows {
+ public:
+  ReflexRows(std::span<const glm::dvec2> p, std::span<const std::uint32_t> reflex) : p_(p), place_(p.size(), kNone) {
+    if (reflex.empty()) return;
+    double hi = p_[reflex[0]].y;
+    lo_ = hi;
+    for (const std::uint32_t q : reflex) {
+      lo_ = std::min(lo_, p_[q].y);
+      hi = std::max(hi, p_[q].y);
+    }
+    height_ = std::max(hi - lo_, 1e-300);
+    rows_ = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(reflex.size()) / 4.0)));
+    order_.assign(reflex.begin(), reflex.end());
+    std::sort(order_.begin(), order_.end(), [&](std::uint32_t u, std::uint32_t v) {
+      const int ru = row_of(p_[u].y), rv = row_of(p_[v].y);
+      return ru != rv ? ru < rv : p_[u].x != p_[v].x ? p_[u].x < p_[v].x : u < v;
+    });
+    start_.assign(static_cast<std::size_t>(rows_) + 1, 0);
+    for (const std::uint32_t q : order_) ++start_[static_cast<std::size_t>(row_of(p_[q].y)) + 1];
+    for (int r = 0; r < rows_; ++r) start_[r + 1] += start_[r];
+    xs_.resize(order_.size());
+    skip_.resize(order_.size() + 1);
+    for (std::uint32_t i = 0; i < order_.size(); ++i) {
+      xs_[i] = p_[order_[i]].x;
+      skip_[i] = i;
+      place_[order_[i]] = i;
+    }
+    skip_[order_.size()] = static_cast<std::uint32_t>(order_.size());
+  }
+
+  /// A corner's angle changed: out when it is no longer reflex; in the late list when it turned reflex.
+  void update(std::uint32_t q, bool reflex) {
+    if (!reflex && place_[q] != kNone) {
+      skip_[place_[q]] = place_[q] + 1;
+      place_[q] = kNone;
+    } else if (!reflex) {
+      late_.erase(std::remove(late_.begin(), late_.end(), q), late_.end());
+    } else if (place_[q] == kNone && std::find(late_.begin(), late_.end(), q) == late_.end()) {
+      late_.push_back(q);
+    }
+  }
+
+  /// Whether `inside` holds for a corner listed near the triangle (a, b, c): every listed corner in
+  /// or on the triangle is offered (some outside it too), until one answers true.
+  template <class Inside>
+  bool any_in_triangle(std::uint32_t a, std::uint32_t b, std::uint32_t c, Inside&& inside) {
+    for (const std::uint32_t q : late_)
+      if (inside(q)) return true;
+    if (order_.empty()) return false;
+    const glm::dvec2 &pa = p_[a], &pb = p_[b], &pc = p_[c];
+    const double y_lo = std::min({pa.y, pb.y, pc.y}), y_hi = std::max({pa.y, pb.y, pc.y});
+    const double x_lo = std::min({pa.x, pb.x, pc.x}), x_hi = std::max({pa.x, pb.x, pc.x});
+    const double margin = 1e-9 * (x_hi - x_lo) + 1e-300;
+    for (int row = row_of(y_lo), last = row_of(y_hi); row <= last; ++row) {
+      // The triangle's x range in the row's band: its edges clipped to the band, whose ends are
+      // where the range's ends lie. The band a thousandth of a row wider on each side, and the
+      // range a little wider, so that rounding never leaves out a corner the triangle touches.
+      const double band_lo = lo_ + height_ * (row - 1e-3) / rows_, band_hi = lo_ + height_ * (row + 1 + 1e-3) / rows_;
+      double from = x_hi, to = x_lo;
+      for (const auto& [s, t] : {std::pair{&pa, &pb}, std::pair{&pb, &pc}, std::pair{&pc, &pa}}) {
+        const double ylo = std::max(std::min(s->y, t->y), band_lo), yhi = std::min(std::max(s->y, t->y), band_hi);
+        if (ylo > yhi) continue;
+        if (s->y == t->y) {
+          from = std::min({from, s->x, t->x});
+          to = std::max({to, s->x, t->x});
+          continue;
+        }
+        for (const double y : {ylo, yhi}) {
+          const double x = s->x + (t->x - s->x) * ((y - s->y) / (t->y - s->y));
+          from = std::min(from, x);
+          to = std::max(to, x);
+        }
+      }
+      from = std::max(from, x_lo) - margin;
+      to = std::min(to, x_hi) + margin;
+      if (from > to) continue;
+      const std::uint32_t end = start_[row + 1];
+      auto i = static_cast<std::uint32_t>(std::lower_bound(xs_.begin() + start_[row], xs_.begin() + end, from) -
+                                          xs_.begin());
+      for (i = alive(i); i < end && xs_[i] <= to; i = alive(i + 1))
+        if (inside(order_[i])) return true;
+    }
+    return false;
+  }
+
+ private:
+  static constexpr std::uint32_t kNone = ~std::uint32_t{0};
+
+  int row_of(double y) const {
+    const double r = std::floor((y - lo_) / height_ * rows_);
+    return std::clamp(std::isfinite(r) ? static_cast<int>(r) : 0, 0, rows_ - 1);
+  }
+
+  /// The first place at or after i whose corner is still listed (order_.size() when none).
+  std::uint32_t alive(std::uint32_t i) {
+    while (skip_[i] != i) {
+      skip_[i] = skip_[skip_[i]];
+      i = skip_[i];
+    }
+    return i;
+  }
+
+  std::span<const glm::dvec2> p_;
+  double lo_ = 0.0, height_ = 1.0;
+  int rows_ = 1;
+  std::vector<std::uint32_t> order_;  ///< the listed corners by row, then x
+  std::vector<double> xs_;            ///< their x, for the search
+  std::vector<std::uint32_t> start_;  ///< each row's first place in order_; rows_ + 1 entries
+  std::vector<std::uint32_t> skip_;   ///< union-find: a place, or one nearer the next listed place
+  std::vector<std::uint32_t> place_;  ///< each corner's place in order_, or kNone
+  std::vector<std::uint32_t> late_;   ///< corners turned reflex by rounding after the start
+};
+
 }  // namespace
 
 std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(std::span<const glm::vec3> corners) {
@@ -171,82 +291,90 @@ std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(std::span<const gl
   // Ear clipping: a corner whose triangle with its neighbours turns the polygon's way and holds no
   // other remaining corner. Only reflex (or flat) corners need checking: if a corner lies in the
   // triangle of a convex one, so does a reflex one (Eberly, "Triangulation by Ear Clipping"); they
-  // are kept in a grid of cells, so that an ear checks the few near it. The ring is a linked list
-  // (cutting an ear is O(1)). After an ear the walk goes on past its far neighbour: a round cuts
-  // every other corner of a convex stretch, the next round the halves left, so the triangles stay
-  // small near the outline and fatten round by round (going back to the near neighbour made a fan
-  // of slivers from one corner). A whole round without an ear (a self-intersecting outline) or a
-  // spent budget of corner checks (4 n^2: no face, however shaped, takes long) leaves the rest to
-  // the fan.
+  // are kept by rows and x (ReflexRows), so that an ear checks the few its triangle spans. The
+  // ring is a linked list (cutting an ear is O(1)). After an ear the walk goes on past its far
+  // neighbour: a round cuts every other corner of a convex stretch, the next round the halves
+  // left, so the triangles stay small near the outline and fatten round by round (going back to
+  // the near neighbour made a fan of slivers from one corner).
+  //
+  // The walk visits only the candidates: corners not yet found to be no ear since their
+  // neighbours last changed (a second linked list in ring order). Cutting an ear changes only its
+  // neighbours' triangles, and the corners left only lose reflex corners, and by the same lemma a
+  // corner whose triangle held one still holds one; so a corner found to be no ear stays no ear
+  // until a neighbour of it is cut, and it is dropped from the walk until then. Walking every
+  // corner round after round was quadratic where each round cuts only a few ears (a comb's spine,
+  // a zig-zag strip, a spiral band: 100,000 corners took 5-16 s). When the candidates run out with
+  // corners left, every corner left is walked once more (a self-intersecting outline breaks the
+  // lemma); a whole round without an ear, or a spent budget of corner checks (4 n^2: no face,
+  // however shaped, takes long), leaves the rest to the fan.
   std::vector<std::uint32_t> next(n), prev(n);
   for (std::size_t k = 0; k < n; ++k) {
     next[k] = static_cast<std::uint32_t>((k + 1) % n);
     prev[k] = static_cast<std::uint32_t>((k + n - 1) % n);
   }
+  std::vector<std::uint32_t> cnext(next), cprev(prev);  // the candidates' ring
+  std::vector<char> candidate(n, 1);
+  std::size_t candidates = n;
+  const auto leave_walk = [&](std::uint32_t q) {
+    candidate[q] = 0;
+    cnext[cprev[q]] = cnext[q];
+    cprev[cnext[q]] = cprev[q];
+    --candidates;
+  };
+  const auto insert_before = [&](std::uint32_t q, std::uint32_t at) {
+    candidate[q] = 1;
+    cprev[q] = cprev[at];
+    cnext[q] = at;
+    cnext[cprev[at]] = q;
+    cprev[at] = q;
+    ++candidates;
+  };
   const auto reflex = [&](std::uint32_t b) { return cross2(p[prev[b]], p[b], p[next[b]]) <= 0.0; };
-  glm::dvec2 lo = p[0], hi = p[0];
-  for (const glm::dvec2& q : p) {
-    lo = glm::min(lo, q);
-    hi = glm::max(hi, q);
-  }
-  const int cells = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(n) / 4.0)));  // per axis
-  const glm::dvec2 extent = glm::max(hi - lo, glm::dvec2(1e-300));
-  const auto cell_of = [&](double x, double lo_, double extent_) {
-    const double c = std::floor((x - lo_) / extent_ * cells);
-    return std::clamp(std::isfinite(c) ? static_cast<int>(c) : 0, 0, cells - 1);
-  };
-  std::vector<std::vector<std::uint32_t>> grid(static_cast<std::size_t>(cells) * cells);
-  std::vector<char> listed(n, 0), removed(n, 0);  // listed: in its cell's list
-  const auto list = [&](std::uint32_t q) {
-    if (listed[q] || !reflex(q)) return;
-    listed[q] = 1;
-    grid[static_cast<std::size_t>(cell_of(p[q].y, lo.y, extent.y)) * cells + cell_of(p[q].x, lo.x, extent.x)].push_back(
-        q);
-  };
-  for (std::uint32_t k = 0; k < n; ++k) list(k);
-  std::size_t r = n, checks = 0, since_ear = 0;
+  std::vector<std::uint32_t> reflex_corners;
+  for (std::uint32_t k = 0; k < n; ++k)
+    if (reflex(k)) reflex_corners.push_back(k);
+  ReflexRows rows(p, reflex_corners);
+  std::size_t r = n, checks = 0;
   std::uint32_t b = 0;
+  bool walked_again = false;  // every corner left made a candidate again, and no ear since
   const std::size_t budget = 4 * n * n;
-  while (r > 3 && since_ear < r && checks < budget) {
+  while (r > 3 && checks < budget) {
+    if (candidates == 0) {
+      if (walked_again) break;  // a whole round without an ear
+      walked_again = true;
+      for (std::size_t k = 0; k < r; ++k, b = next[b]) {
+        candidate[b] = 1;
+        cnext[b] = next[b];
+        cprev[b] = prev[b];
+      }
+      candidates = r;
+    }
     const std::uint32_t a = prev[b], c = next[b];
     bool ear = cross2(p[a], p[b], p[c]) > 0.0;  // reflex or flat: no ear
-    if (ear) {
-      const glm::dvec2 e_lo = glm::min(p[a], glm::min(p[b], p[c])), e_hi = glm::max(p[a], glm::max(p[b], p[c]));
-      const int x0 = cell_of(e_lo.x, lo.x, extent.x), x1 = cell_of(e_hi.x, lo.x, extent.x);
-      const int y0 = cell_of(e_lo.y, lo.y, extent.y), y1 = cell_of(e_hi.y, lo.y, extent.y);
-      for (int y = y0; y <= y1 && ear; ++y)
-        for (int x = x0; x <= x1 && ear; ++x) {
-          std::vector<std::uint32_t>& in_cell = grid[static_cast<std::size_t>(y) * cells + x];
-          for (std::size_t k = 0; k < in_cell.size() && ear;) {
-            ++checks;
-            const std::uint32_t q = in_cell[k];
-            if (removed[q] || !reflex(q)) {  // cut, or convex now: off the list (swap with the last)
-              listed[q] = 0;
-              in_cell[k] = in_cell.back();
-              in_cell.pop_back();
-              continue;
-            }
-            ++k;
-            if (q == a || q == b || q == c || p[q] == p[a] || p[q] == p[b] || p[q] == p[c]) continue;
-            ear = !(cross2(p[a], p[b], p[q]) >= 0.0 && cross2(p[b], p[c], p[q]) >= 0.0 &&
-                    cross2(p[c], p[a], p[q]) >= 0.0);
-          }
-        }
-    }
+    if (ear)
+      ear = !rows.any_in_triangle(a, b, c, [&](std::uint32_t q) {
+        ++checks;
+        if (q == a || q == b || q == c || p[q] == p[a] || p[q] == p[b] || p[q] == p[c]) return false;
+        return cross2(p[a], p[b], p[q]) >= 0.0 && cross2(p[b], p[c], p[q]) >= 0.0 && cross2(p[c], p[a], p[q]) >= 0.0;
+      });
     if (!ear) {
-      b = c;
-      ++since_ear;
+      const std::uint32_t after = cnext[b];
+      leave_walk(b);
+      b = after;
       continue;
     }
     out.push_back({a, b, c});
-    removed[b] = 1;
     next[a] = c;
     prev[c] = a;
     --r;
-    since_ear = 0;
-    list(a);  // their angles changed
-    list(c);
-    b = next[c];
+    walked_again = false;
+    // Their triangles changed: candidates again, in ring order around b (a just before it, c just
+    // after), before b leaves the candidates' ring.
+    if (!candidate[a]) insert_before(a, b);
+    if (!candidate[c]) insert_before(c, cnext[b]);
+    leave_walk(b);
+    for (const std::uint32_t q : {a, c}) rows.update(q, reflex(q));  // their angles changed
+    b = cnext[c];
   }
   std::vector<std::uint32_t> rest;
   rest.reserve(r);
