@@ -200,17 +200,39 @@ RTCBuildQuality to_rtc(EmbreeQuality q) {
 
 // ---- the accelerator ---------------------------------------------------------------
 
+/// Embree's box tests take 1/d with |d| clamped to at least 1e-18 (its
+/// rcp_safe), so a direction whose every component is that small is traced
+/// with other boxes than its own and misses what it hits: measured on the
+/// teapot, rays at distance ~6 lost hits once their largest component fell
+/// to ~1e-17 (all of them from ~1e-19 on). 1e-15 keeps a margin; a zero
+/// direction is refused too (it can hit nothing).
+constexpr float kEmbreeShortest = 1e-15f;
+
+/// The other end of the float range for the same products (overflow: kEmbreeProductLimit below):
+/// below about 1e-38 (FLT_MIN) they are denormal and lose their digits, then 0. Measured with
+/// `verify -s brute,embree` on a 4×4-per-face cube of half-size s (edges s/2; rays of the scene's
+/// size): s = 1e-10 agrees (|e|²·extent = 5e-31), s = 1e-12 mismatched 4 of 5000 rays and s = 1e-14
+/// 418 (5e-37, 5e-43). A scene whose largest edge component e and extent give e²·extent below
+/// this limit is refused; a ray whose largest direction component d gives e²·d below it too.
+constexpr double kEmbreeProductFloor = 1e-33;
+constexpr double kEmbreeDirectionFloor = 1e-37;
+
 /// How far the scene reaches, for the overflow check of Embree's float
-/// triangle test (products_fit_embree).
+/// triangle test (products_fit_embree), and how short a direction it takes
+/// before the test's products fall below float's normal range.
 struct EmbreeReach {
   double coordinate = 0.0;  ///< the largest |vertex component|
   double edge = 0.0;        ///< the largest |component| of a triangle edge
+  double extent = 0.0;      ///< the scene box's largest side
   // products_fit_embree's bounds on a ray's largest origin (o) and
   // direction (d) components, from the two above (set by limit()).
   float o_max = std::numeric_limits<float>::infinity();   ///< o <= it: |C|·|e|² fits
   float d_max = std::numeric_limits<float>::infinity();   ///< d <= it: |e|²·|D| fits
   float od_max = std::numeric_limits<float>::infinity();  ///< (o + coordinate)·d <= it: |C|·|e|·|D| fits
   float coordinate_f = 0.0f;
+  /// A ray's largest direction component must be at least this: kEmbreeShortest, or more where
+  /// |e|²·d would fall below kEmbreeProductFloor.
+  float d_min = kEmbreeShortest;
   void limit(double product_limit) {
     coordinate_f = static_cast<float>(coordinate);
     if (!(edge > 0.0)) return;  // no edge: no product to overflow
@@ -220,7 +242,11 @@ struct EmbreeReach {
     o_max = to_float(product_limit / (edge * edge) - coordinate);
     d_max = to_float(product_limit / (edge * edge));
     od_max = to_float(product_limit / edge);
+    d_min = std::max(kEmbreeShortest, to_float(kEmbreeDirectionFloor / (edge * edge)));
   }
+  /// Whether the scene is too small for the test: |e|²·extent below kEmbreeProductFloor (a scene
+  /// without an edge has nothing to hit and is never too small).
+  bool too_small() const { return edge > 0.0 && edge * edge * extent < kEmbreeProductFloor; }
 };
 
 struct EmbreeAccelerator::Impl {
@@ -249,16 +275,13 @@ bool within_embree_range(const glm::vec3& v) {
   return std::abs(v.x) <= kEmbreeLarge && std::abs(v.y) <= kEmbreeLarge && std::abs(v.z) <= kEmbreeLarge;
 }
 
-/// Embree's box tests take 1/d with |d| clamped to at least 1e-18 (its
-/// rcp_safe), so a direction whose every component is that small is traced
-/// with other boxes than its own and misses what it hits: measured on the
-/// teapot, rays at distance ~6 lost hits once their largest component fell
-/// to ~1e-17 (all of them from ~1e-19 on). 1e-15 keeps a margin; a zero
-/// direction is refused too (it can hit nothing).
-constexpr float kEmbreeShortest = 1e-15f;
+float largest_component(const glm::vec3& d) {
+  return std::max(std::abs(d.x), std::max(std::abs(d.y), std::abs(d.z)));
+}
 
-bool long_enough_for_embree(const glm::vec3& d) {
-  return std::max(std::abs(d.x), std::max(std::abs(d.y), std::abs(d.z))) >= kEmbreeShortest;
+/// At least kEmbreeShortest, and long enough for the scene's products (EmbreeReach::d_min).
+bool long_enough_for_embree(const glm::vec3& d, const EmbreeReach& reach) {
+  return largest_component(d) >= reach.d_min;
 }
 
 /// Embree's triangle tests work in float on C = v0 - o, the edges, their
@@ -307,7 +330,8 @@ std::string vec_text(const glm::vec3& v) {
 /// Whether Embree takes the ray (ray_problem's test, without the words).
 [[gnu::always_inline]] inline bool embree_takes(const Ray& ray, const EmbreeReach& reach) {
   return ray.tmin >= 0.0f && ray.tmax == ray.tmax && within_embree_range(ray.origin) &&
-         within_embree_range(ray.direction) && long_enough_for_embree(ray.direction) && products_fit_embree(ray, reach);
+         within_embree_range(ray.direction) && long_enough_for_embree(ray.direction, reach) &&
+         products_fit_embree(ray, reach);
 }
 
 }  // namespace
@@ -322,10 +346,16 @@ std::string EmbreeAccelerator::ray_problem(const Ray& ray) const {
     why = "origin " + vec_text(ray.origin) + " has a component";
   else if (!within_embree_range(ray.direction))
     why = "direction " + vec_text(ray.direction) + " has a component";
-  else if (!long_enough_for_embree(ray.direction))
+  else if (!(largest_component(ray.direction) >= kEmbreeShortest))
     return "cannot trace a ray whose direction " + vec_text(ray.direction) +
            " has no component of 1e-15 or more (Embree clamps 1/d at 1e18 in its box tests and would miss what "
            "the ray hits; accelviz's own structures trace it)";
+  else if (!long_enough_for_embree(ray.direction, impl_->reach))
+    return "cannot trace a ray whose direction " + vec_text(ray.direction) + " has no component of " +
+           num_text(impl_->reach.d_min) + " or more in this scene (edge components up to " +
+           num_text(static_cast<float>(impl_->reach.edge)) +
+           "): Embree's float triangle test would underflow (products like |e1|·|e2|·|D| below float's normal "
+           "range) and miss what the ray hits; accelviz's own structures trace it";
   else if (!products_fit_embree(ray, impl_->reach))
     return "cannot trace a ray from " + vec_text(ray.origin) + " along " + vec_text(ray.direction) +
            " in this scene (vertex coordinates up to " + num_text(static_cast<float>(impl_->reach.coordinate)) +
@@ -347,6 +377,7 @@ EmbreeAccelerator::EmbreeAccelerator(std::span<const Triangle> triangles, const 
   const std::size_t n = triangles.size();
   std::size_t out_of_range = 0, first_out = 0;
   EmbreeReach& reach = impl_->reach;
+  glm::dvec3 box_lo(std::numeric_limits<double>::infinity()), box_hi(-std::numeric_limits<double>::infinity());
   for (std::size_t i = 0; i < n; ++i) {
     const Triangle& t = triangles[i];
     if (!within_embree_range(t.v0) || !within_embree_range(t.v1) || !within_embree_range(t.v2)) {
@@ -358,6 +389,12 @@ EmbreeAccelerator::EmbreeAccelerator(std::span<const Triangle> triangles, const 
     const glm::dvec3 a(t.v0), b(t.v1), c(t.v2);
     for (const glm::dvec3& edge : {b - a, c - b, a - c})
       reach.edge = std::max({reach.edge, std::abs(edge.x), std::abs(edge.y), std::abs(edge.z)});
+    box_lo = glm::min(box_lo, glm::min(a, glm::min(b, c)));
+    box_hi = glm::max(box_hi, glm::max(a, glm::max(b, c)));
+  }
+  if (box_lo.x <= box_hi.x) {
+    const glm::dvec3 side = box_hi - box_lo;
+    reach.extent = std::max({side.x, side.y, side.z});
   }
   reach.limit(kEmbreeProductLimit);
   if (out_of_range > 0)
@@ -368,6 +405,13 @@ EmbreeAccelerator::EmbreeAccelerator(std::span<const Triangle> triangles, const 
                                  std::to_string(first_out) + ") have") +
         " a vertex coordinate beyond ±1.844e18, which Embree's build leaves out; accelviz's own structures "
         "(bvh, kdtree, grid, ...) keep them");
+  if (reach.too_small())
+    throw std::runtime_error(
+        "embree: the scene is too small for Embree's float triangle test (extent " +
+        num_text(static_cast<float>(reach.extent)) + ", edge components up to " +
+        num_text(static_cast<float>(reach.edge)) +
+        "): its products (|e1|·|e2|·|v0 - o| about edge²·extent) fall below float's normal range and it would "
+        "miss what rays hit; accelviz's own structures (bvh, kdtree, grid, ...) trace it");
   const auto t0 = Clock::now();
   impl_->vertices.resize(9 * n + 3, 0.0f);
   impl_->indices.resize(3 * n);
