@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "core/analysis/sah.h"
 #include "core/query/camera.h"
 #include "core/scene/effects.h"
 #include "core/scene/load.h"
@@ -185,13 +186,11 @@ CLI::Validator cost_constant() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
         double v = 0.0;
-        if (!option_number(text, v)) return "expected a number, got '" + text + "'";
-        // At most the GUI's 1e6: only the ratio of the two matters to a build, and 3e38 overflowed the
-        // cost metric (the cost of a ray read inf).
-        if (!std::isfinite(v) || !(v > 0.0) || v > 1e6) return "must be a number > 0 and at most 1e6, got " + text;
+        if (!option_number(text, v)) return "expected a number from 1e-06 to 1e+06, got '" + text + "'";
+        if (const std::string problem = cost_constant_problem(v); !problem.empty()) return problem + ", got " + text;
         return {};
       },
-      "(0 - 1e6]");
+      "[1e-06 - 1e+06]");
 }
 
 CLI::Validator finite_range(double lo, double hi) {
@@ -466,8 +465,11 @@ void parse_scale_top(const std::string& text, float& value, double& percentile) 
     value = 0.0f;
     return;
   }
-  if (!whole || !(v > 0.0) || v > 3.4e38)
-    throw UsageError("--max " + text + ": expected a finite number above 0, or pNN for a percentile (p99)");
+  // At least float's smallest normal number: 1e-300 was 0 as a float, and 0 is no top (the scale
+  // fell back to the image's maximum under a legend that said "--max 1e-300").
+  if (!whole || !(v >= 1.2e-38) || v > 3.4e38)
+    throw UsageError("--max " + text +
+                     ": expected a number from 1.2e-38 to 3.4e38 (float's range), or pNN for a percentile (p99)");
   value = static_cast<float>(v);
   percentile = 0.0;
 }

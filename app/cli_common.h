@@ -111,7 +111,7 @@ inline constexpr unsigned kMaxThreads = 1024;
 /// through, and word the positive range as "0.000000 to 1797693...".)
 CLI::Validator finite_positive();
 CLI::Validator finite_range(double lo, double hi);
-/// A C_trav or C_isect: > 0 and at most 1e6, as the GUI's fields.
+/// A C_trav or C_isect: from 1e-6 to 1e6 (cost_constant_problem), as the GUI's fields, --compare and sweep.
 CLI::Validator cost_constant();
 
 /// `--threads,-j N` (0: all hardware threads), checked to 0..kMaxThreads.

@@ -9,8 +9,10 @@
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <glm/geometric.hpp>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -41,10 +43,16 @@ OutputDirFiles refit_files() {
   return {"refit", {"refit.csv", "refit.json", "refit-sah.png", "refit-nodes.png", "refit-ms.png"}};
 }
 
+std::string number_text(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", x);
+  return text;
+}
+
 int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
   const ImageSize size = parse_size(o.size);
-  if (!(o.amplitude >= 0) || !std::isfinite(o.amplitude))
-    throw UsageError("--amplitude must be a finite number >= 0");
+  if (!(o.amplitude >= 0) || !(o.amplitude <= 1000))
+    throw UsageError("--amplitude must be a number from 0 to 1000 (times the scene's diagonal)");
   if (!std::isfinite(o.frame_step)) throw UsageError("--frame-step must be a finite number");
   if (!(o.rebuild_ratio == 0 || (o.rebuild_ratio >= 1 && std::isfinite(o.rebuild_ratio))))
     throw UsageError("--rebuild-ratio must be 0 (never) or a finite number >= 1");
@@ -56,6 +64,17 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
   require_flattened(scene, o.scene, "refit");
   progress.end(std::to_string(scene.triangles.size()) + " triangles");
+  // The motion moves a vertex by up to 2 · amplitude · diagonal: near float's range that came out
+  // as NaN SAH figures in the table and the CSV.
+  if (const Aabb b = scene.bounds(); !b.is_empty()) {
+    const glm::dvec3 lo(b.lo), hi(b.hi);
+    const glm::dvec3 far = glm::max(glm::abs(lo), glm::abs(hi));
+    const double reach = std::max({far.x, far.y, far.z}) + 2.0 * o.amplitude * glm::length(hi - lo);
+    if (!(reach <= 1e37))
+      throw std::runtime_error(o.scene + ": --amplitude " + number_text(o.amplitude) +
+                               " would move vertices beyond float's range (to about " + number_text(reach) +
+                               "); a smaller amplitude or scene");
+  }
   // The camera frames the rest pose; the motion is small against the scene, so it stays framed.
   const std::vector<Ray> rays =
       primary_rays(camera_for("", scene, size, /*has_camera_option=*/false), size.width, size.height);
@@ -186,7 +205,7 @@ Command add_refit_command(CLI::App& parent, const GlobalOptions& global) {
                   "smooth bend (neighbours move alike); jitter: every vertex on its own (the mesh crumples)")
       ->check(CLI::IsMember({"explode", "wave", "jitter"}))
       ->capture_default_str();
-  sub->add_option("--amplitude", o->amplitude, "Motion amplitude, relative to the scene diagonal")
+  sub->add_option("--amplitude", o->amplitude, "Motion amplitude, relative to the scene diagonal (0 to 1000)")
       ->capture_default_str();
   sub->add_option("--frame-step", o->frame_step, "Time advance per frame, in motion periods")->capture_default_str();
   sub->add_option("--rebuild-ratio", o->rebuild_ratio,

@@ -17,6 +17,7 @@
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
+#include <functional>
 #include <cstring>
 #include <filesystem>
 #include <new>
@@ -75,6 +76,30 @@ int run(int argc, char** argv) {
       cli::add_trace_command(app, global), cli::add_rays_command(app, global),
   };
   for (cli::CommandFactory factory : cli::registered_commands()) commands.push_back(factory(app, global));
+
+  // Whole numbers in decimal only: CLI11 reads "010" as octal (8 buckets, -j 010 as 8 threads),
+  // "0x10" as hex, and "-1" for an unsigned option as 2^64 - 1 (a seed). Checked on every INT and
+  // UINT option of every command, before the option's own range check converts the text.
+  const std::function<void(CLI::App*)> decimal_only = [&](CLI::App* a) {
+    for (CLI::Option* opt : a->get_options()) {
+      const std::string type = opt->get_type_name();
+      const bool is_unsigned = type.rfind("UINT", 0) == 0, is_signed = type.rfind("INT", 0) == 0;
+      if (!is_unsigned && !is_signed) continue;
+      opt->check(CLI::Validator(
+          [is_unsigned](std::string& text) -> std::string {
+            const std::size_t digits = !is_unsigned && text.size() > 1 && text[0] == '-' ? 1 : 0;
+            bool ok = text.size() > digits;
+            for (std::size_t i = digits; ok && i < text.size(); ++i) ok = text[i] >= '0' && text[i] <= '9';
+            if (ok && text[digits] == '0' && text.size() > digits + 1) ok = false;  // octal in CLI11
+            if (ok) return {};
+            return std::string("expected a whole number in decimal digits (") +
+                   (is_unsigned ? "no sign, " : "") + "no leading zero), got '" + text + "'";
+          },
+          ""));
+    }
+    for (CLI::App* sub : a->get_subcommands({})) decimal_only(sub);
+  };
+  decimal_only(&app);
 
   try {
     app.parse(argc, argv);

@@ -4,9 +4,11 @@
 #include <filesystem>
 #include <iostream>
 #include <limits>
+#include <set>
 #include <sstream>
 
 #include "core/analysis/caption.h"
+#include "core/analysis/sah.h"
 #include "core/analysis/heatmap.h"
 #include "core/analysis/insight/compare_images.h"
 #include "core/query/batch.h"
@@ -26,9 +28,11 @@ T parse_number(const std::string& key, const std::string& value) {
     if constexpr (std::is_same_v<T, int>)
       v = std::stoi(value, &used);
     else
-      v = std::stof(value, &used);
+      v = std::stod(value, &used);
     if (used != value.size()) throw std::invalid_argument("trailing");
     return v;
+  } catch (const std::out_of_range&) {
+    throw UsageError("--compare: " + key + "=" + value + ": out of range");
   } catch (const std::logic_error&) {
     throw UsageError("--compare: " + key + "=" + value + ": not a number");
   }
@@ -53,12 +57,14 @@ CompareSide parse_compare_spec(const std::string& spec, const CompareSide& a) {
   std::istringstream in(text);
   std::string pair;
   int pairs = 0;
+  std::set<std::string> keys;
   while (in >> pair) {
     ++pairs;
     const auto eq = pair.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == pair.size())
       throw UsageError("--compare: '" + pair + "': expected key=value");
     const std::string key = pair.substr(0, eq), value = pair.substr(eq + 1);
+    if (!keys.insert(key).second) throw UsageError("--compare: " + key + " given twice in '" + spec + "'");
     if (key == "structure") {
       bool known = false;
       for (const std::string& n : structure_names()) known = known || n == value;
@@ -77,9 +83,10 @@ CompareSide parse_compare_spec(const std::string& spec, const CompareSide& a) {
       (key == "leaf" ? b.structure_opts.leaf : b.structure_opts.leaf_cap) = v;
       if (key == "leaf-cap") b.structure_opts.leaf_cap_given = true;
     } else if (key == "ctrav" || key == "cisect") {
-      const float v = parse_number<float>(key, value);
-      if (!(v > 0.0f) || !std::isfinite(v)) throw UsageError("--compare: " + key + "=" + value + ": expected > 0");
-      (key == "ctrav" ? b.structure_opts.ctrav : b.structure_opts.cisect) = v;
+      const double v = parse_number<double>(key, value);
+      if (const std::string problem = cost_constant_problem(v); !problem.empty())
+        throw UsageError("--compare: " + key + "=" + value + ": " + problem + " (as --" + key + ")");
+      (key == "ctrav" ? b.structure_opts.ctrav : b.structure_opts.cisect) = static_cast<float>(v);
     } else if (key == "embree-quality") {
       require_one_of(key, value, {"low", "medium", "high"});
       b.structure_opts.embree_quality = value;

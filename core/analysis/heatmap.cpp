@@ -334,7 +334,7 @@ float metric_percentile(std::span<const MetricImage* const> images, double perce
   std::vector<float> values;
   for (const MetricImage* img : images)
     for (const float v : img->values)
-      if (std::isfinite(v)) values.push_back(v);
+      if (std::isfinite(v) && v > 0.0f) values.push_back(v);
   if (values.empty()) return 0.0f;
   const double p = std::clamp(percent, 0.0, 100.0) / 100.0;
   const std::size_t rank = std::min(

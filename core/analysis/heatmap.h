@@ -173,9 +173,13 @@ struct ValueRange {
 };
 ValueRange metric_value_range(const MetricImage& image);
 
-/// The value below which `percent` % of the images' finite values lie (the
-/// nearest rank; 0 when they have none): a colour scale's top that a few
-/// outliers (a silhouette's grazing rays) do not set, `render --max p99`.
+/// The value below which `percent` % of the images' finite values above 0 lie
+/// (the nearest rank; 0 when they have none): a colour scale's top that a few
+/// outliers (a silhouette's grazing rays) do not set, `render --max p99`. The
+/// pixels that counted nothing (rays that missed the scene's box) are left out
+/// with the misses: half a soup's image was background, so `p50` came out 0,
+/// which is no top, and the scale fell back to the maximum under a legend that
+/// said "50th percentile".
 float metric_percentile(std::span<const MetricImage* const> images, double percent);
 
 /// Top of the colour scale for `image`: `fixed_max` when > 0, else the image's

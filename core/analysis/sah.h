@@ -11,10 +11,23 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <string>
 
 #include "core/accel/bvh/bvh.h"
 
 namespace accelviz {
+
+/// The range an SAH cost constant (C_trav, C_isect) is taken in, from the command line, `--compare`,
+/// a sweep and the GUI's fields alike: only the ratio of the two matters to a build, 3e38 overflowed
+/// the cost metric (a ray's cost read inf) and the tree's float SAH sums, and 1e-300 is 0 in float.
+inline constexpr double kMinCostConstant = 1e-6;
+inline constexpr double kMaxCostConstant = 1e6;
+
+/// "" when `v` lies in [kMinCostConstant, kMaxCostConstant], else "must be a number from 1e-06 to 1e+06".
+inline std::string cost_constant_problem(double v) {
+  if (v >= kMinCostConstant && v <= kMaxCostConstant) return {};
+  return "must be a number from 1e-06 to 1e+06";
+}
 
 /// SAH cost of `nodes` (root at 0). 0 for an empty tree. When the root box
 /// has zero area (all primitives on a point or a line) every ratio is taken

@@ -6,6 +6,7 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <set>
 #include <sstream>
@@ -44,6 +45,15 @@ float parse_positive(const std::string& name, const std::string& v) {
   if (ec != std::errc() || p != v.data() + v.size() || !std::isfinite(out) || out <= 0)
     bad_value(name, v, "expected a finite number > 0");
   return out;
+}
+
+/// An SAH cost constant: a number in the range the command line takes (cost_constant_problem).
+float parse_cost(const std::string& name, const std::string& v) {
+  double out = 0;
+  const auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), out);
+  if (ec != std::errc() || p != v.data() + v.size()) bad_value(name, v, "expected a number from 1e-06 to 1e+06");
+  if (const std::string problem = cost_constant_problem(out); !problem.empty()) bad_value(name, v, problem);
+  return static_cast<float>(out);
 }
 
 bool parse_on_off(const std::string& name, const std::string& v) {
@@ -151,17 +161,17 @@ void apply_sweep_setting(std::string_view structure, const SweepSetting& setting
         o.bvh.max_leaf_size = parse_int(name, v, 1, 255);
         o.bvh.leaf_size_cap = std::max(o.bvh.leaf_size_cap, o.bvh.max_leaf_size);
       } else if (name == "ctrav") {
-        o.bvh.cost_traversal = parse_positive(name, v);
+        o.bvh.cost_traversal = parse_cost(name, v);
       } else if (name == "cisect") {
-        o.bvh.cost_intersect = parse_positive(name, v);
+        o.bvh.cost_intersect = parse_cost(name, v);
       }
     } else if (structure == "kdtree") {
       if (name == "depth")
         o.kdtree.max_depth = parse_int(name, v, 0, 64);
       else if (name == "ctrav")
-        o.kdtree.cost_traversal = parse_positive(name, v);
+        o.kdtree.cost_traversal = parse_cost(name, v);
       else if (name == "cisect")
-        o.kdtree.cost_intersect = parse_positive(name, v);
+        o.kdtree.cost_intersect = parse_cost(name, v);
       else if (name == "leaf")
         o.kdtree.max_leaf_size = parse_int(name, v, 1, 1 << 20);
       else if (name == "mailbox")
@@ -208,6 +218,24 @@ std::vector<SweepSetting> expand_sweep(std::string_view structure, std::span<con
       QueryOptions q;
       apply_sweep_setting(structure, {{p.name, v}}, o, q);
     }
+  }
+  // A fixed resolution leaves lambda nothing to choose: each lambda would be the same grid under
+  // another label.
+  if (structure == "grid" && seen.count("lambda") && seen.count("res"))
+    throw std::invalid_argument("sweep parameters lambda and res together: a fixed resolution (res) ignores lambda");
+  // Counted before they are made: 2e14 combinations filled 8 GB before the first build.
+  double count = 1.0;
+  std::string product;
+  for (const SweepParam& p : params) {
+    count *= static_cast<double>(p.values.size());
+    product += (product.empty() ? "" : " x ") + std::to_string(p.values.size());
+  }
+  if (count > static_cast<double>(kMaxSweepSettings)) {
+    char n[32];
+    std::snprintf(n, sizeof n, "%.4g", count);
+    throw std::invalid_argument("sweep parameters give " + std::string(n) + " settings (" + product +
+                                " values), more than the " + std::to_string(kMaxSweepSettings) +
+                                " one sweep takes: give fewer values");
   }
   std::vector<SweepSetting> out{SweepSetting{}};
   for (const SweepParam& p : params) {

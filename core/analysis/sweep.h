@@ -48,6 +48,9 @@ SweepParam parse_sweep_param(std::string_view text);
 /// and for a parameter given twice or an empty list.
 std::vector<SweepSetting> expand_sweep(std::string_view structure, std::span<const SweepParam> params);
 
+/// The most settings one sweep takes (expand_sweep refuses more, before making any).
+inline constexpr std::size_t kMaxSweepSettings = 10000;
+
 /// Whether parameter `name` sets a query option only (the triangle test):
 /// settings that differ only in such parameters build the same structure.
 bool sweep_param_is_query(std::string_view name);

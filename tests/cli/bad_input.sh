@@ -62,13 +62,36 @@ expect 2 "--threads: Value 100000 not in range 0 to 1024" -- bench 'builtin:soup
 expect 2 "--threads" -- render 'builtin:soup?size=10' --out "$tmp/y.png" -j 4294967295
 # Floating-point options: NaN, infinity and overflow are refused, in words
 # (CLI11's own checks let nan through and printed 0.000000 to 1797693...).
-expect 2 "--ctrav: must be a number > 0 and at most 1e6, got nan" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --ctrav nan
-expect 2 "--cisect: must be a number > 0 and at most 1e6, got 1e308" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --cisect 1e308
+expect 2 "--ctrav: must be a number from 1e-06 to 1e+06, got nan" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --ctrav nan
+expect 2 "--cisect: must be a number from 1e-06 to 1e+06, got 1e308" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --cisect 1e308
 # animate --dt: 3e38 overflowed the frames' times (a transform of inf), 1e30 moved nothing.
 expect 2 "--dt: must be a number from 1e-06 to 10000, got 3e38" -- animate 'builtin:dynamic?size=2000' --frames 3 --dt 3e38
 # At most the GUI's 1e6: 3e38 overflowed the cost metric (a ray's cost read inf).
-expect 2 "--ctrav: must be a number > 0 and at most 1e6, got 3e38" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --ctrav 3e38 -m cost
-expect 2 "--max nan: expected a finite number above 0, or pNN for a percentile (p99)" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --max nan
+expect 2 "--ctrav: must be a number from 1e-06 to 1e+06, got 3e38" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --ctrav 3e38 -m cost
+expect 2 "--max nan: expected a number from 1.2e-38 to 3.4e38 (float's range), or pNN for a percentile (p99)" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --max nan
+expect 2 "--max 1e-300: expected a number from 1.2e-38" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --max 1e-300
+# Whole numbers in decimal only: CLI11 read 010 as octal (8) and -1 for a seed as 2^64 - 1.
+expect 2 "--buckets: expected a whole number in decimal digits (no leading zero), got '010'" -- \
+  render 'builtin:soup?size=10' --out "$tmp/y.png" --buckets 010
+expect 2 "--seed: expected a whole number in decimal digits (no sign, no leading zero), got '-1'" -- \
+  rays 'builtin:soup?size=10' -k diffuse --seed -1 --out "$tmp/y.rays"
+expect 2 "--threads: expected a whole number in decimal digits (no sign, no leading zero), got '0x2'" -- \
+  render 'builtin:soup?size=10' --out "$tmp/y.png" -j 0x2
+# SAH costs in one range everywhere (a sweep took 3e38 and built the wrong tree; --compare took 2e6).
+expect 2 "--ctrav: must be a number from 1e-06 to 1e+06, got 1e-300" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --ctrav 1e-300
+expect 2 "--compare: ctrav=2e6: must be a number from 1e-06 to 1e+06" -- \
+  render 'builtin:soup?size=10' --out "$tmp/y.png" --compare ctrav=2e6
+expect 2 "--compare: buckets given twice" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --compare 'buckets=4 buckets=8'
+expect 2 "sweep parameter cisect: bad value '3e38' (must be a number from 1e-06 to 1e+06)" -- sweep 'builtin:soup?size=10' --param cisect=1,3e38 --out "$tmp/sw"
+expect 2 "more than the 10000 one sweep takes" -- sweep 'builtin:soup?size=10' --param buckets=2,3,4,5,6,7,8,9,10,11 \
+  --param leaf=1,2,3,4,5,6,7,8,9,10 --param ctrav=1,2,3,4,5,6,7,8,9,10 --param cisect=1,2,3,4,5,6,7,8,9,10,11 --out "$tmp/sw"
+expect 2 "lambda and res together" -- sweep 'builtin:soup?size=10' -s grid --param lambda=1,2 --param res=4x4x4 --out "$tmp/sw"
+[ ! -e "$tmp/sw" ] || { echo "FAIL: a refused sweep made its folder"; fail=1; }
+# refit's motion within float's range (3e38 gave NaN SAH figures).
+expect 2 "--amplitude must be a number from 0 to 1000" -- refit 'builtin:soup?size=10' --frames 1 --amplitude 3e38 --out "$tmp/rf"
+printf 'v -1e37 0 0\nv 1e37 0 0\nv 0 1e37 0\nf 1 2 3\n' >"$tmp/big37.obj"
+expect 1 "$tmp/big37.obj: --amplitude 1 would move vertices beyond float's range" -- \
+  refit "$tmp/big37.obj" --frames 1 --amplitude 1 --out "$tmp/rf"
 expect 2 "--max p0: a percentile is p followed by a number above 0 and at most 100" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --max p0
 expect 2 "--max p99: a percentile top is for the heatmap view" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --max p99 --view raster
 expect 2 "--blend: must be a number from 0 to 1, got nan" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --view raster --blend nan

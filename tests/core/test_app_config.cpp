@@ -114,6 +114,7 @@ TEST(AppConfig, ErrorsNameTheOptionAndChangeNothing) {
                        Bad{"buckets", "16x"},    Bad{"leaf", "0"},
                        Bad{"ctrav", "0"},        Bad{"ctrav", "-1"},
                        Bad{"ctrav", "nan"},      Bad{"cisect", "inf"},
+                       Bad{"ctrav", "1e-7"},     Bad{"kd-cisect", "2e6"},
                        Bad{"splitter", "sah"},   Bad{"structure", "octopus"},
                        Bad{"grid-res", "1,2"},   Bad{"grid-res", "0,4,4"},
                        Bad{"grid-res", "a,b,c"}, Bad{"scale", "5,1"},

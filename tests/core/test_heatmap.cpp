@@ -135,7 +135,7 @@ TEST(Heatmap, BruteForceWithBoxesCountsEveryBoxAsANodeVisit) {
   EXPECT_EQ(plain.build_stats().sah_cost, static_cast<double>(tris.size()));
 }
 
-TEST(Heatmap, PercentileOfTheImagesFiniteValues) {
+TEST(Heatmap, PercentileOfTheImagesValuesAboveZero) {
   MetricImage a, b;
   a.width = 5;
   a.height = 1;
@@ -151,9 +151,15 @@ TEST(Heatmap, PercentileOfTheImagesFiniteValues) {
   EXPECT_EQ(metric_percentile(two, 100.0), 100.0f);
   EXPECT_EQ(metric_percentile(two, 1.0), 1.0f);
   MetricImage none;
-  none.values = {std::numeric_limits<float>::quiet_NaN()};
+  none.values = {std::numeric_limits<float>::quiet_NaN(), 0.0f};
   const MetricImage* empty[] = {&none};
   EXPECT_EQ(metric_percentile(empty, 99.0), 0.0f);
+  // Pixels that counted nothing are left out: the 50th percentile of a mostly empty image is not 0.
+  MetricImage sparse;
+  sparse.values = {0, 0, 0, 0, 0, 0, 3, 5, 7};
+  const MetricImage* background[] = {&sparse};
+  EXPECT_EQ(metric_percentile(background, 50.0), 5.0f);
+  EXPECT_EQ(metric_percentile(background, 10.0), 3.0f);
 }
 
 TEST(Heatmap, PngHasTheColourTheMapGives) {

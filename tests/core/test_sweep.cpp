@@ -61,6 +61,21 @@ TEST(SweepParams, UnknownNameOrBadValueIsNamed) {
   EXPECT_NE(message("kdtree", {{"mailbox", {"yes"}}}).find("'yes'"), std::string::npos);
   EXPECT_NE(message("bvh", {{"triangle", {"exact"}}}).find("'exact'"), std::string::npos);
   EXPECT_NE(message("bvh", {{"leaf", {"1"}}, {"leaf", {"2"}}}).find("twice"), std::string::npos);
+  // The SAH costs in the command line's range: 3e38 overflowed the float sums and built bigger leaves.
+  EXPECT_NE(message("bvh", {{"cisect", {"1", "3e38"}}}).find("'3e38' (must be a number from 1e-06 to 1e+06)"),
+            std::string::npos);
+  EXPECT_NE(message("kdtree", {{"ctrav", {"1e-300"}}}).find("'1e-300'"), std::string::npos);
+  // A fixed resolution leaves lambda nothing to choose.
+  EXPECT_NE(message("grid", {{"lambda", {"1", "2"}}, {"res", {"4x4x4"}}}).find("lambda and res together"),
+            std::string::npos);
+  // Counted before they are made: 2e14 settings filled 8 GB before the first build.
+  std::vector<std::string> many(200);
+  for (std::size_t i = 0; i < many.size(); ++i) many[i] = std::to_string(1 + i);
+  EXPECT_NE(message("bvh", {{"ctrav", many}, {"cisect", many}}).find("give 4e+04 settings (200 x 200 values), more "
+                                                                       "than the 10000 one sweep takes"),
+            std::string::npos)
+      << message("bvh", {{"ctrav", many}, {"cisect", many}});
+  EXPECT_EQ(expand_sweep("bvh", std::vector<SweepParam>{{"ctrav", many}, {"cisect", {"1", "2"}}}).size(), 400u);
 }
 
 TEST(SweepParams, AppliesToTheRightOptions) {

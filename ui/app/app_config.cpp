@@ -1,5 +1,7 @@
 #include "ui/app/app_config.h"
 
+#include "core/analysis/sah.h"
+
 #include <algorithm>
 #include <array>
 #include <charconv>
@@ -206,10 +208,10 @@ const std::vector<Entry>& entries() {
                    b.leaf_size_cap = static_cast<int>(*x);
                    return {};
                  }});
-    t.push_back(float_option("ctrav", "BVH SAH cost of an inner-node visit (C_trav; also the cost metric's)", 0, 1e6,
-                             true, [](AppConfig& c) -> float& { return c.structure.options.bvh.cost_traversal; }));
-    t.push_back(float_option("cisect", "BVH SAH cost of a triangle test (C_isect; also the cost metric's)", 0, 1e6,
-                             true, [](AppConfig& c) -> float& { return c.structure.options.bvh.cost_intersect; }));
+    t.push_back(float_option("ctrav", "BVH SAH cost of an inner-node visit (C_trav; also the cost metric's)", kMinCostConstant, kMaxCostConstant,
+                             false, [](AppConfig& c) -> float& { return c.structure.options.bvh.cost_traversal; }));
+    t.push_back(float_option("cisect", "BVH SAH cost of a triangle test (C_isect; also the cost metric's)", kMinCostConstant, kMaxCostConstant,
+                             false, [](AppConfig& c) -> float& { return c.structure.options.bvh.cost_intersect; }));
     t.push_back(int_option("threads", "build threads (0: all hardware threads)", 0, 256, [](AppConfig& c) -> int& {
       // unsigned in StructureOptions; the range keeps the cast exact.
       return reinterpret_cast<int&>(c.structure.options.threads);
@@ -217,9 +219,9 @@ const std::vector<Entry>& entries() {
     t.push_back(bool_option("epo", "BVH: compute the EPO figure after the build",
                             [](AppConfig& c) -> bool& { return c.structure.options.bvh.compute_epo; }));
     // K-D tree (KdTreeOptions).
-    t.push_back(float_option("kd-ctrav", "K-D tree C_trav", 0, 1e6, true,
+    t.push_back(float_option("kd-ctrav", "K-D tree C_trav", kMinCostConstant, kMaxCostConstant, false,
                              [](AppConfig& c) -> float& { return c.structure.options.kdtree.cost_traversal; }));
-    t.push_back(float_option("kd-cisect", "K-D tree C_isect", 0, 1e6, true,
+    t.push_back(float_option("kd-cisect", "K-D tree C_isect", kMinCostConstant, kMaxCostConstant, false,
                              [](AppConfig& c) -> float& { return c.structure.options.kdtree.cost_intersect; }));
     t.push_back(int_option("kd-max-depth", "K-D tree deepest leaf (0: auto, 8 + 1.3 log2 N)", 0, 64,
                            [](AppConfig& c) -> int& { return c.structure.options.kdtree.max_depth; }));
