@@ -64,6 +64,9 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
   const Scene scene = load_scene_noting_warnings(o.scene, global.quiet);
   require_flattened(scene, o.scene, "refit");
   progress.end(std::to_string(scene.triangles.size()) + " triangles");
+  // The camera frames the rest pose; the motion is small against the scene, so it stays framed.
+  const std::vector<Ray> rays =
+      primary_rays(camera_for("", scene, size, /*has_camera_option=*/false), size.width, size.height);
   // The motion moves a vertex by up to 2 · amplitude · diagonal: near float's range that came out
   // as NaN SAH figures in the table and the CSV.
   if (const Aabb b = scene.bounds(); !b.is_empty()) {
@@ -75,9 +78,6 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
                                " would move vertices beyond float's range (to about " + number_text(reach) +
                                "); a smaller amplitude or scene");
   }
-  // The camera frames the rest pose; the motion is small against the scene, so it stays framed.
-  const std::vector<Ray> rays =
-      primary_rays(camera_for("", scene, size, /*has_camera_option=*/false), size.width, size.height);
 
   RefitDecayOptions opts;
   opts.frames = o.frames;

@@ -503,11 +503,12 @@ Command add_render_command(CLI::App& parent, const GlobalOptions& global) {
                   "OpenGL renderer headless (mesh, node boxes, a ray path, heatmap blend)")
       ->check(CLI::IsMember({"heatmap", "raster"}))
       ->capture_default_str();
+  // A range, not NonNegativeNumber: its message printed the 309 digits of DBL_MAX.
   sub->add_option("--depth", o->raster.box_depth, "raster: draw the BVH node boxes at this depth (root = 0)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, 1 << 20));
   sub->add_option("--depth-last", o->raster.box_depth_last,
                   "raster: with --depth, draw every depth from --depth to this one (inclusive)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, 1 << 20));
   sub->add_flag("--leaves", o->raster.leaves, "raster: draw every leaf box");
   sub->add_option("--ray-pixel", o->ray_pixel,
                   "raster: draw the primary ray of pixel X,Y (row 0 at the top): its path, hit, normal, the boxes "

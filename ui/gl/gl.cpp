@@ -33,13 +33,19 @@ void check_gl_errors(std::string_view where) {
   std::string names;
   // glGetError returns one flag per call; a lost context can keep returning
   // errors, so the loop is bounded.
+  bool out_of_memory = false;
   for (int i = 0; i < 16; ++i) {
     const GLenum e = glGetError();
     if (e == GL_NO_ERROR) break;
     if (!names.empty()) names += ", ";
     names += gl_error_name(e);
+    out_of_memory = out_of_memory || e == GL_OUT_OF_MEMORY;
   }
-  if (!names.empty()) throw GlError(names + " after " + std::string(where));
+  // What to do about it, as the CPU's out-of-memory message says (a 16384x16384 GPU heatmap said only
+  // "GL_OUT_OF_MEMORY after GPU trace setup").
+  if (!names.empty())
+    throw GlError(names + " after " + std::string(where) +
+                  (out_of_memory ? " (the GPU ran out of memory: a smaller image size or scene needs less)" : ""));
 }
 
 GlInfo query_gl_info() {
