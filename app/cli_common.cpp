@@ -174,9 +174,9 @@ CLI::Validator finite_positive() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
         double v = 0.0;
-        if (!option_number(text, v)) return "expected a number, got '" + text + "'";
-        if (!std::isfinite(v) || !(v > 0.0) || !std::isfinite(static_cast<float>(v)))
-          return "must be a finite number > 0, got " + text;
+        // A float: 1e300 is inf there, and "must be finite" read oddly for a finite number.
+        if (!option_number(text, v) || !(v >= 1.2e-38 && v <= 3.4e38))
+          return "must be a number from 1.2e-38 to 3.4e38 (float's range), got " + text;
         return {};
       },
       "POSITIVE");

@@ -49,7 +49,7 @@ int run_verify(const VerifyOptions& o, const GlobalOptions& global) {
     throw std::runtime_error(o.scene + ": " + e.what());
   }
   // "tlas": two levels from the scene's instances, checked against the flattened brute force.
-  const VerifyResult r = verify_structures(scene.triangles, rays, structures, o.threads, &scene);
+  const VerifyResult r = verify_structures(scene.triangles, rays, structures, o.threads, &scene, progress.callback());
   progress.end(std::to_string(static_cast<long long>(r.total_ms)) + " ms");
 
   if (!global.quiet)

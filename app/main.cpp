@@ -118,7 +118,10 @@ int run(int argc, char** argv) {
         if (opt->count() > 0 && opt->get_items_expected_min() > 0)
           for (const std::string& value : opt->results())
             if (value.empty())
-              throw cli::UsageError(opt->get_name() + ": an empty value (leave the option out for its default)");
+              throw cli::UsageError(opt->get_name() + ": an empty value" +
+                                    (opt->get_required() || opt->get_positional()
+                                         ? std::string(" (it needs one)")
+                                         : std::string(" (leave the option out for its default)")));
     }
     for (const cli::Command& c : commands)
       if (c.app->parsed()) return c.run();

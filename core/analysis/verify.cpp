@@ -1,6 +1,7 @@
 #include "core/analysis/verify.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <mutex>
@@ -191,7 +192,8 @@ std::vector<Ray> verify_rays(std::span<const Triangle> triangles, std::size_t co
 }
 
 VerifyResult verify_structures(std::span<const Triangle> triangles, std::span<const Ray> rays,
-                               const std::vector<VerifyStructure>& structures, unsigned threads, const Scene* scene) {
+                               const std::vector<VerifyStructure>& structures, unsigned threads, const Scene* scene,
+                               const ProgressCallback& progress) {
   if (scene && (scene->triangles.data() != triangles.data() || scene->triangles.size() != triangles.size()))
     throw std::invalid_argument("verify: the scene given is not the one whose triangles are traced");
   using Clock = std::chrono::steady_clock;
@@ -199,12 +201,22 @@ VerifyResult verify_structures(std::span<const Triangle> triangles, std::span<co
   VerifyResult res;
   res.rays = rays.size();
 
+  // The rays traced so far, the reference's and each structure's, as a fraction of all of them
+  // (100 million rays ran silent for minutes).
+  std::atomic<std::size_t> traced{0};
+  const double all_rays = static_cast<double>(rays.size()) * static_cast<double>(structures.size() + 1);
+  const auto advance = [&](std::size_t n) {
+    const std::size_t done = traced.fetch_add(n, std::memory_order_relaxed) + n;
+    if (progress) (void)progress(static_cast<double>(done) / all_rays);
+  };
+
   // Reference once: the brute force in double dominates the cost.
   const ReferenceTracer ref_tracer(triangles);
   std::vector<ReferenceHit> ref(rays.size());
   const auto t_ref = Clock::now();
   parallel_for(rays.size(), threads, 64, [&](std::size_t b, std::size_t e, unsigned) {
     for (std::size_t i = b; i < e; ++i) ref[i] = ref_tracer.closest_hit(rays[i]);
+    advance(e - b);
   });
   res.reference_ms = ms_since(t_ref);
   for (const ReferenceHit& h : ref) res.reference_hits += h.valid();
@@ -222,6 +234,7 @@ VerifyResult verify_structures(std::span<const Triangle> triangles, std::span<co
       // the other structures are still checked.
       if (s.factory_name != "embree") throw;
       res.not_checked.push_back({s.label, s.named, true, rays.size(), 0, without_name_prefix(e.what(), "embree")});
+      advance(rays.size());
       continue;
     }
     // Rays the structure cannot take (Embree's limits) are left out of its
@@ -230,7 +243,10 @@ VerifyResult verify_structures(std::span<const Triangle> triangles, std::span<co
     const std::vector<std::uint8_t>& refused = refusals.refused;
     const VerifyNotChecked skipped{s.label, s.named, false, refusals.count, refusals.first, std::move(refusals.reason)};
     if (skipped.rays > 0) res.not_checked.push_back(skipped);
-    if (skipped.rays == rays.size() && !rays.empty()) continue;  // no ray to check it on: not among the checked
+    if (skipped.rays == rays.size() && !rays.empty()) {  // no ray to check it on: not among the checked
+      advance(rays.size());
+      continue;
+    }
     const unsigned nt = resolve_threads(threads);
     std::vector<VerifyCounts> per_thread(nt);
     parallel_for(rays.size(), threads, 256, [&](std::size_t b, std::size_t e, unsigned ti) {
@@ -260,6 +276,7 @@ VerifyResult verify_structures(std::span<const Triangle> triangles, std::span<co
           }
         }
       }
+      advance(e - b);
     });
     VerifyCounts sum;
     for (const VerifyCounts& c : per_thread) sum += c;

@@ -94,9 +94,10 @@ struct VerifyResult {
 /// `triangles`. A structure whose build refuses the scene (Embree: a vertex
 /// beyond its range) or that refuses rays (Accelerator::ray_problem) does not
 /// stop the others: it is checked on the rays it takes and listed in
-/// `not_checked`.
+/// `not_checked`. `progress` hears the fraction of the rays traced (the reference's and every
+/// structure's), from the tracing threads; it cannot cancel.
 VerifyResult verify_structures(std::span<const Triangle> triangles, std::span<const Ray> rays,
                                const std::vector<VerifyStructure>& structures, unsigned threads,
-                               const Scene* scene = nullptr);
+                               const Scene* scene = nullptr, const ProgressCallback& progress = {});
 
 }  // namespace accelviz

@@ -96,7 +96,7 @@ expect 2 "--max p0: a percentile is p followed by a number above 0 and at most 1
 expect 2 "--max p99: a percentile top is for the heatmap view" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --max p99 --view raster
 expect 2 "--blend: must be a number from 0 to 1, got nan" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --view raster --blend nan
 expect 2 "--structure: 'bvh' is listed twice" -- bench 'builtin:soup?size=10' -s bvh,bvh -n 1 --size 4x4
-expect 2 "--ray-budget: must be a finite number > 0, got inf" -- sweep 'builtin:soup?size=10' -p leaf=2 --ray-budget inf --out "$tmp/swb"
+expect 2 "--ray-budget: must be a number from 1.2e-38 to 3.4e38 (float's range), got inf" -- sweep 'builtin:soup?size=10' -p leaf=2 --ray-budget inf --out "$tmp/swb"
 expect 2 "--scene: an empty scene name" -- calibrate --scene ""
 expect 2 "--metric" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --metric colour
 expect 2 "camera" -- render 'builtin:soup?size=10' --out "$tmp/y.png" --camera 1,2,3
@@ -227,7 +227,8 @@ expect 1 "$tmp/dangling-dir: is a symbolic link to $tmp/no-such-dir, which does 
 expect 1 "$tmp/no/dir/a.png" -- render 'builtin:soup?size=10' --out "$tmp/no/dir/a.png"
 
 # A folder the user cannot write in is refused before the work (it failed after it), as is an empty name.
-expect 2 "--out: an empty value (leave the option out for its default)" -- sweep 'builtin:soup?size=20' --param buckets=2,4 -o ""
+expect 2 "--out: an empty value (it needs one)" -- sweep 'builtin:soup?size=20' --param buckets=2,4 -o ""
+expect 2 "SCENE: an empty value (it needs one)" -- info ""
 # An empty value is a usage error, not the default taken in silence (a shell variable that was not set).
 expect 2 "--camera: an empty value" -- render 'builtin:soup?size=20' --camera "" -o "$tmp/e.png"
 expect 2 "--max: an empty value" -- render 'builtin:soup?size=20' --max "" -o "$tmp/e.png"
