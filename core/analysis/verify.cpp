@@ -202,7 +202,7 @@ VerifyResult verify_structures(std::span<const Triangle> triangles, std::span<co
   res.rays = rays.size();
 
   // The rays traced so far, the reference's and each structure's, as a fraction of all of them
-  // (100 million rays ran silent for minutes).
+  // (100 million rays showed nothing for 10 s and more).
   std::atomic<std::size_t> traced{0};
   const double all_rays = static_cast<double>(rays.size()) * static_cast<double>(structures.size() + 1);
   const auto advance = [&](std::size_t n) {

@@ -185,7 +185,7 @@ TEST(Verify, StructureListParsing) {
   }
 }
 
-// verify reports how far it is (100 million rays ran silent for minutes): the fraction of the rays
+// verify reports how far it is (100 million rays showed nothing for 10 s and more): the fraction of the rays
 // traced, the reference's and each structure's, reaching 1.
 TEST(Verify, ReportsTheFractionOfTheRaysTraced) {
   const std::vector<Triangle> tris = test_scenes::soup(4, 200, 0.2f);
