@@ -2,20 +2,19 @@
 // refit decay of the BVH under a deterministic synthetic motion, frame by
 // frame against a fresh build (core/analysis/refit_decay.h), written as
 // refit.csv, refit.json and charts.
-#include "app/cli_common.h"
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <glm/geometric.hpp>
+#include <sstream>
 
+#include "app/cli_common.h"
 #include "core/analysis/chart.h"
 #include "core/analysis/refit_decay.h"
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
-
-#include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <glm/geometric.hpp>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
 
 namespace accelviz::cli {
 

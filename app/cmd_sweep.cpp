@@ -422,7 +422,8 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
   if (const double load = load_average(); load > static_cast<double>(std::thread::hardware_concurrency()) + 1.0)
     std::printf("note: load average %.2f on %u hardware threads: other work shared the cores while this was timed\n",
                 load, std::thread::hardware_concurrency());
-  std::printf("wrote %s: sweep.csv, sweep.json and %zu charts\n", path_line(absolute_path(o.out)).c_str(), charts.size());
+  std::printf("wrote %s: sweep.csv, sweep.json and %zu charts\n", path_line(absolute_path(o.out)).c_str(),
+              charts.size());
   return 0;
 }
 

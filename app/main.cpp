@@ -17,9 +17,9 @@
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
-#include <functional>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <new>
 #include <string>
 #include <vector>
@@ -92,8 +92,8 @@ int run(int argc, char** argv) {
             for (std::size_t i = digits; ok && i < text.size(); ++i) ok = text[i] >= '0' && text[i] <= '9';
             if (ok && text[digits] == '0' && text.size() > digits + 1) ok = false;  // octal in CLI11
             if (ok) return {};
-            return std::string("expected a whole number in decimal digits (") +
-                   (is_unsigned ? "no sign, " : "") + "no leading zero), got '" + text + "'";
+            return std::string("expected a whole number in decimal digits (") + (is_unsigned ? "no sign, " : "") +
+                   "no leading zero), got '" + text + "'";
           },
           ""));
     }

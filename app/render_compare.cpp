@@ -8,9 +8,9 @@
 #include <sstream>
 
 #include "core/analysis/caption.h"
-#include "core/analysis/sah.h"
 #include "core/analysis/heatmap.h"
 #include "core/analysis/insight/compare_images.h"
+#include "core/analysis/sah.h"
 #include "core/query/batch.h"
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"

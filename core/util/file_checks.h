@@ -109,7 +109,8 @@ inline std::string output_path_problem(const std::string& path) {
   const std::filesystem::file_status st = std::filesystem::status(path, ec);
   if (ec || !std::filesystem::exists(st)) return {};
   if (std::filesystem::is_regular_file(st)) {
-    struct stat file {}, stream {};
+    struct stat file {
+    }, stream{};
     if (::stat(path.c_str(), &file) == 0)
       for (const int fd : {1, 2})
         if (::fstat(fd, &stream) == 0 && stream.st_dev == file.st_dev && stream.st_ino == file.st_ino)

@@ -110,18 +110,13 @@ TEST(AppConfig, ErrorsNameTheOptionAndChangeNothing) {
     const char* key;
     const char* value;
   };
-  for (const Bad& b : {Bad{"buckets", "1"},      Bad{"buckets", "300"},
-                       Bad{"buckets", "16x"},    Bad{"leaf", "0"},
-                       Bad{"ctrav", "0"},        Bad{"ctrav", "-1"},
-                       Bad{"ctrav", "nan"},      Bad{"cisect", "inf"},
-                       Bad{"ctrav", "1e-7"},     Bad{"kd-cisect", "2e6"},
-                       Bad{"splitter", "sah"},   Bad{"structure", "octopus"},
-                       Bad{"grid-res", "1,2"},   Bad{"grid-res", "0,4,4"},
-                       Bad{"grid-res", "a,b,c"}, Bad{"scale", "5,1"},
-                       Bad{"scale", "x"},        Bad{"opacity", "1.5"},
-                       Bad{"mesh", "maybe"},     Bad{"msaa", "3"},
-                       Bad{"voxel-level", "11"}, Bad{"octree-depth", "17"},
-                       Bad{"metric", "time"},    Bad{"colormap", "diverging"}}) {
+  for (const Bad& b :
+       {Bad{"buckets", "1"},      Bad{"buckets", "300"},     Bad{"buckets", "16x"},    Bad{"leaf", "0"},
+        Bad{"ctrav", "0"},        Bad{"ctrav", "-1"},        Bad{"ctrav", "nan"},      Bad{"cisect", "inf"},
+        Bad{"ctrav", "1e-7"},     Bad{"kd-cisect", "2e6"},   Bad{"splitter", "sah"},   Bad{"structure", "octopus"},
+        Bad{"grid-res", "1,2"},   Bad{"grid-res", "0,4,4"},  Bad{"grid-res", "a,b,c"}, Bad{"scale", "5,1"},
+        Bad{"scale", "x"},        Bad{"opacity", "1.5"},     Bad{"mesh", "maybe"},     Bad{"msaa", "3"},
+        Bad{"voxel-level", "11"}, Bad{"octree-depth", "17"}, Bad{"metric", "time"},    Bad{"colormap", "diverging"}}) {
     const std::string e = apply_option(c, b.key, b.value);
     EXPECT_EQ(e.rfind(std::string(b.key) + ": ", 0), 0u) << b.key << "=" << b.value << " gave '" << e << "'";
     EXPECT_NE(e.find(b.value), std::string::npos) << e;

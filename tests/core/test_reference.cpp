@@ -192,12 +192,12 @@ TEST(Verify, ReportsTheFractionOfTheRaysTraced) {
   const std::vector<Ray> rays = verify_rays(tris, 3000, 5);
   std::mutex mutex;
   std::vector<double> heard;
-  const VerifyResult r = verify_structures(tris, rays, parse_verify_structures("bvh-binned,grid", 2), 2, nullptr,
-                                           [&](double f) {
-                                             const std::lock_guard<std::mutex> lock(mutex);
-                                             heard.push_back(f);
-                                             return true;
-                                           });
+  const VerifyResult r =
+      verify_structures(tris, rays, parse_verify_structures("bvh-binned,grid", 2), 2, nullptr, [&](double f) {
+        const std::lock_guard<std::mutex> lock(mutex);
+        heard.push_back(f);
+        return true;
+      });
   EXPECT_EQ(r.total.rays, 2 * rays.size());
   ASSERT_GE(heard.size(), 3u);
   EXPECT_DOUBLE_EQ(*std::max_element(heard.begin(), heard.end()), 1.0);

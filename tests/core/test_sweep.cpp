@@ -71,8 +71,9 @@ TEST(SweepParams, UnknownNameOrBadValueIsNamed) {
   // Counted before they are made: 2e14 settings filled 8 GB before the first build.
   std::vector<std::string> many(200);
   for (std::size_t i = 0; i < many.size(); ++i) many[i] = std::to_string(1 + i);
-  EXPECT_NE(message("bvh", {{"ctrav", many}, {"cisect", many}}).find("give 4e+04 settings (200 x 200 values), more "
-                                                                       "than the 10000 one sweep takes"),
+  EXPECT_NE(message("bvh", {{"ctrav", many}, {"cisect", many}})
+                .find("give 4e+04 settings (200 x 200 values), more "
+                      "than the 10000 one sweep takes"),
             std::string::npos)
       << message("bvh", {{"ctrav", many}, {"cisect", many}});
   EXPECT_EQ(expand_sweep("bvh", std::vector<SweepParam>{{"ctrav", many}, {"cisect", {"1", "2"}}}).size(), 400u);

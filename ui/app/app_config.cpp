@@ -1,7 +1,5 @@
 #include "ui/app/app_config.h"
 
-#include "core/analysis/sah.h"
-
 #include <algorithm>
 #include <array>
 #include <charconv>
@@ -11,6 +9,8 @@
 #include <functional>
 #include <limits>
 #include <optional>
+
+#include "core/analysis/sah.h"
 
 namespace accelviz {
 namespace {
@@ -208,10 +208,12 @@ const std::vector<Entry>& entries() {
                    b.leaf_size_cap = static_cast<int>(*x);
                    return {};
                  }});
-    t.push_back(float_option("ctrav", "BVH SAH cost of an inner-node visit (C_trav; also the cost metric's)", kMinCostConstant, kMaxCostConstant,
-                             false, [](AppConfig& c) -> float& { return c.structure.options.bvh.cost_traversal; }));
-    t.push_back(float_option("cisect", "BVH SAH cost of a triangle test (C_isect; also the cost metric's)", kMinCostConstant, kMaxCostConstant,
-                             false, [](AppConfig& c) -> float& { return c.structure.options.bvh.cost_intersect; }));
+    t.push_back(float_option("ctrav", "BVH SAH cost of an inner-node visit (C_trav; also the cost metric's)",
+                             kMinCostConstant, kMaxCostConstant, false,
+                             [](AppConfig& c) -> float& { return c.structure.options.bvh.cost_traversal; }));
+    t.push_back(float_option("cisect", "BVH SAH cost of a triangle test (C_isect; also the cost metric's)",
+                             kMinCostConstant, kMaxCostConstant, false,
+                             [](AppConfig& c) -> float& { return c.structure.options.bvh.cost_intersect; }));
     t.push_back(int_option("threads", "build threads (0: all hardware threads)", 0, 256, [](AppConfig& c) -> int& {
       // unsigned in StructureOptions; the range keeps the cast exact.
       return reinterpret_cast<int&>(c.structure.options.threads);
