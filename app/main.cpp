@@ -79,7 +79,8 @@ int run(int argc, char** argv) {
 
   // Whole numbers in decimal only: CLI11 reads "010" as octal (8 buckets, -j 010 as 8 threads),
   // "0x10" as hex, and "-1" for an unsigned option as 2^64 - 1 (a seed). Checked on every INT and
-  // UINT option of every command, before the option's own range check converts the text.
+  // UINT option of every command, after the option's own range check (whose message comes first
+  // where both refuse: "09" is out of range as octal).
   const std::function<void(CLI::App*)> decimal_only = [&](CLI::App* a) {
     for (CLI::Option* opt : a->get_options()) {
       const std::string type = opt->get_type_name();
