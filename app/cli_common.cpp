@@ -43,59 +43,93 @@ CLI::Validator size_validator() {
 }
 
 void StructureCli::add_to(CLI::App* app, bool with_embree) {
-  app->add_option("--splitter", splitter,
-                  "BVH split strategy: binned (binned SAH), exact (full SAH sweep), median, lbvh (Morton codes)")
-      ->check(CLI::IsMember({"binned", "exact", "median", "lbvh"}))
-      ->capture_default_str()
-      ->group("Structure");
-  app->add_option("--buckets", buckets, "BVH binned-SAH bucket count")
-      ->check(CLI::Range(2, 256))
-      ->capture_default_str()
-      ->group("Structure");
-  app->add_option("--leaf", leaf, "BVH: nodes with at most this many triangles always become leaves")
-      ->check(CLI::Range(1, 255))
-      ->capture_default_str()
-      ->group("Structure");
-  app->add_option("--leaf-cap", leaf_cap,
-                  "BVH: SAH may keep up to this many triangles in a leaf when cheaper (at least --leaf; raised to "
-                  "--leaf when not given)")
-      ->check(CLI::Range(1, 255))
-      ->each([this](const std::string&) { leaf_cap_given = true; })
-      ->capture_default_str()
-      ->group("Structure");
-  app->add_option("--ctrav", ctrav, "SAH cost of visiting an inner node (C_trav)")
-      ->check(cost_constant())
-      ->capture_default_str()
-      ->group("Structure");
-  app->add_option("--cisect", cisect, "SAH cost of one ray-triangle test (C_isect)")
-      ->check(cost_constant())
-      ->capture_default_str()
-      ->group("Structure");
-  app->add_option("--wide", wide,
-                  "BVH fast path: width of the SIMD tree the uninstrumented queries walk: 0 = 8 (AVX2) where the "
-                  "CPU has AVX2 and FMA, else 4 (SSE); 4; 8 (4 without AVX2 and FMA)")
-      ->check(CLI::IsMember({0, 4, 8}))
-      ->capture_default_str()
-      ->group("Structure");
+  bvh_options_.clear();
+  embree_options_.clear();
+  const auto bvh = [this](CLI::Option* opt) { bvh_options_.push_back(opt); };
+  const auto embree = [this](CLI::Option* opt) { embree_options_.push_back(opt); };
+  bvh(app->add_option("--splitter", splitter,
+                      "BVH split strategy: binned (binned SAH), exact (full SAH sweep), median, lbvh (Morton codes)")
+          ->check(CLI::IsMember({"binned", "exact", "median", "lbvh"}))
+          ->capture_default_str()
+          ->group("Structure"));
+  bvh(app->add_option("--buckets", buckets, "BVH binned-SAH bucket count")
+          ->check(CLI::Range(2, 256))
+          ->capture_default_str()
+          ->group("Structure"));
+  bvh(app->add_option("--leaf", leaf, "BVH: nodes with at most this many triangles always become leaves")
+          ->check(CLI::Range(1, 255))
+          ->capture_default_str()
+          ->group("Structure"));
+  bvh(app->add_option("--leaf-cap", leaf_cap,
+                      "BVH: SAH may keep up to this many triangles in a leaf when cheaper (at least --leaf; raised to "
+                      "--leaf when not given)")
+          ->check(CLI::Range(1, 255))
+          ->each([this](const std::string&) { leaf_cap_given = true; })
+          ->capture_default_str()
+          ->group("Structure"));
+  bvh(app->add_option("--ctrav", ctrav, "SAH cost of visiting an inner node (C_trav)")
+          ->check(cost_constant())
+          ->capture_default_str()
+          ->group("Structure"));
+  bvh(app->add_option("--cisect", cisect, "SAH cost of one ray-triangle test (C_isect)")
+          ->check(cost_constant())
+          ->capture_default_str()
+          ->group("Structure"));
+  bvh(app->add_option("--wide", wide,
+                      "BVH fast path: width of the SIMD tree the uninstrumented queries walk: 0 = 8 (AVX2) where the "
+                      "CPU has AVX2 and FMA, else 4 (SSE); 4; 8 (4 without AVX2 and FMA)")
+          ->check(CLI::IsMember({0, 4, 8}))
+          ->capture_default_str()
+          ->group("Structure"));
   if (!with_embree) return;
-  app->add_option("--embree-quality", embree_quality, "Embree build quality: low, medium, high")
-      ->check(CLI::IsMember({"low", "medium", "high"}))
-      ->capture_default_str()
-      ->group("Structure");
-  app->add_flag("--embree-robust", embree_robust,
-                "Embree robust mode (RTC_SCENE_FLAG_ROBUST: no optimisations that lose watertightness), the "
-                "counterpart of our watertight triangle test")
-      ->group("Structure");
-  app->add_option("--embree-isa", embree_isa,
-                  "Embree's kernels: auto (its own choice, the widest the CPU has), sse2, sse4.2, avx, avx2 (our "
-                  "fast path's), avx512")
-      ->check(CLI::IsMember([] {
-        std::vector<std::string> names;  // embree_isa_name's
-        for (EmbreeIsa isa : kEmbreeIsas) names.emplace_back(embree_isa_name(isa));
-        return names;
-      }()))
-      ->capture_default_str()
-      ->group("Structure");
+  embree(app->add_option("--embree-quality", embree_quality, "Embree build quality: low, medium, high")
+             ->check(CLI::IsMember({"low", "medium", "high"}))
+             ->capture_default_str()
+             ->group("Structure"));
+  embree(app->add_flag("--embree-robust", embree_robust,
+                       "Embree robust mode (RTC_SCENE_FLAG_ROBUST: no optimisations that lose watertightness), the "
+                       "counterpart of our watertight triangle test")
+             ->group("Structure"));
+  embree(
+      app->add_option("--embree-isa", embree_isa,
+                      "Embree's kernels: auto (its own choice, the widest the CPU has), sse2, sse4.2, avx, avx2 (our "
+                      "fast path's), avx512")
+          ->check(CLI::IsMember([] {
+            std::vector<std::string> names;  // embree_isa_name's
+            for (EmbreeIsa isa : kEmbreeIsas) names.emplace_back(embree_isa_name(isa));
+            return names;
+          }()))
+          ->capture_default_str()
+          ->group("Structure"));
+}
+
+std::string StructureCli::unused_note(const std::vector<std::string>& structures, bool cost_metric) const {
+  bool bvh = false, embree = false;
+  for (const std::string& s : structures) {
+    bvh = bvh || s == "bvh" || s == "tlas";
+    embree = embree || s == "embree";
+  }
+  std::string names;
+  const auto note = [&](const CLI::Option* opt) {
+    if (opt->count() > 0) names += (names.empty() ? "" : ", ") + opt->get_name();
+  };
+  for (const CLI::Option* opt : bvh_options_) {
+    const bool cost = opt->get_name() == "--ctrav" || opt->get_name() == "--cisect";
+    if (!bvh && !(cost && cost_metric)) note(opt);
+  }
+  for (const CLI::Option* opt : embree_options_)
+    if (!embree) note(opt);
+  if (names.empty()) return {};
+  std::string list;
+  for (const std::string& s : structures) list += (list.empty() ? "" : ", ") + s;
+  return list + (structures.size() == 1 ? " does" : " do") + " not use " + names +
+         " (the BVH's options act on bvh and tlas, --ctrav and --cisect also on the cost metric, --embree-* on "
+         "embree)";
+}
+
+void StructureCli::say_unused(const std::vector<std::string>& structures, bool cost_metric, bool quiet) const {
+  if (const std::string note = unused_note(structures, cost_metric); !note.empty() && !quiet)
+    std::fprintf(stderr, "accelviz: note: %s\n", note.c_str());
 }
 
 StructureOptions StructureCli::to_options(unsigned threads, bool compute_epo) const {

@@ -86,10 +86,21 @@ struct StructureCli {
 
   /// Adds the options to `app`; without `with_embree` (a command that builds BVHs only) no --embree-*.
   void add_to(CLI::App* app, bool with_embree = true);
+  /// The options given on the command line that none of `structures` uses, as one line ("" when
+  /// there are none): "grid does not use --leaf, --ctrav (...)". The BVH's options act on bvh and
+  /// tlas (--ctrav and --cisect also on any structure's `cost` metric, `cost_metric`), --embree-* on
+  /// embree. A knob turned on a structure that ignores it changed nothing, without a word.
+  std::string unused_note(const std::vector<std::string>& structures, bool cost_metric) const;
+  /// unused_note's line on stderr as "accelviz: note: ...", unless `quiet`.
+  void say_unused(const std::vector<std::string>& structures, bool cost_metric, bool quiet) const;
   /// Options for the factory; `threads` is the build thread count. The leaf
   /// cap is raised to --leaf where it was not given; a --leaf-cap given below
   /// --leaf is a UsageError (it was ignored in silence).
   StructureOptions to_options(unsigned threads, bool compute_epo) const;
+
+ private:
+  std::vector<const CLI::Option*> bvh_options_;     ///< --splitter ... --wide, as added
+  std::vector<const CLI::Option*> embree_options_;  ///< --embree-*, as added
 };
 
 /// camera_from_spec with a bad spec reported as a usage error. A scene no

@@ -271,6 +271,7 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   if (o.structures.empty())
     o.structures = kHaveEmbree ? std::vector<std::string>{"bvh", "embree"} : std::vector<std::string>{"bvh"};
   if (o.repeat < 1) throw UsageError("--repeat must be at least 1");
+  o.structure_opts.say_unused(o.structures, false, global.quiet);
   // Each structure is one row: a name twice would build and time it twice.
   for (std::size_t i = 0; i < o.structures.size(); ++i) {
     for (std::size_t j = 0; j < i; ++j)

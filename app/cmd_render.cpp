@@ -379,6 +379,7 @@ int run_render(const RenderOptions& given, const GlobalOptions& global) {
     if (o.view != "heatmap") throw UsageError("--device gpu needs --view heatmap");
 #endif
   }
+  if (!o.compare) o.structure_opts.say_unused(comma_items(o.structure), o.metric == "cost", global.quiet);
   if (o.structure.find(',') != std::string::npos) {
     if (o.compare) throw UsageError("--compare: one structure for A (B names its own: structure=...)");
     return run_render_several(o, comma_items(o.structure), global);  // checked when parsed

@@ -26,6 +26,7 @@ struct TraceOptions {
 
 int run_trace(const TraceOptions& o, const GlobalOptions& global) {
   check_output_path(o.out, o.force);
+  o.structure_opts.say_unused({o.structure}, false, global.quiet);
   Progress progress(global.quiet);
 
   progress.begin("reading " + o.rays);

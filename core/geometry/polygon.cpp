@@ -185,9 +185,11 @@ class ReflexRows {
  private:
   static constexpr std::uint32_t kNone = ~std::uint32_t{0};
 
+  /// Clamped in double before the cast: the bounds are the reflex corners', and an ear's corner may
+  /// lie far outside them (a float-to-int cast out of range is undefined; the fuzzer found one).
   int row_of(double y) const {
     const double r = std::floor((y - lo_) / height_ * rows_);
-    return std::clamp(std::isfinite(r) ? static_cast<int>(r) : 0, 0, rows_ - 1);
+    return r >= 0.0 ? static_cast<int>(std::min(r, static_cast<double>(rows_ - 1))) : 0;  // NaN: 0
   }
 
   /// The first place at or after i whose corner is still listed (order_.size() when none).

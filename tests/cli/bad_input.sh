@@ -189,6 +189,14 @@ leftovers=$(find "$tmp" -name '.accelviz-*.tmp')
 [ "$(wc -l <"$tmp/stdout")" -eq 2 ] && [ "$(head -n 1 "$tmp/stdout")" = "$tmp/a?b.png" ] &&
   grep -qF "\"out\":\"$tmp/a\\nb.png\"" "$tmp/stdout" ||
   { echo "FAIL: the path printed for a name with a newline: $(cat "$tmp/stdout")"; fail=1; }
+# A knob the structure does not use is said on stderr (it changed nothing, without a word); one
+# that a listed structure uses, or --ctrav with the cost metric, is not.
+"$accelviz" render 'builtin:soup?size=10' -s grid --leaf 3 --embree-robust --size 8x8 -o "$tmp/unused.png" \
+  >/dev/null 2>"$tmp/stderr" && grep -qF "accelviz: note: grid does not use --leaf, --embree-robust" "$tmp/stderr" ||
+  { echo "FAIL: no note of the options grid does not use: $(cat "$tmp/stderr")"; fail=1; }
+"$accelviz" render 'builtin:soup?size=10' -s bvh,grid --leaf 3 --size 8x8 -o "$tmp/unused2.png" >/dev/null 2>"$tmp/stderr" &&
+  "$accelviz" render 'builtin:soup?size=10' -s grid -m cost --ctrav 2 --size 8x8 -o "$tmp/unused3.png" >/dev/null \
+    2>>"$tmp/stderr" && ! grep -q "note:" "$tmp/stderr" || { echo "FAIL: a note for used options: $(cat "$tmp/stderr")"; fail=1; }
 # The file standard output goes to is not replaced: `-o /dev/stdout -f > out` renamed a new file
 # over it, and what was printed there, before and after, went to the old one.
 expect 1 "/dev/stdout: is this program's standard output" -- \

@@ -132,6 +132,16 @@ TEST(Polygon, OutlinesWhoseEarsComeFewAtATimeAreCutWhole) {
   }
 }
 
+// An ear whose corner lies far outside the reflex corners' rows: its row index was a float far
+// beyond int's range, cast before it was clamped (undefined behaviour; the OBJ fuzzer found this
+// pentagon, tests/fuzz/corpus/obj/ear_outside_reflex_rows.obj).
+TEST(Polygon, AnEarFarOutsideTheReflexCornersRowsIsCut) {
+  const std::vector<glm::vec3> p = {{0, 1, 0}, {2, 0, 0}, {2, 2, 0}, {0, 2, 0}, {-1, 1, 0}};
+  const auto tris = triangulate_polygon(p);
+  ASSERT_EQ(tris.size(), 3u);
+  EXPECT_NEAR(covered(p, tris), shoelace(p), 1e-9);
+}
+
 // A convex face with flat corners (a T-junction's vertex on a straight side: a rectangle with a
 // point on one side is the commonest pentagon of CAD exports) gives n - 2 triangles, none of zero
 // area, tiling it exactly once in its winding, every outline edge used by one triangle as it is
