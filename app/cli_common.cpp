@@ -196,13 +196,13 @@ bool option_number(const std::string& text, double& value) {
   return used == text.size();
 }
 
+}  // namespace
+
 std::string number_text(double x) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", x);
   return buf;
 }
-
-}  // namespace
 
 CLI::Validator finite_positive() {
   return CLI::Validator(

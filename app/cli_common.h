@@ -182,6 +182,9 @@ class OutputDirWriter {
 /// overwrite)" or "<path>: <problem>"; then no file has changed.
 void write_output_set(const std::vector<OutputBytes>& files, bool force);
 
+/// `x` as printf's %g writes it ("1e+06", "0.02"), for messages.
+std::string number_text(double x);
+
 /// Absolute, normalised form of a path for messages.
 std::string absolute_path(const std::string& path);
 

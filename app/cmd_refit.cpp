@@ -42,12 +42,6 @@ OutputDirFiles refit_files() {
   return {"refit", {"refit.csv", "refit.json", "refit-sah.png", "refit-nodes.png", "refit-ms.png"}};
 }
 
-std::string number_text(double x) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", x);
-  return text;
-}
-
 int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
   const ImageSize size = parse_size(o.size);
   if (!(o.amplitude >= 0) || !(o.amplitude <= 1000))

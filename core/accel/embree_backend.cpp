@@ -305,10 +305,7 @@ constexpr double kEmbreeProductLimit = 3e38 / 12.0;
 // scene (EmbreeReach::limit), so the check inside the queries is a few float
 // operations (rounding is far inside the margin).
 [[gnu::always_inline]] inline bool products_fit_embree(const Ray& ray, const EmbreeReach& reach) {
-  const auto largest = [](const glm::vec3& v) {
-    return std::max(std::abs(v.x), std::max(std::abs(v.y), std::abs(v.z)));
-  };
-  const float o = largest(ray.origin), d = largest(ray.direction);
+  const float o = largest_component(ray.origin), d = largest_component(ray.direction);
   return o <= reach.o_max && d <= reach.d_max && (o + reach.coordinate_f) * d <= reach.od_max;
 }
 
