@@ -414,7 +414,21 @@ std::string name_list_problem(const std::string& text, const std::vector<std::st
 }
 
 void print_json_line(const nlohmann::json& j) {
-  std::cout << j.dump() << std::endl;
+  std::cout << j.dump() << '\n';
+  flush_stdout();
+}
+
+namespace {
+int first_stdout_flush_errno = 0;
+}
+
+void flush_stdout() {
+  errno = 0;
+  if (std::fflush(stdout) != 0 && first_stdout_flush_errno == 0) first_stdout_flush_errno = errno ? errno : EIO;
+}
+
+int stdout_flush_errno() {
+  return first_stdout_flush_errno;
 }
 
 namespace {

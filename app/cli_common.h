@@ -202,8 +202,16 @@ std::string braced_names(const std::vector<std::string>& names);
 /// empty item, a name not among them, or one listed twice.
 std::string name_list_problem(const std::string& text, const std::vector<std::string>& names);
 
-/// One-line JSON on stdout.
+/// One-line JSON on stdout, flushed (animate streams a line per frame).
 void print_json_line(const nlohmann::json& j);
+
+/// Flushes stdout and remembers the reason of the first failed flush: glibc
+/// drops the buffer after a failed write, so that main's final flush succeeds
+/// with nothing to write and the reason (a full disk) would be lost.
+void flush_stdout();
+
+/// errno of the first failed flush_stdout(), 0 if none failed.
+int stdout_flush_errno();
 
 // ---- progress and timing -----------------------------------------------------------
 

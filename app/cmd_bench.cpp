@@ -519,7 +519,7 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
     }
   }
   if (o.json) {
-    std::cout << j.dump(2) << std::endl;
+    std::cout << j.dump(2) << '\n';
     return exit_code;
   }
 

@@ -81,7 +81,7 @@ int run_calibrate(const CalibrateCliOptions& o, const GlobalOptions& global) {
                   {"calibrated", figures_json(report.with_calibrated)}};
   }
   if (o.json) {
-    std::cout << j.dump(2) << std::endl;
+    std::cout << j.dump(2) << '\n';
     return 0;
   }
   std::printf("ray-box slab test           %7.2f ns\n", c.ns_box);

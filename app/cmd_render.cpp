@@ -63,12 +63,6 @@ struct RenderOptions {
   std::string caption = "auto";   ///< the strip under the heatmap: auto (render_caption), none, or this text
 };
 
-std::string short_number(double x) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", x);
-  return text;
-}
-
 /// What the heatmap shows, as the command that draws it: the scene, the
 /// structure, the metric, the size and every option that differs from its
 /// default (not the output, the colours or the threads): on the picture, so
@@ -94,8 +88,8 @@ std::string render_caption(const RenderOptions& o) {
     add(s.leaf_cap != ds.leaf_cap, "--leaf-cap " + std::to_string(s.leaf_cap));
   }
   if (o.structure == "bvh" || o.structure == "tlas" || o.metric == "cost") {
-    add(s.ctrav != ds.ctrav, "--ctrav " + short_number(s.ctrav));
-    add(s.cisect != ds.cisect, "--cisect " + short_number(s.cisect));
+    add(s.ctrav != ds.ctrav, "--ctrav " + number_text(s.ctrav));
+    add(s.cisect != ds.cisect, "--cisect " + number_text(s.cisect));
   }
   if (o.structure == "embree") {
     add(s.embree_quality != ds.embree_quality, "--embree-quality " + s.embree_quality);
@@ -348,7 +342,7 @@ int run_render_several(const RenderOptions& o, const std::vector<std::string>& s
     if (o.caption != "none") {
       // The single-structure command that draws the same picture: its --max is the shared top.
       RenderOptions alone = os;
-      if (o.max_percentile > 0.0 || o.max_text.empty()) alone.max_text = short_number(shared.max);
+      if (o.max_percentile > 0.0 || o.max_text.empty()) alone.max_text = number_text(shared.max);
       figures["caption"] = o.caption == "auto" ? render_caption(alone) : o.caption;
       rgb = add_caption(rgb, figures["caption"].get<std::string>());
     }

@@ -282,6 +282,7 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
   config.warmup = o.warmup;
   config.threads = o.threads;
   config.ray_budget = o.ray_budget;
+  config.progress = progress.callback();  // inside each setting: its label (begin below) and a percentage
   std::vector<SweepResult> results;
   results.reserve(settings.size());
   for (std::size_t i = 0; i < settings.size(); ++i) {

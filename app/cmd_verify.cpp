@@ -102,7 +102,7 @@ int run_verify(const VerifyOptions& o, const GlobalOptions& global) {
     std::cout << "verify: " << o.scene << " rays=" << r.rays << " structures=" << r.per_structure.size()
               << " mismatched_prim=" << t.mismatched_prim << " t_beyond_tolerance=" << t.t_beyond_tolerance
               << " anyhit_disagree=" << t.anyhit_disagree << " near_ties=" << t.near_ties << " -> "
-              << (ok ? "OK" : "FAIL") << std::endl;
+              << (ok ? "OK" : "FAIL") << '\n';
   }
   return ok ? 0 : 1;
 }

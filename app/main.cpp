@@ -79,14 +79,14 @@ int run(int argc, char** argv) {
 
   // Whole numbers in decimal only: CLI11 reads "010" as octal (8 buckets, -j 010 as 8 threads),
   // "0x10" as hex, and "-1" for an unsigned option as 2^64 - 1 (a seed). Checked on every INT and
-  // UINT option of every command, after the option's own range check (whose message comes first
-  // where both refuse: "09" is out of range as octal).
+  // UINT option of every command, before the option's own range check (a transform runs first), so
+  // that "abc" and "09" are answered as not decimal rather than out of range.
   const std::function<void(CLI::App*)> decimal_only = [&](CLI::App* a) {
     for (CLI::Option* opt : a->get_options()) {
       const std::string type = opt->get_type_name();
       const bool is_unsigned = type.rfind("UINT", 0) == 0, is_signed = type.rfind("INT", 0) == 0;
       if (!is_unsigned && !is_signed) continue;
-      opt->check(CLI::Validator(
+      opt->transform(CLI::Validator(
           [is_unsigned](std::string& text) -> std::string {
             const std::size_t digits = !is_unsigned && text.size() > 1 && text[0] == '-' ? 1 : 0;
             bool ok = text.size() > digits;
@@ -185,10 +185,12 @@ int main(int argc, char** argv) {
   const int code = run(argc, argv);
   // What went to stdout (tables, JSON) must have arrived: `bench --json >
   // full-disk/results.json` said nothing and exited 0 with the file cut short.
+  // An earlier failed flush (a JSON line) dropped its buffer: its reason was kept.
   errno = 0;
   const bool flushed = std::fflush(stdout) == 0;
   if (!flushed || std::ferror(stdout)) {
-    std::fprintf(stderr, "accelviz: stdout: write failed%s%s\n", errno ? ": " : "", errno ? std::strerror(errno) : "");
+    const int err = accelviz::cli::stdout_flush_errno() ? accelviz::cli::stdout_flush_errno() : errno;
+    std::fprintf(stderr, "accelviz: stdout: write failed%s%s\n", err ? ": " : "", err ? std::strerror(err) : "");
     return code == 0 ? 1 : code;
   }
   return code;

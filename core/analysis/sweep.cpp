@@ -382,26 +382,45 @@ std::uint64_t count_ray_double_hits(std::span<const Triangle> triangles,
 TimedStructure time_structure(
     const std::function<std::unique_ptr<Accelerator>(const ProgressCallback& progress)>& build,
     std::span<const Ray> rays, const QueryOptions& query, unsigned threads, int warmup, int repeat,
-    const std::function<bool()>& keep_going, bool time_builds) {
+    const std::function<bool()>& keep_going, bool time_builds, const ProgressCallback& report) {
   const auto check = [&] {
     if (keep_going && !keep_going()) throw BuildCancelled();
   };
+  // Steps: each build and each pass (the warm-up rounds' passes, the timed ones and the counting one).
+  const int warmups = std::max(0, warmup);
+  const int timed_builds = time_builds ? std::max(1, repeat) : warmups > 0 ? 0 : 1;
+  const int passes = rays.empty() ? 0 : warmups + std::max(1, repeat) + 1;
+  const double steps = static_cast<double>(warmups + timed_builds + passes);
+  int done = 0;  ///< steps finished; changed only between builds (no builder thread reads it then)
+  const auto step_done = [&] {
+    ++done;
+    if (report) report(done / steps);
+  };
   ProgressCallback progress;
-  if (keep_going) progress = [&](double) { return keep_going(); };
+  if (keep_going || report)
+    progress = [&](double f) {
+      if (report) report((done + std::clamp(f, 0.0, 1.0)) / steps);
+      return !keep_going || keep_going();
+    };
   const unsigned n_threads = resolve_threads(threads);
   TimedStructure t;
   t.hits.resize(rays.size());
-  for (int k = 0; k < std::max(0, warmup); ++k) {
+  for (int k = 0; k < warmups; ++k) {
     t.accel.reset();  // never two copies in memory
     check();
     t.accel = build(progress);
+    step_done();
     check();
-    if (!rays.empty()) trace_closest(*t.accel, rays, t.hits, query, n_threads);
+    if (!rays.empty()) {
+      trace_closest(*t.accel, rays, t.hits, query, n_threads);
+      step_done();
+    }
   }
-  for (int k = 0; k < (time_builds ? std::max(1, repeat) : t.accel ? 0 : 1); ++k) {
+  for (int k = 0; k < timed_builds; ++k) {
     t.accel.reset();
     check();
     t.accel = build(progress);
+    step_done();
     if (time_builds) t.build_ms_runs.push_back(t.accel->build_stats().build_ms);
   }
   if (rays.empty()) return t;
@@ -411,10 +430,12 @@ TimedStructure time_structure(
     trace_closest(*t.accel, rays, t.hits, query, n_threads);
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     t.rays_per_s_runs.push_back(s > 0 ? static_cast<double>(rays.size()) / s : 0.0);
+    step_done();
   }
   check();
   std::vector<RayStats> stats(rays.size());
   trace_closest(*t.accel, rays, t.hits, query, n_threads, stats);
+  step_done();
   double nodes = 0, prims = 0, hit_count = 0;
   for (std::size_t i = 0; i < rays.size(); ++i) {
     nodes += stats[i].nodes_visited;
@@ -487,7 +508,7 @@ SweepResult measure_sweep_setting(std::span<const Triangle> triangles, std::span
   r.triangle_test = q.triangle_test == TriangleTest::watertight ? "watertight" : "fast";
   TimedStructure t = time_structure(
       [&](const ProgressCallback& progress) { return build_accelerator(config.structure, triangles, so, progress); },
-      rays, q, config.threads, config.warmup, config.repeat, config.keep_going, same_build == nullptr);
+      rays, q, config.threads, config.warmup, config.repeat, config.keep_going, same_build == nullptr, config.progress);
   if (same_build) {
     r.build_of = same_build->build_of.empty() ? setting_label(same_build->setting) : same_build->build_of;
     r.build_ms_runs = same_build->build_ms_runs;

@@ -121,6 +121,10 @@ struct SweepConfig {
   /// Asked during builds and between timed passes (any thread); false
   /// cancels the setting being measured (BuildCancelled). Empty: never.
   std::function<bool()> keep_going;
+  /// Told the fraction of one setting's measurement done: inside each build
+  /// (from the builder's threads, as builders report) and after each build
+  /// and pass. Its return value is ignored (keep_going cancels). Empty: none.
+  ProgressCallback progress;
 };
 
 struct SweepResult {
@@ -175,10 +179,12 @@ struct TimedStructure {
 /// builds and passes and during builds; false throws BuildCancelled.
 /// `time_builds` false: no timed builds (build_ms_runs stays empty); the
 /// tree of the last warm-up round is kept (one untimed build without one).
+/// `report` (empty: none) is told the fraction of the whole done, builds and
+/// passes each one step: inside builds, from the builder's threads.
 TimedStructure time_structure(
     const std::function<std::unique_ptr<Accelerator>(const ProgressCallback& progress)>& build,
     std::span<const Ray> rays, const QueryOptions& query, unsigned threads, int warmup, int repeat,
-    const std::function<bool()>& keep_going, bool time_builds = true);
+    const std::function<bool()>& keep_going, bool time_builds = true, const ProgressCallback& report = {});
 
 /// BVH built with the default constants (1, 1) and with the calibrated ones
 /// (1, C_isect of the query's triangle test), judged by the same yardstick.

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <memory>
 #include <stdexcept>
 #include <thread>
@@ -161,6 +162,33 @@ TEST(RunSweepRequest, PublishesASnapshotPerSettingAndEndsDone) {
   EXPECT_EQ(last->results[0].edges.misses, 0u);
   EXPECT_EQ(last->results[2].edges.misses, 0u);
   EXPECT_LE(last->results[2].sah_cost, last->results[0].sah_cost);
+}
+
+// The panel's bar moves inside a setting: one slow build did not move it.
+TEST(RunSweepRequest, TheFractionMovesInsideASetting) {
+  SweepRequest r = small_request("builtin:teapot?size=3000", "buckets=8");
+  r.structure = "octree";
+  r.params = parse_sweep_params_text("octree", "depth=8,10");
+  std::vector<double> between;  ///< fractions of snapshots that were strictly between two settings' ends
+  const auto last = run_sweep_request(r, 3, {}, [&](std::shared_ptr<const SweepSnapshot> s) {
+    const double steps = static_cast<double>(s->settings.size());
+    const double f = s->fraction() * steps;
+    if (s->state == SweepSnapshot::State::running && f - std::floor(f) > 1e-9) between.push_back(s->fraction());
+    EXPECT_LE(s->fraction(), 1.0);
+  });
+  ASSERT_EQ(last->state, SweepSnapshot::State::done) << last->error;
+  EXPECT_DOUBLE_EQ(last->fraction(), 1.0);
+  SweepSnapshot s = *last;
+  s.state = SweepSnapshot::State::running;
+  s.results.resize(1);
+  s.setting_fraction = 0.5;
+  EXPECT_DOUBLE_EQ(s.fraction(), 0.75);
+  // At most one snapshot per 0.1 s inside a setting, the first at once.
+  EXPECT_FALSE(between.empty());
+  for (double f : between) {
+    EXPECT_GT(f, 0.0);
+    EXPECT_LT(f, 1.0);
+  }
 }
 
 TEST(RunSweepRequest, CancelKeepsWhatWasMeasuredAndBadInputFails) {

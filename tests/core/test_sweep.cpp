@@ -376,6 +376,42 @@ TEST(Sweep, WarmupRoundsRunUntimed) {
   EXPECT_EQ(SweepConfig{}.warmup, 1);
 }
 
+// A sweep's octree builds showed nothing until the setting ended: the setting's
+// fraction now moves inside each build (1 % steps of the builder) and after
+// each build and pass, and ends at 1.
+TEST(Sweep, ASettingReportsItsProgressInsideItsBuilds) {
+  const Scene scene = load_scene("builtin:teapot?size=3000");
+  const std::vector<Ray> rays = small_primary(scene, 24, 18);
+  const std::vector<SweepParam> params{{"depth", {"8"}}};
+  const std::vector<SweepSetting> settings = expand_sweep("octree", params);
+  SweepConfig cfg;
+  cfg.structure = "octree";
+  cfg.repeat = 2;
+  cfg.warmup = 1;
+  cfg.threads = 1;  // one builder thread: the fractions arrive in order
+  std::vector<double> seen;
+  cfg.progress = [&seen](double f) {
+    seen.push_back(f);
+    return true;
+  };
+  (void)measure_sweep_setting(scene.triangles, rays, {}, cfg, settings[0]);
+  // Steps: 1 warm-up build + 2 timed builds, 1 warm-up pass + 2 timed passes + the counting pass.
+  const double steps = 7;
+  ASSERT_FALSE(seen.empty());
+  EXPECT_DOUBLE_EQ(seen.back(), 1.0);
+  std::size_t inside = 0;
+  for (std::size_t i = 0; i < seen.size(); ++i) {
+    EXPECT_GE(seen[i], 0.0);
+    EXPECT_LE(seen[i], 1.0);
+    if (i) {
+      EXPECT_GE(seen[i], seen[i - 1]) << i;
+    }
+    const double in_steps = seen[i] * steps;
+    inside += std::abs(in_steps - std::round(in_steps)) > 1e-9;
+  }
+  EXPECT_GE(inside, 3u * 10u) << "each of the 3 builds reports at least 10 fractions inside";
+}
+
 TEST(SweepParams, SettingsDifferingOnlyInTheTriangleTestShareABuild) {
   const std::vector<SweepParam> params{{"triangle", {"watertight", "fast"}}, {"buckets", {"4", "8"}}};
   const std::vector<SweepSetting> s = expand_sweep("bvh", params);  // wt/4, wt/8, fast/4, fast/8

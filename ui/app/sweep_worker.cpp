@@ -1,8 +1,10 @@
 #include "ui/app/sweep_worker.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <map>
+#include <mutex>
 #include <stdexcept>
 
 #include "core/accel/bvh/bvh.h"
@@ -120,7 +122,8 @@ double SweepSnapshot::fraction() const {
   const std::size_t steps = settings.size() + (calibration || stage == "calibrating" ? 1 : 0);
   if (state == State::done) return 1.0;
   const std::size_t done = results.size() + (calibration ? 1 : 0);
-  return steps ? static_cast<double>(done) / static_cast<double>(steps) : 0.0;
+  const double within = done < settings.size() ? std::clamp(setting_fraction, 0.0, 1.0) : 0.0;
+  return steps ? std::min(1.0, (static_cast<double>(done) + within) / static_cast<double>(steps)) : 0.0;
 }
 
 std::shared_ptr<const SweepSnapshot> run_sweep_request(
@@ -156,14 +159,31 @@ std::shared_ptr<const SweepSnapshot> run_sweep_request(
     cfg.repeat = r.repeat;
     cfg.threads = r.threads;
     cfg.keep_going = keep_going;
+    // Inside a setting: a snapshot at most every 0.1 s, from whichever builder thread gets the lock
+    // (the worker's own thread waits in measure_sweep_setting meanwhile and does not touch `snap`).
+    std::mutex progress_mutex;
+    std::chrono::steady_clock::time_point last_emit{};
+    cfg.progress = [&](double f) {
+      std::unique_lock lock(progress_mutex, std::try_to_lock);
+      if (!lock.owns_lock()) return true;
+      snap->setting_fraction = f;
+      const auto now = std::chrono::steady_clock::now();
+      if (now - last_emit >= std::chrono::milliseconds(100)) {
+        last_emit = now;
+        emit();
+      }
+      return true;
+    };
     for (std::size_t i = 0; i < snap->settings.size(); ++i) {
       if (keep_going && !keep_going()) throw BuildCancelled();
       const SweepSetting& s = snap->settings[i];
       snap->stage = r.structure + " " + setting_label(s);
+      snap->setting_fraction = 0;
       emit();
       const auto same = earlier_same_build(snap->settings, i);
       SweepResult m = measure_sweep_setting(tris, rays, probes, cfg, s, same ? &snap->results[*same] : nullptr);
       snap->results.push_back(std::move(m));
+      snap->setting_fraction = 0;
     }
     if (r.calibrate) {
       snap->stage = "calibrating";

@@ -81,8 +81,12 @@ struct SweepSnapshot {
   std::string stage;  ///< what runs now ("bvh buckets=8", "calibrating")
   std::string error;  ///< when failed: one line
   std::optional<CalibrationReport> calibration;
+  /// How far the setting being measured is (0..1): its builds report inside,
+  /// so that one slow build (a deep octree) does not stall the bar.
+  double setting_fraction = 0;
 
-  double fraction() const;  ///< settings measured / settings (the calibration counts as one)
+  /// (settings measured + setting_fraction) / settings (the calibration counts as one)
+  double fraction() const;
 };
 
 /// Runs request `r` synchronously, publishing a snapshot after each step;
