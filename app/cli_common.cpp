@@ -9,9 +9,14 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <thread>
 
+#include "app/build_info.h"
+#include "core/accel/embree_backend.h"
 #include "core/analysis/sah.h"
 #include "core/query/camera.h"
 #include "core/scene/effects.h"
@@ -411,6 +416,74 @@ std::string name_list_problem(const std::string& text, const std::vector<std::st
       return "'" + items[i] + "' is listed twice";
   }
   return {};
+}
+
+namespace {
+
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("model name", 0) == 0) {
+      const std::size_t c = line.find(':');
+      if (c != std::string::npos && c + 1 < line.size()) {
+        const std::size_t first = line.find_first_not_of(' ', c + 1);
+        if (first != std::string::npos) return line.substr(first);
+      }
+    }
+  return "unknown";
+}
+
+std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+/// This process's command line, arguments joined by spaces.
+std::string command_line() {
+  std::ifstream in("/proc/self/cmdline", std::ios::binary);
+  std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  while (!all.empty() && all.back() == '\0') all.pop_back();
+  for (char& c : all)
+    if (c == '\0') c = ' ';
+  return all;
+}
+
+}  // namespace
+
+double load_average() {
+  std::ifstream in("/proc/loadavg");
+  double l = -1;
+  in >> l;
+  return in ? l : -1.0;
+}
+
+nlohmann::json machine_json(unsigned threads_used) {
+  nlohmann::json program = {
+      {"version", build_info::kVersion}, {"commit", build_info::kCommit}, {"build_type", build_info::kBuildType}};
+#ifdef ACCELVIZ_HAVE_EMBREE
+  program["embree"] = std::string(embree_version());
+#endif
+  return {{"cpu_model", cpu_model()},
+          {"hardware_threads", std::thread::hardware_concurrency()},
+          {"threads_used", threads_used},
+          {"load_average_1min", load_average()},
+          {"date", utc_now()},
+          {"command_line", command_line()},
+          {"program", program}};
+}
+
+std::string version_line() {
+  std::string line = std::string("accelviz ") + build_info::kVersion + " (commit " + build_info::kCommit + ", " +
+                     build_info::kBuildType + " build";
+#ifdef ACCELVIZ_HAVE_EMBREE
+  line += ", Embree " + std::string(embree_version());
+#endif
+  return line + ")";
 }
 
 void print_json_line(const nlohmann::json& j) {

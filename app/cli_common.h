@@ -202,6 +202,18 @@ std::string braced_names(const std::vector<std::string>& names);
 /// empty item, a name not among them, or one listed twice.
 std::string name_list_problem(const std::string& text, const std::vector<std::string>& names);
 
+/// The 1-minute load average of /proc/loadavg (-1 where it cannot be read).
+double load_average();
+
+/// Where and with what a measurement ran, recorded in the JSON of bench,
+/// sweep and calibrate: the CPU model, hardware threads, `threads_used`, the
+/// load average, the UTC date, this command line, and the program (version,
+/// commit, build type, Embree's version).
+nlohmann::json machine_json(unsigned threads_used);
+
+/// "accelviz 0.1.0 (commit 9627f3c8f5bd, Release build, Embree 3.13.5)": --version's line.
+std::string version_line();
+
 /// One-line JSON on stdout, flushed (animate streams a line per frame).
 void print_json_line(const nlohmann::json& j);
 

@@ -519,6 +519,7 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
     }
   }
   if (o.json) {
+    j["machine"] = machine_json(all);
     std::cout << j.dump(2) << '\n';
     return exit_code;
   }

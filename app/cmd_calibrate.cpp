@@ -81,6 +81,7 @@ int run_calibrate(const CalibrateCliOptions& o, const GlobalOptions& global) {
                   {"calibrated", figures_json(report.with_calibrated)}};
   }
   if (o.json) {
+    j["machine"] = machine_json(resolve_threads(o.threads));
     std::cout << j.dump(2) << '\n';
     return 0;
   }

@@ -44,43 +44,6 @@ struct SweepCliOptions {
   bool force = false;
 };
 
-std::string cpu_model() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line))
-    if (line.rfind("model name", 0) == 0) {
-      const std::size_t c = line.find(':');
-      if (c != std::string::npos) return line.substr(line.find_first_not_of(' ', c + 1));
-    }
-  return "unknown";
-}
-
-std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
-
-/// This process's command line, arguments joined by spaces (for the record in sweep.json).
-std::string command_line() {
-  std::ifstream in("/proc/self/cmdline", std::ios::binary);
-  std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  while (!all.empty() && all.back() == '\0') all.pop_back();
-  for (char& c : all)
-    if (c == '\0') c = ' ';
-  return all;
-}
-
-double load_average() {
-  std::ifstream in("/proc/loadavg");
-  double l = -1;
-  in >> l;
-  return l;
-}
-
 const glm::u8vec3 kPalette[] = {{31, 119, 180}, {255, 127, 14}, {44, 160, 44}, {214, 39, 40}, {148, 103, 189},
                                 {140, 86, 75},  {227, 119, 194}, {127, 127, 127}, {188, 189, 34}, {23, 190, 207}};
 
@@ -308,13 +271,7 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
   OutputDirWriter out(o.out, files, o.force);
   out.add("sweep.csv", sweep_csv(results, o.ray_budget));
   nlohmann::json j;
-  const std::string cmdline = command_line();
-  j["machine"] = {{"cpu_model", cpu_model()},
-                  {"hardware_threads", std::thread::hardware_concurrency()},
-                  {"threads_used", threads},
-                  {"load_average_1min", load_average()},
-                  {"date", utc_now()},
-                  {"command_line", cmdline}};
+  j["machine"] = machine_json(threads);
   j["scene"] = o.scene;
   j["triangles"] = scene.triangles.size();
   j["structure"] = o.structure;

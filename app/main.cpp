@@ -54,7 +54,7 @@ int run(int argc, char** argv) {
       "accelviz: a lab for ray-tracing acceleration structures.\n"
       "Without a subcommand it opens the interactive window on SCENE (default: the demo scene); without a\n"
       "display it renders the demo scene's heatmap to a PNG in the current directory instead."};
-  app.set_version_flag("--version", "accelviz 0.1.0");
+  app.set_version_flag("--version", cli::version_line());
   app.require_subcommand(0, 1);
   app.footer("\nSCENE is a .gltf/.glb/.obj file or builtin:NAME[?key=value&...].\n" + builtin_list() +
              "Exit codes: 0 success, 1 error (bad file, failed build...), 2 usage error.\n"

@@ -73,6 +73,10 @@ using Clock = std::chrono::steady_clock;
 
 }  // namespace
 
+std::string_view embree_version() {
+  return RTC_VERSION_STRING;
+}
+
 bool embree_cpu_has(EmbreeIsa isa) {
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
   __builtin_cpu_init();

@@ -53,6 +53,9 @@ struct EmbreeOptions {
 
 #ifdef ACCELVIZ_HAVE_EMBREE
 
+/// The Embree this program was built against ("3.13.5", RTC_VERSION_STRING).
+std::string_view embree_version();
+
 /// Whether this CPU has what Embree's kernels for `isa` use (its AVX2
 /// kernels also use FMA, BMI1/2 and LZCNT; its AVX-512 ones AVX-512 F, CD,
 /// DQ, BW and VL). Always true for automatic.

@@ -28,9 +28,24 @@ for s in j["structures"]:
 print("bench warmup ok")' "$tmp/warm.json"
 "$accelviz" bench 'builtin:soup?size=2000' --structure bvh --rays primary --size 8x8 --warmup -1 2>/dev/null &&
   { echo "FAIL: --warmup -1 accepted"; exit 1; }
-python3 - "$tmp/bench.json" <<'PY'
-import json, sys
+# Where and with what it ran: the machine, and the program as --version names it (its commit).
+"$accelviz" --version >"$tmp/version.txt"
+python3 - "$tmp/bench.json" "$tmp/version.txt" <<'PY'
+import json, re, sys
 j = json.load(open(sys.argv[1]))
+version = open(sys.argv[2]).read().strip()
+m = re.fullmatch(r"accelviz (\d+\.\d+\.\d+) \(commit ([0-9a-f]{7,}(-dirty)?|unknown), (\w+) build(, Embree [\d.]+)?\)", version)
+assert m, version
+machine = j["machine"]
+for k in ["cpu_model", "hardware_threads", "threads_used", "load_average_1min", "date", "command_line", "program"]:
+    assert k in machine, k
+assert machine["threads_used"] == j["threads"], (machine["threads_used"], j["threads"])
+assert "bench builtin:soup?size=2000" in machine["command_line"], machine["command_line"]
+assert re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ", machine["date"]), machine["date"]
+p = machine["program"]
+assert (p["version"], p["commit"], p["build_type"]) == (m.group(1), m.group(2), m.group(4)), (p, version)
+assert ("embree" in p) == (m.group(5) is not None), (p, version)
+print("bench machine ok:", version)
 for k in ["scene", "triangles", "threads", "repeat", "warmup", "ray_sets", "structures"]:
     assert k in j, k
 assert j["warmup"] == 0

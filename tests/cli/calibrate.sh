@@ -22,6 +22,8 @@ c = j["c_isect_" + test]
 assert c > 0 and j["c_trav"] == 1.0, j
 s = j["scene"]
 assert s["rays"] == 32 * 24 and s["threads"] == 1 and s["triangle_test"] == test and s["triangles"] > 0, s
+assert j["machine"]["threads_used"] == 1 and "calibrate" in j["machine"]["command_line"], j["machine"]
+assert j["machine"]["program"]["commit"], j["machine"]
 d, k = s["default"], s["calibrated"]
 assert d["c_trav"] == 1.0 and d["c_isect"] == 1.0, d
 assert k["c_trav"] == 1.0 and abs(k["c_isect"] - c) <= 1e-6 * c, (k, c)

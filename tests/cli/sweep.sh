@@ -42,6 +42,7 @@ for k in ("cpu_model", "hardware_threads", "threads_used", "date", "command_line
 assert j["machine"]["threads_used"] == 1
 assert j["warmup"] == 1 and j["repeat"] == 1, (j["warmup"], j["repeat"])
 assert "sweep" in j["machine"]["command_line"]
+assert j["machine"]["program"]["version"] and j["machine"]["program"]["commit"], j["machine"]
 assert len(j["results"]) == 6 and len(j["pareto_front"]) >= 1
 assert {b["rays"] for b in j["best_for_budget"]} >= {1e6, 1e9}, j["best_for_budget"]
 assert len(j["best_for_budget"]) == 2, j["best_for_budget"]  # the default budget 1e6 is listed once
