@@ -3,9 +3,9 @@
 // frame. Builds and heatmaps run on worker threads, so a frame never waits
 // for them; scripts are run between frames through the same calls as the
 // mouse and keyboard.
-#include "app/gui/gui.h"
-
+#include "app/cli_common.h"
 #include "app/gui/gpu_heatmap.h"
+#include "app/gui/gui.h"
 #include "app/gui/insight_views.h"
 #include "app/gui/scene_view.h"
 #include "core/accel/tlas/tlas.h"
@@ -530,6 +530,7 @@ SavedScreenshot Gui::write_frame(const std::optional<std::filesystem::path>& exp
   const RgbImage frame = to_rgb(view_->renderer().read_pixels());
   const glm::vec2 range = view_->heatmap_range(app_);
   ScreenshotInfo info = app_.screenshot_info(range.x, range.y);
+  info.program = cli::version_line();
   info.boxes_drawn = view_->boxes_drawn();
   info.boxes_matched = view_->boxes_matched();
   if (app_.config().view.show_boxes) {

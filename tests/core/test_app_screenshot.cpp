@@ -173,6 +173,10 @@ TEST(AppScreenshot, SideCarSaysHowToReproduceThePicture) {
   const ScreenshotInfo info = test_info();
   const nlohmann::json j = screenshot_sidecar(info, "/x/accelviz-1.png");
   EXPECT_EQ(j["png"], "/x/accelviz-1.png");
+  EXPECT_FALSE(j.contains("program"));  // the GUI sets it (--version's line); left out when unknown
+  ScreenshotInfo named = info;
+  named.program = "accelviz 0.1.0 (commit abc, Release build)";
+  EXPECT_EQ(screenshot_sidecar(named, "/x/accelviz-1.png")["program"], named.program);
   EXPECT_EQ(j["scene"], "builtin:teapot?size=2000");
   EXPECT_EQ(j["triangles"], 2256);
   EXPECT_EQ(j["size"]["width"], 64);

@@ -264,7 +264,7 @@ nlohmann::json screenshot_sidecar(const ScreenshotInfo& info, const fs::path& pn
   script.push_back("screenshot " + stem + "-replay.png");
   script.push_back("quit");
 
-  return {
+  nlohmann::json out = {
       {"png", fs::absolute(png).string()},
       {"caption", screenshot_caption(info)},
       {"boxes",
@@ -304,6 +304,8 @@ nlohmann::json screenshot_sidecar(const ScreenshotInfo& info, const fs::path& pn
       {"reproduce",
        {{"render_heatmap", heatmap_cmd}, {"render_raster", raster_cmd}, {"notes", notes}, {"script", script}}},
   };
+  if (!info.program.empty()) out["program"] = info.program;
+  return out;
 }
 
 SavedScreenshot save_screenshot(const fs::path& dir, const RgbImage& frame, const ScreenshotInfo& info,
