@@ -23,6 +23,7 @@
 #include "core/scene/load.h"
 #include "core/util/file_checks.h"
 #include "core/util/output_file.h"
+#include "core/util/shell_quote.h"
 
 namespace accelviz::cli {
 
@@ -443,14 +444,23 @@ std::string utc_now() {
   return buf;
 }
 
-/// This process's command line, arguments joined by spaces.
+/// This process's command line, each argument quoted for the shell where it
+/// needs it (a built-in scene's '?', a space in a file name), so that it
+/// pastes back as it ran.
 std::string command_line() {
   std::ifstream in("/proc/self/cmdline", std::ios::binary);
   std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  while (!all.empty() && all.back() == '\0') all.pop_back();
-  for (char& c : all)
-    if (c == '\0') c = ' ';
-  return all;
+  std::string line, arg;
+  for (std::size_t i = 0; i <= all.size(); ++i) {
+    if (i < all.size() && all[i] != '\0') {
+      arg += all[i];
+      continue;
+    }
+    if (i == all.size() && arg.empty()) break;  // cmdline ends with a NUL
+    line += (line.empty() ? "" : " ") + shell_quote(arg);
+    arg.clear();
+  }
+  return line;
 }
 
 }  // namespace

@@ -19,6 +19,7 @@
 #include "core/query/camera.h"
 #include "core/scene/load.h"
 #include "core/util/output_file.h"
+#include "core/util/shell_quote.h"
 #ifdef ACCELVIZ_HAVE_UI
 #include "ui/gl/headless.h"
 #include "ui/render/gpu_trace.h"
@@ -65,21 +66,25 @@ struct RenderOptions {
 
 /// What the heatmap shows, as the command that draws it: the scene, the
 /// structure, the metric, the size and every option that differs from its
-/// default (not the output, the colours or the threads): on the picture, so
-/// that a heatmap pasted into a lecture or a bug report still says what it is.
+/// default (not the output or the threads), each word quoted for the shell
+/// where it needs it: on the picture, so that a heatmap pasted into a lecture
+/// or a bug report still says what it is, and pasted back draws it again.
 std::string render_caption(const RenderOptions& o) {
   const RenderOptions d;
   const StructureCli& s = o.structure_opts;
   const StructureCli& ds = d.structure_opts;
-  std::string c = "accelviz render " + o.scene + " -s " + o.structure + " -m " + o.metric + " --size " + o.size;
+  std::string c =
+      "accelviz render " + shell_quote(o.scene) + " -s " + o.structure + " -m " + o.metric + " --size " + o.size;
   const auto add = [&c](bool differs, const std::string& text) {
     if (differs) c += " " + text;
   };
-  add(!o.camera.empty(), "--camera " + o.camera);
+  add(!o.camera.empty(), "--camera " + shell_quote(o.camera));
+  add(o.colormap != d.colormap, "--colormap " + o.colormap);
+  add(o.legend != d.legend, "--legend " + o.legend);
   add(o.triangle_test != d.triangle_test, "--triangle-test " + o.triangle_test);
   add(o.order != d.order, "--order " + o.order);
   add(o.xray, "--xray");
-  add(!o.max_text.empty(), "--max " + o.max_text);
+  add(!o.max_text.empty(), "--max " + shell_quote(o.max_text));
   add(o.device != d.device, "--device " + o.device);
   if (o.structure == "bvh" || o.structure == "tlas") {
     add(s.splitter != ds.splitter, "--splitter " + s.splitter);
@@ -148,6 +153,7 @@ int run_render_raster(const RenderOptions& o, const GlobalOptions& global) {
   progress.end();
   const std::string abs = absolute_path(o.out);
   figures["out"] = abs;
+  figures["program"] = version_line();
   std::cout << path_line(abs) << "\n";
   print_json_line(figures);
   return 0;
@@ -339,19 +345,21 @@ int run_render_several(const RenderOptions& o, const std::vector<std::string>& s
     co.scale_note = (shared.scale_note.empty() ? "" : shared.scale_note + "; ") + "scale shared with " + others;
     RgbImage rgb = colour_heatmap(os, traced[i], co);
     nlohmann::json& figures = traced[i].figures;
+    // The single-structure command that draws the same picture: its --max is the shared top.
+    RenderOptions alone = os;
+    if (o.max_percentile > 0.0 || o.max_text.empty()) alone.max_text = number_text(shared.max);
     if (o.caption != "none") {
-      // The single-structure command that draws the same picture: its --max is the shared top.
-      RenderOptions alone = os;
-      if (o.max_percentile > 0.0 || o.max_text.empty()) alone.max_text = number_text(shared.max);
       figures["caption"] = o.caption == "auto" ? render_caption(alone) : o.caption;
       rgb = add_caption(rgb, figures["caption"].get<std::string>());
     }
-    files.push_back({os.out, encode_png(rgb, os.out)});
+    const std::vector<PngText> text{{"Description", render_caption(alone)}, {"Software", version_line()}};
+    files.push_back({os.out, encode_png(rgb, os.out, text)});
     figures["out"] = absolute_path(os.out);
     out["images"].push_back(figures);
   }
   write_output_set(files, o.force);
   for (const nlohmann::json& figures : out["images"]) std::cout << path_line(figures["out"].get<std::string>()) << "\n";
+  out["program"] = version_line();
   print_json_line(out);
   return 0;
 }
@@ -409,9 +417,12 @@ int run_render(const RenderOptions& given, const GlobalOptions& global) {
     figures["caption"] = o.caption == "auto" ? render_caption(o) : o.caption;
     rgb = add_caption(rgb, figures["caption"].get<std::string>());
   }
-  write_png(o.out, rgb, o.force);
+  // The command that draws it and the build, in the file (a caption cut on a small picture, or none).
+  write_png(o.out, rgb, o.force,
+            std::vector<PngText>{{"Description", render_caption(o)}, {"Software", version_line()}});
   const std::string abs = absolute_path(o.out);
   figures["out"] = abs;
+  figures["program"] = version_line();
   std::cout << path_line(abs) << "\n";
   print_json_line(figures);
   return 0;

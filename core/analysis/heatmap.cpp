@@ -697,7 +697,38 @@ std::string png_name_problem(const std::string& path) {
   return path + ": a PNG file's name must end in .png";
 }
 
-std::string encode_png(const RgbImage& img, const std::string& path) {
+namespace {
+
+std::uint32_t png_crc(std::string_view bytes) {
+  static const std::array<std::uint32_t, 256> table = [] {
+    std::array<std::uint32_t, 256> t{};
+    for (std::uint32_t n = 0; n < 256; ++n) {
+      std::uint32_t c = n;
+      for (int k = 0; k < 8; ++k) c = c & 1 ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+      t[n] = c;
+    }
+    return t;
+  }();
+  std::uint32_t c = 0xFFFFFFFFu;
+  for (unsigned char b : bytes) c = table[(c ^ b) & 0xFF] ^ (c >> 8);
+  return c ^ 0xFFFFFFFFu;
+}
+
+void put_u32(std::string& out, std::uint32_t v) {
+  for (int s = 24; s >= 0; s -= 8) out += static_cast<char>((v >> s) & 0xFF);
+}
+
+std::uint32_t get_u32(const std::string& in, std::size_t at) {
+  std::uint32_t v = 0;
+  for (int k = 0; k < 4; ++k) v = (v << 8) | static_cast<unsigned char>(in[at + static_cast<std::size_t>(k)]);
+  return v;
+}
+
+constexpr std::string_view kPngSignature("\x89PNG\r\n\x1a\n", 8);
+
+}  // namespace
+
+std::string encode_png(const RgbImage& img, const std::string& path, std::span<const PngText> text) {
   if (const std::string problem = png_name_problem(path); !problem.empty()) throw std::runtime_error(problem);
   if (img.width <= 0 || img.height <= 0) throw std::runtime_error(path + ": cannot write an empty image");
   std::string bytes;
@@ -707,13 +738,54 @@ std::string encode_png(const RgbImage& img, const std::string& path) {
       },
       &bytes, img.width, img.height, 3, img.pixels.data(), img.width * 3);
   if (!encoded) throw std::runtime_error(path + ": the PNG could not be encoded");
+  if (text.empty()) return bytes;
+  // stb writes IEND last (12 bytes: length 0, type, CRC): the iTXt chunks go before it.
+  const std::size_t iend = bytes.size() - 12;
+  if (bytes.size() < kPngSignature.size() + 12 || bytes.compare(iend + 4, 4, "IEND") != 0)
+    throw std::runtime_error(path + ": the PNG could not be encoded (no end chunk)");
+  std::string chunks;
+  for (const PngText& t : text) {
+    if (t.keyword.empty() || t.keyword.size() > 79 || t.keyword.find('\0') != std::string::npos)
+      throw std::invalid_argument("PNG text keyword must be 1-79 characters without NUL: '" + t.keyword + "'");
+    // keyword NUL, compression flag 0, method 0, language "" NUL, translated keyword "" NUL, UTF-8 text.
+    std::string body = "iTXt" + t.keyword;
+    body += std::string("\0\0\0\0\0", 5);
+    body += t.text.substr(0, t.text.find('\0'));
+    put_u32(chunks, static_cast<std::uint32_t>(body.size() - 4));
+    chunks += body;
+    put_u32(chunks, png_crc(body));
+  }
+  bytes.insert(iend, chunks);
   return bytes;
 }
 
-void write_png(const std::string& path, const RgbImage& img, bool overwrite) {
+std::vector<PngText> png_text(const std::string& bytes) {
+  std::vector<PngText> out;
+  if (bytes.compare(0, kPngSignature.size(), kPngSignature) != 0) return out;
+  for (std::size_t at = kPngSignature.size(); at + 12 <= bytes.size();) {
+    const std::uint32_t length = get_u32(bytes, at);
+    if (length > bytes.size() - at - 12) break;
+    const std::string type = bytes.substr(at + 4, 4);
+    if (type == "iTXt") {
+      const std::string body = bytes.substr(at + 8, length);
+      const std::size_t key_end = body.find('\0');
+      // keyword NUL, flag, method, language NUL, translated keyword NUL, text: uncompressed only.
+      if (key_end != std::string::npos && key_end + 2 < body.size() && body[key_end + 1] == 0) {
+        const std::size_t lang_end = body.find('\0', key_end + 3);
+        const std::size_t trans_end = lang_end == std::string::npos ? lang_end : body.find('\0', lang_end + 1);
+        if (trans_end != std::string::npos) out.push_back({body.substr(0, key_end), body.substr(trans_end + 1)});
+      }
+    }
+    if (type == "IEND") break;
+    at += 12 + static_cast<std::size_t>(length);
+  }
+  return out;
+}
+
+void write_png(const std::string& path, const RgbImage& img, bool overwrite, std::span<const PngText> text) {
   // Encoded in memory, then written through a temporary beside the file
   // (write_output_file): a failed write never costs the file that was there.
-  const std::string bytes = encode_png(img, path);
+  const std::string bytes = encode_png(img, path, text);
   const OutputWrite w = write_output_file(path, {bytes}, overwrite);
   if (w.exists) throw FileExistsError(path + ": exists (use --force to overwrite)");
   if (!w.ok()) throw std::runtime_error(path + ": " + w.problem);

@@ -245,18 +245,33 @@ class FileExistsError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// Text a PNG carries beside its pixels, as an uncompressed iTXt chunk
+/// (UTF-8): the full caption and the program that drew it, which image
+/// viewers and `exiftool` show, and which a caption cut on a small picture
+/// no longer says. Keyword: 1-79 Latin-1 letters ("Description", "Software").
+struct PngText {
+  std::string keyword;
+  std::string text;
+};
+
 /// Writes a PNG (stb_image_write). Refuses, with FileExistsError "<file>:
 /// exists (use --force to overwrite)", when the file exists and `overwrite`
 /// is false (the existence check and the creation are one step); a name not
 /// ending in .png is png_name_problem's message; other failures are "<file>:
 /// <reason>". Throws std::runtime_error.
-void write_png(const std::string& path, const RgbImage& img, bool overwrite = false);
+/// `text`: stored in the file beside the pixels (PngText).
+void write_png(const std::string& path, const RgbImage& img, bool overwrite = false,
+               std::span<const PngText> text = {});
 
 /// The PNG file's bytes of `img`, for a file named `path` (for a set of files
-/// written all or nothing: write_output_files, OutputFolder). Throws
-/// std::runtime_error as write_png does for a name not ending in .png, an
-/// empty image or a failed encoding.
-std::string encode_png(const RgbImage& img, const std::string& path);
+/// written all or nothing: write_output_files, OutputFolder), with `text` in
+/// iTXt chunks before the end. Throws std::runtime_error as write_png does for
+/// a name not ending in .png, an empty image or a failed encoding.
+std::string encode_png(const RgbImage& img, const std::string& path, std::span<const PngText> text = {});
+
+/// The iTXt chunks (uncompressed) of a PNG file's bytes; empty for none or
+/// bytes that are no PNG.
+std::vector<PngText> png_text(const std::string& bytes);
 
 /// Reads any image stb_image understands as 8-bit RGB. Throws std::runtime_error "<file>: <reason>".
 RgbImage read_png(const std::string& path);

@@ -40,7 +40,8 @@ machine = j["machine"]
 for k in ["cpu_model", "hardware_threads", "threads_used", "load_average_1min", "date", "command_line", "program"]:
     assert k in machine, k
 assert machine["threads_used"] == j["threads"], (machine["threads_used"], j["threads"])
-assert "bench builtin:soup?size=2000" in machine["command_line"], machine["command_line"]
+# Each word quoted for the shell where it needs it ('?'), so that the line pastes back as it ran.
+assert "bench 'builtin:soup?size=2000' --structure bvh,brute-bbox" in machine["command_line"], machine["command_line"]
 assert re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ", machine["date"]), machine["date"]
 p = machine["program"]
 assert (p["version"], p["commit"], p["build_type"]) == (m.group(1), m.group(2), m.group(4)), (p, version)

@@ -10,15 +10,31 @@ scene='builtin:teapot?size=2000'
 out=$("$accelviz" -q render "$scene" --metric nodes --size 64x48 --out "$tmp/a.png")
 echo "$out"
 [ "$(sed -n 1p <<<"$out")" = "$tmp/a.png" ] || { echo "FAIL: first line is not the path"; exit 1; }
-python3 - "$tmp/a.png" "$(sed -n 2p <<<"$out")" <<'PY'
-import json, struct, sys
+python3 - "$tmp/a.png" "$(sed -n 2p <<<"$out")" "$("$accelviz" --version)" <<'PY'
+import json, struct, sys, zlib
 png = open(sys.argv[1], "rb").read()
 assert png[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
 w, h = struct.unpack(">II", png[16:24])
 assert w == 64 and h > 48, (w, h)  # legend and caption below the 64x48 picture
 j = json.loads(sys.argv[2])
-# The caption is the command that draws the picture (the options not at their default too).
-assert j["caption"] == "accelviz render builtin:teapot?size=2000 -s bvh -m nodes --size 64x48", j["caption"]
+# The caption is the command that draws the picture (the options not at their default too), its
+# words quoted for the shell where they need it: pasted back, it runs.
+assert j["caption"] == "accelviz render 'builtin:teapot?size=2000' -s bvh -m nodes --size 64x48", j["caption"]
+assert j["program"] == sys.argv[3], (j["program"], sys.argv[3])
+# The file carries the command and the program (iTXt chunks, each CRC right) beside the pixels.
+at, text = 8, {}
+while at < len(png):
+    n, kind = struct.unpack(">I4s", png[at:at + 8])
+    body = png[at + 8:at + 8 + n]
+    assert struct.unpack(">I", png[at + 8 + n:at + 12 + n])[0] == zlib.crc32(kind + body), kind
+    if kind == b"iTXt":
+        key, rest = body.split(b"\0", 1)
+        assert rest[:2] == b"\0\0", rest[:2]  # uncompressed
+        lang, trans, value = rest[2:].split(b"\0", 2)
+        text[key.decode()] = value.decode()
+    at += 12 + n
+assert kind == b"IEND"
+assert text == {"Description": j["caption"], "Software": sys.argv[3]}, text
 for k in ["mean", "max", "render_ms", "rays_per_s", "build_ms", "rays", "out"]:
     assert k in j, k
 assert j["rays"] == 64 * 48 and j["max"] >= j["mean"] > 0
@@ -54,8 +70,20 @@ print("--max p90 ok")'
 cap=$("$accelviz" -q render "$scene" --size 40x30 --out "$tmp/c1.png" --max 10 --camera 0,5,20,0,0,0,30 \
   --triangle-test fast --splitter median --buckets 8 --order unordered | sed -n 2p |
   python3 -c 'import json, sys; print(json.load(sys.stdin)["caption"])')
-[ "$cap" = "accelviz render $scene -s bvh -m nodes --size 40x30 --camera 0,5,20,0,0,0,30 --triangle-test fast --order unordered --max 10 --splitter median --buckets 8" ] ||
+[ "$cap" = "accelviz render '$scene' -s bvh -m nodes --size 40x30 --camera 0,5,20,0,0,0,30 --triangle-test fast --order unordered --max 10 --splitter median --buckets 8" ] ||
   { echo "FAIL: caption: $cap"; exit 1; }
+# Pasted back into a shell, the caption draws the same file: a scene whose name has spaces, a colour map,
+# a legend and a percentile top (the caption used to leave the colours out and the name unquoted).
+mkdir -p "$tmp/my scenes"
+"$accelviz" -q export "$scene" "$tmp/my scenes/tea pot.glb" >/dev/null
+"$accelviz" -q render "$tmp/my scenes/tea pot.glb" --size 40x30 --colormap inferno --legend right --max p95 \
+  --out "$tmp/r1.png" >"$tmp/r1.txt"
+cap=$(sed -n 2p "$tmp/r1.txt" | python3 -c 'import json, sys; print(json.load(sys.stdin)["caption"])')
+case "$cap" in "accelviz render '$tmp/my scenes/tea pot.glb' "*"--colormap inferno --legend right --max p95"*) ;;
+  *) echo "FAIL: caption of a spaced name: $cap"; exit 1 ;; esac
+(cd "$tmp" && bash -c "'$accelviz' -q ${cap#accelviz } --out r2.png" >/dev/null) || { echo "FAIL: caption did not run: $cap"; exit 1; }
+cmp "$tmp/r1.png" "$tmp/r2.png" || { echo "FAIL: the caption's command drew another file"; exit 1; }
+echo "caption pasted back ok: $cap"
 "$accelviz" -q render "$scene" --size 40x30 --out "$tmp/c2.png" --caption none >/dev/null
 "$accelviz" -q render "$scene" --size 40x30 --out "$tmp/c3.png" --caption "fig. 3: the teapot" >/dev/null
 "$accelviz" -q render "$scene" --size 40x30 --out "$tmp/c4.png" >/dev/null

@@ -41,6 +41,7 @@ ScreenshotInfo test_info() {
   EXPECT_EQ(apply_option(info.config, "metric", "prims"), "");
   EXPECT_EQ(apply_option(info.config, "colormap", "inferno"), "");
   EXPECT_EQ(apply_option(info.config, "buckets", "8"), "");
+  EXPECT_EQ(apply_option(info.config, "msaa", "1"), "");  // as render --view raster draws (its own test below)
   info.scale_min = 0.0f;
   info.scale_max = 39.0f;
   info.ray_pixel = std::make_pair(32, 24);
@@ -273,6 +274,42 @@ TEST(AppScreenshot, TheCommandsCarryTheTraversalOrderAndXray) {
   const std::string cmd = j["reproduce"]["render_heatmap"];
   EXPECT_NE(cmd.find(" --order unordered"), std::string::npos) << cmd;
   EXPECT_EQ(cmd.find(" --xray"), std::string::npos) << cmd;
+}
+
+// The audit: a grid screenshot's side-car listed each note twice (the heatmap's and the raster's
+// commands both added the shared ones), and a default screenshot's raster command drew without the
+// window's multisampling and did not say so.
+TEST(AppScreenshot, NotesComeOnceAndNameTheWindowsMultisampling) {
+  ScreenshotInfo info = test_info();
+  info.config.structure.name = "grid";
+  EXPECT_EQ(apply_option(info.config, "grid-res", "8,8,8"), "");
+  info.config.view.auto_scale = false;
+  info.config.view.scale_min = 5.0f;
+  nlohmann::json notes = screenshot_sidecar(info, "shot.png")["reproduce"]["notes"];
+  ASSERT_EQ(notes.size(), 2u) << notes;
+  EXPECT_NE(notes[0].get<std::string>().find("the heatmap range starts at 5"), std::string::npos) << notes;
+  EXPECT_NE(notes[1].get<std::string>().find("grid-res=8,8,8"), std::string::npos) << notes;
+  EXPECT_EQ(apply_option(info.config, "msaa", "4"), "");
+  notes = screenshot_sidecar(info, "shot.png")["reproduce"]["notes"];
+  ASSERT_EQ(notes.size(), 3u) << notes;
+  EXPECT_NE(notes[2].get<std::string>().find("4x multisampling"), std::string::npos) << notes;
+}
+
+// The whole caption rides in the PNG (the strip cuts it on a small window), with the build.
+TEST(AppScreenshot, ThePngCarriesTheWholeCaptionAndTheProgram) {
+  TempDir dir("shots");
+  ScreenshotInfo info = test_info();
+  info.program = "accelviz 0.1.0 (commit abc, Release build)";
+  const SavedScreenshot saved = save_screenshot(dir.path(), test_frame(64, 48), info, std::time_t(1700000000));
+  ASSERT_TRUE(saved.ok) << saved.error;
+  std::ifstream in(saved.png, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::vector<PngText> text = png_text(bytes);
+  ASSERT_EQ(text.size(), 2u);
+  EXPECT_EQ(text[0].keyword, "Description");
+  EXPECT_EQ(text[0].text, screenshot_caption(info));
+  EXPECT_EQ(text[1].keyword, "Software");
+  EXPECT_EQ(text[1].text, info.program);
 }
 
 // A depth range whose last depth is below the first (a script or settings

@@ -300,6 +300,35 @@ TEST(Heatmap, WritePngRefusesToOverwrite) {
   EXPECT_THROW(read_png(path), std::runtime_error);
 }
 
+// The caption and the program ride in the file as iTXt chunks: a viewer shows them, the
+// pixels stay the same, and the chunks' lengths and CRCs are right (stb reads the file back).
+TEST(Heatmap, PngCarriesItsTextBesideThePixels) {
+  const test_support::TempDir tmp("heatmap");
+  RgbImage img(5, 3, {10, 20, 30});
+  img.pixels[7] = 200;
+  const std::string plain = encode_png(img, "a.png");
+  EXPECT_TRUE(png_text(plain).empty());
+  const std::vector<PngText> text{{"Description", "accelviz render 'builtin:teapot?size=2000' -s bvh \xc3\xa9"},
+                                  {"Software", "accelviz 0.1.0 (commit abc, Release build)"},
+                                  {"Comment", ""}};
+  const std::string with = encode_png(img, "a.png", text);
+  EXPECT_GT(with.size(), plain.size());
+  const std::vector<PngText> back = png_text(with);
+  ASSERT_EQ(back.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(back[i].keyword, text[i].keyword);
+    EXPECT_EQ(back[i].text, text[i].text);
+  }
+  EXPECT_EQ(with.substr(with.size() - 12, 8), plain.substr(plain.size() - 12, 8));  // IEND still last
+  const std::string path = tmp.file("t.png");
+  write_png(path, img, false, text);
+  const RgbImage read = read_png(path);
+  EXPECT_EQ(read.pixels, img.pixels);
+  EXPECT_TRUE(png_text("not a png").empty());
+  EXPECT_TRUE(png_text(with.substr(0, with.size() / 2)).size() <= 3u);  // cut short: no read past the end
+  EXPECT_THROW(encode_png(img, "a.png", std::vector<PngText>{{"", "x"}}), std::invalid_argument);
+}
+
 TEST(Heatmap, TickFormatting) {
   EXPECT_EQ(format_tick(0.0), "0");
   EXPECT_EQ(format_tick(12.0), "12");

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "core/util/output_file.h"
+#include "core/util/shell_quote.h"
 #include "ui/app/orbit_camera.h"
 
 namespace accelviz {
@@ -20,19 +21,6 @@ std::string replay_step_text(std::size_t step, std::size_t steps) {
 }  // namespace
 
 namespace {
-
-// Single-quoted for a POSIX shell ('...' with ' written as '\'').
-std::string shell_quote(const std::string& s) {
-  bool plain = !s.empty();
-  for (char c : s)
-    if (!(std::isalnum(static_cast<unsigned char>(c)) ||
-          std::string_view("-_./,:=+").find(c) != std::string_view::npos))
-      plain = false;
-  if (plain) return s;
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
 
 std::string heatmap_display_name(HeatmapDisplay d) {
   switch (d) {
@@ -65,7 +53,10 @@ SavedScreenshot write_pair(const ScreenshotPaths& paths, const RgbImage& frame, 
     }
   std::string png;
   try {
-    png = encode_png(add_caption(frame, screenshot_caption(info)), paths.png.string());
+    // The whole caption in the file too (the picture's strip cuts it on a small window), and the build.
+    std::vector<PngText> text{{"Description", screenshot_caption(info)}};
+    if (!info.program.empty()) text.push_back({"Software", info.program});
+    png = encode_png(add_caption(frame, screenshot_caption(info)), paths.png.string(), text);
   } catch (const std::exception& e) {
     r.error = e.what();
     return r;
@@ -135,7 +126,7 @@ std::string render_command(const ScreenshotInfo& info, bool raster, const std::s
   if (q.xray) cmd += " --xray";
   if (!c.view.auto_scale) {
     cmd += " --max " + format_number(c.view.scale_max);
-    if (notes && c.view.scale_min != 0.0f)
+    if (notes && !raster && c.view.scale_min != 0.0f)
       notes->push_back("the heatmap range starts at " + format_number(c.view.scale_min) +
                        "; `render --max` always starts at 0");
   }
@@ -144,7 +135,7 @@ std::string render_command(const ScreenshotInfo& info, bool raster, const std::s
   for (const char* key : {"splitter", "buckets", "leaf", "leaf-cap", "ctrav", "cisect"})
     cmd += std::string(" --") + key + " " + option_value(c, key);
   if (s.name == "embree") cmd += " --embree-quality " + option_value(c, "embree-quality");
-  if (notes) {
+  if (notes && !raster) {  // once: the heatmap's and the raster's commands share these
     const AppConfig defaults;
     for (std::string_view key : structure_option_keys(s.name)) {
       if (s.name == "bvh" || s.name == "tlas" || s.name == "embree") break;  // render takes these
@@ -185,6 +176,10 @@ std::string render_command(const ScreenshotInfo& info, bool raster, const std::s
                          std::to_string(info.boxes_matched) +
                          " boxes, spread evenly over the selection; the command line draws all");
     }
+    if (notes && v.msaa > 1)
+      notes->push_back("raster: the window drew with " + std::to_string(v.msaa) +
+                       "x multisampling; render --view raster draws without (edges differ; `set msaa 1` in the window "
+                       "draws as the command line does)");
     if (v.show_wireframe) cmd += " --wireframe";
     if (v.heatmap == HeatmapDisplay::blend) cmd += " --blend " + format_number(v.opacity);
     if (v.heatmap == HeatmapDisplay::full_screen) cmd += " --blend 1";
