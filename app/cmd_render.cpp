@@ -429,7 +429,7 @@ int run_render(const RenderOptions& given, const GlobalOptions& global) {
 }
 
 /// accelviz-demo-YYYYmmdd-HHMMSS[-k].png in the current directory, never an existing file.
-std::string write_unique_demo_png(const RgbImage& rgb) {
+std::string write_unique_demo_png(const RgbImage& rgb, std::span<const PngText> text) {
   namespace fs = std::filesystem;
   const std::time_t now = std::time(nullptr);
   std::tm tm{};
@@ -440,7 +440,7 @@ std::string write_unique_demo_png(const RgbImage& rgb) {
     const std::string name = std::string("accelviz-demo-") + stamp + (k == 0 ? "" : "-" + std::to_string(k)) + ".png";
     if (name_taken(name)) continue;  // a dangling link too: the write refuses it
     try {
-      write_png(name, rgb, /*overwrite=*/false);
+      write_png(name, rgb, /*overwrite=*/false, text);
       return name;
     } catch (const std::runtime_error&) {
       if (name_taken(name)) continue;  // another process took the name in between
@@ -551,8 +551,10 @@ int run_demo(const GlobalOptions& global) {
   nlohmann::json figures;
   const RgbImage rgb = add_caption(render_job(o, global, figures), render_caption(o));
   figures["caption"] = render_caption(o);  // the command that draws the same picture
-  const std::string abs = absolute_path(write_unique_demo_png(rgb));
+  const std::string abs = absolute_path(write_unique_demo_png(
+      rgb, std::vector<PngText>{{"Description", render_caption(o)}, {"Software", version_line()}}));
   figures["out"] = abs;
+  figures["program"] = version_line();
   std::cout << "No display: rendered the demo heatmap to " << path_line(abs) << "\n" << path_line(abs) << "\n";
   print_json_line(figures);
   return 0;

@@ -18,6 +18,14 @@ b=$(sed -n 2p <<<"$second")
 [ "$a" != "$b" ] || { echo "FAIL: same name twice"; exit 1; }
 [ "$(ls "$tmp" | wc -l)" -eq 2 ] || { echo "FAIL: expected two files"; ls "$tmp"; exit 1; }
 head -c 8 "$a" | od -An -c | grep -q 'P   N   G' || { echo "FAIL: not a PNG"; exit 1; }
+# The file says what drew it: the command (as its caption) and the program.
+python3 - "$a" "$(sed -n 3p <<<"$first")" "$("$accelviz" --version)" <<'PY'
+import json, sys
+png, j = open(sys.argv[1], "rb").read(), json.loads(sys.argv[2])
+assert j["program"] == sys.argv[3], (j["program"], sys.argv[3])
+for key, value in (("Description", j["caption"]), ("Software", sys.argv[3])):
+    assert b"iTXt" + key.encode() + b"\0\0\0\0\0" + value.encode() in png, key
+PY
 
 # Dangling symbolic links with the names of the next seconds take those names too (the demo
 # gave up with "exists (use --force to overwrite)", an option it does not have).
