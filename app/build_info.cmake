@@ -4,10 +4,21 @@
 # --dirty`: "-dirty" when it had changes not committed; "unknown" outside a git
 # checkout, e.g. from a tarball), the version and the build type.
 # Usage: cmake -DSRC=... -DOUT=... -DVERSION=... -DBUILD_TYPE=... -P build_info.cmake
-execute_process(COMMAND git -C "${SRC}" describe --always --dirty --abbrev=12
-                OUTPUT_VARIABLE commit OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET RESULT_VARIABLE rc)
-if(NOT rc EQUAL 0 OR commit STREQUAL "")
-  set(commit "unknown")
+# Only when SRC is the top of its own checkout: a tarball unpacked inside another project's git
+# tree would otherwise be named by that project's commit.
+set(commit "unknown")
+execute_process(COMMAND git -C "${SRC}" rev-parse --show-toplevel
+                OUTPUT_VARIABLE top OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET RESULT_VARIABLE rc)
+if(rc EQUAL 0 AND NOT top STREQUAL "")
+  file(REAL_PATH "${top}" top_real)
+  file(REAL_PATH "${SRC}" src_real)
+  if(top_real STREQUAL src_real)
+    execute_process(COMMAND git -C "${SRC}" describe --always --dirty --abbrev=12
+                    OUTPUT_VARIABLE described OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET RESULT_VARIABLE rc)
+    if(rc EQUAL 0 AND NOT described STREQUAL "")
+      set(commit "${described}")
+    endif()
+  endif()
 endif()
 if(BUILD_TYPE STREQUAL "")
   set(BUILD_TYPE "unspecified")

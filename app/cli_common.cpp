@@ -22,6 +22,7 @@
 #include "core/scene/effects.h"
 #include "core/scene/load.h"
 #include "core/util/file_checks.h"
+#include "core/util/json_text.h"
 #include "core/util/output_file.h"
 #include "core/util/shell_quote.h"
 
@@ -497,7 +498,7 @@ std::string version_line() {
 }
 
 void print_json_line(const nlohmann::json& j) {
-  std::cout << j.dump() << '\n';
+  std::cout << json_text(j) << '\n';
   flush_stdout();
 }
 

@@ -26,6 +26,7 @@
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
 #include "core/scene/effects.h"
+#include "core/util/json_text.h"
 #include "core/util/parallel.h"
 
 namespace accelviz::cli {
@@ -520,7 +521,7 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   }
   if (o.json) {
     j["machine"] = machine_json(all);
-    std::cout << j.dump(2) << '\n';
+    std::cout << json_text(j, 2) << '\n';
     return exit_code;
   }
 

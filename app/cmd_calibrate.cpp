@@ -12,6 +12,7 @@
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
 #include "core/util/huge_page_allocator.h"
+#include "core/util/json_text.h"
 #include "core/util/parallel.h"
 
 namespace accelviz::cli {
@@ -82,7 +83,7 @@ int run_calibrate(const CalibrateCliOptions& o, const GlobalOptions& global) {
   }
   if (o.json) {
     j["machine"] = machine_json(resolve_threads(o.threads));
-    std::cout << j.dump(2) << '\n';
+    std::cout << json_text(j, 2) << '\n';
     return 0;
   }
   std::printf("ray-box slab test           %7.2f ns\n", c.ns_box);

@@ -15,6 +15,7 @@
 #include "core/analysis/refit_decay.h"
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
+#include "core/util/json_text.h"
 
 namespace accelviz::cli {
 
@@ -124,7 +125,7 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
                             {"seed", o.seed},
                             {"rebuilds", r.rebuilds},
                             {"per_frame", frames}};
-  out.add("refit.json", j.dump(2) + "\n");
+  out.add("refit.json", json_text(j, 2) + "\n");
 
   ChartSeries refit{"refitted", {}, {}, {}, {214, 39, 40}, true, true, 2};
   ChartSeries fresh{"fresh build", {}, {}, {}, {31, 119, 180}, true, true, 2};

@@ -73,8 +73,10 @@ std::string render_caption(const RenderOptions& o) {
   const RenderOptions d;
   const StructureCli& s = o.structure_opts;
   const StructureCli& ds = d.structure_opts;
+  // A file name starting with '-' would read as an option: ./ keeps it a name.
+  const std::string scene = o.scene.starts_with("-") ? "./" + o.scene : o.scene;
   std::string c =
-      "accelviz render " + shell_quote(o.scene) + " -s " + o.structure + " -m " + o.metric + " --size " + o.size;
+      "accelviz render " + shell_quote(scene) + " -s " + o.structure + " -m " + o.metric + " --size " + o.size;
   const auto add = [&c](bool differs, const std::string& text) {
     if (differs) c += " " + text;
   };
@@ -418,8 +420,9 @@ int run_render(const RenderOptions& given, const GlobalOptions& global) {
     rgb = add_caption(rgb, figures["caption"].get<std::string>());
   }
   // The command that draws it and the build, in the file (a caption cut on a small picture, or none).
-  write_png(o.out, rgb, o.force,
-            std::vector<PngText>{{"Description", render_caption(o)}, {"Software", version_line()}});
+  std::vector<PngText> text{{"Description", render_caption(o)}, {"Software", version_line()}};
+  if (o.caption != "auto" && o.caption != "none") text.push_back({"Comment", o.caption});  // the strip's own text
+  write_png(o.out, rgb, o.force, text);
   const std::string abs = absolute_path(o.out);
   figures["out"] = abs;
   figures["program"] = version_line();

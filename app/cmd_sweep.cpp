@@ -19,6 +19,7 @@
 #include "core/query/camera.h"
 #include "core/scene/effects.h"
 #include "core/util/huge_page_allocator.h"
+#include "core/util/json_text.h"
 #include "core/util/parallel.h"
 
 namespace accelviz::cli {
@@ -301,7 +302,7 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
   }
   const TimingScatter scatter = timing_scatter(results);
   j["timing_scatter"] = {{"rays_per_s", scatter.rays_per_s}, {"build_ms", scatter.build_ms}};
-  out.add("sweep.json", j.dump(2) + "\n");
+  out.add("sweep.json", json_text(j, 2) + "\n");
 
   std::vector<std::string> charts;
   auto chart = [&](const std::string& name, const RgbImage& img) {

@@ -15,7 +15,9 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <csignal>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -92,9 +94,17 @@ int run(int argc, char** argv) {
             bool ok = text.size() > digits;
             for (std::size_t i = digits; ok && i < text.size(); ++i) ok = text[i] >= '0' && text[i] <= '9';
             if (ok && text[digits] == '0' && text.size() > digits + 1) ok = false;  // octal in CLI11
-            if (ok) return {};
-            return std::string("expected a whole number in decimal digits (") + (is_unsigned ? "no sign, " : "") +
-                   "no leading zero), got '" + text + "'";
+            if (!ok)
+              return std::string("expected a whole number in decimal digits (") + (is_unsigned ? "no sign, " : "") +
+                     "no leading zero), got '" + text + "'";
+            // CLI11 clamps a value beyond 64 bits to the largest (a --seed of 10^23 ran as 2^64 - 1).
+            std::uint64_t u = 0;
+            std::int64_t s = 0;
+            const char* end = text.data() + text.size();
+            const bool fits = is_unsigned ? std::from_chars(text.data(), end, u).ec == std::errc()
+                                          : std::from_chars(text.data(), end, s).ec == std::errc();
+            if (!fits) return "'" + text + "' is beyond a 64-bit whole number";
+            return {};
           },
           ""));
     }

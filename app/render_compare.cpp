@@ -15,6 +15,7 @@
 #include "core/query/camera.h"
 #include "core/query/ray_sets.h"
 #include "core/scene/load.h"
+#include "core/util/json_text.h"
 
 namespace accelviz::cli {
 
@@ -264,7 +265,7 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
   {
     const nlohmann::json da = describe_side(*side[0], metric), db = describe_side(*side[1], metric);
     // A value as the caption writes it: a string without JSON's quotes.
-    const auto text = [](const nlohmann::json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); };
+    const auto text = [](const nlohmann::json& v) { return v.is_string() ? v.get<std::string>() : json_text(v); };
     std::string differs;
     for (const auto& [key, value] : da.items())
       if (key != "structure" && db.contains(key) && db[key] != value)

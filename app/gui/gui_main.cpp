@@ -11,6 +11,7 @@
 #include "core/accel/tlas/tlas.h"
 #include "core/scene/load.h"
 #include "core/util/huge_page_allocator.h"
+#include "core/util/json_text.h"
 #include "ui/app/app_state.h"
 #include "ui/app/dynamics.h"
 #include "ui/app/flatten_worker.h"
@@ -721,7 +722,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
     case K::dump_ray: {
       const auto& insp = app_.inspection();
       if (!insp) throw std::runtime_error("no ray cast yet (use click first)");
-      fail_if(write_new_file(c.arg, inspection_json(*insp, app_.replay_step()).dump(2) + "\n"));
+      fail_if(write_new_file(c.arg, json_text(inspection_json(*insp, app_.replay_step()), 2) + "\n"));
       return Status::done;
     }
     case K::dump_stats: {
@@ -738,7 +739,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       doc["tree"] = {{"swatch_max", insight_.tree_swatch_max(app_, ramp_max)},
                      {"swatch_of_boxes", ramp_max.has_value()}};
       doc["ab_window"] = insight_.ab_window_json();
-      fail_if(write_new_file(c.arg, doc.dump(2) + "\n"));
+      fail_if(write_new_file(c.arg, json_text(doc, 2) + "\n"));
       return Status::done;
     }
     case K::frames:
@@ -804,7 +805,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
             r->instances == flatten_prediction_->instances && r->scene == flatten_prediction_->scene)
           doc["committed"] = r->committed->spec;
       }
-      fail_if(write_new_file(c.arg, doc.dump(2) + "\n"));
+      fail_if(write_new_file(c.arg, json_text(doc, 2) + "\n"));
       return Status::done;
     }
     case K::force_effect:
@@ -872,7 +873,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       } else {
         doc["dynamics"] = nullptr;
       }
-      fail_if(write_new_file(c.arg, doc.dump(2) + "\n"));
+      fail_if(write_new_file(c.arg, json_text(doc, 2) + "\n"));
       return Status::done;
     }
     case K::window: {

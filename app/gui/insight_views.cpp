@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "core/accel/bvh/bvh.h"
+#include "core/util/json_text.h"
 #include "ui/app/settings.h"
 
 namespace accelviz {
@@ -423,7 +424,7 @@ ScriptHost::Status InsightViews::execute(AppState& app, const ScriptCommand& c) 
       if (scenario_job_.busy()) return ScriptHost::Status::again;
       if (!scenario_job_.error().empty()) throw std::runtime_error("scenario: " + scenario_job_.error());
       if (!scenario_job_.figures()) throw std::runtime_error("no scenario run yet (use scenario first)");
-      if (const std::string err = write_new_file(c.arg, figures_json(*scenario_job_.figures()).dump(2) + "\n");
+      if (const std::string err = write_new_file(c.arg, json_text(figures_json(*scenario_job_.figures()), 2) + "\n");
           !err.empty())
         throw std::runtime_error(err);
       return ScriptHost::Status::done;
@@ -438,7 +439,7 @@ ScriptHost::Status InsightViews::execute(AppState& app, const ScriptCommand& c) 
       if (insight_job_.busy()) return ScriptHost::Status::again;
       script_insight_requested_ = false;
       if (!insight_job_.error().empty()) throw std::runtime_error("insight: " + insight_job_.error());
-      if (const std::string err = write_new_file(c.arg, insight_json(app).dump(2) + "\n"); !err.empty())
+      if (const std::string err = write_new_file(c.arg, json_text(insight_json(app), 2) + "\n"); !err.empty())
         throw std::runtime_error(err);
       return ScriptHost::Status::done;
     }

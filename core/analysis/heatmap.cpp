@@ -20,6 +20,7 @@
 #include "core/query/batch.h"
 #include "core/query/camera.h"
 #include "core/util/file_checks.h"
+#include "core/util/json_text.h"
 #include "core/util/output_file.h"
 #include "core/util/parallel.h"
 #include "core/util/timing.h"
@@ -750,7 +751,8 @@ std::string encode_png(const RgbImage& img, const std::string& path, std::span<c
     // keyword NUL, compression flag 0, method 0, language "" NUL, translated keyword "" NUL, UTF-8 text.
     std::string body = "iTXt" + t.keyword;
     body += std::string("\0\0\0\0\0", 5);
-    body += t.text.substr(0, t.text.find('\0'));
+    body +=
+        valid_utf8(t.text.substr(0, t.text.find('\0')));  // iTXt is UTF-8: a Latin-1 file name's bytes become U+FFFD
     put_u32(chunks, static_cast<std::uint32_t>(body.size() - 4));
     chunks += body;
     put_u32(chunks, png_crc(body));

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/util/file_checks.h"
+#include "core/util/json_text.h"
 #include "core/util/output_file.h"
 
 namespace accelviz {
@@ -412,12 +413,12 @@ void write_gltf(const Scene& scene, const std::string& path, bool binary, bool o
   std::string bytes;
   if (binary) {
     if (!bin.empty()) doc["buffers"] = json::array({json{{"byteLength", bin.size()}}});
-    bytes = glb_bytes(path, doc.dump(), bin);
+    bytes = glb_bytes(path, json_text(doc), bin);
   } else {
     if (!bin.empty())
       doc["buffers"] = json::array(
           {json{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}});
-    bytes = doc.dump(1) + "\n";
+    bytes = json_text(doc, 1) + "\n";
   }
 
   // A fresh temporary beside the target, then its name (write_output_file):

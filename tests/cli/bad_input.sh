@@ -77,6 +77,9 @@ expect 2 "--seed: expected a whole number in decimal digits (no sign, no leading
   rays 'builtin:soup?size=10' -k diffuse --seed -1 --out "$tmp/y.rays"
 expect 2 "--threads: expected a whole number in decimal digits (no sign, no leading zero), got '0x2'" -- \
   render 'builtin:soup?size=10' --out "$tmp/y.png" -j 0x2
+# Beyond 64 bits: CLI11 clamped --seed 10^23 to 2^64 - 1 and ran.
+expect 2 "--seed: '99999999999999999999999' is beyond a 64-bit whole number" -- \
+  rays 'builtin:soup?size=10' -k diffuse --seed 99999999999999999999999 --out "$tmp/y.rays"
 # Checked before the range: "abc" was answered "Value abc not in range".
 expect 2 "--threads: expected a whole number in decimal digits (no sign, no leading zero), got 'abc'" -- \
   render 'builtin:soup?size=10' --out "$tmp/y.png" -j abc

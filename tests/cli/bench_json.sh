@@ -28,6 +28,23 @@ for s in j["structures"]:
 print("bench warmup ok")' "$tmp/warm.json"
 "$accelviz" bench 'builtin:soup?size=2000' --structure bvh --rays primary --size 8x8 --warmup -1 2>/dev/null &&
   { echo "FAIL: --warmup -1 accepted"; exit 1; }
+# A file name that is not UTF-8 (a Latin-1 e-acute): the JSON has U+FFFD for that byte. The JSON
+# writer threw on it and bench failed after all its work; a render's PNG text (UTF-8) the same.
+lat="$tmp/lat$(printf '\xe9').glb"
+"$accelviz" -q export 'builtin:soup?size=200' "$lat" >/dev/null
+"$accelviz" -q bench "$lat" -s bvh --rays primary --size 8x8 -n 1 -j 1 --json >"$tmp/lat.json"
+"$accelviz" -q render "$lat" --size 16x12 -j 1 --out "$tmp/lat.png" >"$tmp/lat-render.txt"
+python3 - "$tmp/lat.json" "$tmp/lat-render.txt" "$tmp/lat.png" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["scene"].endswith("lat\ufffd.glb"), j["scene"]
+assert "lat\ufffd.glb" in j["machine"]["command_line"], j["machine"]["command_line"]
+r = json.loads(open(sys.argv[2], "rb").read().split(b"\n")[1])
+assert "lat\ufffd.glb" in r["caption"], r["caption"]
+png = open(sys.argv[3], "rb").read()
+assert "lat\ufffd.glb".encode() in png, "iTXt Description not UTF-8"
+print("not-UTF-8 name ok")
+PY
 # Where and with what it ran: the machine, and the program as --version names it (its commit).
 "$accelviz" --version >"$tmp/version.txt"
 python3 - "$tmp/bench.json" "$tmp/version.txt" <<'PY'

@@ -84,6 +84,12 @@ case "$cap" in "accelviz render '$tmp/my scenes/tea pot.glb' "*"--colormap infer
 (cd "$tmp" && bash -c "'$accelviz' -q ${cap#accelviz } --out r2.png" >/dev/null) || { echo "FAIL: caption did not run: $cap"; exit 1; }
 cmp "$tmp/r1.png" "$tmp/r2.png" || { echo "FAIL: the caption's command drew another file"; exit 1; }
 echo "caption pasted back ok: $cap"
+# A file name starting with '-' (given after --): the caption names it ./-lead.glb, which pastes back.
+cp "$tmp/my scenes/tea pot.glb" "$tmp/-lead.glb"
+(cd "$tmp" && "$accelviz" -q render --size 40x30 --out r3.png -- -lead.glb >r3.txt)
+cap=$(sed -n 2p "$tmp/r3.txt" | python3 -c 'import json, sys; print(json.load(sys.stdin)["caption"])')
+[ "$cap" = "accelviz render ./-lead.glb -s bvh -m nodes --size 40x30" ] || { echo "FAIL: caption of -lead.glb: $cap"; exit 1; }
+(cd "$tmp" && bash -c "'$accelviz' -q ${cap#accelviz } --out r4.png" >/dev/null) || { echo "FAIL: ./-lead.glb did not run"; exit 1; }
 "$accelviz" -q render "$scene" --size 40x30 --out "$tmp/c2.png" --caption none >/dev/null
 "$accelviz" -q render "$scene" --size 40x30 --out "$tmp/c3.png" --caption "fig. 3: the teapot" >/dev/null
 "$accelviz" -q render "$scene" --size 40x30 --out "$tmp/c4.png" >/dev/null
@@ -91,6 +97,8 @@ python3 - "$tmp" <<'PY'
 import struct, sys
 h = lambda n: struct.unpack(">II", open(f"{sys.argv[1]}/{n}.png", "rb").read()[16:24])[1]
 assert h("c2") < h("c3") and h("c2") < h("c4"), (h("c2"), h("c3"), h("c4"))
+# A caption of one's own is in the file too (Comment), beside the command (Description).
+assert b"iTXtComment\0\0\0\0\0fig. 3: the teapot" in open(f"{sys.argv[1]}/c3.png", "rb").read()
 print("caption ok")
 PY
 

@@ -327,6 +327,9 @@ TEST(Heatmap, PngCarriesItsTextBesideThePixels) {
   EXPECT_TRUE(png_text("not a png").empty());
   EXPECT_TRUE(png_text(with.substr(0, with.size() / 2)).size() <= 3u);  // cut short: no read past the end
   EXPECT_THROW(encode_png(img, "a.png", std::vector<PngText>{{"", "x"}}), std::invalid_argument);
+  // iTXt is UTF-8: a Latin-1 byte of a file name becomes U+FFFD, valid sequences stay.
+  const std::vector<PngText> latin1{{"Description", "lat\xe9.glb \xc3\xa9"}};
+  EXPECT_EQ(png_text(encode_png(img, "a.png", latin1))[0].text, "lat\xef\xbf\xbd.glb \xc3\xa9");
 }
 
 TEST(Heatmap, TickFormatting) {

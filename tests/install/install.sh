@@ -15,6 +15,7 @@ check() { if eval "$2"; then echo "ok: $1"; else echo "FAIL: $1"; fail=1; fi; }
 bin=$tmp/prefix/bin/accelviz
 check "the executable is installed" '[ -x "$bin" ]'
 check "the example scenes are installed" '[ -f "$tmp/prefix/share/accelviz/assets/teapot.glb" ] && [ -f "$tmp/prefix/share/accelviz/assets/README.md" ]'
+check "the shader sources are installed (to edit and reload live)" '[ -f "$tmp/prefix/share/accelviz/shaders/trace_bvh.comp" ]'
 check "the documentation is installed" '[ -f "$tmp/prefix/share/doc/accelviz/README.md" ] && [ -f "$tmp/prefix/share/doc/accelviz/docs/cli.md" ]'
 check "nothing of the test tree is installed" '! find "$tmp/prefix" -name "*_tests" -o -name "*.sh" | grep -q .'
 

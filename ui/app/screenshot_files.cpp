@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <memory>
 
+#include "core/util/json_text.h"
 #include "core/util/output_file.h"
 #include "core/util/shell_quote.h"
 #include "ui/app/orbit_camera.h"
@@ -61,9 +62,10 @@ SavedScreenshot write_pair(const ScreenshotPaths& paths, const RgbImage& frame, 
     r.error = e.what();
     return r;
   }
-  const OutputWrite w = write_output_files(
-      {{paths.png.string(), std::move(png)}, {paths.json.string(), screenshot_sidecar(info, paths.png).dump(2) + "\n"}},
-      /*overwrite=*/false);
+  const OutputWrite w =
+      write_output_files({{paths.png.string(), std::move(png)},
+                          {paths.json.string(), json_text(screenshot_sidecar(info, paths.png), 2) + "\n"}},
+                         /*overwrite=*/false);
   if (!w.ok()) {
     *name_taken = w.exists;
     r.error = w.path + ": " + (w.exists ? std::string("exists (not overwritten)") : w.problem);

@@ -4,6 +4,7 @@
 #include <cstdlib>
 
 #include "core/util/file_checks.h"
+#include "core/util/json_text.h"
 #include "core/util/output_file.h"
 
 namespace accelviz {
@@ -185,7 +186,7 @@ std::string write_new_file(const std::filesystem::path& file, std::string_view c
 }
 
 std::string save_settings(const std::filesystem::path& file, const AppSettings& s) {
-  return write_file_atomic(file, settings_to_json(s).dump(2) + "\n");
+  return write_file_atomic(file, json_text(settings_to_json(s), 2) + "\n");
 }
 
 }  // namespace accelviz
