@@ -449,18 +449,9 @@ std::string utc_now() {
 /// needs it (a built-in scene's '?', a space in a file name), so that it
 /// pastes back as it ran.
 std::string command_line() {
-  std::ifstream in("/proc/self/cmdline", std::ios::binary);
-  std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::ifstream in("/proc/self/cmdline", std::ios::binary);  // each argument ends with a NUL
   std::string line, arg;
-  for (std::size_t i = 0; i <= all.size(); ++i) {
-    if (i < all.size() && all[i] != '\0') {
-      arg += all[i];
-      continue;
-    }
-    if (i == all.size() && arg.empty()) break;  // cmdline ends with a NUL
-    line += (line.empty() ? "" : " ") + shell_quote(arg);
-    arg.clear();
-  }
+  while (std::getline(in, arg, '\0')) line += (line.empty() ? "" : " ") + shell_quote(arg);
   return line;
 }
 

@@ -105,6 +105,11 @@ std::string render_caption(const RenderOptions& o) {
   return c;
 }
 
+/// The text a heatmap's PNG carries: the command that draws it and the program.
+std::vector<PngText> png_text_of(const RenderOptions& o) {
+  return {{"Description", render_caption(o)}, {"Software", version_line()}};
+}
+
 /// --ray-pixel "X,Y".
 std::pair<int, int> parse_pixel(const std::string& text) {
   const auto comma = text.find(',');
@@ -354,8 +359,7 @@ int run_render_several(const RenderOptions& o, const std::vector<std::string>& s
       figures["caption"] = o.caption == "auto" ? render_caption(alone) : o.caption;
       rgb = add_caption(rgb, figures["caption"].get<std::string>());
     }
-    const std::vector<PngText> text{{"Description", render_caption(alone)}, {"Software", version_line()}};
-    files.push_back({os.out, encode_png(rgb, os.out, text)});
+    files.push_back({os.out, encode_png(rgb, os.out, png_text_of(alone))});
     figures["out"] = absolute_path(os.out);
     out["images"].push_back(figures);
   }
@@ -420,7 +424,7 @@ int run_render(const RenderOptions& given, const GlobalOptions& global) {
     rgb = add_caption(rgb, figures["caption"].get<std::string>());
   }
   // The command that draws it and the build, in the file (a caption cut on a small picture, or none).
-  std::vector<PngText> text{{"Description", render_caption(o)}, {"Software", version_line()}};
+  std::vector<PngText> text = png_text_of(o);
   if (o.caption != "auto" && o.caption != "none") text.push_back({"Comment", o.caption});  // the strip's own text
   write_png(o.out, rgb, o.force, text);
   const std::string abs = absolute_path(o.out);
@@ -554,8 +558,7 @@ int run_demo(const GlobalOptions& global) {
   nlohmann::json figures;
   const RgbImage rgb = add_caption(render_job(o, global, figures), render_caption(o));
   figures["caption"] = render_caption(o);  // the command that draws the same picture
-  const std::string abs = absolute_path(write_unique_demo_png(
-      rgb, std::vector<PngText>{{"Description", render_caption(o)}, {"Software", version_line()}}));
+  const std::string abs = absolute_path(write_unique_demo_png(rgb, png_text_of(o)));
   figures["out"] = abs;
   figures["program"] = version_line();
   std::cout << "No display: rendered the demo heatmap to " << path_line(abs) << "\n" << path_line(abs) << "\n";
