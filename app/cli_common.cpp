@@ -464,19 +464,24 @@ double load_average() {
   return in ? l : -1.0;
 }
 
-nlohmann::json machine_json(unsigned threads_used) {
+nlohmann::json program_json() {
   nlohmann::json program = {
       {"version", build_info::kVersion}, {"commit", build_info::kCommit}, {"build_type", build_info::kBuildType}};
 #ifdef ACCELVIZ_HAVE_EMBREE
   program["embree"] = std::string(embree_version());
 #endif
+  program["line"] = version_line();
+  return program;
+}
+
+nlohmann::json machine_json(unsigned threads_used) {
   return {{"cpu_model", cpu_model()},
           {"hardware_threads", std::thread::hardware_concurrency()},
           {"threads_used", threads_used},
           {"load_average_1min", load_average()},
           {"date", utc_now()},
           {"command_line", command_line()},
-          {"program", program}};
+          {"program", program_json()}};
 }
 
 std::string version_line() {
@@ -489,8 +494,12 @@ std::string version_line() {
 }
 
 void print_json_line(const nlohmann::json& j) {
-  std::cout << json_text(j) << '\n';
-  flush_stdout();
+  write_stdout(json_text(j) + '\n');
+}
+
+void print_picture_line(nlohmann::json figures) {
+  figures["program"] = program_json();
+  print_json_line(figures);
 }
 
 namespace {
@@ -500,6 +509,13 @@ int first_stdout_flush_errno = 0;
 void flush_stdout() {
   errno = 0;
   if (std::fflush(stdout) != 0 && first_stdout_flush_errno == 0) first_stdout_flush_errno = errno ? errno : EIO;
+}
+
+void write_stdout(std::string_view text) {
+  errno = 0;
+  if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() && first_stdout_flush_errno == 0)
+    first_stdout_flush_errno = errno ? errno : EIO;
+  flush_stdout();
 }
 
 int stdout_flush_errno() {

@@ -8,6 +8,7 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/accel/factory.h"
@@ -207,22 +208,34 @@ double load_average();
 
 /// Where and with what a measurement ran, recorded in the JSON of bench,
 /// sweep and calibrate: the CPU model, hardware threads, `threads_used`, the
-/// load average, the UTC date, this command line, and the program (version,
-/// commit, build type, Embree's version).
+/// load average, the UTC date, this command line, and program_json().
 nlohmann::json machine_json(unsigned threads_used);
 
 /// "accelviz 0.1.0 (commit 9627f3c8f5bd, Release build, Embree 3.13.5)": --version's line.
 std::string version_line();
 
+/// The build that made an output, one shape in every JSON that names it (bench,
+/// sweep and calibrate's `machine`, render's and the demo's line, screenshot
+/// side-cars): {version, commit, build_type, embree (where built with it),
+/// line: version_line()}.
+nlohmann::json program_json();
+
 /// One-line JSON on stdout, flushed (animate streams a line per frame).
 void print_json_line(const nlohmann::json& j);
+
+/// print_json_line of a picture's figures with the `program` that drew it.
+void print_picture_line(nlohmann::json figures);
 
 /// Flushes stdout and remembers the reason of the first failed flush: glibc
 /// drops the buffer after a failed write, so that main's final flush succeeds
 /// with nothing to write and the reason (a full disk) would be lost.
 void flush_stdout();
 
-/// errno of the first failed flush_stdout(), 0 if none failed.
+/// Writes TEXT to stdout and flushes it, keeping a failed write's reason as
+/// flush_stdout does (a text longer than stdout's buffer fails inside the write).
+void write_stdout(std::string_view text);
+
+/// errno of the first failed flush_stdout() or write_stdout(), 0 if none failed.
 int stdout_flush_errno();
 
 // ---- progress and timing -----------------------------------------------------------

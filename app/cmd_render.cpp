@@ -160,9 +160,8 @@ int run_render_raster(const RenderOptions& o, const GlobalOptions& global) {
   progress.end();
   const std::string abs = absolute_path(o.out);
   figures["out"] = abs;
-  figures["program"] = version_line();
   std::cout << path_line(abs) << "\n";
-  print_json_line(figures);
+  print_picture_line(figures);
   return 0;
 }
 
@@ -365,8 +364,7 @@ int run_render_several(const RenderOptions& o, const std::vector<std::string>& s
   }
   write_output_set(files, o.force);
   for (const nlohmann::json& figures : out["images"]) std::cout << path_line(figures["out"].get<std::string>()) << "\n";
-  out["program"] = version_line();
-  print_json_line(out);
+  print_picture_line(out);
   return 0;
 }
 
@@ -429,9 +427,8 @@ int run_render(const RenderOptions& given, const GlobalOptions& global) {
   write_png(o.out, rgb, o.force, text);
   const std::string abs = absolute_path(o.out);
   figures["out"] = abs;
-  figures["program"] = version_line();
   std::cout << path_line(abs) << "\n";
-  print_json_line(figures);
+  print_picture_line(figures);
   return 0;
 }
 
@@ -560,9 +557,8 @@ int run_demo(const GlobalOptions& global) {
   figures["caption"] = render_caption(o);  // the command that draws the same picture
   const std::string abs = absolute_path(write_unique_demo_png(rgb, png_text_of(o)));
   figures["out"] = abs;
-  figures["program"] = version_line();
   std::cout << "No display: rendered the demo heatmap to " << path_line(abs) << "\n" << path_line(abs) << "\n";
-  print_json_line(figures);
+  print_picture_line(figures);
   return 0;
 }
 

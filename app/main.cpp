@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <functional>
 #include <new>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -115,8 +116,12 @@ int run(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    // --help and --version exit 0; every real parse error is a usage error (2).
-    const int code = app.exit(e);
+    // --help and --version exit 0; every real parse error is a usage error (2). Their text goes
+    // through flush_stdout, which keeps a failed write's reason (CLI11's own std::endl flush would
+    // fail first, glibc drop the buffer, and main's last flush succeed with no reason to tell).
+    std::ostringstream out;
+    const int code = app.exit(e, out, std::cerr);
+    cli::write_stdout(out.str());
     return code == 0 ? 0 : 2;
   }
 

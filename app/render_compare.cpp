@@ -319,8 +319,7 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
   std::cout << path_line(absolute_path(paths.a)) << "\n"
             << path_line(absolute_path(paths.b)) << "\n"
             << path_line(absolute_path(paths.diff)) << "\n";
-  figures["program"] = version_line();
-  print_json_line(figures);
+  print_picture_line(figures);
   return 0;
 }
 

@@ -531,7 +531,7 @@ SavedScreenshot Gui::write_frame(const std::optional<std::filesystem::path>& exp
   const RgbImage frame = to_rgb(view_->renderer().read_pixels());
   const glm::vec2 range = view_->heatmap_range(app_);
   ScreenshotInfo info = app_.screenshot_info(range.x, range.y);
-  info.program = cli::version_line();
+  info.program = cli::program_json();
   info.boxes_drawn = view_->boxes_drawn();
   info.boxes_matched = view_->boxes_matched();
   if (app_.config().view.show_boxes) {

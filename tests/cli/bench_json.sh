@@ -63,6 +63,7 @@ assert re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ", machine["date"]), machin
 p = machine["program"]
 assert (p["version"], p["commit"], p["build_type"]) == (m.group(1), m.group(2), m.group(4)), (p, version)
 assert ("embree" in p) == (m.group(5) is not None), (p, version)
+assert p["line"] == version, (p, version)
 print("bench machine ok:", version)
 for k in ["scene", "triangles", "threads", "repeat", "warmup", "ray_sets", "structures"]:
     assert k in j, k

@@ -22,7 +22,7 @@ head -c 8 "$a" | od -An -c | grep -q 'P   N   G' || { echo "FAIL: not a PNG"; ex
 python3 - "$a" "$(sed -n 3p <<<"$first")" "$("$accelviz" --version)" <<'PY'
 import json, sys
 png, j = open(sys.argv[1], "rb").read(), json.loads(sys.argv[2])
-assert j["program"] == sys.argv[3], (j["program"], sys.argv[3])
+assert j["program"]["line"] == sys.argv[3] and j["program"]["commit"] in sys.argv[3], (j["program"], sys.argv[3])
 for key, value in (("Description", j["caption"]), ("Software", sys.argv[3])):
     assert b"iTXt" + key.encode() + b"\0\0\0\0\0" + value.encode() in png, key
 PY

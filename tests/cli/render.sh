@@ -20,7 +20,8 @@ j = json.loads(sys.argv[2])
 # The caption is the command that draws the picture (the options not at their default too), its
 # words quoted for the shell where they need it: pasted back, it runs.
 assert j["caption"] == "accelviz render 'builtin:teapot?size=2000' -s bvh -m nodes --size 64x48", j["caption"]
-assert j["program"] == sys.argv[3], (j["program"], sys.argv[3])
+# The program in the shape bench's machine record has: the facts, and --version's line.
+assert j["program"]["line"] == sys.argv[3] and j["program"]["commit"] in sys.argv[3], (j["program"], sys.argv[3])
 # The file carries the command and the program (iTXt chunks, each CRC right) beside the pixels.
 at, text = 8, {}
 while at < len(png):
@@ -126,6 +127,7 @@ top = max(i["max"] for i in j["images"])
 assert j["scale_max"] == top and all(i["scale_max"] == top for i in j["images"]), j
 assert all(i["caption"].endswith("--max %g" % top) for i in j["images"]), [i["caption"] for i in j["images"]]
 assert sys.argv[2].split("\n") == [i["out"] for i in j["images"]]
+assert j["program"]["line"].startswith("accelviz ") and j["program"]["commit"], j["program"]
 print("several structures ok")
 PY
 # --max pNN: the percentile of every image's values, shared.

@@ -28,6 +28,7 @@ assert abs(j["total_diff"] - (j["total_b"] - j["total_a"])) < 1e-6 * max(1.0, j[
 assert j["scale_max"] >= max(j["a"]["max"], j["b"]["max"]) - 1e-6  # one locked scale
 # Bigger leaves and 2 buckets: fewer nodes per ray is not the point; the totals must differ.
 assert j["total_a"] != j["total_b"], "A and B rendered the same"
+assert j["program"]["line"].startswith("accelviz ") and j["program"]["commit"], j["program"]
 # Each image's caption says which side, what it differs in, the scene, metric and size.
 c = j["captions"]
 assert c["a"] == "A: bvh buckets=16 leaf=8; builtin:teapot?size=2000, nodes, 48x36".replace("leaf=8", "leaf=4"), c

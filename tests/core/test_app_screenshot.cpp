@@ -174,9 +174,9 @@ TEST(AppScreenshot, SideCarSaysHowToReproduceThePicture) {
   const ScreenshotInfo info = test_info();
   const nlohmann::json j = screenshot_sidecar(info, "/x/accelviz-1.png");
   EXPECT_EQ(j["png"], "/x/accelviz-1.png");
-  EXPECT_FALSE(j.contains("program"));  // the GUI sets it (--version's line); left out when unknown
+  EXPECT_FALSE(j.contains("program"));  // the GUI sets it (the CLI's program record); left out when unknown
   ScreenshotInfo named = info;
-  named.program = "accelviz 0.1.0 (commit abc, Release build)";
+  named.program = {{"commit", "abc"}, {"line", "accelviz 0.1.0 (commit abc, Release build)"}};
   EXPECT_EQ(screenshot_sidecar(named, "/x/accelviz-1.png")["program"], named.program);
   EXPECT_EQ(j["scene"], "builtin:teapot?size=2000");
   EXPECT_EQ(j["triangles"], 2256);
@@ -299,7 +299,7 @@ TEST(AppScreenshot, NotesComeOnceAndNameTheWindowsMultisampling) {
 TEST(AppScreenshot, ThePngCarriesTheWholeCaptionAndTheProgram) {
   TempDir dir("shots");
   ScreenshotInfo info = test_info();
-  info.program = "accelviz 0.1.0 (commit abc, Release build)";
+  info.program = {{"commit", "abc"}, {"line", "accelviz 0.1.0 (commit abc, Release build)"}};
   const SavedScreenshot saved = save_screenshot(dir.path(), test_frame(64, 48), info, std::time_t(1700000000));
   ASSERT_TRUE(saved.ok) << saved.error;
   std::ifstream in(saved.png, std::ios::binary);
@@ -309,7 +309,7 @@ TEST(AppScreenshot, ThePngCarriesTheWholeCaptionAndTheProgram) {
   EXPECT_EQ(text[0].keyword, "Description");
   EXPECT_EQ(text[0].text, screenshot_caption(info));
   EXPECT_EQ(text[1].keyword, "Software");
-  EXPECT_EQ(text[1].text, info.program);
+  EXPECT_EQ(text[1].text, "accelviz 0.1.0 (commit abc, Release build)");
 }
 
 // A depth range whose last depth is below the first (a script or settings

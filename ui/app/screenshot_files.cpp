@@ -56,7 +56,7 @@ SavedScreenshot write_pair(const ScreenshotPaths& paths, const RgbImage& frame, 
   try {
     // The whole caption in the file too (the picture's strip cuts it on a small window), and the build.
     std::vector<PngText> text{{"Description", screenshot_caption(info)}};
-    if (!info.program.empty()) text.push_back({"Software", info.program});
+    if (info.program.is_object()) text.push_back({"Software", info.program.value("line", "")});
     png = encode_png(add_caption(frame, screenshot_caption(info)), paths.png.string(), text);
   } catch (const std::exception& e) {
     r.error = e.what();
@@ -301,7 +301,7 @@ nlohmann::json screenshot_sidecar(const ScreenshotInfo& info, const fs::path& pn
       {"reproduce",
        {{"render_heatmap", heatmap_cmd}, {"render_raster", raster_cmd}, {"notes", notes}, {"script", script}}},
   };
-  if (!info.program.empty()) out["program"] = info.program;
+  if (!info.program.is_null()) out["program"] = info.program;
   return out;
 }
 

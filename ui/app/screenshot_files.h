@@ -60,10 +60,11 @@ struct ScreenshotInfo {
   /// entered nodes instead of the selection, or colours by visits. Neither is
   /// a view setting, so the side-car's script does not bring them back.
   bool boxes_of_region = false, boxes_by_visits = false;
-  /// What made the picture ("accelviz 0.1.0 (commit ..., Release build, ...)",
-  /// --version's line; "" leaves it out of the side-car): a bug report's
-  /// screenshot names the build it came from.
-  std::string program;
+  /// What made the picture, as the CLI's JSON names it: {version, commit,
+  /// build_type, embree, line}, `line` being --version's ("accelviz 0.1.0
+  /// (commit ..., Release build, ...)"), the PNG's Software text. Null leaves
+  /// it out: a bug report's screenshot names the build it came from.
+  nlohmann::json program;
 };
 
 /// screenshot_caption(info.config), ", boxes N of M" when the overlay
