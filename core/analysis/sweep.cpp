@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <mutex>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -386,20 +387,50 @@ TimedStructure time_structure(
   const auto check = [&] {
     if (keep_going && !keep_going()) throw BuildCancelled();
   };
-  // Steps: each build and each pass (the warm-up rounds' passes, the timed ones and the counting one).
+  // Steps: each build and each pass (the warm-up rounds' passes, the timed ones and the counting one),
+  // weighed by how long a build and a pass take, as measured so far: with -n 100, quick builds and
+  // slow passes are not half of the time as they are half of the steps. Until a kind has been
+  // measured it weighs as much as the other (as 1 when neither has).
   const int warmups = std::max(0, warmup);
   const int timed_builds = time_builds ? std::max(1, repeat) : warmups > 0 ? 0 : 1;
   const int passes = rays.empty() ? 0 : warmups + std::max(1, repeat) + 1;
-  const double steps = static_cast<double>(warmups + timed_builds + passes);
-  int done = 0;  ///< steps finished; changed only between builds (no builder thread reads it then)
-  const auto step_done = [&] {
-    ++done;
-    if (report) report(done / steps);
+  // Changed only between builds and passes (no builder thread reads them then).
+  int builds_done = 0, passes_done = 0;
+  double build_s = 0, pass_s = 0;  ///< total seconds of the finished builds and passes
+  bool in_build = true;            ///< the kind of the step under way
+  std::mutex report_mutex;         ///< builder threads report too: one at a time, in order
+  double reported = 0;             ///< the largest fraction reported: the next is never less
+  auto step_start = std::chrono::steady_clock::now();
+  const auto fraction = [&](double of_current) {
+    const double b = builds_done ? build_s / builds_done : passes_done ? pass_s / passes_done : 1.0;
+    const double p = passes_done ? pass_s / passes_done : b;
+    const double total = (warmups + timed_builds) * b + passes * p;
+    const double done = builds_done * b + passes_done * p + of_current * (in_build ? b : p);
+    return total > 0 ? std::min(1.0, done / total) : 1.0;
   };
+  // Weights change as steps are measured, so a fraction may come out below the last one told.
+  const auto tell = [&](double f) {
+    const std::lock_guard lock(report_mutex);
+    reported = std::max(reported, f);
+    report(reported);
+  };
+  const auto step_done = [&](bool was_build) {
+    const auto now = std::chrono::steady_clock::now();
+    const double s = std::chrono::duration<double>(now - step_start).count();
+    (was_build ? build_s : pass_s) += std::max(s, 1e-9);  // a step never weighs nothing
+    ++(was_build ? builds_done : passes_done);
+    step_start = now;
+    if (report) tell(fraction(0));
+  };
+  const auto begin = [&](bool build_step) {
+    in_build = build_step;
+    step_start = std::chrono::steady_clock::now();
+  };
+  const bool kBuild = true, kPass = false;
   ProgressCallback progress;
   if (keep_going || report)
     progress = [&](double f) {
-      if (report) report((done + std::clamp(f, 0.0, 1.0)) / steps);
+      if (report) tell(fraction(std::clamp(f, 0.0, 1.0)));
       return !keep_going || keep_going();
     };
   const unsigned n_threads = resolve_threads(threads);
@@ -408,34 +439,39 @@ TimedStructure time_structure(
   for (int k = 0; k < warmups; ++k) {
     t.accel.reset();  // never two copies in memory
     check();
+    begin(kBuild);
     t.accel = build(progress);
-    step_done();
+    step_done(kBuild);
     check();
     if (!rays.empty()) {
+      begin(kPass);
       trace_closest(*t.accel, rays, t.hits, query, n_threads);
-      step_done();
+      step_done(kPass);
     }
   }
   for (int k = 0; k < timed_builds; ++k) {
     t.accel.reset();
     check();
+    begin(kBuild);
     t.accel = build(progress);
-    step_done();
+    step_done(kBuild);
     if (time_builds) t.build_ms_runs.push_back(t.accel->build_stats().build_ms);
   }
   if (rays.empty()) return t;
   for (int k = 0; k < std::max(1, repeat); ++k) {
     check();
+    begin(kPass);
     const auto t0 = std::chrono::steady_clock::now();
     trace_closest(*t.accel, rays, t.hits, query, n_threads);
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     t.rays_per_s_runs.push_back(s > 0 ? static_cast<double>(rays.size()) / s : 0.0);
-    step_done();
+    step_done(kPass);
   }
   check();
+  begin(kPass);
   std::vector<RayStats> stats(rays.size());
   trace_closest(*t.accel, rays, t.hits, query, n_threads, stats);
-  step_done();
+  step_done(kPass);
   double nodes = 0, prims = 0, hit_count = 0;
   for (std::size_t i = 0; i < rays.size(); ++i) {
     nodes += stats[i].nodes_visited;

@@ -179,8 +179,10 @@ struct TimedStructure {
 /// builds and passes and during builds; false throws BuildCancelled.
 /// `time_builds` false: no timed builds (build_ms_runs stays empty); the
 /// tree of the last warm-up round is kept (one untimed build without one).
-/// `report` (empty: none) is told the fraction of the whole done, builds and
-/// passes each one step: inside builds, from the builder's threads.
+/// `report` (empty: none) is told the fraction of the whole done, never less
+/// than it was told before: builds and passes are steps weighed by the mean
+/// time of the builds and of the passes measured so far (the same weight
+/// until both have been); inside builds, from the builder's threads.
 TimedStructure time_structure(
     const std::function<std::unique_ptr<Accelerator>(const ProgressCallback& progress)>& build,
     std::span<const Ray> rays, const QueryOptions& query, unsigned threads, int warmup, int repeat,
