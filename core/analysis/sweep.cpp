@@ -30,29 +30,32 @@ namespace {
   throw std::invalid_argument("sweep parameter " + name + ": bad value '" + value + "' (" + why + ")");
 }
 
-int parse_int(const std::string& name, const std::string& v, int lo, int hi) {
-  int out = 0;
+/// The whole of `v` as a T, or bad_value saying `expected` (from_chars for floating point is in
+/// GCC 12's libstdc++; strtof would accept "1x").
+template <class T>
+T parse_number(const std::string& name, const std::string& v, const std::string& expected) {
+  T out{};
   const auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), out);
-  if (ec != std::errc() || p != v.data() + v.size())
-    bad_value(name, v, "expected an integer " + std::to_string(lo) + ".." + std::to_string(hi));
-  if (out < lo || out > hi) bad_value(name, v, "expected " + std::to_string(lo) + ".." + std::to_string(hi));
+  if (ec != std::errc() || p != v.data() + v.size()) bad_value(name, v, expected);
+  return out;
+}
+
+int parse_int(const std::string& name, const std::string& v, int lo, int hi) {
+  const std::string range = std::to_string(lo) + ".." + std::to_string(hi);
+  const int out = parse_number<int>(name, v, "expected an integer " + range);
+  if (out < lo || out > hi) bad_value(name, v, "expected " + range);
   return out;
 }
 
 float parse_positive(const std::string& name, const std::string& v) {
-  // from_chars for float is in GCC 12's libstdc++; strtof would accept "1x".
-  float out = 0;
-  const auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), out);
-  if (ec != std::errc() || p != v.data() + v.size() || !std::isfinite(out) || out <= 0)
-    bad_value(name, v, "expected a finite number > 0");
+  const float out = parse_number<float>(name, v, "expected a finite number > 0");
+  if (!std::isfinite(out) || out <= 0) bad_value(name, v, "expected a finite number > 0");
   return out;
 }
 
 /// An SAH cost constant: a number in the range the command line takes (cost_constant_problem).
 float parse_cost(const std::string& name, const std::string& v) {
-  double out = 0;
-  const auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), out);
-  if (ec != std::errc() || p != v.data() + v.size()) bad_value(name, v, "expected a number from 1e-06 to 1e+06");
+  const double out = parse_number<double>(name, v, "expected a number from 1e-06 to 1e+06");
   if (const std::string problem = cost_constant_problem(out); !problem.empty()) bad_value(name, v, problem);
   return static_cast<float>(out);
 }
