@@ -18,6 +18,7 @@
 #include <charconv>
 #include <csignal>
 #include <cstdint>
+#include <cstdlib>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -139,6 +140,9 @@ int run(int argc, char** argv) {
                                          ? std::string(" (it needs one)")
                                          : std::string(" (leave the option out for its default)")));
     }
+    // ACCELVIZ_PARSE_ONLY=1: the command line is read and checked as above, then nothing runs
+    // (tests/cli/docs_commands.sh checks every command the documentation prints this way).
+    if (const char* only = std::getenv("ACCELVIZ_PARSE_ONLY"); only && std::string(only) == "1") return 0;
     for (const cli::Command& c : commands)
       if (c.app->parsed()) return c.run();
     if (!scene_arg.empty() && !looks_like_scene(scene_arg)) {
