@@ -19,6 +19,10 @@
 #include "core/util/output_file.h"
 #include "core/util/timing.h"
 
+namespace accelviz {
+struct SweepResult;  // core/analysis/sweep.h
+}
+
 namespace accelviz::cli {
 
 /// A registered subcommand: its CLI11 app and what runs it once parsed.
@@ -219,6 +223,10 @@ std::string version_line();
 /// side-cars): {version, commit, build_type, embree (where built with it),
 /// line: version_line()}.
 nlohmann::json program_json();
+
+/// One setting's figures as sweep.json's `results` hold them (`budget`: the
+/// ray budget of trace_ms_budget and total_ms_budget); the GUI's dump-sweep too.
+nlohmann::json sweep_result_json(const SweepResult& r, double budget);
 
 /// One-line JSON on stdout, flushed (animate streams a line per frame).
 void print_json_line(const nlohmann::json& j);

@@ -163,7 +163,9 @@ RgbImage figure_chart(const std::vector<SweepResult>& results, const std::vector
   return draw_chart(o, series);
 }
 
-nlohmann::json result_json(const SweepResult& r, double budget) {
+}  // namespace
+
+nlohmann::json sweep_result_json(const SweepResult& r, double budget) {
   nlohmann::json s = nlohmann::json::object();
   for (const auto& [k, v] : r.setting) s[k] = v;
   nlohmann::json j = {
@@ -196,6 +198,8 @@ nlohmann::json result_json(const SweepResult& r, double budget) {
                   {"ray_double_hits", r.ray_double_hits}};
   return j;
 }
+
+namespace {
 
 int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
   use_fixed_malloc_thresholds();  // the settings' builds compare fairly from the first on
@@ -284,7 +288,7 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
   j["params"] = nlohmann::json::object();
   for (const SweepParam& p : params) j["params"][p.name] = p.values;
   j["results"] = nlohmann::json::array();
-  for (const SweepResult& r : results) j["results"].push_back(result_json(r, o.ray_budget));
+  for (const SweepResult& r : results) j["results"].push_back(sweep_result_json(r, o.ray_budget));
   j["pareto_front"] = nlohmann::json::array();
   for (std::size_t i : front) j["pareto_front"].push_back(setting_label(results[i].setting));
   j["best_for_budget"] = nlohmann::json::array();

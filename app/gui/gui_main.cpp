@@ -117,6 +117,9 @@ class Gui final : public ScriptHost {
   std::uint64_t request_flatten(FlattenRequest::Kind kind, std::vector<std::uint32_t> ids);
   /// A finished commit (once): its merged scene is opened and built.
   void take_flatten_commit();
+  /// The Cost of accuracy panel's Run: a sweep of accuracy_.params over the
+  /// shown scene, structure and view; its id, or none with accuracy_.error set.
+  std::optional<std::uint64_t> request_sweep();
   /// Keeps the worker's latest result when it is a prediction (flatten_prediction_).
   void note_flatten_prediction();
   /// The spec of the scene `r` was computed on when that is the flatten panel's scene, else "".
@@ -155,6 +158,7 @@ class Gui final : public ScriptHost {
   std::shared_ptr<const FlattenResult> flatten_prediction_;
   std::string flatten_prediction_spec_;
   std::optional<std::uint64_t> flatten_wait_;         ///< script flatten / flatten-commit: the job waited for
+  std::optional<std::uint64_t> sweep_wait_;           ///< script sweep: its request, which dump-sweep waits for
   std::optional<SceneEffects> effects_;
   std::shared_ptr<const LoadedScene> effects_scene_;  ///< held: a freed scene's address may come back
   EffectForces effects_forces_;
@@ -412,26 +416,7 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
   const panels::AccuracyAction aa =
       panels::accuracy_panel(accuracy_, sweep.get(), sweeps_.busy(), app_.config().structure.name, layout);
   if (aa.cancel) sweeps_.cancel();
-  if (aa.run) {
-    accuracy_.error.clear();
-    try {
-      if (!app_.current()) throw std::invalid_argument("no scene shown yet");
-      SweepRequest r;
-      r.scene = app_.current()->scene;
-      r.structure = app_.config().structure.name;
-      r.base = app_.config().structure.options;
-      r.query = app_.config().structure.query;
-      r.params = parse_sweep_params_text(r.structure, accuracy_.params);
-      r.camera = app_.camera();
-      r.width = accuracy_.width;
-      r.height = accuracy_.height;
-      r.repeat = accuracy_.repeat;
-      r.calibrate = accuracy_.calibrate;
-      sweeps_.request(std::move(r));
-    } catch (const std::exception& e) {
-      accuracy_.error = e.what();
-    }
-  }
+  if (aa.run) (void)request_sweep();
   if (aa.apply) {
     const std::string err = apply_sweep_point(app_.config().structure, aa.apply_structure, *aa.apply);
     if (err.empty())
@@ -590,6 +575,28 @@ void Gui::note_flatten_prediction() {
   if (!r || r->kind != FlattenRequest::Kind::preview || r == flatten_prediction_) return;
   flatten_prediction_ = r;
   flatten_prediction_spec_ = flatten_spec_of(*r);
+}
+
+std::optional<std::uint64_t> Gui::request_sweep() {
+  accuracy_.error.clear();
+  try {
+    if (!app_.current()) throw std::invalid_argument("no scene shown yet");
+    SweepRequest r;
+    r.scene = app_.current()->scene;
+    r.structure = app_.config().structure.name;
+    r.base = app_.config().structure.options;
+    r.query = app_.config().structure.query;
+    r.params = parse_sweep_params_text(r.structure, accuracy_.params);
+    r.camera = app_.camera();
+    r.width = accuracy_.width;
+    r.height = accuracy_.height;
+    r.repeat = accuracy_.repeat;
+    r.calibrate = accuracy_.calibrate;
+    return sweeps_.request(std::move(r));
+  } catch (const std::exception& e) {
+    accuracy_.error = e.what();
+    return std::nullopt;
+  }
 }
 
 void Gui::take_flatten_commit() {
@@ -805,6 +812,34 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
             r->instances == flatten_prediction_->instances && r->scene == flatten_prediction_->scene)
           doc["committed"] = r->committed->spec;
       }
+      fail_if(write_new_file(c.arg, json_text(doc, 2) + "\n"));
+      return Status::done;
+    }
+    case K::sweep: {
+      // As the panel's Run, once the structure chosen so far is shown (the sweep starts from its options).
+      if (!app_.settled()) return Status::again;
+      panels::request_window("Cost of accuracy", true);
+      accuracy_.params = c.arg;
+      accuracy_.params_for = app_.config().structure.name;
+      sweep_wait_ = request_sweep();
+      if (!sweep_wait_) throw std::runtime_error("sweep: " + accuracy_.error);
+      return Status::done;
+    }
+    case K::dump_sweep: {
+      if (!sweep_wait_) throw std::runtime_error("no sweep run yet (use sweep PARAMS first)");
+      const std::shared_ptr<const SweepSnapshot> s = sweeps_.latest();
+      if (!s || s->id < *sweep_wait_ || s->state == SweepSnapshot::State::running) return Status::again;
+      const char* const states[] = {"running", "done", "cancelled", "failed"};
+      nlohmann::json doc = {{"structure", s->structure},
+                            {"state", states[static_cast<int>(s->state)]},
+                            {"error", s->error},
+                            {"triangles", s->triangles},
+                            {"rays", s->rays},
+                            {"ray_budget", accuracy_.ray_budget},
+                            {"params", nlohmann::json::object()},
+                            {"results", nlohmann::json::array()}};
+      for (const SweepParam& p : s->params) doc["params"][p.name] = p.values;
+      for (const SweepResult& r : s->results) doc["results"].push_back(cli::sweep_result_json(r, accuracy_.ray_budget));
       fail_if(write_new_file(c.arg, json_text(doc, 2) + "\n"));
       return Status::done;
     }

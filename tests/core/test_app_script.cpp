@@ -175,6 +175,30 @@ TEST(AppScript, WindowCommandNamesAPanel) {
   }
 }
 
+// `sweep PARAMS` is checked for the structure the script has chosen by then, as the Cost of
+// accuracy panel's Run checks it; `dump-sweep PATH` takes the rest of the line.
+TEST(AppScript, SweepCommandIsCheckedForTheStructureChosen) {
+  const auto cmds =
+      parse_script("sweep buckets=2,8 leaf=1,4\nstructure grid\nsweep lambda=1,4\ndump-sweep a b.json\n", "s.txt");
+  ASSERT_EQ(cmds.size(), 4u);
+  EXPECT_EQ(cmds[0].kind, K::sweep);
+  EXPECT_EQ(cmds[0].arg, "buckets=2,8 leaf=1,4");
+  EXPECT_EQ(cmds[2].arg, "lambda=1,4");
+  EXPECT_EQ(cmds[3].kind, K::dump_sweep);
+  EXPECT_EQ(cmds[3].arg, "a b.json");
+  EXPECT_EQ(command_name(K::sweep), "sweep");
+  EXPECT_EQ(command_name(K::dump_sweep), "dump-sweep");
+  for (const auto& [text, expected] : {
+           std::pair{"sweep\n", "s.txt:1: sweep: expected parameters, e.g. buckets=2,8 leaf=1,4"},
+           std::pair{"sweep buckets=abc\n", "s.txt:1: sweep: sweep parameter buckets: bad value 'abc'"},
+           std::pair{"structure grid\nsweep buckets=2,8\n", "s.txt:2: sweep: "},
+           std::pair{"dump-sweep\n", "s.txt:1: dump-sweep: expected a file path"},
+       }) {
+    const std::string e = parse_error(text);
+    EXPECT_EQ(e.rfind(expected, 0), 0u) << "script: " << text << "\ngot: " << e;
+  }
+}
+
 // `frames N` lets N frames draw (the GPU heatmap test watches a trace
 // progress across frames with it).
 TEST(AppScript, FramesCommandTakesACount) {

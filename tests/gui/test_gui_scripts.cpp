@@ -1052,3 +1052,49 @@ TEST_F(GuiScript, ATerminatedWindowSavesItsSettingsAndLayout) {
   const nlohmann::json settings = read_json(config / "accelviz" / "settings.json");
   EXPECT_EQ(settings["last_scene"], "builtin:teapot?size=300");
 }
+
+// The Cost of accuracy window, scripted: `sweep` runs the panel's sweep on the shown scene and view,
+// `dump-sweep` waits for it and writes its settings' figures as sweep.json's results hold them. The
+// trees it builds are the CLI's: the same SAH cost, nodes, leaves and memory for every setting as
+// `accelviz sweep` on the same scene (what is timed differs; what is built must not).
+TEST_F(GuiScript, CostOfAccuracySweepBuildsWhatTheCommandLineBuilds) {
+  const RunResult r =
+      run("open " + std::string(kTeapot) + "\nstructure bvh\nsweep buckets=2,8 leaf=1,4\ndump-sweep " +
+          path("gui.json").string() + "\nstructure grid\ndump-sweep " + path("again.json").string() + "\n");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json gui = read_json(path("gui.json"));
+  EXPECT_EQ(gui["state"], "done");
+  EXPECT_EQ(gui["structure"], "bvh");
+  EXPECT_EQ(gui["triangles"], 2256);
+  EXPECT_EQ(gui["rays"], 160 * 120);  // the panel's default ray size over the view
+  EXPECT_EQ(gui["params"], nlohmann::json::parse(R"({"buckets": ["2", "8"], "leaf": ["1", "4"]})"));
+  // A later dump-sweep writes the same sweep (a structure change starts none).
+  nlohmann::json again = read_json(path("again.json"));
+  EXPECT_EQ(again["results"].size(), gui["results"].size());
+
+  const std::string cmd = std::string("'") + ACCELVIZ_BIN + "' -q sweep '" + kTeapot +
+                          "' --param buckets=2,8 --param leaf=1,4 --size 32x24 --repeat 1 -j 1 --out '" +
+                          path("cli").string() + "' > /dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  const nlohmann::json cli = read_json(path("cli") / "sweep.json");
+  ASSERT_EQ(gui["results"].size(), 4u);
+  ASSERT_EQ(cli["results"].size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) {
+    const nlohmann::json &g = gui["results"][i], &c = cli["results"][i];
+    EXPECT_EQ(g["label"], c["label"]);
+    for (const char* key : {"sah_cost", "nodes", "leaves", "max_depth", "memory_bytes"})
+      EXPECT_EQ(g[key], c[key]) << g["label"] << " " << key;
+    EXPECT_GT(g["rays_per_s"].get<double>(), 0.0) << g["label"];
+    EXPECT_GT(g["nodes_per_ray"].get<double>(), 0.0) << g["label"];
+  }
+  EXPECT_NE(gui["results"][0]["sah_cost"], gui["results"][2]["sah_cost"]) << "buckets=2 and 8 built the same tree";
+}
+
+// dump-sweep before any sweep is a script error naming the line, not a wait for ever.
+TEST_F(GuiScript, DumpSweepWithoutASweepIsAnError) {
+  const RunResult r = run("open " + std::string(kTeapot) + "\ndump-sweep " + path("none.json").string() + "\n");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find(":2: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("no sweep run yet (use sweep PARAMS first)"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("none.json")));
+}

@@ -12,6 +12,7 @@
 #include "ui/app/dynamics.h"
 #include "ui/app/flatten_worker.h"
 #include "ui/app/scenarios.h"
+#include "ui/app/sweep_worker.h"
 #include "ui/app/window_titles.h"
 
 namespace accelviz {
@@ -101,6 +102,8 @@ constexpr NamedKind kCommands[] = {
     {"dump-flatten", ScriptCommand::Kind::dump_flatten},
     {"reload-shaders", ScriptCommand::Kind::reload_shaders},
     {"window", ScriptCommand::Kind::window},
+    {"sweep", ScriptCommand::Kind::sweep},
+    {"dump-sweep", ScriptCommand::Kind::dump_sweep},
 };
 
 }  // namespace
@@ -169,6 +172,7 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
       case ScriptCommand::Kind::dump_dynamics:
       case ScriptCommand::Kind::dump_ab:
       case ScriptCommand::Kind::dump_flatten:
+      case ScriptCommand::Kind::dump_sweep:
         // The rest of the line, so paths may hold spaces.
         need_rest(c.kind == ScriptCommand::Kind::open ? "a scene (file or builtin:NAME)" : "a file path");
         c.arg = std::string(rest);
@@ -247,6 +251,16 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
         break;
       case ScriptCommand::Kind::reload_shaders:
         c.arg = std::string(rest);  // optional: the folder whose files win over the built-in shaders
+        break;
+      case ScriptCommand::Kind::sweep:
+        // Checked against the structure the script has chosen by then, as the panel's Run does.
+        need_rest("parameters, e.g. buckets=2,8 leaf=1,4");
+        c.arg = std::string(rest);
+        try {
+          (void)parse_sweep_params_text(scratch.structure.name, c.arg);
+        } catch (const std::invalid_argument& e) {
+          fail("sweep: " + std::string(e.what()));
+        }
         break;
       case ScriptCommand::Kind::flatten:
         // The ids are checked against the scene's instance count when it runs.

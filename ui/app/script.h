@@ -42,6 +42,8 @@ struct ScriptCommand {
     dump_flatten,    ///< arg: path; the last prediction's figures as JSON
     reload_shaders,  ///< arg: "" or a folder (then the shader override folder); rebuilds the shader programs
     window,          ///< value: "open" | "close", arg: a panel's title (kPanelTitles); expands or collapses it
+    sweep,           ///< arg: parameters ("buckets=2,8 leaf=1,4"); runs the Cost of accuracy sweep on this view
+    dump_sweep,      ///< arg: path; waits for the sweep, writes its settings' figures as JSON
   };
   Kind kind = Kind::wait;
   int line = 0;        ///< 1-based line in the script file
