@@ -21,6 +21,7 @@
 
 namespace accelviz {
 struct SweepResult;  // core/analysis/sweep.h
+struct LabResult;    // core/analysis/robustness_lab.h
 }
 
 namespace accelviz::cli {
@@ -227,6 +228,10 @@ nlohmann::json program_json();
 /// One setting's figures as sweep.json's `results` hold them (`budget`: the
 /// ray budget of trace_ms_budget and total_ms_budget); the GUI's dump-sweep too.
 nlohmann::json sweep_result_json(const SweepResult& r, double budget);
+
+/// The robustness lab's figures as `robustness --json` prints them (triangles, rays,
+/// rays_by_family, reference_hits, reference_ms, variants); the GUI's dump-robustness too.
+nlohmann::json lab_result_json(const LabResult& r);
 
 /// One-line JSON on stdout, flushed (animate streams a line per frame).
 void print_json_line(const nlohmann::json& j);

@@ -18,6 +18,40 @@
 
 namespace accelviz::cli {
 
+nlohmann::json lab_result_json(const LabResult& r) {
+  nlohmann::json variants = nlohmann::json::array();
+  for (const LabVariant& v : r.variants) {
+    nlohmann::json miss_f = nlohmann::json::object(), dbl_f = nlohmann::json::object();
+    for (int f = 0; f < kLabFamilies; ++f) {
+      miss_f[to_string(static_cast<LabFamily>(f))] = v.misses_by_family[f];
+      dbl_f[to_string(static_cast<LabFamily>(f))] =
+          v.double_hits_counted ? nlohmann::json(v.double_hits_by_family[f]) : nlohmann::json(nullptr);
+    }
+    // Embree's rows: its own modes, not our triangle test; it reports one hit per ray (no double hits).
+    const nlohmann::json test = !v.embree_mode.empty()                        ? "embree-" + v.embree_mode
+                                : v.triangle_test == TriangleTest::watertight ? "watertight"
+                                                                              : "moller-trumbore";
+    variants.push_back(
+        {{"name", v.name},
+         {"triangle_test", test},
+         {"embree_mode", v.embree_mode.empty() ? nlohmann::json(nullptr) : nlohmann::json(v.embree_mode)},
+         {"slab", v.own_structure ? "structure" : (v.padded_slab ? "padded" : "plain")},
+         {"misses", v.misses},
+         {"not_traced", v.not_traced},
+         {"double_hits", v.double_hits_counted ? nlohmann::json(v.double_hits) : nlohmann::json(nullptr)},
+         {"wrong", v.wrong},
+         {"misses_by_family", miss_f},
+         {"double_hits_by_family", dbl_f},
+         {"ms", v.ms},
+         {"mrays_per_s", v.mrays_per_s}});
+  }
+  nlohmann::json fam = nlohmann::json::object();
+  for (int f = 0; f < kLabFamilies; ++f) fam[to_string(static_cast<LabFamily>(f))] = r.rays_by_family[f];
+  return {{"triangles", r.triangles},       {"rays", r.rays},
+          {"rays_by_family", fam},          {"reference_hits", r.reference_hits},
+          {"reference_ms", r.reference_ms}, {"variants", variants}};
+}
+
 namespace {
 
 struct RobustnessOptions {
@@ -71,43 +105,10 @@ int run_robustness(const RobustnessOptions& o, const GlobalOptions& global) {
   }
 
   if (o.json) {
-    nlohmann::json variants = nlohmann::json::array();
-    for (const LabVariant& v : r.variants) {
-      nlohmann::json miss_f = nlohmann::json::object(), dbl_f = nlohmann::json::object();
-      for (int f = 0; f < kLabFamilies; ++f) {
-        miss_f[to_string(static_cast<LabFamily>(f))] = v.misses_by_family[f];
-        dbl_f[to_string(static_cast<LabFamily>(f))] =
-            v.double_hits_counted ? nlohmann::json(v.double_hits_by_family[f]) : nlohmann::json(nullptr);
-      }
-      // Embree's rows: its own modes, not our triangle test; it reports one hit per ray (no double hits).
-      const nlohmann::json test = !v.embree_mode.empty()                        ? "embree-" + v.embree_mode
-                                  : v.triangle_test == TriangleTest::watertight ? "watertight"
-                                                                                : "moller-trumbore";
-      variants.push_back(
-          {{"name", v.name},
-           {"triangle_test", test},
-           {"embree_mode", v.embree_mode.empty() ? nlohmann::json(nullptr) : nlohmann::json(v.embree_mode)},
-           {"slab", v.own_structure ? "structure" : (v.padded_slab ? "padded" : "plain")},
-           {"misses", v.misses},
-           {"not_traced", v.not_traced},
-           {"double_hits", v.double_hits_counted ? nlohmann::json(v.double_hits) : nlohmann::json(nullptr)},
-           {"wrong", v.wrong},
-           {"misses_by_family", miss_f},
-           {"double_hits_by_family", dbl_f},
-           {"ms", v.ms},
-           {"mrays_per_s", v.mrays_per_s}});
-    }
-    nlohmann::json fam = nlohmann::json::object();
-    for (int f = 0; f < kLabFamilies; ++f) fam[to_string(static_cast<LabFamily>(f))] = r.rays_by_family[f];
-    print_json_line({{"scene", o.scene},
-                     {"triangles", r.triangles},
-                     {"rays", r.rays},
-                     {"rays_by_family", fam},
-                     {"seed", o.seed},
-                     {"reference_hits", r.reference_hits},
-                     {"reference_ms", r.reference_ms},
-                     {"variants", variants},
-                     {"not_checked", refused ? nlohmann::json(refusal) : nlohmann::json(nullptr)}});
+    nlohmann::json j = {{"scene", o.scene}, {"seed", o.seed}};
+    j.update(lab_result_json(r));
+    j["not_checked"] = refused ? nlohmann::json(refusal) : nlohmann::json(nullptr);
+    print_json_line(j);
     return refused ? 1 : 0;
   }
   std::cout << "robustness: " << o.scene << " triangles=" << r.triangles << " rays=" << r.rays << " (vertex "

@@ -120,6 +120,9 @@ class Gui final : public ScriptHost {
   /// The Cost of accuracy panel's Run: a sweep of accuracy_.params over the
   /// shown scene, structure and view; its id, or none with accuracy_.error set.
   std::optional<std::uint64_t> request_sweep();
+  /// The Robustness panel's Run over the shown scene (and structure, when the
+  /// panel's box says so); its id, or none when no scene is shown.
+  std::optional<std::uint64_t> request_robustness();
   /// Keeps the worker's latest result when it is a prediction (flatten_prediction_).
   void note_flatten_prediction();
   /// The spec of the scene `r` was computed on when that is the flatten panel's scene, else "".
@@ -159,6 +162,7 @@ class Gui final : public ScriptHost {
   std::string flatten_prediction_spec_;
   std::optional<std::uint64_t> flatten_wait_;         ///< script flatten / flatten-commit: the job waited for
   std::optional<std::uint64_t> sweep_wait_;           ///< script sweep: its request, which dump-sweep waits for
+  std::optional<std::uint64_t> lab_wait_;  ///< script robustness: its request, which dump-robustness waits for
   std::optional<SceneEffects> effects_;
   std::shared_ptr<const LoadedScene> effects_scene_;  ///< held: a freed scene's address may come back
   EffectForces effects_forces_;
@@ -431,18 +435,17 @@ void Gui::draw_panels(const panels::PanelLayout& layout) {
   const panels::RobustnessAction ra =
       panels::robustness_panel(robustness_panel_, lab.get(), robustness_.busy(), app_.config().structure.name, layout);
   if (ra.cancel) robustness_.cancel();
-  if (ra.run) {
-    if (!app_.current()) {
-      app_.set_error("robustness: no scene shown yet");
-    } else {
-      RobustnessRequest r;
-      r.scene = app_.current()->scene;
-      r.options.rays = static_cast<std::size_t>(robustness_panel_.rays);
-      const std::string& shown = app_.config().structure.name;
-      r.options.structure = robustness_panel_.with_structure && lab_times_own_traversal(shown) ? shown : "";
-      robustness_.request(std::move(r));
-    }
-  }
+  if (ra.run && !request_robustness()) app_.set_error("robustness: no scene shown yet");
+}
+
+std::optional<std::uint64_t> Gui::request_robustness() {
+  if (!app_.current()) return std::nullopt;
+  RobustnessRequest r;
+  r.scene = app_.current()->scene;
+  r.options.rays = static_cast<std::size_t>(robustness_panel_.rays);
+  const std::string& shown = app_.config().structure.name;
+  r.options.structure = robustness_panel_.with_structure && lab_times_own_traversal(shown) ? shown : "";
+  return robustness_.request(std::move(r));
 }
 
 void Gui::sync_overlay() {
@@ -840,6 +843,28 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
                             {"results", nlohmann::json::array()}};
       for (const SweepParam& p : s->params) doc["params"][p.name] = p.values;
       for (const SweepResult& r : s->results) doc["results"].push_back(cli::sweep_result_json(r, accuracy_.ray_budget));
+      fail_if(write_new_file(c.arg, json_text(doc, 2) + "\n"));
+      return Status::done;
+    }
+    case K::robustness: {
+      // As the panel's Run, once the structure chosen so far is shown (its own traversal is one row).
+      if (!app_.settled()) return Status::again;
+      panels::request_window("Robustness", true);
+      if (c.x > 0) robustness_panel_.rays = c.x;
+      lab_wait_ = request_robustness();
+      if (!lab_wait_) throw std::runtime_error("robustness: no scene shown");
+      return Status::done;
+    }
+    case K::dump_robustness: {
+      if (!lab_wait_) throw std::runtime_error("no robustness run yet (use robustness [N] first)");
+      const std::shared_ptr<const RobustnessSnapshot> s = robustness_.latest();
+      if (!s || s->id < *lab_wait_ || s->state == RobustnessSnapshot::State::running) return Status::again;
+      const char* const states[] = {"running", "done", "cancelled", "failed"};
+      nlohmann::json doc = {{"scene", s->scene},
+                            {"structure", s->structure},
+                            {"state", states[static_cast<int>(s->state)]},
+                            {"error", s->error}};
+      if (s->result) doc.update(cli::lab_result_json(*s->result));
       fail_if(write_new_file(c.arg, json_text(doc, 2) + "\n"));
       return Status::done;
     }

@@ -199,6 +199,23 @@ TEST(AppScript, SweepCommandIsCheckedForTheStructureChosen) {
   }
 }
 
+// `robustness [N]`: the Robustness window's ray count (its field's range) or none (the window's).
+TEST(AppScript, RobustnessCommandTakesAnOptionalRayCount) {
+  const auto cmds = parse_script("robustness\nrobustness 5000\ndump-robustness lab.json\n", "s.txt");
+  ASSERT_EQ(cmds.size(), 3u);
+  EXPECT_EQ(cmds[0].kind, K::robustness);
+  EXPECT_EQ(cmds[0].x, 0);
+  EXPECT_EQ(cmds[1].x, 5000);
+  EXPECT_EQ(cmds[2].kind, K::dump_robustness);
+  EXPECT_EQ(cmds[2].arg, "lab.json");
+  EXPECT_EQ(command_name(K::dump_robustness), "dump-robustness");
+  for (const char* text : {"robustness 3\n", "robustness 4194305\n", "robustness many\n", "robustness 10 20\n"}) {
+    const std::string e = parse_error(text);
+    EXPECT_EQ(e.rfind("s.txt:1: robustness: expected N rays (an integer in 4..4194304) or nothing", 0), 0u)
+        << text << "\ngot: " << e;
+  }
+}
+
 // `frames N` lets N frames draw (the GPU heatmap test watches a trace
 // progress across frames with it).
 TEST(AppScript, FramesCommandTakesACount) {

@@ -1098,3 +1098,33 @@ TEST_F(GuiScript, DumpSweepWithoutASweepIsAnError) {
   EXPECT_NE(r.err.find("no sweep run yet (use sweep PARAMS first)"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(path("none.json")));
 }
+
+// The Robustness window, scripted: `robustness N` runs its lab on the shown scene with the shown
+// structure's own traversal as a row, `dump-robustness` writes what `accelviz robustness --json`
+// prints for the same scene, structure and rays: every variant's misses, double hits and wrong hits.
+TEST_F(GuiScript, RobustnessLabFindsWhatTheCommandLineFinds) {
+  const RunResult r = run("open " + std::string(kTeapot) + "\nstructure kdtree\nrobustness 3000\ndump-robustness " +
+                          path("lab.json").string() + "\n");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json gui = read_json(path("lab.json"));
+  EXPECT_EQ(gui["state"], "done");
+  EXPECT_EQ(gui["structure"], "kdtree");
+  EXPECT_EQ(gui["rays"], 3000);
+  const fs::path out = path("cli.json");
+  const std::string cmd = std::string("'") + ACCELVIZ_BIN + "' -q robustness '" + kTeapot +
+                          "' --structure kdtree --rays 3000 -j 1 --json > '" + out.string() + "'";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  const nlohmann::json cli = read_json(out);
+  EXPECT_EQ(gui["reference_hits"], cli["reference_hits"]);
+  EXPECT_EQ(gui["rays_by_family"], cli["rays_by_family"]);
+  ASSERT_EQ(gui["variants"].size(), cli["variants"].size());
+  ASSERT_EQ(gui["variants"].size(), 6u);  // four lab variants and the K-D tree's two tests
+  for (std::size_t i = 0; i < gui["variants"].size(); ++i) {
+    const nlohmann::json &g = gui["variants"][i], &c = cli["variants"][i];
+    EXPECT_EQ(g["name"], c["name"]);
+    for (const char* key : {"misses", "double_hits", "wrong", "misses_by_family", "not_traced"})
+      EXPECT_EQ(g[key], c[key]) << g["name"] << " " << key;
+  }
+  EXPECT_EQ(gui["variants"][3]["misses"], 0) << "watertight + padded slab missed";
+  EXPECT_GT(gui["variants"][0]["misses"].get<int>(), 0) << "Moller-Trumbore missed nothing: the rays are not hard";
+}

@@ -104,6 +104,8 @@ constexpr NamedKind kCommands[] = {
     {"window", ScriptCommand::Kind::window},
     {"sweep", ScriptCommand::Kind::sweep},
     {"dump-sweep", ScriptCommand::Kind::dump_sweep},
+    {"robustness", ScriptCommand::Kind::robustness},
+    {"dump-robustness", ScriptCommand::Kind::dump_robustness},
 };
 
 }  // namespace
@@ -173,6 +175,7 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
       case ScriptCommand::Kind::dump_ab:
       case ScriptCommand::Kind::dump_flatten:
       case ScriptCommand::Kind::dump_sweep:
+      case ScriptCommand::Kind::dump_robustness:
         // The rest of the line, so paths may hold spaces.
         need_rest(c.kind == ScriptCommand::Kind::open ? "a scene (file or builtin:NAME)" : "a file path");
         c.arg = std::string(rest);
@@ -299,6 +302,11 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
       }
       case ScriptCommand::Kind::play:
         if (!parse_int(rest, c.x) || c.x < 1 || c.x > 100000) fail("play: expected FRAMES (an integer in 1..100000)");
+        break;
+      case ScriptCommand::Kind::robustness:
+        // The window's range (its Rays field); none: the window's count.
+        if (!rest.empty() && (!parse_int(rest, c.x) || c.x < 4 || c.x > (1 << 22)))
+          fail("robustness: expected N rays (an integer in 4..4194304) or nothing");
         break;
       case ScriptCommand::Kind::frames:
         if (!parse_int(rest, c.x) || c.x < 1 || c.x > 100000) fail("frames: expected N (an integer in 1..100000)");

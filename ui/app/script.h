@@ -38,12 +38,14 @@ struct ScriptCommand {
     dump_ab,        ///< arg: path; compares A with the current choice (B) on this view, writes the totals as JSON
     frames,         ///< x: frames; lets that many frames draw before the next command (no waiting on work)
     flatten,        ///< arg: instance ids ("0,2,5-9", "all"); predicts the flatten what-if on this view, waits
-    flatten_commit,  ///< commits the last prediction (its instances merged) and waits for the merged scene's build
-    dump_flatten,    ///< arg: path; the last prediction's figures as JSON
-    reload_shaders,  ///< arg: "" or a folder (then the shader override folder); rebuilds the shader programs
-    window,          ///< value: "open" | "close", arg: a panel's title (kPanelTitles); expands or collapses it
-    sweep,           ///< arg: parameters ("buckets=2,8 leaf=1,4"); runs the Cost of accuracy sweep on this view
-    dump_sweep,      ///< arg: path; waits for the sweep, writes its settings' figures as JSON
+    flatten_commit,   ///< commits the last prediction (its instances merged) and waits for the merged scene's build
+    dump_flatten,     ///< arg: path; the last prediction's figures as JSON
+    reload_shaders,   ///< arg: "" or a folder (then the shader override folder); rebuilds the shader programs
+    window,           ///< value: "open" | "close", arg: a panel's title (kPanelTitles); expands or collapses it
+    sweep,            ///< arg: parameters ("buckets=2,8 leaf=1,4"); runs the Cost of accuracy sweep on this view
+    dump_sweep,       ///< arg: path; waits for the sweep, writes its settings' figures as JSON
+    robustness,       ///< x: rays (0: the window's count); runs the Robustness window's lab on the shown scene
+    dump_robustness,  ///< arg: path; waits for the lab, writes its variants' figures as JSON
   };
   Kind kind = Kind::wait;
   int line = 0;        ///< 1-based line in the script file
