@@ -846,6 +846,15 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       fail_if(write_new_file(c.arg, json_text(doc, 2) + "\n"));
       return Status::done;
     }
+    case K::cancel:
+      // The Cancel button of the Structure, Cost of accuracy or Robustness window.
+      if (c.arg == "build")
+        app_.cancel_build();
+      else if (c.arg == "sweep")
+        sweeps_.cancel();
+      else
+        robustness_.cancel();
+      return Status::done;
     case K::robustness: {
       // As the panel's Run, once the structure chosen so far is shown (its own traversal is one row).
       if (!app_.settled()) return Status::again;

@@ -216,6 +216,19 @@ TEST(AppScript, RobustnessCommandTakesAnOptionalRayCount) {
   }
 }
 
+// `cancel build|sweep|robustness`: the Cancel button of one window.
+TEST(AppScript, CancelNamesTheWorkItStops) {
+  const auto cmds = parse_script("cancel build\ncancel sweep\ncancel robustness\n", "s.txt");
+  ASSERT_EQ(cmds.size(), 3u);
+  EXPECT_EQ(cmds[0].kind, K::cancel);
+  EXPECT_EQ(cmds[0].arg, "build");
+  EXPECT_EQ(cmds[2].arg, "robustness");
+  for (const char* text : {"cancel\n", "cancel all\n", "cancel sweep now\n"}) {
+    const std::string e = parse_error(text);
+    EXPECT_EQ(e.rfind("s.txt:1: cancel: expected build, sweep or robustness", 0), 0u) << text << "\ngot: " << e;
+  }
+}
+
 // `frames N` lets N frames draw (the GPU heatmap test watches a trace
 // progress across frames with it).
 TEST(AppScript, FramesCommandTakesACount) {

@@ -243,6 +243,25 @@ TEST(SweepWorker, ANewRequestSupersedesAndCancelStops) {
   EXPECT_LT(s->results.size(), 15u);
 }
 
+// A request shows at once as queued; a Cancel before its job starts leaves its snapshot cancelled
+// (the GUI script's dump-sweep waited for ever for a snapshot of a sweep that never ran).
+TEST(SweepWorker, ACancelBeforeTheJobStartsSaysCancelled) {
+  SweepWorker w;
+  const SweepRequest slow = small_request("builtin:soup?size=20000", "buckets=2,3,4,5,6,7,8,9,10,11,12,13,14,15,16");
+  const std::uint64_t a = w.request(slow);
+  const std::uint64_t b = w.request(slow);  // a is dropped or superseded; b queued or running
+  auto s = w.latest();
+  ASSERT_TRUE(s);
+  EXPECT_EQ(s->id, b);
+  EXPECT_EQ(s->structure, "bvh");
+  w.cancel();
+  ASSERT_TRUE(eventually([&] { return !w.busy(); }));
+  s = w.latest();
+  EXPECT_EQ(s->id, b) << "a's snapshot (" << a << ") replaced b's";
+  EXPECT_EQ(s->state, SweepSnapshot::State::cancelled);
+  EXPECT_LT(s->results.size(), 15u);
+}
+
 TEST(CalibratedBvh, BuildsWithTheMeasuredRatioAndJudgesBothTreesAlike) {
   const auto scene = scene_of("builtin:soup?size=3000");
   const SweepRequest r = small_request("builtin:soup?size=3000", "leaf=1");

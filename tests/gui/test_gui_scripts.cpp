@@ -1128,3 +1128,16 @@ TEST_F(GuiScript, RobustnessLabFindsWhatTheCommandLineFinds) {
   EXPECT_EQ(gui["variants"][3]["misses"], 0) << "watertight + padded slab missed";
   EXPECT_GT(gui["variants"][0]["misses"].get<int>(), 0) << "Moller-Trumbore missed nothing: the rays are not hard";
 }
+
+// `cancel sweep` is the Cost of accuracy window's Cancel: the sweep stops inside the setting being
+// measured and keeps what was measured; `dump-sweep` then says `cancelled` with fewer results than
+// settings. (24 settings over a 20,000-triangle teapot take seconds; the cancel comes a frame later.)
+TEST_F(GuiScript, CancelStopsASweepAndKeepsWhatItMeasured) {
+  const RunResult r =
+      run("open builtin:teapot?size=20000\nsweep buckets=2,4,8,16,32,exact leaf=1,2,4,8\ncancel sweep\ndump-sweep " +
+          path("cut.json").string() + "\n");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json cut = read_json(path("cut.json"));
+  EXPECT_EQ(cut["state"], "cancelled");
+  EXPECT_LT(cut["results"].size(), 24u);
+}

@@ -106,6 +106,7 @@ constexpr NamedKind kCommands[] = {
     {"dump-sweep", ScriptCommand::Kind::dump_sweep},
     {"robustness", ScriptCommand::Kind::robustness},
     {"dump-robustness", ScriptCommand::Kind::dump_robustness},
+    {"cancel", ScriptCommand::Kind::cancel},
 };
 
 }  // namespace
@@ -302,6 +303,11 @@ std::vector<ScriptCommand> parse_script(std::string_view text, const std::string
       }
       case ScriptCommand::Kind::play:
         if (!parse_int(rest, c.x) || c.x < 1 || c.x > 100000) fail("play: expected FRAMES (an integer in 1..100000)");
+        break;
+      case ScriptCommand::Kind::cancel:
+        c.arg = std::string(rest);
+        if (c.arg != "build" && c.arg != "sweep" && c.arg != "robustness")
+          fail("cancel: expected build, sweep or robustness");
         break;
       case ScriptCommand::Kind::robustness:
         // The window's range (its Rays field); none: the window's count.

@@ -46,6 +46,7 @@ struct ScriptCommand {
     dump_sweep,       ///< arg: path; waits for the sweep, writes its settings' figures as JSON
     robustness,       ///< x: rays (0: the window's count); runs the Robustness window's lab on the shown scene
     dump_robustness,  ///< arg: path; waits for the lab, writes its variants' figures as JSON
+    cancel,           ///< arg: "build" | "sweep" | "robustness"; that window's Cancel button
   };
   Kind kind = Kind::wait;
   int line = 0;        ///< 1-based line in the script file

@@ -209,11 +209,29 @@ namespace {
 
 LatestJobWorker<SweepRequest, std::shared_ptr<const SweepSnapshot>>::Hooks sweep_hooks() {
   LatestJobWorker<SweepRequest, std::shared_ptr<const SweepSnapshot>>::Hooks h;
+  // A request shows as running at once (a Cancel before it starts then has a snapshot to say so).
+  h.queued = [](std::uint64_t id, const SweepRequest& r, std::shared_ptr<const SweepSnapshot>& latest) {
+    auto snap = std::make_shared<SweepSnapshot>();
+    snap->id = id;
+    snap->structure = r.structure;
+    snap->params = r.params;
+    snap->stage = "queued";
+    latest = std::move(snap);
+  };
   h.store = [](std::uint64_t id, std::shared_ptr<const SweepSnapshot>&& s, bool superseded, bool newer_queued,
                std::shared_ptr<const SweepSnapshot>& latest) {
     // A superseded job's snapshots never replace a newer job's; its
     // own final "cancelled" snapshot is shown only if nothing newer is queued.
     if (!superseded || (!newer_queued && (!latest || latest->id <= id))) latest = std::move(s);
+  };
+  // Dropped before it started (cancelled, or replaced by a newer request): its snapshot says so.
+  h.dropped = [](std::uint64_t id, std::shared_ptr<const SweepSnapshot>& latest) {
+    if (latest && latest->id == id) {
+      auto snap = std::make_shared<SweepSnapshot>(*latest);
+      snap->state = SweepSnapshot::State::cancelled;
+      snap->stage.clear();
+      latest = std::move(snap);
+    }
   };
   return h;
 }
