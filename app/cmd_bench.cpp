@@ -521,7 +521,7 @@ int run_bench(BenchOptions o, const GlobalOptions& global) {
   }
   if (o.json) {
     j["machine"] = machine_json(all);
-    std::cout << json_text(j, 2) << '\n';
+    write_stdout(json_text(j, 2) + '\n');
     return exit_code;
   }
 

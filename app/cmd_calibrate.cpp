@@ -83,7 +83,7 @@ int run_calibrate(const CalibrateCliOptions& o, const GlobalOptions& global) {
   }
   if (o.json) {
     j["machine"] = machine_json(resolve_threads(o.threads));
-    std::cout << json_text(j, 2) << '\n';
+    write_stdout(json_text(j, 2) + '\n');
     return 0;
   }
   std::printf("ray-box slab test           %7.2f ns\n", c.ns_box);

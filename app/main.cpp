@@ -28,6 +28,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 namespace {
 
 /// Whether a lone argument names a scene rather than a mistyped subcommand:
@@ -201,6 +203,10 @@ int main(int argc, char** argv) {
   // the signal killing the process: the write's error is reported and the
   // output's temporary file removed, as for a full disk.
   std::signal(SIGXFSZ, SIG_IGN);
+  // Into a file or pipe, stdout keeps up to 1 MiB before writing: a write that fails then fails in a
+  // flush, whose reason is kept (flush_stdout, below). With glibc's 4 KiB buffer a table or JSON
+  // longer than that failed inside `<<`, and the reason (a full disk) was lost.
+  if (!isatty(STDOUT_FILENO)) std::setvbuf(stdout, nullptr, _IOFBF, std::size_t{1} << 20);
   const int code = run(argc, argv);
   // What went to stdout (tables, JSON) must have arrived: `bench --json >
   // full-disk/results.json` said nothing and exited 0 with the file cut short.

@@ -320,6 +320,8 @@ if [ -w /dev/full ]; then
   # With the reason, also where an earlier flush failed (glibc drops the buffer; a JSON line is flushed).
   for args in "info builtin:soup?size=20" "info builtin:soup?size=20 --json" \
     "bench builtin:soup?size=200 -s bvh --rays primary --size 8x8 -n 1 -j 1 --json" "--version" "--help" \
+    "bench builtin:soup?size=200 -s bvh,kdtree,grid --rays all --size 8x8 -n 1 -j 1 --json" \
+    "sweep builtin:soup?size=300 --param buckets=$(seq -s, 2 60) --size 8x8 -n 1 -j 1 --out $tmp/sweep-full" \
     "render --help"; do
     # shellcheck disable=SC2086
     "$accelviz" -q $args >/dev/full 2>"$tmp/stderr"
