@@ -63,7 +63,6 @@ const Figure kFigures[] = {
 };
 
 /// The structures sweep takes.
-const std::vector<std::string> kSweepStructures = {"bvh", "kdtree", "grid", "octree", "voxels"};
 
 /// A figure's chart against one parameter: sweep-FIGURE-vs-PARAM.png.
 std::string sweep_chart_name(std::string_view figure, std::string_view param) {
@@ -74,7 +73,7 @@ std::string sweep_chart_name(std::string_view figure, std::string_view param) {
 /// the only files of the folder it refuses, replaces or removes.
 OutputDirFiles sweep_files() {
   OutputDirFiles files{"sweep", {"sweep.csv", "sweep.json", "sweep-pareto.png"}};
-  for (const std::string& structure : kSweepStructures)
+  for (const std::string& structure : sweep_structures())
     for (const std::string& param : sweep_param_names(structure))
       for (const Figure& f : kFigures)
         if (const std::string name = sweep_chart_name(f.key, param);
@@ -397,7 +396,7 @@ Command add_sweep_command(CLI::App& parent, const GlobalOptions& global) {
                "setting, the Pareto front, CSV/JSON and charts");
   sub->add_option("SCENE", o->scene, "Scene file (.gltf, .glb, .obj) or builtin:NAME[?key=value&...]")->required();
   sub->add_option("--structure,-s", o->structure, "Structure to sweep: bvh, kdtree, grid, octree, voxels")
-      ->check(CLI::IsMember(kSweepStructures))
+      ->check(CLI::IsMember(sweep_structures()))
       ->capture_default_str();
   sub->add_option("--param,-p", o->params,
                   "NAME=V1,V2,... (repeatable; the cartesian product is swept). bvh: buckets (2..256 or exact), "

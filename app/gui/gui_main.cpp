@@ -162,6 +162,7 @@ class Gui final : public ScriptHost {
   std::string flatten_prediction_spec_;
   std::optional<std::uint64_t> flatten_wait_;         ///< script flatten / flatten-commit: the job waited for
   std::optional<std::uint64_t> sweep_wait_;           ///< script sweep: its request, which dump-sweep waits for
+  nlohmann::json sweep_context_;                      ///< script sweep: the scene, view and options it started from
   std::optional<std::uint64_t> lab_wait_;  ///< script robustness: its request, which dump-robustness waits for
   std::optional<SceneEffects> effects_;
   std::shared_ptr<const LoadedScene> effects_scene_;  ///< held: a freed scene's address may come back
@@ -825,7 +826,17 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       accuracy_.params = c.arg;
       accuracy_.params_for = app_.config().structure.name;
       sweep_wait_ = request_sweep();
-      if (!sweep_wait_) throw std::runtime_error("sweep: " + accuracy_.error);
+      if (!sweep_wait_) throw std::runtime_error(accuracy_.error);
+      // What each setting starts from (the labels name only the swept values), as dump-stats names it.
+      nlohmann::json options = nlohmann::json::object();
+      for (std::string_view key : structure_option_keys(app_.config().structure.name))
+        options[std::string(key)] = option_value(app_.config(), key);
+      sweep_context_ = {{"scene", app_.scene_spec()},
+                        {"camera", explicit_camera_spec(app_.camera())},  // render --camera takes it
+                        {"size", {{"width", accuracy_.width}, {"height", accuracy_.height}}},
+                        {"repeat", accuracy_.repeat},
+                        {"options", options},
+                        {"program", cli::program_json()}};
       return Status::done;
     }
     case K::dump_sweep: {
@@ -841,6 +852,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
                             {"ray_budget", accuracy_.ray_budget},
                             {"params", nlohmann::json::object()},
                             {"results", nlohmann::json::array()}};
+      doc.update(sweep_context_);
       for (const SweepParam& p : s->params) doc["params"][p.name] = p.values;
       for (const SweepResult& r : s->results) doc["results"].push_back(cli::sweep_result_json(r, accuracy_.ray_budget));
       fail_if(write_new_file(c.arg, json_text(doc, 2) + "\n"));
@@ -861,7 +873,7 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
       panels::request_window("Robustness", true);
       if (c.x > 0) robustness_panel_.rays = c.x;
       lab_wait_ = request_robustness();
-      if (!lab_wait_) throw std::runtime_error("robustness: no scene shown");
+      if (!lab_wait_) throw std::runtime_error("no scene shown");
       return Status::done;
     }
     case K::dump_robustness: {

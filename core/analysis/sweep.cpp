@@ -80,6 +80,11 @@ std::string setting_label(const SweepSetting& setting) {
   return s.empty() ? "default" : s;
 }
 
+const std::vector<std::string>& sweep_structures() {
+  static const std::vector<std::string> names{"bvh", "kdtree", "grid", "octree", "voxels"};
+  return names;
+}
+
 const std::vector<std::string>& sweep_param_names(std::string_view structure) {
   static const std::map<std::string, std::vector<std::string>, std::less<>> names{
       {"bvh", {"buckets", "splitter", "leaf", "ctrav", "cisect", "triangle"}},

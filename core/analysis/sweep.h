@@ -39,6 +39,11 @@ std::string setting_label(const SweepSetting& setting);
 /// Parameters a structure accepts (every structure also accepts "triangle").
 const std::vector<std::string>& sweep_param_names(std::string_view structure);
 
+/// The structures a sweep measures: bvh, kdtree, grid, octree, voxels (each
+/// setting is built over the scene's triangles; not tlas, whose instances
+/// those builds would flatten, nor brute force or Embree, which have no knobs).
+const std::vector<std::string>& sweep_structures();
+
 /// Parses "NAME=V1,V2,...". Throws std::invalid_argument on a missing '=' or an empty value.
 SweepParam parse_sweep_param(std::string_view text);
 

@@ -192,6 +192,8 @@ TEST(AppScript, SweepCommandIsCheckedForTheStructureChosen) {
            std::pair{"sweep\n", "s.txt:1: sweep: expected parameters, e.g. buckets=2,8 leaf=1,4"},
            std::pair{"sweep buckets=abc\n", "s.txt:1: sweep: sweep parameter buckets: bad value 'abc'"},
            std::pair{"structure grid\nsweep buckets=2,8\n", "s.txt:2: sweep: "},
+           std::pair{"structure tlas\nsweep triangle=fast,watertight\n",
+                     "s.txt:2: sweep: tlas is not swept (the sweep measures bvh, kdtree, grid, octree, voxels)"},
            std::pair{"dump-sweep\n", "s.txt:1: dump-sweep: expected a file path"},
        }) {
     const std::string e = parse_error(text);

@@ -1068,6 +1068,12 @@ TEST_F(GuiScript, CostOfAccuracySweepBuildsWhatTheCommandLineBuilds) {
   EXPECT_EQ(gui["triangles"], 2256);
   EXPECT_EQ(gui["rays"], 160 * 120);  // the panel's default ray size over the view
   EXPECT_EQ(gui["params"], nlohmann::json::parse(R"({"buckets": ["2", "8"], "leaf": ["1", "4"]})"));
+  // What it started from: the scene, the view (as render --camera takes it), the structure's options.
+  EXPECT_EQ(gui["scene"], kTeapot);
+  const std::string camera = gui["camera"].get<std::string>();
+  EXPECT_EQ(std::count(camera.begin(), camera.end(), ','), 6) << camera;
+  EXPECT_EQ(gui["options"]["splitter"], "binned");
+  EXPECT_EQ(gui["program"]["line"].get<std::string>().rfind("accelviz ", 0), 0u) << gui["program"];
   // A later dump-sweep writes the same sweep (a structure change starts none).
   nlohmann::json again = read_json(path("again.json"));
   EXPECT_EQ(again["results"].size(), gui["results"].size());

@@ -15,6 +15,14 @@
 namespace accelviz {
 
 std::vector<SweepParam> parse_sweep_params_text(std::string_view structure, std::string_view text) {
+  // As `accelviz sweep --structure` takes them: a tlas swept here measured one instance over the
+  // flattened triangles, not the two-level structure shown.
+  const std::vector<std::string>& sweepable = sweep_structures();
+  if (std::find(sweepable.begin(), sweepable.end(), structure) == sweepable.end()) {
+    std::string names;
+    for (const std::string& s : sweepable) names += (names.empty() ? "" : ", ") + s;
+    throw std::invalid_argument(std::string(structure) + " is not swept (the sweep measures " + names + ")");
+  }
   std::vector<SweepParam> params;
   std::size_t i = 0;
   while (i < text.size()) {
