@@ -144,15 +144,21 @@ int run(int argc, char** argv) {
     }
     // ACCELVIZ_PARSE_ONLY=1: the command line is read and checked as above, then nothing runs
     // (tests/cli/docs_commands.sh checks every command the documentation prints this way).
-    if (const char* only = std::getenv("ACCELVIZ_PARSE_ONLY"); only && std::string(only) == "1") return 0;
+    const char* parse_only_env = std::getenv("ACCELVIZ_PARSE_ONLY");
+    const bool parse_only = parse_only_env && std::string(parse_only_env) == "1";
+    const auto parsed_only = [] {
+      std::fprintf(stderr, "accelviz: ACCELVIZ_PARSE_ONLY=1: the command line parses; nothing was run\n");
+      return 0;
+    };
     for (const cli::Command& c : commands)
-      if (c.app->parsed()) return c.run();
+      if (c.app->parsed()) return parse_only ? parsed_only() : c.run();
     if (!scene_arg.empty() && !looks_like_scene(scene_arg)) {
       std::string names;
       for (const cli::Command& c : commands) names += (names.empty() ? "" : ", ") + c.app->get_name();
       throw cli::UsageError("'" + scene_arg + "' is neither a subcommand (" + names +
                             ") nor a scene (.gltf/.glb/.obj file or builtin:NAME)");
     }
+    if (parse_only) return parsed_only();
     const bool want_window = !scene_arg.empty() || !script_arg.empty();
 #ifdef ACCELVIZ_HAVE_UI
     if (display_available()) {
