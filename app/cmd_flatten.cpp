@@ -58,6 +58,7 @@ int run_flatten(const FlattenOptions& o, const GlobalOptions& global) {
   if (o.json) {
     nlohmann::json j = {{"scene", o.scene}};
     j.update(flatten_what_if_json(w));
+    j["program"] = program_json();
     print_json_line(j);
     return 0;
   }

@@ -124,7 +124,8 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
                             {"rays", rays.size()},
                             {"seed", o.seed},
                             {"rebuilds", r.rebuilds},
-                            {"per_frame", frames}};
+                            {"per_frame", frames},
+                            {"program", program_json()}};
   out.add("refit.json", json_text(j, 2) + "\n");
 
   ChartSeries refit{"refitted", {}, {}, {}, {214, 39, 40}, true, true, 2};

@@ -108,6 +108,7 @@ int run_robustness(const RobustnessOptions& o, const GlobalOptions& global) {
     nlohmann::json j = {{"scene", o.scene}, {"seed", o.seed}};
     j.update(lab_result_json(r));
     j["not_checked"] = refused ? nlohmann::json(refusal) : nlohmann::json(nullptr);
+    j["program"] = program_json();
     print_json_line(j);
     return refused ? 1 : 0;
   }

@@ -77,6 +77,7 @@ int run_trace(const TraceOptions& o, const GlobalOptions& global) {
       {"trace_ms", trace_ms},
       {"mrays_per_s", trace_ms > 0.0 ? static_cast<double>(rays.size()) / (trace_ms * 1e3) : 0.0},
       {"out", absolute_path(o.out)},
+      {"program", program_json()},
   };
   print_json_line(j);
   return 0;

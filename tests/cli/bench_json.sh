@@ -87,6 +87,21 @@ assert bvh["build"]["nodes"] > 0 and bvh["build"]["sah_cost"] > 0
 assert bvh["rays"]["primary"]["closest_nodes_per_ray"] > 0
 print("bench json ok")
 PY
+# The other outputs with timings name the same build: trace, robustness, flatten and refit.json.
+"$accelviz" -q rays 'builtin:soup?size=200' --size 8x8 --out "$tmp/p.rays" >/dev/null
+"$accelviz" -q trace 'builtin:soup?size=200' --rays "$tmp/p.rays" --out "$tmp/p.hits" -j 1 >"$tmp/trace.json"
+"$accelviz" -q robustness 'builtin:soup?size=200' --rays 200 -j 1 --json >"$tmp/lab.json"
+"$accelviz" -q flatten 'builtin:forest?size=2000' --instances 0 --size 8x8 -j 1 --json >"$tmp/flatten.json"
+"$accelviz" -q refit 'builtin:soup?size=200' --frames 2 --size 8x8 -j 1 --out "$tmp/refit" >/dev/null
+python3 - "$tmp/version.txt" "$tmp/trace.json" "$tmp/lab.json" "$tmp/flatten.json" "$tmp/refit/refit.json" <<'PY'
+import json, sys
+version = open(sys.argv[1]).read().strip()
+for path in sys.argv[2:]:
+    text = open(path).read().strip().splitlines()[-1] if not path.endswith("refit.json") else open(path).read()
+    p = json.loads(text)["program"]
+    assert p["line"] == version and p["commit"] in version, (path, p, version)
+print("program named by trace, robustness, flatten, refit: ok")
+PY
 
 # With Embree: ratios and Embree's binary-BVH SAH beside ours.
 # (The help goes to a file first: with pipefail, `grep -q` closing the pipe
