@@ -1,9 +1,10 @@
 #include "app/render_raster.h"
 
+#include <stdexcept>
+
+#include "app/cli_common.h"
 #include "core/analysis/heatmap.h"
 #include "core/query/camera.h"
-
-#include <stdexcept>
 
 #ifdef ACCELVIZ_HAVE_UI
 #include "core/accel/bvh/bvh.h"
@@ -110,7 +111,8 @@ void render_raster(const Scene& scene, const Accelerator& accel, const Camera& c
 
   renderer.render(view, size.width, size.height);
   const Rgba8Image pixels = renderer.read_pixels();
-  const SaveResult saved = write_screenshot_png(out, pixels, force);
+  const std::vector<PngText> text{{"Software", version_line()}};  // the build, as every PNG of render's
+  const SaveResult saved = write_screenshot_png(out, pixels, force, text);
   if (!saved) throw std::runtime_error(saved.error);
   figures["boxes"] = box_count;
   figures["view"] = "raster";

@@ -13,6 +13,7 @@ echo "$out"
 [ "$(sed -n 1p <<<"$out")" = "$tmp/cmp-a.png" ] || { echo "FAIL: A path"; exit 1; }
 [ "$(sed -n 2p <<<"$out")" = "$tmp/cmp-b.png" ] || { echo "FAIL: B path"; exit 1; }
 [ "$(sed -n 3p <<<"$out")" = "$tmp/cmp-diff.png" ] || { echo "FAIL: diff path"; exit 1; }
+python3 "$2/tests/support/png_software.py" "$("$accelviz" --version)" "$tmp"/cmp-{a,b,diff}.png || { echo "FAIL: the trio without Software text"; exit 1; }
 python3 - "$tmp" "$(sed -n 4p <<<"$out")" <<'PY'
 import json, struct, sys
 d = sys.argv[1]

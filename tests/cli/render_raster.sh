@@ -13,6 +13,7 @@ export GALLIUM_DRIVER=llvmpipe
 out=$("$accelviz" -q render "$scene" --view raster --depth 3 --ray-pixel 80,60 --size 160x120 --out "$tmp/r.png")
 echo "$out"
 json=$(sed -n 2p <<<"$out")
+python3 "$2/tests/support/png_software.py" "$("$accelviz" --version)" "$tmp/r.png" || { echo "FAIL: the raster PNG without Software text"; exit 1; }
 python3 - "$tmp/r.png" "$json" <<'PY'
 import json, struct, sys, zlib
 png = open(sys.argv[1], "rb").read()

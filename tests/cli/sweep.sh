@@ -18,6 +18,8 @@ for f in sweep.csv sweep.json sweep-pareto.png sweep-sah_cost-vs-buckets.png swe
          sweep-nodes_per_ray-vs-triangle.png sweep-build_ms-vs-buckets.png sweep-total_ms-vs-triangle.png; do
   [ -s "$out/$f" ] || fail "missing $f"
 done
+# The charts name the build that drew them (Software), as render's PNGs do.
+python3 "$2/tests/support/png_software.py" "$("$bin" --version)" "$out"/sweep-*.png || fail "a chart without the program's Software text"
 
 python3 - "$out" <<'PY'
 import csv, json, struct, sys, zlib, glob, os

@@ -12,7 +12,8 @@ RgbImage to_rgb(const Rgba8Image& frame) {
   return out;
 }
 
-SaveResult write_screenshot_png(const std::filesystem::path& path, const Rgba8Image& image, bool overwrite) {
+SaveResult write_screenshot_png(const std::filesystem::path& path, const Rgba8Image& image, bool overwrite,
+                                std::span<const PngText> text) {
   const std::string name = path.string();
   if (image.empty() || image.pixels.size() != static_cast<std::size_t>(image.width) * image.height * 4) {
     return {false, name + ": nothing to write (empty image)"};
@@ -21,7 +22,7 @@ SaveResult write_screenshot_png(const std::filesystem::path& path, const Rgba8Im
   // core's writer (the one every PNG of the project goes through); its
   // refusal of an existing file is said this function's way.
   try {
-    write_png(name, rgb, overwrite);
+    write_png(name, rgb, overwrite, text);
   } catch (const FileExistsError&) {
     return {false, name + ": exists (not overwritten)"};
   } catch (const std::runtime_error& e) {

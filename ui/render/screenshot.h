@@ -22,7 +22,8 @@ RgbImage to_rgb(const Rgba8Image& frame);
 /// dropped). Never replaces an existing file unless `overwrite`: the file is
 /// created exclusively, so a file that appears meanwhile is not clobbered
 /// either. The error for an existing file is "<file>: exists (not overwritten)".
-SaveResult write_screenshot_png(const std::filesystem::path& path, const Rgba8Image& image, bool overwrite = false);
+SaveResult write_screenshot_png(const std::filesystem::path& path, const Rgba8Image& image, bool overwrite = false,
+                                std::span<const PngText> text = {});
 
 /// A free name "<stem>-NNN.png" in `dir` (first unused number from 1), for
 /// F12-style screenshots that must never overwrite.
