@@ -64,6 +64,19 @@ void catch_quit_signals() {
   for (const int sig : {SIGTERM, SIGHUP, SIGINT}) sigaction(sig, &sa, nullptr);
 }
 
+// A background job's snapshot (sweep, robustness lab: their State enums share these four names).
+template <class State>
+const char* job_state_name(State s) {
+  static const char* const names[] = {"running", "done", "cancelled", "failed"};
+  return names[static_cast<int>(s)];
+}
+
+/// Job `id` (or a newer one) has published its last snapshot: done, cancelled or failed.
+template <class Snapshot>
+bool job_ended(const Snapshot* s, std::uint64_t id) {
+  return s && s->id >= id && s->state != Snapshot::State::running;
+}
+
 // Dropped file names arrive in a GLFW callback; they are queued here and
 // opened by the main loop (one window, so one queue).
 std::vector<std::string>* g_dropped = nullptr;
@@ -842,10 +855,9 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
     case K::dump_sweep: {
       if (!sweep_wait_) throw std::runtime_error("no sweep run yet (use sweep PARAMS first)");
       const std::shared_ptr<const SweepSnapshot> s = sweeps_.latest();
-      if (!s || s->id < *sweep_wait_ || s->state == SweepSnapshot::State::running) return Status::again;
-      const char* const states[] = {"running", "done", "cancelled", "failed"};
+      if (!job_ended(s.get(), *sweep_wait_)) return Status::again;
       nlohmann::json doc = {{"structure", s->structure},
-                            {"state", states[static_cast<int>(s->state)]},
+                            {"state", job_state_name(s->state)},
                             {"error", s->error},
                             {"triangles", s->triangles},
                             {"rays", s->rays},
@@ -879,12 +891,12 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
     case K::dump_robustness: {
       if (!lab_wait_) throw std::runtime_error("no robustness run yet (use robustness [N] first)");
       const std::shared_ptr<const RobustnessSnapshot> s = robustness_.latest();
-      if (!s || s->id < *lab_wait_ || s->state == RobustnessSnapshot::State::running) return Status::again;
-      const char* const states[] = {"running", "done", "cancelled", "failed"};
+      if (!job_ended(s.get(), *lab_wait_)) return Status::again;
       nlohmann::json doc = {{"scene", s->scene},
                             {"structure", s->structure},
-                            {"state", states[static_cast<int>(s->state)]},
-                            {"error", s->error}};
+                            {"state", job_state_name(s->state)},
+                            {"error", s->error},
+                            {"program", cli::program_json()}};
       if (s->result) doc.update(cli::lab_result_json(*s->result));
       fail_if(write_new_file(c.arg, json_text(doc, 2) + "\n"));
       return Status::done;

@@ -27,6 +27,14 @@ std::string parse_error(const std::string& text) {
   return "(no error)";
 }
 
+/// Each script of `cases` fails to parse with a message starting with its expected text.
+void expect_parse_errors(std::initializer_list<std::pair<const char*, const char*>> cases) {
+  for (const auto& [text, expected] : cases) {
+    const std::string e = parse_error(text);
+    EXPECT_EQ(e.rfind(expected, 0), 0u) << "script: " << text << "\ngot: " << e;
+  }
+}
+
 // A host that records commands and answers from a function.
 struct FakeHost : ScriptHost {
   std::vector<std::string> log;
@@ -139,18 +147,15 @@ TEST(AppScript, InsightRegionAndABCommands) {
   EXPECT_EQ(cmds[2].kind, K::dump_ab);
   EXPECT_EQ(cmds[2].arg, "/tmp/ab out.json");
   EXPECT_EQ(command_name(K::select_region), "select-region");
-  for (const auto& [text, expected] : {
-           std::pair{"select-region 1 2 3\n", "s.txt:1: select-region: expected X0 Y0 X1 Y1"},
-           std::pair{"select-region 1 2 3 4 5\n", "s.txt:1: select-region: expected X0 Y0 X1 Y1"},
-           std::pair{"select-region 1 -2 3 4\n", "s.txt:1: select-region: expected X0 Y0 X1 Y1"},
-           std::pair{"select-region 5 2 5 4\n", "s.txt:1: select-region: the rectangle is empty"},
-           std::pair{"pin-a now\n", "s.txt:1: pin-a: takes no argument"},
-           std::pair{"dump-ab\n", "s.txt:1: dump-ab: expected a file path"},
-           std::pair{"set xray maybe\n", "s.txt:1: set xray: expected on or off"},
-       }) {
-    const std::string e = parse_error(text);
-    EXPECT_EQ(e.rfind(expected, 0), 0u) << "script: " << text << "\ngot: " << e;
-  }
+  expect_parse_errors({
+      {"select-region 1 2 3\n", "s.txt:1: select-region: expected X0 Y0 X1 Y1"},
+      {"select-region 1 2 3 4 5\n", "s.txt:1: select-region: expected X0 Y0 X1 Y1"},
+      {"select-region 1 -2 3 4\n", "s.txt:1: select-region: expected X0 Y0 X1 Y1"},
+      {"select-region 5 2 5 4\n", "s.txt:1: select-region: the rectangle is empty"},
+      {"pin-a now\n", "s.txt:1: pin-a: takes no argument"},
+      {"dump-ab\n", "s.txt:1: dump-ab: expected a file path"},
+      {"set xray maybe\n", "s.txt:1: set xray: expected on or off"},
+  });
 }
 
 // `window open|close TITLE`: a panel by its title (with spaces), checked
@@ -164,15 +169,12 @@ TEST(AppScript, WindowCommandNamesAPanel) {
   EXPECT_EQ(cmds[1].value, "close");
   EXPECT_EQ(cmds[1].arg, "Tree");
   EXPECT_EQ(command_name(K::window), "window");
-  for (const auto& [text, expected] : {
-           std::pair{"window\n", "s.txt:1: window: expected open|close TITLE"},
-           std::pair{"window show Tree\n", "s.txt:1: window: expected open|close TITLE"},
-           std::pair{"window open\n", "s.txt:1: window: no panel titled '' (valid: Scene, Structure"},
-           std::pair{"window open tree\n", "s.txt:1: window: no panel titled 'tree' (valid: Scene, Structure"},
-       }) {
-    const std::string e = parse_error(text);
-    EXPECT_EQ(e.rfind(expected, 0), 0u) << "script: " << text << "\ngot: " << e;
-  }
+  expect_parse_errors({
+      {"window\n", "s.txt:1: window: expected open|close TITLE"},
+      {"window show Tree\n", "s.txt:1: window: expected open|close TITLE"},
+      {"window open\n", "s.txt:1: window: no panel titled '' (valid: Scene, Structure"},
+      {"window open tree\n", "s.txt:1: window: no panel titled 'tree' (valid: Scene, Structure"},
+  });
 }
 
 // `sweep PARAMS` is checked for the structure the script has chosen by then, as the Cost of
@@ -188,17 +190,14 @@ TEST(AppScript, SweepCommandIsCheckedForTheStructureChosen) {
   EXPECT_EQ(cmds[3].arg, "a b.json");
   EXPECT_EQ(command_name(K::sweep), "sweep");
   EXPECT_EQ(command_name(K::dump_sweep), "dump-sweep");
-  for (const auto& [text, expected] : {
-           std::pair{"sweep\n", "s.txt:1: sweep: expected parameters, e.g. buckets=2,8 leaf=1,4"},
-           std::pair{"sweep buckets=abc\n", "s.txt:1: sweep: sweep parameter buckets: bad value 'abc'"},
-           std::pair{"structure grid\nsweep buckets=2,8\n", "s.txt:2: sweep: "},
-           std::pair{"structure tlas\nsweep triangle=fast,watertight\n",
-                     "s.txt:2: sweep: tlas is not swept (the sweep measures bvh, kdtree, grid, octree, voxels)"},
-           std::pair{"dump-sweep\n", "s.txt:1: dump-sweep: expected a file path"},
-       }) {
-    const std::string e = parse_error(text);
-    EXPECT_EQ(e.rfind(expected, 0), 0u) << "script: " << text << "\ngot: " << e;
-  }
+  expect_parse_errors({
+      {"sweep\n", "s.txt:1: sweep: expected parameters, e.g. buckets=2,8 leaf=1,4"},
+      {"sweep buckets=abc\n", "s.txt:1: sweep: sweep parameter buckets: bad value 'abc'"},
+      {"structure grid\nsweep buckets=2,8\n", "s.txt:2: sweep: "},
+      {"structure tlas\nsweep triangle=fast,watertight\n",
+       "s.txt:2: sweep: tlas is not swept (the sweep measures bvh, kdtree, grid, octree, voxels)"},
+      {"dump-sweep\n", "s.txt:1: dump-sweep: expected a file path"},
+  });
 }
 
 // `robustness [N]`: the Robustness window's ray count (its field's range) or none (the window's).
@@ -211,11 +210,11 @@ TEST(AppScript, RobustnessCommandTakesAnOptionalRayCount) {
   EXPECT_EQ(cmds[2].kind, K::dump_robustness);
   EXPECT_EQ(cmds[2].arg, "lab.json");
   EXPECT_EQ(command_name(K::dump_robustness), "dump-robustness");
-  for (const char* text : {"robustness 3\n", "robustness 4194305\n", "robustness many\n", "robustness 10 20\n"}) {
-    const std::string e = parse_error(text);
-    EXPECT_EQ(e.rfind("s.txt:1: robustness: expected N rays (an integer in 4..4194304) or nothing", 0), 0u)
-        << text << "\ngot: " << e;
-  }
+  const char* const rays = "s.txt:1: robustness: expected N rays (an integer in 4..4194304) or nothing";
+  expect_parse_errors({{"robustness 3\n", rays},
+                       {"robustness 4194305\n", rays},
+                       {"robustness many\n", rays},
+                       {"robustness 10 20\n", rays}});
 }
 
 // `cancel build|sweep|robustness`: the Cancel button of one window.
@@ -225,10 +224,8 @@ TEST(AppScript, CancelNamesTheWorkItStops) {
   EXPECT_EQ(cmds[0].kind, K::cancel);
   EXPECT_EQ(cmds[0].arg, "build");
   EXPECT_EQ(cmds[2].arg, "robustness");
-  for (const char* text : {"cancel\n", "cancel all\n", "cancel sweep now\n"}) {
-    const std::string e = parse_error(text);
-    EXPECT_EQ(e.rfind("s.txt:1: cancel: expected build, sweep or robustness", 0), 0u) << text << "\ngot: " << e;
-  }
+  const char* const which = "s.txt:1: cancel: expected build, sweep or robustness";
+  expect_parse_errors({{"cancel\n", which}, {"cancel all\n", which}, {"cancel sweep now\n", which}});
 }
 
 // `frames N` lets N frames draw (the GPU heatmap test watches a trace
