@@ -120,7 +120,7 @@ int run(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     // --help and --version exit 0; every real parse error is a usage error (2). Their text goes
-    // through flush_stdout, which keeps a failed write's reason (CLI11's own std::endl flush would
+    // through write_stdout, which keeps a failed write's reason (CLI11's own std::endl flush would
     // fail first, glibc drop the buffer, and main's last flush succeed with no reason to tell).
     std::ostringstream out;
     const int code = app.exit(e, out, std::cerr);
