@@ -17,6 +17,7 @@
 
 #include "app/build_info.h"
 #include "core/accel/embree_backend.h"
+#include "core/analysis/heatmap.h"
 #include "core/analysis/sah.h"
 #include "core/query/camera.h"
 #include "core/scene/effects.h"
@@ -495,6 +496,10 @@ std::string version_line() {
 
 void print_json_line(const nlohmann::json& j) {
   write_stdout(json_text(j) + '\n');
+}
+
+PngText software_png_text() {
+  return {"Software", version_line()};
 }
 
 void print_picture_line(nlohmann::json figures) {

@@ -22,6 +22,7 @@
 namespace accelviz {
 struct SweepResult;  // core/analysis/sweep.h
 struct LabResult;    // core/analysis/robustness_lab.h
+struct PngText;      // core/analysis/heatmap.h
 }
 
 namespace accelviz::cli {
@@ -235,6 +236,9 @@ nlohmann::json lab_result_json(const LabResult& r);
 
 /// One-line JSON on stdout, flushed (animate streams a line per frame).
 void print_json_line(const nlohmann::json& j);
+
+/// The PNG text naming the build that drew a picture: {"Software", version_line()}.
+PngText software_png_text();
 
 /// print_json_line of a picture's figures with the `program` that drew it.
 void print_picture_line(nlohmann::json figures);

@@ -143,7 +143,7 @@ int run_refit(const RefitCliOptions& o, const GlobalOptions& global) {
     ms_build.x.push_back(x), ms_build.y.push_back(f.rebuild_ms);
   }
   const auto chart = [&](const std::string& name, const RgbImage& img) {
-    out.add(name, encode_png(img, (fs::path(o.out) / name).string(), {{PngText{"Software", version_line()}}}));
+    out.add(name, encode_png(img, (fs::path(o.out) / name).string(), {{software_png_text()}}));
   };
   ChartOptions c;
   c.x_label = "frame";

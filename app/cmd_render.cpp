@@ -107,7 +107,7 @@ std::string render_caption(const RenderOptions& o) {
 
 /// The text a heatmap's PNG carries: the command that draws it and the program.
 std::vector<PngText> png_text_of(const RenderOptions& o) {
-  return {{"Description", render_caption(o)}, {"Software", version_line()}};
+  return {{"Description", render_caption(o)}, software_png_text()};
 }
 
 /// --ray-pixel "X,Y".

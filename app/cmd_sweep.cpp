@@ -309,7 +309,7 @@ int run_sweep_command(const SweepCliOptions& o, const GlobalOptions& global) {
 
   std::vector<std::string> charts;
   auto chart = [&](const std::string& name, const RgbImage& img) {
-    out.add(name, encode_png(img, (fs::path(o.out) / name).string(), {{PngText{"Software", version_line()}}}));
+    out.add(name, encode_png(img, (fs::path(o.out) / name).string(), {{software_png_text()}}));
     charts.push_back(name);
   };
   chart("sweep-pareto.png", pareto_chart(results, front, o.ray_budget, o.scene, !probes.empty()));

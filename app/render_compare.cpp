@@ -286,7 +286,7 @@ int run_render_compare(const CompareJob& job, const GlobalOptions& global) {
     rgb_diff = add_caption(rgb_diff, caption_diff);
   }
   // The trio all or nothing: a failure on the second image left a mixed old and new set.
-  const std::vector<PngText> text{{"Software", version_line()}};  // the build, as every PNG of render's
+  const std::vector<PngText> text{software_png_text()};
   write_output_set({{paths.a, encode_png(rgb[0], paths.a, text)},
                     {paths.b, encode_png(rgb[1], paths.b, text)},
                     {paths.diff, encode_png(rgb_diff, paths.diff, text)}},

@@ -111,7 +111,7 @@ void render_raster(const Scene& scene, const Accelerator& accel, const Camera& c
 
   renderer.render(view, size.width, size.height);
   const Rgba8Image pixels = renderer.read_pixels();
-  const std::vector<PngText> text{{"Software", version_line()}};  // the build, as every PNG of render's
+  const std::vector<PngText> text{software_png_text()};
   const SaveResult saved = write_screenshot_png(out, pixels, force, text);
   if (!saved) throw std::runtime_error(saved.error);
   figures["boxes"] = box_count;
