@@ -5,10 +5,14 @@
 #   1b. libFuzzer targets for the loaders, bounded time (skip with ACCELVIZ_SKIP_FUZZ=1).
 #   1c. A build without the renderer on the core's scalar code paths
 #      (ACCELVIZ_BUILD_UI=OFF, ACCELVIZ_NO_SIMD: binning, box and triangle
-#      tests without SSE2/AVX2): core and CLI tests (skip with
-#      ACCELVIZ_SKIP_NOSIMD=1).
-#   2. Debug + AddressSanitizer + UndefinedBehaviorSanitizer build, whole suite
-#      again (skip with ACCELVIZ_SKIP_SANITIZERS=1 for a quick local run).
+#      tests without SSE2/AVX2): the core tests of the BVH and what runs on
+#      it (skip with ACCELVIZ_SKIP_NOSIMD=1).
+#   2. Debug + AddressSanitizer + UndefinedBehaviorSanitizer build without the
+#      renderer (preset asan): core, app logic and command-line tests again
+#      (skip with ACCELVIZ_SKIP_SANITIZERS=1 for a quick local run). With
+#      ACCELVIZ_SANITIZE_UI=1 it is preset asan-ui instead: also the renderer,
+#      the GL tests and the GUI scripts under the sanitizers (about 10 more
+#      minutes on 2 cores, which CI's 30-minute budget leaves out).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -35,17 +39,19 @@ if [ "${ACCELVIZ_SKIP_FUZZ:-0}" != "1" ]; then
 fi
 
 if [ "${ACCELVIZ_SKIP_NOSIMD:-0}" != "1" ]; then
-  phase "no-renderer build on the scalar code paths (preset nosimd): core and CLI tests"
+  phase "no-renderer build on the scalar code paths (preset nosimd): the BVH's core tests"
   cmake --preset nosimd >/dev/null
   cmake --build --preset nosimd -j "$jobs"
   ctest --preset nosimd -j "$jobs"
 fi
 
 if [ "${ACCELVIZ_SKIP_SANITIZERS:-0}" != "1" ]; then
-  phase "asan+ubsan build"
-  cmake --preset asan >/dev/null
-  cmake --build --preset asan -j "$jobs"
-  phase "asan+ubsan tests"
-  ctest --preset asan -j "$jobs"
+  asan=asan
+  [ "${ACCELVIZ_SANITIZE_UI:-0}" = "1" ] && asan=asan-ui
+  phase "asan+ubsan build (preset $asan)"
+  cmake --preset "$asan" >/dev/null
+  cmake --build --preset "$asan" -j "$jobs"
+  phase "asan+ubsan tests (preset $asan)"
+  ctest --preset "$asan" -j "$jobs"
 fi
 phase "done"

@@ -1,5 +1,9 @@
 #include "core/accel/embree_backend.h"
 
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#include <cpuid.h>
+#endif
+
 namespace accelviz {
 
 std::string_view embree_quality_name(EmbreeQuality q) {
@@ -71,6 +75,15 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+// LZCNT (CPUID 0x80000001, ECX bit 5; AMD calls it ABM). GCC's
+// __builtin_cpu_supports knows "lzcnt", clang 14's does not, so ask CPUID.
+bool cpu_has_lzcnt() {
+  unsigned a = 0, b = 0, c = 0, d = 0;
+  return __get_cpuid(0x80000001u, &a, &b, &c, &d) != 0 && (c & (1u << 5)) != 0;
+}
+#endif
+
 }  // namespace
 
 std::string_view embree_version() {
@@ -91,7 +104,7 @@ bool embree_cpu_has(EmbreeIsa isa) {
       return __builtin_cpu_supports("avx");
     case EmbreeIsa::avx2:
       return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") &&
-             __builtin_cpu_supports("bmi2") && __builtin_cpu_supports("lzcnt");
+             __builtin_cpu_supports("bmi2") && cpu_has_lzcnt();
     case EmbreeIsa::avx512:
       return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512cd") &&
              __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") &&

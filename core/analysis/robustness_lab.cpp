@@ -173,7 +173,10 @@ std::vector<LabRay> lab_rays(std::span<const Triangle> triangles, std::size_t co
     // Non-degenerate triangles only, a few tries.
     const Triangle* t = &triangles[r.below(triangles.size())];
     for (int k = 0; k < 8 && !(t->area() > 0.0f); ++k) t = &triangles[r.below(triangles.size())];
-    const glm::vec3 outside = centre + r.unit_vector() * radius * r.uniform(0.6f, 1.5f);
+    // One draw per statement: the order of two draws in one expression is
+    // unspecified (GCC and Clang differ), and the rays must not depend on it.
+    const float reach = r.uniform(0.6f, 1.5f);
+    const glm::vec3 outside = centre + r.unit_vector() * radius * reach;
     glm::vec3 o, d;
     switch (family) {
       case LabFamily::vertex:

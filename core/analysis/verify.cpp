@@ -120,7 +120,13 @@ std::vector<Ray> verify_rays(std::span<const Triangle> triangles, std::size_t co
   const Camera cam = frame_bounds(b, 1.0f);
   const bool have_tris = !triangles.empty();
 
-  auto outside_point = [&](Rng& r) { return centre + r.unit_vector() * (radius * r.uniform(0.6f, 1.5f)); };
+  // One draw per statement here and below: the order of two draws in one
+  // expression or argument list is unspecified (GCC and Clang differ), and a
+  // seed must give the same rays whatever compiled the program.
+  auto outside_point = [&](Rng& r) {
+    const float reach = r.uniform(0.6f, 1.5f);
+    return centre + r.unit_vector() * (radius * reach);
+  };
   auto vertex = [&](const Triangle& t, std::size_t i) { return i == 0 ? t.v0 : i == 1 ? t.v1 : t.v2; };
 
   for (std::size_t i = 0; i < count; ++i) {
@@ -157,8 +163,7 @@ std::vector<Ray> verify_rays(std::span<const Triangle> triangles, std::size_t co
         const int axis = static_cast<int>(r.below(3));
         const glm::vec3 target = r.uniform() < 0.5 ? vertex(t, r.below(3)) : in_box(r, b.lo, b.hi);
         const float sign = r.uniform() < 0.5 ? 1.0f : -1.0f;
-        d = glm::vec3(r.uniform() < 0.5 ? 0.0f : -0.0f, r.uniform() < 0.5 ? 0.0f : -0.0f,
-                      r.uniform() < 0.5 ? 0.0f : -0.0f);
+        for (int k = 0; k < 3; ++k) d[k] = r.uniform() < 0.5 ? 0.0f : -0.0f;
         d[axis] = sign * unit;
         o = target;
         o[axis] = sign > 0 ? wide_lo[axis] : wide_hi[axis];
@@ -181,7 +186,9 @@ std::vector<Ray> verify_rays(std::span<const Triangle> triangles, std::size_t co
       }
     } else {
       o = cam.position;
-      const Ray cr = camera_ray(cam, static_cast<float>(r.uniform()), static_cast<float>(r.uniform()), 1.0f);
+      const float px = r.uniform();
+      const float py = r.uniform();
+      const Ray cr = camera_ray(cam, px, py, 1.0f);
       o = cr.origin;
       d = cr.direction * unit;
     }

@@ -2,7 +2,7 @@
 # Differential test at scale: `accelviz verify` over several small procedural
 # scenes on every structure, at least 1,000,000 rays in all (Release). Each
 # scene must print "-> OK". ACCELVIZ_VERIFY_SCALE (default 1) scales the ray
-# counts down for slow builds (the AddressSanitizer run uses 0.1).
+# counts down for slow builds (the AddressSanitizer run uses 0.05).
 set -euo pipefail
 accelviz="$(realpath "$1")"
 scale="${ACCELVIZ_VERIFY_SCALE:-1}"

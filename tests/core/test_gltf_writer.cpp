@@ -247,8 +247,8 @@ TEST_F(GltfWriter, GlbLayoutAndAccessorBounds) {
   const json& idx = doc["accessors"][1];
   EXPECT_EQ(idx["componentType"], 5125);
   EXPECT_EQ(idx["count"], 6);
-  EXPECT_EQ(idx["min"], json({0}));
-  EXPECT_EQ(idx["max"], json({3}));
+  EXPECT_EQ(idx["min"], json::array({0}));
+  EXPECT_EQ(idx["max"], json::array({3}));
   EXPECT_EQ(doc["extensionsUsed"], json({"KHR_lights_punctual"}));
 }
 

@@ -164,7 +164,8 @@ TEST_F(Malformed, RayFilesTruncatedAtEveryLength) {
   const std::string rf = (dir_ / "full.rays").string(), hf = (dir_ / "full.hits").string();
   write_rays(rf, rays);
   write_hits(hf, hits);
-  for (const auto& [file, reader] : std::vector<std::pair<std::string, int>>{{rf, 0}, {hf, 1}}) {
+  for (const auto& [file, which] : std::vector<std::pair<std::string, int>>{{rf, 0}, {hf, 1}}) {
+    const int reader = which;  // a lambda cannot capture a structured binding before clang 16
     std::ifstream in(file, std::ios::binary);
     const std::string full((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     ASSERT_GT(full.size(), kRayFileHeaderBytes);

@@ -113,7 +113,8 @@ AppSettings settings_from_json(const nlohmann::json& j) {
       const std::string error = apply_option(s.config, info.key, it->get<std::string>());
       if (!error.empty()) throw runtime_error("options." + error);
     }
-    for (const auto& [key, value] : o.items()) {
+    for (const auto& item : o.items()) {
+      const std::string& key = item.key();
       const auto& table = option_table();
       if (std::none_of(table.begin(), table.end(), [&](const OptionInfo& i) { return i.key == key; }))
         throw runtime_error("options: unknown option '" + key + "'");

@@ -66,8 +66,8 @@ InstanceOverlap instance_overlap(std::span<const Aabb> boxes) {
       const std::size_t m = std::min(kChunk, end - j0);
       unsigned char meets[kChunk];
       for (std::size_t k = 0; k < m; ++k)
-        meets[k] = static_cast<unsigned char>(!(loy[j0 + k] > hy) & !(hiy[j0 + k] < ly) & !(loz[j0 + k] > hz) &
-                                              !(hiz[j0 + k] < lz));
+        meets[k] = static_cast<unsigned char>(int{!(loy[j0 + k] > hy)} & int{!(hiy[j0 + k] < ly)} &
+                                              int{!(loz[j0 + k] > hz)} & int{!(hiz[j0 + k] < lz)});
       for (std::size_t k = 0; k < m; ++k) {
         if (!meets[k]) continue;
         const Aabb c = Aabb::intersection(live[i], live[j0 + k]);

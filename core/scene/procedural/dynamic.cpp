@@ -133,7 +133,7 @@ Scene make_dynamic(const BuiltinArgs& args) {
   }
   scene.animations.push_back(std::move(anim));
 
-  const Aabb view(glm::vec3(-half, 0.0f, -half), glm::vec3(half, 1.2f, half));
+  const Aabb view{glm::vec3(-half, 0.0f, -half), glm::vec3(half, 1.2f, half)};
   scene.cameras.push_back(frame_box("overview", view, glm::vec3(0.3f, 0.5f, 1.0f)));
   scene.lights.push_back(directional_light("sun", glm::vec3(-0.4f, -1.0f, -0.3f), 3.0f));
   finish(scene, args);
