@@ -11,8 +11,8 @@
 #      renderer (preset asan): core, app logic and command-line tests again
 #      (skip with ACCELVIZ_SKIP_SANITIZERS=1 for a quick local run). With
 #      ACCELVIZ_SANITIZE_UI=1 it is preset asan-ui instead: also the renderer,
-#      the GL tests and the GUI scripts under the sanitizers (about 10 more
-#      minutes on 2 cores, which CI's 30-minute budget leaves out).
+#      the GL tests and the GUI scripts under the sanitizers (which CI leaves
+#      out to stay near its 30-minute budget).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
