@@ -6,17 +6,49 @@
 
 namespace accelviz {
 
-ReferenceTriangleHit intersect_reference(const Ray& ray, const Triangle& tri, double tmin, double tmax) {
-  ReferenceTriangleHit r;
-  const glm::dvec3 o(ray.origin), d(ray.direction);
+namespace {
+
+// What the watertight test derives from the ray alone, computed once per ray
+// (the brute force over every triangle repeated it per triangle).
+struct ReferenceRay {
+  glm::dvec3 o;
+  int kx = 0, ky = 1, kz = 2;
+  double sx = 0.0, sy = 0.0, sz = 0.0;
+  double o_mx = 0.0, o_my = 0.0;  ///< the translation's rounding magnitudes (step 2)
+  bool zero = false;              ///< zero dominant direction component: nothing is hit
+};
+
+ReferenceRay prepare_reference_ray(const Ray& ray) {
+  ReferenceRay r;
+  r.o = glm::dvec3(ray.origin);
+  const glm::dvec3 d(ray.direction);
   // 1. Permute so the dominant direction axis is z (swap x/y to keep the
   //    winding when it is negative), exactly as the float test does.
   const glm::dvec3 a = glm::abs(d);
-  const int kz = (a.x > a.y) ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
-  int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
-  if (d[kz] == 0.0) return r;  // zero direction: nothing is hit
-  if (d[kz] < 0.0) std::swap(kx, ky);
-  const double sx = d[kx] / d[kz], sy = d[ky] / d[kz], sz = 1.0 / d[kz];
+  r.kz = (a.x > a.y) ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
+  r.kx = (r.kz + 1) % 3;
+  r.ky = (r.kx + 1) % 3;
+  if (d[r.kz] == 0.0) {
+    r.zero = true;
+    return r;
+  }
+  if (d[r.kz] < 0.0) std::swap(r.kx, r.ky);
+  r.sx = d[r.kx] / d[r.kz];
+  r.sy = d[r.ky] / d[r.kz];
+  r.sz = 1.0 / d[r.kz];
+  // Float rounding of the translation itself is relative to the coordinates'
+  // absolute size (a scene far from the origin loses bits there).
+  r.o_mx = std::abs(r.o[r.kx]) + std::abs(r.sx * r.o[r.kz]);
+  r.o_my = std::abs(r.o[r.ky]) + std::abs(r.sy * r.o[r.kz]);
+  return r;
+}
+
+ReferenceTriangleHit intersect_prepared(const ReferenceRay& rr, const Triangle& tri, double tmin, double tmax) {
+  ReferenceTriangleHit r;
+  if (rr.zero) return r;
+  const glm::dvec3& o = rr.o;
+  const int kx = rr.kx, ky = rr.ky, kz = rr.kz;
+  const double sx = rr.sx, sy = rr.sy, sz = rr.sz;
 
   // 2. Translate to the origin and shear so the ray runs along +z.
   const glm::dvec3 p[3] = {glm::dvec3(tri.v0) - o, glm::dvec3(tri.v1) - o, glm::dvec3(tri.v2) - o};
@@ -25,16 +57,13 @@ ReferenceTriangleHit intersect_reference(const Ray& ray, const Triangle& tri, do
     x[i] = p[i][kx] - sx * p[i][kz];
     y[i] = p[i][ky] - sy * p[i][kz];
     z[i] = sz * p[i][kz];
-    // Magnitudes the float test rounds: the shear's terms, not their difference.
+    // Magnitudes the float test rounds: the shear's terms, not their difference,
+    // plus the translation's (rr.o_mx, rr.o_my).
     mx[i] = std::abs(p[i][kx]) + std::abs(sx * p[i][kz]);
     my[i] = std::abs(p[i][ky]) + std::abs(sy * p[i][kz]);
     mz[i] = std::abs(z[i]);
-  }
-  // Float rounding of the translation itself is relative to the coordinates'
-  // absolute size (a scene far from the origin loses bits there).
-  for (int i = 0; i < 3; ++i) {
-    mx[i] += std::abs(o[kx]) + std::abs(sx * o[kz]);
-    my[i] += std::abs(o[ky]) + std::abs(sy * o[kz]);
+    mx[i] += rr.o_mx;
+    my[i] += rr.o_my;
   }
 
   // 3. Edge functions (signed areas), exact enough in double, with the size
@@ -60,6 +89,9 @@ ReferenceTriangleHit intersect_reference(const Ray& ray, const Triangle& tri, do
     widened_inside_pos = widened_inside_pos && e[i] >= -tol[i];
     widened_inside_neg = widened_inside_neg && e[i] <= tol[i];
   }
+  // Outside by more than rounding on both windings: neither a hit nor a near
+  // miss, whatever t is (the usual answer of a brute force, so skip the rest).
+  if (!widened_inside_pos && !widened_inside_neg) return r;
   const double det_tol = tol[0] + tol[1] + tol[2];
   const bool inside = !(neg && pos) && det != 0.0;
 
@@ -94,6 +126,12 @@ ReferenceTriangleHit intersect_reference(const Ray& ray, const Triangle& tri, do
   return r;
 }
 
+}  // namespace
+
+ReferenceTriangleHit intersect_reference(const Ray& ray, const Triangle& tri, double tmin, double tmax) {
+  return intersect_prepared(prepare_reference_ray(ray), tri, tmin, tmax);
+}
+
 void fold_reference_hit(ReferenceHit& best, const ReferenceTriangleHit& h, std::uint32_t id, const Ray& ray) {
   if (h.hit) {
     best.near_hit = true;
@@ -114,15 +152,16 @@ void fold_reference_hit(ReferenceHit& best, const ReferenceTriangleHit& h, std::
 
 ReferenceHit ReferenceTracer::closest_hit(const Ray& ray) const {
   ReferenceHit best;
+  const ReferenceRay rr = prepare_reference_ray(ray);
   for (std::size_t i = 0; i < tris_.size(); ++i)
-    fold_reference_hit(best, intersect_reference(ray, tris_[i], ray.tmin, ray.tmax), static_cast<std::uint32_t>(i),
-                       ray);
+    fold_reference_hit(best, intersect_prepared(rr, tris_[i], ray.tmin, ray.tmax), static_cast<std::uint32_t>(i), ray);
   return best;
 }
 
 bool ReferenceTracer::any_hit(const Ray& ray) const {
+  const ReferenceRay rr = prepare_reference_ray(ray);
   for (const Triangle& tri : tris_)
-    if (intersect_reference(ray, tri, ray.tmin, ray.tmax).hit) return true;
+    if (intersect_prepared(rr, tri, ray.tmin, ray.tmax).hit) return true;
   return false;
 }
 
