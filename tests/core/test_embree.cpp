@@ -18,6 +18,7 @@
 #include "core/query/ray_sets.h"
 #include "core/scene/effects.h"
 #include "core/scene/load.h"
+#include "tests/support/test_scale.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_embree {
@@ -140,11 +141,10 @@ TEST(Embree, PacketsAgreeWithSingleRays) {
 // edge) and the same any-hit answer on camera rays, their diffuse bounces
 // and shadow rays, and random rays through the mesh's box. Release: the
 // bunny, the dragon and the kitchen, about 1.4 M rays each;
-// ACCELVIZ_VERIFY_SCALE < 1 (the sanitizer run) keeps the bunny and scales
-// the ray counts.
+// ACCELVIZ_VERIFY_SCALE < 1 (the sanitizer run; tests/support/test_scale.h)
+// keeps the bunny and scales the ray counts.
 TEST(EmbreeOracle, SharedMeshesClosestAndAnyHitAgreeWithTheBvh) {
-  const char* scale_env = std::getenv("ACCELVIZ_VERIFY_SCALE");
-  const double scale = scale_env ? std::clamp(std::atof(scale_env), 0.01, 1.0) : 1.0;
+  const double scale = test_scale::verify_scale();
   std::vector<std::string> meshes = {"bunny", "dragon", "kitchen_partial"};
   if (scale < 1.0) meshes.resize(1);
   int tested = 0;

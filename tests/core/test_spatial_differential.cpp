@@ -6,7 +6,9 @@
 // seeded scenes: random soups, a "teapot in a stadium", thin walls rotated
 // 45°, axis-aligned boxes on a lattice (triangles in split planes), and the
 // degenerate scenes (all centroids equal, duplicates, a flat wall, degenerate
-// triangles, one primitive, no primitive). About 330,000 rays in all.
+// triangles, one primitive, no primitive). About 330,000 rays in all at full
+// size; ACCELVIZ_VERIFY_SCALE scales each scene's rays (at least 2,000; the
+// sanitizer run: tests/support/test_scale.h).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -25,6 +27,7 @@
 #include "core/accel/octree/octree.h"
 #include "core/util/parallel.h"
 #include "tests/core/spatial_test_scenes.h"
+#include "tests/support/test_scale.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_spatial_differential {
@@ -327,7 +330,8 @@ Outcome differential(const Scene& scene, const std::vector<Ray>& rays, bool use_
 
 // Moller-Trumbore is only compared on scenes without degenerate triangles:
 // its det != 0 test lets rounding noise "hit" a zero-area triangle anywhere.
-void check(const Scene& scene, std::uint64_t seed, int rays, bool use_moller_trumbore = true) {
+void check(const Scene& scene, std::uint64_t seed, int full_rays, bool use_moller_trumbore = true) {
+  const int rays = static_cast<int>(test_scale::scaled(static_cast<std::size_t>(full_rays), 2000));
   const Outcome o = differential(scene, make_rays(scene, seed, rays), use_moller_trumbore);
   EXPECT_TRUE(o.errors.empty()) << o.errors.size() << " mismatches (first few shown)";
   for (std::size_t i = 0; i < std::min<std::size_t>(o.errors.size(), 20); ++i) ADD_FAILURE() << o.errors[i];

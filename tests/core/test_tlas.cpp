@@ -5,9 +5,10 @@
 // instance ids, normals and the dynamic updates (rigid motion, BLAS refit
 // vs rebuild) all agree with a fresh flattened build.
 //
-// Ray count: ACCELVIZ_TLAS_RAYS (default 1,000,000; 100,000 under
-// AddressSanitizer, where the release CI run still does the full million);
-// the other differential tests use 1/50 or 1/20 of it (at least 2,000 / 5,000).
+// Ray count: ACCELVIZ_TLAS_RAYS, else 1,000,000 scaled by ACCELVIZ_VERIFY_SCALE
+// (tests/support/test_scale.h: 50,000 in the sanitizer run, 250,000 in the
+// scalar-path run; the release CI run does the full million); the other differential tests use 1/50 or 1/20 of it (at
+// least 2,000 / 5,000).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -26,30 +27,20 @@
 #include "core/accel/tlas/tlas.h"
 #include "core/scene/load.h"
 #include "core/util/parallel.h"
+#include "tests/support/test_scale.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
 namespace unity_test_tlas {
 
 using namespace accelviz;
 
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define ACCELVIZ_TLAS_HAS_ASAN 1
-#endif
-#endif
-#ifndef ACCELVIZ_TLAS_HAS_ASAN
-#define ACCELVIZ_TLAS_HAS_ASAN 0
-#endif
-
 namespace {
 
+// A million rays at full size (Release), scaled by ACCELVIZ_VERIFY_SCALE
+// (tests/support/test_scale.h); ACCELVIZ_TLAS_RAYS sets the count outright.
 std::size_t ray_count() {
   if (const char* v = std::getenv("ACCELVIZ_TLAS_RAYS")) return static_cast<std::size_t>(std::strtoull(v, nullptr, 10));
-#if defined(__SANITIZE_ADDRESS__) || ACCELVIZ_TLAS_HAS_ASAN
-  return 100'000;
-#else
-  return 1'000'000;
-#endif
+  return test_scale::scaled(1'000'000, 20'000);
 }
 
 glm::mat4 trs(const glm::vec3& t, float angle, const glm::vec3& axis, const glm::vec3& s) {
