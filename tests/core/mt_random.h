@@ -15,7 +15,7 @@ inline float uniform(std::mt19937& rng) {
 /// A random unit vector (rejection sampling in the unit ball's shell).
 inline glm::vec3 random_direction(std::mt19937& rng) {
   for (;;) {
-    const glm::vec3 d(2 * uniform(rng) - 1, 2 * uniform(rng) - 1, 2 * uniform(rng) - 1);
+    const glm::vec3 d{2 * uniform(rng) - 1, 2 * uniform(rng) - 1, 2 * uniform(rng) - 1};
     const float l = glm::length(d);
     if (l > 0.05f && l <= 1.0f) return d / l;
   }

@@ -28,7 +28,7 @@ struct Rng {
   /// A random unit vector (rejection sampling in the unit ball's shell).
   glm::vec3 unit() {
     for (;;) {
-      const glm::vec3 v(range(-1, 1), range(-1, 1), range(-1, 1));
+      const glm::vec3 v{range(-1, 1), range(-1, 1), range(-1, 1)};
       const float l = glm::length(v);
       if (l > 0.05f && l <= 1.0f) return v / l;
     }

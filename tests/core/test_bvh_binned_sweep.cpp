@@ -22,7 +22,7 @@ TEST(BvhBinnedSweep, CandidateCostsEqualTheScalarFormulaBitForBit) {
     std::vector<bvh_detail::BuildPrim> prims(n);
     Aabb cb;
     for (std::uint32_t i = 0; i < n; ++i) {
-      const glm::vec3 a(u(rng), u(rng), u(rng)), b(u(rng), u(rng), u(rng));
+      const glm::vec3 a{u(rng), u(rng), u(rng)}, b{u(rng), u(rng), u(rng)};
       prims[i] = {(a + b) * 0.5f, i, Aabb{glm::min(a, b), glm::max(a, b)}};
       if (round % 5 == 0) prims[i].centroid.z = 1.0f;  // a flat axis: unusable
       cb.extend(prims[i].centroid);
@@ -77,14 +77,14 @@ TEST(BvhBinnedSweep, BranchFreeSelectionPicksTheSequentialLoopsPlane) {
     const int distinct = 1 + static_cast<int>(rng() % 6);  // few distinct boxes: equal costs
     std::vector<glm::vec3> lo(distinct), hi(distinct);
     for (int d = 0; d < distinct; ++d) {
-      const glm::vec3 a(u(rng), u(rng), u(rng)), b(u(rng), u(rng), u(rng));
+      const glm::vec3 a{u(rng), u(rng), u(rng)}, b{u(rng), u(rng), u(rng)};
       lo[d] = glm::min(a, b);
       hi[d] = glm::max(a, b);
     }
     for (std::uint32_t i = 0; i < n; ++i) {
       const int d = round % 2 == 0 ? static_cast<int>(rng() % distinct) : -1;
-      const glm::vec3 a = d >= 0 ? lo[d] : glm::vec3(u(rng), u(rng), u(rng));
-      const glm::vec3 b = d >= 0 ? hi[d] : glm::vec3(u(rng), u(rng), u(rng));
+      const glm::vec3 a = d >= 0 ? lo[d] : glm::vec3{u(rng), u(rng), u(rng)};
+      const glm::vec3 b = d >= 0 ? hi[d] : glm::vec3{u(rng), u(rng), u(rng)};
       prims[i] = {(a + b) * 0.5f, i, Aabb{glm::min(a, b), glm::max(a, b)}};
       if (round % 7 == 0) prims[i].centroid.y = 2.0f;  // a flat axis: unusable
       cb.extend(prims[i].centroid);

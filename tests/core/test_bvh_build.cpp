@@ -34,8 +34,8 @@ std::vector<Triangle> random_soup(std::size_t n, std::uint32_t seed, float size 
   std::mt19937 rng(seed);
   std::vector<Triangle> tris(n);
   for (Triangle& t : tris) {
-    const glm::vec3 c(uniform(rng), uniform(rng), uniform(rng));
-    const auto jitter = [&] { return glm::vec3(uniform(rng), uniform(rng), uniform(rng)) * size - 0.5f * size; };
+    const glm::vec3 c{uniform(rng), uniform(rng), uniform(rng)};
+    const auto jitter = [&] { return glm::vec3{uniform(rng), uniform(rng), uniform(rng)} * size - 0.5f * size; };
     t = {c + jitter(), c + jitter(), c + jitter()};
   }
   return tris;
@@ -591,7 +591,7 @@ TEST(BvhBuild, SimdBinningAgreesWithScalarTwin) {
     const int buckets = 2 + static_cast<int>(rng() % 255);
     std::vector<bvh_detail::BuildPrim> prims(sizes[round % 5]);  // even and odd counts
     for (std::uint32_t i = 0; i < prims.size(); ++i) {
-      const glm::vec3 a(uniform(rng), uniform(rng), uniform(rng)), b(uniform(rng), uniform(rng), uniform(rng));
+      const glm::vec3 a{uniform(rng), uniform(rng), uniform(rng)}, b{uniform(rng), uniform(rng), uniform(rng)};
       prims[i] = {(a + b) * 0.5f, i, Aabb{glm::min(a, b), glm::max(a, b)}};
       if (i % 17 == 0) prims[i].centroid.x = -1.0f;  // below the origin: bucket 0
       if (i % 19 == 0) prims[i].centroid.y = 5.0f;   // beyond the top: bucket B-1
@@ -638,10 +638,10 @@ TEST(BvhBuild, ParallelSplitEqualsTheSerialSplitElementForElement) {
     SCOPED_TRACE("scene " + std::to_string(scene));
     std::vector<bvh_detail::BuildPrim> prims(n);
     for (std::uint32_t i = 0; i < n; ++i) {
-      glm::vec3 a(uniform(rng), uniform(rng), uniform(rng)), b = a + 0.01f * glm::vec3(uniform(rng), 1.0f, 0.5f);
+      glm::vec3 a{uniform(rng), uniform(rng), uniform(rng)}, b = a + 0.01f * glm::vec3(uniform(rng), 1.0f, 0.5f);
       if (scene == 1) {
         const float v[4] = {-0.0f, 0.0f, 0.25f, 1.0f};
-        a = glm::vec3(v[rng() % 4], v[rng() % 4], v[rng() % 4]);
+        a = glm::vec3{v[rng() % 4], v[rng() % 4], v[rng() % 4]};
         b = a;
       } else if (scene == 2) {
         a.x = i < n / 3 ? 0.1f * a.x : 0.5f + 0.5f * a.x;  // sorted into two clusters already
@@ -738,7 +738,7 @@ constexpr int kPlaneTestPlane = 7;
 std::vector<bvh_detail::BuildPrim> plane_test_records(std::mt19937& rng, std::size_t n, int axis, float share) {
   std::vector<bvh_detail::BuildPrim> prims(n);
   for (std::uint32_t i = 0; i < n; ++i) {
-    glm::vec3 c(uniform(rng), uniform(rng), uniform(rng));
+    glm::vec3 c{uniform(rng), uniform(rng), uniform(rng)};
     const std::uint32_t pick = rng() % 16;
     if (pick == 0) c[axis] = 0.5f;  // on the plane
     if (pick == 1) c[(axis + 1) % 3] = -0.0f;
@@ -926,7 +926,7 @@ TEST(BvhBuild, LeafSizeCapLetsTheSahKeepLargerLeaves) {
   std::mt19937 rng(14);
   std::vector<Triangle> tris;
   for (int i = 0; i < 2000; ++i) {
-    const glm::vec3 c(uniform(rng), uniform(rng), uniform(rng));
+    const glm::vec3 c{uniform(rng), uniform(rng), uniform(rng)};
     tris.push_back({c - glm::vec3(5, 0, 0), c + glm::vec3(5, 0.01f, 0), c + glm::vec3(0, 0, 5)});
   }
   BvhOptions o;

@@ -25,7 +25,7 @@ std::vector<BuildPrim> random_prims(std::size_t n, std::uint32_t seed) {
   std::mt19937 rng(seed);
   std::vector<BuildPrim> p(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const glm::vec3 c(uniform(rng), uniform(rng), uniform(rng));
+    const glm::vec3 c{uniform(rng), uniform(rng), uniform(rng)};
     p[i] = BuildPrim{c, static_cast<std::uint32_t>(i), Aabb{c - 0.01f, c + 0.01f}};
   }
   return p;

@@ -237,8 +237,8 @@ TEST(BvhPackets, LanesOfMixedShearAxesAndSignsAnswerAsSingleRays) {
     for (bool exact : {true, false})
       for (int y = -8; y <= 8; y += 2)
         for (int x = -8; x <= 8; x += 2) {
-          const glm::vec3 target(x / 8.0f + (exact ? 0.0f : jitter(rng)), y / 8.0f + (exact ? 0.0f : jitter(rng)),
-                                 0.0f);
+          const glm::vec3 target{x / 8.0f + (exact ? 0.0f : jitter(rng)), y / 8.0f + (exact ? 0.0f : jitter(rng)),
+                                 0.0f};
           for (const D& d : pattern) {
             const glm::vec3 dir = exact ? d : glm::normalize(d);
             rays.emplace_back(target - 1.37f * dir, dir);

@@ -30,7 +30,7 @@ std::vector<Triangle> soup(std::size_t n, std::uint32_t seed, float size = 0.08f
   std::mt19937 rng(seed);
   std::vector<Triangle> tris(n);
   for (Triangle& t : tris) {
-    const glm::vec3 c(uniform(rng), uniform(rng), uniform(rng));
+    const glm::vec3 c{uniform(rng), uniform(rng), uniform(rng)};
     t = {c + size * random_direction(rng), c + size * random_direction(rng), c + size * random_direction(rng)};
   }
   return tris;
@@ -40,7 +40,7 @@ std::vector<Ray> rays_through_unit_cube(std::size_t n, std::uint32_t seed) {
   std::mt19937 rng(seed);
   std::vector<Ray> rays;
   for (std::size_t i = 0; i < n; ++i) {
-    const glm::vec3 target(uniform(rng), uniform(rng), uniform(rng));
+    const glm::vec3 target{uniform(rng), uniform(rng), uniform(rng)};
     const glm::vec3 o = glm::vec3(0.5f) + 2.0f * random_direction(rng);
     rays.emplace_back(o, glm::normalize(target - o));
   }
@@ -70,7 +70,7 @@ TEST(BvhSlab, SimdAgreesWithScalarTwinOnRandomAndAdversarialInput) {
   for (int i = 0; i < 200000; ++i) {
     BvhNode pair[2];
     for (BvhNode& n : pair) {
-      glm::vec3 a(uniform(rng), uniform(rng), uniform(rng)), b(uniform(rng), uniform(rng), uniform(rng));
+      glm::vec3 a{uniform(rng), uniform(rng), uniform(rng)}, b{uniform(rng), uniform(rng), uniform(rng)};
       if (i % 5 == 1) b[static_cast<int>(rng() % 3)] = a[static_cast<int>(rng() % 3)];  // flat on some axis
       if (i % 7 == 2) std::swap(a, b);                                                  // possibly empty
       if (i % 11 == 3) a[static_cast<int>(rng() % 3)] = -kInfinity;                     // unbounded
@@ -79,7 +79,7 @@ TEST(BvhSlab, SimdAgreesWithScalarTwinOnRandomAndAdversarialInput) {
       n.index = rng();  // garbage in the lane the loads pick up
       n.count = rng() % 2;
     }
-    glm::vec3 o(2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f);
+    glm::vec3 o{2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f};
     glm::vec3 d = random_direction(rng);
     for (int a = 0; a < 3; ++a) {
       const unsigned r = rng() % 8;
@@ -135,7 +135,7 @@ bvh_detail::WideNodeT<W> random_wide_node(std::mt19937& rng, int i, const EmptyB
                                           const EmptySlot& empty_slot) {
   bvh_detail::WideNodeT<W> n;
   for (int s = 0; s < W; ++s) {
-    glm::vec3 a(uniform(rng), uniform(rng), uniform(rng)), b(uniform(rng), uniform(rng), uniform(rng));
+    glm::vec3 a{uniform(rng), uniform(rng), uniform(rng)}, b{uniform(rng), uniform(rng), uniform(rng)};
     if (i % 5 == 1) b[static_cast<int>(rng() % 3)] = a[static_cast<int>(rng() % 3)];
     Aabb box{glm::min(a, b), glm::max(a, b)};
     if (empty_box(s)) box = Aabb::empty();
@@ -155,7 +155,7 @@ TEST(BvhSlab, WideTestAgreesWithScalarTwinPerSlot) {
   for (int i = 0; i < 100000; ++i) {
     const auto n = random_wide_node<4>(
         rng, i, [&](int s) { return i % 7 == 2 && s == 1; }, [&](int s) { return i % 9 == 4 && s == 3; });
-    glm::vec3 o(2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f);
+    glm::vec3 o{2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f};
     glm::vec3 d = random_direction(rng);
     for (int a = 0; a < 3; ++a) {
       const unsigned r = rng() % 8;
@@ -191,7 +191,7 @@ TEST(BvhSlab, EightWideAvx2TestAgreesWithScalarTwinPerSlot) {
   for (int i = 0; i < 50000; ++i) {
     const auto n = random_wide_node<8>(
         rng, i, [&](int s) { return i % 7 == 2 && s == 5; }, [&](int s) { return i % 9 == 4 && s >= 6; });
-    glm::vec3 o(2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f);
+    glm::vec3 o{2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f};
     glm::vec3 d = random_direction(rng);
     for (int a = 0; a < 3; ++a) {
       const unsigned r = rng() % 8;
@@ -235,7 +235,7 @@ TEST(BvhSlab, EightWideFastTestHoldsToTheScalarTest) {
   for (int i = 0; i < 50000; ++i) {
     const auto empty = [&](int s) { return i % 7 == 2 && s >= 5; };  // box and slot
     auto n = random_wide_node<8>(rng, i, empty, empty);
-    glm::vec3 o(2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f);
+    glm::vec3 o{2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f};
     // Boxes and origin far from 0: origin · inv_dir is large next to the
     // boxes' distances, so the pad on its rounding is what keeps them.
     const float shift = i % 6 == 5 ? 4096.0f : 0.0f;
@@ -419,7 +419,7 @@ TEST(BvhWide, EveryWidthAnswersLikeTheBinaryTree) {
     const double expect = width == 4 || !bvh_detail::cpu_has_wide8() ? 4.0 : 8.0;
     EXPECT_EQ(bvh.build_stats().extra.at("wide_width"), expect) << width;
     for (int i = 0; i < 20000; ++i) {
-      const glm::vec3 orig(2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f);
+      const glm::vec3 orig{2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f, 2 * uniform(rng) - 0.5f};
       const Ray ray(orig, random_direction(rng));
       for (bool ordered : {true, false}) {
         QueryOptions q;
@@ -624,7 +624,7 @@ TEST(BvhQuery, CountedWalkMatchesTheTracedWalkPerRay) {
   std::vector<Ray> rays = rays_through_unit_cube(600, 12);
   std::mt19937 rng(13);
   for (int i = 0; i < 150; ++i) {
-    const glm::vec3 inside(uniform(rng), uniform(rng), uniform(rng));
+    const glm::vec3 inside{uniform(rng), uniform(rng), uniform(rng)};
     rays.emplace_back(inside, random_direction(rng));                                      // starts inside
     rays.emplace_back(glm::vec3(inside.x, inside.y, -1.0f), glm::vec3(0.0f, 0.0f, 1.0f));  // along +z: ±0 components
     rays.emplace_back(glm::vec3(-1.0f, inside.y, inside.z), glm::vec3(1.0f, 0.0f, 0.0f), 0.5f, 1.0f + inside.x);
@@ -741,7 +741,7 @@ TEST(BvhQuery, TraversalOfATreeAtTheDepthBudget) {
   for (int i = 0; i < 2000; ++i) {
     // From the far end back toward 0, through the dense region.
     const float x0 = std::ldexp(1.0f, static_cast<int>(rng() % 40));
-    const Ray r({x0, 0.5f * uniform(rng) - 0.25f, 0.5f * uniform(rng) - 0.25f}, {-1, 0.001f * uniform(rng), 0});
+    const Ray r{{x0, 0.5f * uniform(rng) - 0.25f, 0.5f * uniform(rng) - 0.25f}, {-1, 0.001f * uniform(rng), 0}};
     EXPECT_TRUE(same_answer(bvh.closest_hit(r, {}), bf.closest_hit(r, {})));
     RayStats st;
     EXPECT_TRUE(same_answer(bvh.closest_hit(r, {}, &st), bf.closest_hit(r, {})));

@@ -148,7 +148,7 @@ int expect_pair_same(const Ray& ray, const Triangle& first, const Triangle& seco
 }
 
 glm::vec3 rand_vec(std::mt19937& rng, float scale) {
-  return scale * glm::vec3(2 * uniform(rng) - 1, 2 * uniform(rng) - 1, 2 * uniform(rng) - 1);
+  return scale * glm::vec3{2 * uniform(rng) - 1, 2 * uniform(rng) - 1, 2 * uniform(rng) - 1};
 }
 
 }  // namespace
@@ -166,7 +166,9 @@ TEST(BvhInlineTriangle, RandomRaysAndTrianglesAgreeBitForBit) {
     const glm::vec3 d = (i & 1) ? target - o : rand_vec(rng, 1);
     const Ray ray(o, d);
     expect_same(ray, tri, 0.0f, kInfinity, c);
-    expect_same(ray, tri, 0.5f * uniform(rng), 0.5f + uniform(rng), c);
+    const float seg_lo = 0.5f * uniform(rng);
+    const float seg_hi = 0.5f + uniform(rng);
+    expect_same(ray, tri, seg_lo, seg_hi, c);
     const Triangle other{rand_vec(rng, 1), rand_vec(rng, 1), rand_vec(rng, 1)};
     pair_lanes += expect_pair_same(ray, (i & 2) ? tri : other, (i & 2) ? other : tri, (i & 4) ? 0.0f : 0.1f);
   }

@@ -25,9 +25,9 @@ std::vector<Triangle> merge_soup(std::size_t n, std::uint32_t seed) {
   std::mt19937 rng(seed);
   std::vector<Triangle> tris(n);
   for (Triangle& t : tris) {
-    const glm::vec3 c(merge_uniform(rng), merge_uniform(rng), merge_uniform(rng));
+    const glm::vec3 c{merge_uniform(rng), merge_uniform(rng), merge_uniform(rng)};
     const auto jitter = [&] {
-      return glm::vec3(merge_uniform(rng), merge_uniform(rng), merge_uniform(rng)) * 0.06f - 0.03f;
+      return glm::vec3{merge_uniform(rng), merge_uniform(rng), merge_uniform(rng)} * 0.06f - 0.03f;
     };
     t = {c + jitter(), c + jitter(), c + jitter()};
   }
@@ -88,8 +88,8 @@ TEST(BvhWideMerge, MergingTreeAnswersLikeBruteForce) {
     const Bvh bvh(tris, o);
     EXPECT_EQ(bvh.build_stats().extra.at("wide_merge_blocks"), 2.0);
     for (int i = 0; i < 3000; ++i) {
-      const glm::vec3 a(merge_uniform(rng), merge_uniform(rng), merge_uniform(rng));
-      const glm::vec3 b(merge_uniform(rng), merge_uniform(rng), merge_uniform(rng));
+      const glm::vec3 a{merge_uniform(rng), merge_uniform(rng), merge_uniform(rng)};
+      const glm::vec3 b{merge_uniform(rng), merge_uniform(rng), merge_uniform(rng)};
       if (glm::length(b - a) < 1e-3f) continue;
       const Ray ray(a * 1.4f - 0.2f, glm::normalize(b - a));
       for (TriangleTest test : {TriangleTest::watertight, TriangleTest::moller_trumbore}) {

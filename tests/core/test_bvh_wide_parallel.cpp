@@ -160,9 +160,9 @@ std::vector<Triangle> soup(std::size_t n, std::uint32_t seed) {
   std::uniform_real_distribution<float> u(0.0f, 1.0f), j(-0.02f, 0.02f);
   std::vector<Triangle> tris(n);
   for (Triangle& t : tris) {
-    const glm::vec3 c(u(rng), u(rng), u(rng));
-    t = {c + glm::vec3(j(rng), j(rng), j(rng)), c + glm::vec3(j(rng), j(rng), j(rng)),
-         c + glm::vec3(j(rng), j(rng), j(rng))};
+    const glm::vec3 c{u(rng), u(rng), u(rng)};
+    t = {c + glm::vec3{j(rng), j(rng), j(rng)}, c + glm::vec3{j(rng), j(rng), j(rng)},
+         c + glm::vec3{j(rng), j(rng), j(rng)}};
   }
   return tris;
 }

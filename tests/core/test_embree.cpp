@@ -35,9 +35,9 @@ std::vector<Triangle> random_soup(std::size_t n, std::uint32_t seed) {
   std::uniform_real_distribution<float> pos(-1.0f, 1.0f), off(-0.15f, 0.15f);
   std::vector<Triangle> tris;
   for (std::size_t i = 0; i < n; ++i) {
-    const glm::vec3 c(pos(rng), pos(rng), pos(rng));
-    tris.push_back({c + glm::vec3(off(rng), off(rng), off(rng)), c + glm::vec3(off(rng), off(rng), off(rng)),
-                    c + glm::vec3(off(rng), off(rng), off(rng))});
+    const glm::vec3 c{pos(rng), pos(rng), pos(rng)};
+    tris.push_back({c + glm::vec3{off(rng), off(rng), off(rng)}, c + glm::vec3{off(rng), off(rng), off(rng)},
+                    c + glm::vec3{off(rng), off(rng), off(rng)}});
   }
   return tris;
 }
@@ -49,10 +49,10 @@ std::vector<Ray> random_rays(std::size_t n, std::uint32_t seed) {
   std::uniform_real_distribution<float> u(-1.0f, 1.0f), len(0.1f, 3.0f);
   std::vector<Ray> rays;
   while (rays.size() < n) {
-    const glm::vec3 d(u(rng), u(rng), u(rng));
+    const glm::vec3 d{u(rng), u(rng), u(rng)};
     if (glm::dot(d, d) < 1e-4f) continue;
     const bool outside = rays.size() % 2 == 0;
-    const glm::vec3 o = outside ? glm::vec3(u(rng), u(rng), u(rng)) * 3.0f : glm::vec3(u(rng), u(rng), u(rng));
+    const glm::vec3 o = outside ? glm::vec3{u(rng), u(rng), u(rng)} * 3.0f : glm::vec3{u(rng), u(rng), u(rng)};
     const float tmin = rays.size() % 5 == 0 ? 0.2f : 0.0f;
     const float tmax = rays.size() % 3 == 0 ? tmin + len(rng) : kInfinity;
     rays.emplace_back(o, outside ? glm::normalize(-o + 0.5f * d) : d, tmin, tmax);
@@ -181,7 +181,7 @@ TEST(EmbreeOracle, SharedMeshesClosestAndAnyHitAgreeWithTheBvh) {
     const float radius = glm::length(box.hi - box.lo);
     const std::size_t random_count = static_cast<std::size_t>(600'000 * scale);
     for (std::size_t i = 0; i < random_count; ++i) {
-      const glm::vec3 target = box.lo + glm::vec3(u(rng), u(rng), u(rng)) * (box.hi - box.lo);
+      const glm::vec3 target = box.lo + glm::vec3{u(rng), u(rng), u(rng)} * (box.hi - box.lo);
       const float z = 2.0f * u(rng) - 1.0f, phi = 6.2831853f * u(rng), r = std::sqrt(std::max(0.0f, 1.0f - z * z));
       const glm::vec3 origin = box.center() + radius * glm::vec3(r * std::cos(phi), r * std::sin(phi), z);
       rays.emplace_back(origin, target - origin);

@@ -33,8 +33,8 @@ Scene integer_lattice(std::uint64_t seed) {
   Rng rng{seed};
   Scene s;
   const auto lattice_point = [&] {
-    return glm::vec3(std::floor(rng.range(0, 4.999f)), std::floor(rng.range(0, 4.999f)),
-                     std::floor(rng.range(0, 4.999f)));
+    return glm::vec3{std::floor(rng.range(0, 4.999f)), std::floor(rng.range(0, 4.999f)),
+                     std::floor(rng.range(0, 4.999f))};
   };
   quad(s, {0, 0, 0}, {4, 0, 0}, {4, 4, 0}, {0, 4, 0});  // pin the bounds to [0, 4]^3
   quad(s, {0, 0, 4}, {4, 0, 4}, {4, 4, 4}, {0, 4, 4});
@@ -132,14 +132,14 @@ TEST(Grid, FlatBoundsGiveThatAxisOneCell) {
   for (int i = 0; i < 2000; ++i) {
     const glm::vec3 o = rng.in_box({-1, -1, 3}, {3, 2, 7});
     const glm::vec3 d =
-        i % 4 == 0 ? glm::vec3(rng.range(-1, 1), rng.range(-1, 1), -0.0f) : rng.in_box({0, 0, 5}, {2, 1, 5}) - o;
+        i % 4 == 0 ? glm::vec3{rng.range(-1, 1), rng.range(-1, 1), -0.0f} : rng.in_box({0, 0, 5}, {2, 1, 5}) - o;
     ASSERT_TRUE(agrees(g, bf, Ray(o, d))) << i;
   }
   // A ray lying in the wall's plane (z = 5, direction z = ±0) grazes edges.
   for (int i = 0; i < 200; ++i)
     ASSERT_TRUE(agrees(
         g, bf,
-        Ray({rng.range(-1, 3), rng.range(-1, 2), 5}, {rng.range(-1, 1), rng.range(-1, 1), (i & 1) ? 0.0f : -0.0f})));
+        Ray{{rng.range(-1, 3), rng.range(-1, 2), 5}, {rng.range(-1, 1), rng.range(-1, 1), (i & 1) ? 0.0f : -0.0f}}));
 }
 
 TEST(Grid, CsrListsHoldExactlyTheOverlappingTriangles) {
@@ -326,7 +326,7 @@ TEST(Grid, StatsMailboxingAndEmptyCells) {
   RayStats sa, sb;
   Rng rng{9};
   for (int i = 0; i < 2000; ++i) {
-    const Ray r(glm::vec3(-3, 0, 0) + 0.3f * rng.unit(), glm::vec3(1, rng.range(-0.3f, 0.3f), rng.range(-0.3f, 0.3f)));
+    const Ray r{glm::vec3(-3, 0, 0) + 0.3f * rng.unit(), glm::vec3{1, rng.range(-0.3f, 0.3f), rng.range(-0.3f, 0.3f)}};
     ASSERT_EQ(a.closest_hit(r, {}, &sa).prim, b.closest_hit(r, {}, &sb).prim);
   }
   EXPECT_GT(sb.repeated_prim_tests, 0u);

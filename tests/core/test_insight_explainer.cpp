@@ -147,7 +147,7 @@ TEST(InsightExplainer, MatchesWhatTheBuilderDid) {
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   std::vector<Triangle> tris(300);
   for (Triangle& t : tris) {
-    const glm::vec3 c(u(rng), u(rng), u(rng));
+    const glm::vec3 c{u(rng), u(rng), u(rng)};
     t = {c, c + glm::vec3(0.05f * u(rng), 0.02f, 0.0f), c + glm::vec3(0.0f, 0.03f * u(rng), 0.04f)};
   }
   BvhOptions o;

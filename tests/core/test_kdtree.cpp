@@ -193,7 +193,7 @@ TEST(KdTree, MailboxingSavesRepeatedTestsOfStraddlingTriangles) {
   RayStats sa, sb;
   Rng rng{4};
   for (int i = 0; i < 2000; ++i) {
-    const Ray r(glm::vec3(-3, 0, 0) + 0.3f * rng.unit(), glm::vec3(1, rng.range(-0.3f, 0.3f), rng.range(-0.3f, 0.3f)));
+    const Ray r{glm::vec3(-3, 0, 0) + 0.3f * rng.unit(), glm::vec3{1, rng.range(-0.3f, 0.3f), rng.range(-0.3f, 0.3f)}};
     const Hit ha = a.closest_hit(r, {}, &sa), hb = b.closest_hit(r, {}, &sb);
     ASSERT_EQ(ha.prim, hb.prim);
   }
@@ -361,7 +361,7 @@ TEST(KdTree, PerfectSplitsReduceReferences) {
   const BruteForce bf(s);
   Rng rng{8};
   for (int i = 0; i < 500; ++i) {
-    const Ray r(glm::vec3(0, 0, -3) + 0.5f * rng.unit(), glm::vec3(rng.range(-0.5f, 0.5f), rng.range(-0.5f, 0.5f), 1));
+    const Ray r{glm::vec3(0, 0, -3) + 0.5f * rng.unit(), glm::vec3{rng.range(-0.5f, 0.5f), rng.range(-0.5f, 0.5f), 1}};
     EXPECT_TRUE(agrees(perfect, bf, r));
     EXPECT_TRUE(agrees(bounds_only, bf, r));
   }
@@ -372,7 +372,10 @@ TEST(KdTree, DegenerateInputsTerminate) {
   Scene same;
   Rng rng{9};
   for (int i = 0; i < 500; ++i) {
-    const glm::vec3 a = rng.unit() * rng.range(0.1f, 1.0f), b = rng.unit() * rng.range(0.1f, 1.0f);
+    const glm::vec3 da = rng.unit();
+    const glm::vec3 a = da * rng.range(0.1f, 1.0f);
+    const glm::vec3 db = rng.unit();
+    const glm::vec3 b = db * rng.range(0.1f, 1.0f);
     same.push_back({a, b, -a - b});
   }
   // Duplicates, a flat wall, point triangles, one triangle repeated.
@@ -389,7 +392,7 @@ TEST(KdTree, DegenerateInputsTerminate) {
     EXPECT_LT(kd.build_stats().node_count, 40 * s->size() + 10);
     const BruteForce bf(*s);
     for (int i = 0; i < 300; ++i) {
-      const Ray r(glm::vec3(0.5f, 0.5f, -3) + rng.unit(), glm::vec3(rng.range(-0.3f, 0.3f), rng.range(-0.3f, 0.3f), 1));
+      const Ray r{glm::vec3(0.5f, 0.5f, -3) + rng.unit(), glm::vec3{rng.range(-0.3f, 0.3f), rng.range(-0.3f, 0.3f), 1}};
       EXPECT_TRUE(agrees(kd, bf, r));
     }
   }
@@ -421,7 +424,7 @@ TEST(KdTree, UnorderedTraversalSameAnswerMoreWork) {
   RayStats so, su;
   Rng rng{13};
   for (int i = 0; i < 1000; ++i) {
-    const Ray r(glm::vec3(0, 0, 0) + 3.0f * rng.unit(), rng.unit());
+    const Ray r{glm::vec3(0, 0, 0) + 3.0f * rng.unit(), rng.unit()};
     const Hit a = kd.closest_hit(r, {}, &so), b = kd.closest_hit(r, unordered, &su);
     ASSERT_EQ(a.prim, b.prim);
   }

@@ -58,10 +58,10 @@ std::vector<Ray> random_rays(std::size_t n) {
   std::uniform_real_distribution<float> u(-10.0f, 10.0f);
   std::vector<Ray> rays;
   for (std::size_t i = 0; i < n; ++i) {
-    glm::vec3 d(u(rng), u(rng), u(rng));
+    glm::vec3 d{u(rng), u(rng), u(rng)};
     if (glm::dot(d, d) == 0.0f) d = {1, 0, 0};
     const float t0 = std::abs(u(rng)) * 0.1f;
-    rays.emplace_back(glm::vec3(u(rng), u(rng), u(rng)), d, t0, i % 3 == 0 ? kInfinity : t0 + std::abs(u(rng)));
+    rays.push_back(Ray{glm::vec3{u(rng), u(rng), u(rng)}, d, t0, i % 3 == 0 ? kInfinity : t0 + std::abs(u(rng))});
   }
   return rays;
 }

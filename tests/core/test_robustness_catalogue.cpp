@@ -102,7 +102,7 @@ std::vector<Triangle> cubes_and_soup() {
       }
   Rng r{7};
   for (int i = 0; i < 120; ++i) {
-    const glm::vec3 p(r.uniform(-1, 6), r.uniform(-1, 6), r.uniform(-1, 6));
+    const glm::vec3 p{r.uniform(-1, 6), r.uniform(-1, 6), r.uniform(-1, 6)};
     out.push_back({p, p + 0.7f * r.unit_vector(), p + 0.7f * r.unit_vector()});
   }
   return out;
@@ -503,7 +503,7 @@ TEST_P(Catalogue, PlusAndMinusZeroDirectionComponents) {
     d[axis] = sign;
     for (int k = 0; k < 3; ++k)
       if (k != axis) d[k] = (r.next() & 1) ? -0.0f : 0.0f;
-    glm::vec3 o(r.uniform(b.lo.x, b.hi.x), r.uniform(b.lo.y, b.hi.y), r.uniform(b.lo.z, b.hi.z));
+    glm::vec3 o{r.uniform(b.lo.x, b.hi.x), r.uniform(b.lo.y, b.hi.y), r.uniform(b.lo.z, b.hi.z)};
     // Half the rays exactly on a cube coordinate (0,1,2,...) in the other axes.
     if (i % 2 == 0)
       for (int k = 0; k < 3; ++k)
@@ -525,9 +525,11 @@ TEST_P(Catalogue, RaysParallelToAndLyingInSlabAndSplitPlanes) {
   std::vector<Ray> rays;
   for (const auto& [axis, v] : structure_planes(*accel, tris)) {
     for (int k = 0; k < 3; ++k) {
-      glm::vec3 o(r.uniform(b.lo.x - 1, b.hi.x + 1), r.uniform(b.lo.y - 1, b.hi.y + 1), r.uniform(b.lo.z - 1, b.hi.z + 1));
+      glm::vec3 o{r.uniform(b.lo.x - 1, b.hi.x + 1), r.uniform(b.lo.y - 1, b.hi.y + 1),
+                  r.uniform(b.lo.z - 1, b.hi.z + 1)};
       o[axis] = k == 0 ? v : k == 1 ? std::nextafter(v, kInfinity) : std::nextafter(v, -kInfinity);
-      const glm::vec3 d = zero_signed(r.unit_vector(), axis, r.next() & 1);  // in (or parallel to) the plane
+      const glm::vec3 dir = r.unit_vector();
+      const glm::vec3 d = zero_signed(dir, axis, r.next() & 1);  // in (or parallel to) the plane
       rays.emplace_back(o, d);
     }
     // In the plane, aimed at the scene centre's projection: crosses the scene.
@@ -550,7 +552,7 @@ TEST_P(Catalogue, OriginExactlyOnBoxFace) {
   const Aabb b = bounds_of(tris);
   for (int i = 0; i < 400; ++i) {
     const int axis = static_cast<int>(r.next() % 3);
-    glm::vec3 o(r.uniform(b.lo.x, b.hi.x), r.uniform(b.lo.y, b.hi.y), r.uniform(b.lo.z, b.hi.z));
+    glm::vec3 o{r.uniform(b.lo.x, b.hi.x), r.uniform(b.lo.y, b.hi.y), r.uniform(b.lo.z, b.hi.z)};
     const int cube = static_cast<int>(r.next() % 3);
     o[axis] = i % 4 == 0 ? (r.next() & 1 ? b.lo[axis] : b.hi[axis]) : 2.0f * static_cast<float>(cube) + (r.next() & 1);
     glm::vec3 d = r.unit_vector();
@@ -570,7 +572,7 @@ TEST_P(Catalogue, TSplitEqualToTminOrTmax) {
   Rng r{24};
   std::vector<Ray> rays;
   for (const auto& [axis, v] : structure_planes(*accel, tris)) {
-    glm::vec3 o(r.uniform(b.lo.x, b.hi.x), r.uniform(b.lo.y, b.hi.y), r.uniform(b.lo.z, b.hi.z));
+    glm::vec3 o{r.uniform(b.lo.x, b.hi.x), r.uniform(b.lo.y, b.hi.y), r.uniform(b.lo.z, b.hi.z)};
     if (r.next() & 1)
       for (int k = 0; k < 3; ++k)
         if (k != axis) o[k] = std::round(o[k]);
@@ -639,7 +641,8 @@ TEST_P(Catalogue, RaysStartingInsideALeafOrCell) {
   Rng r{26};
   std::vector<Ray> rays;
   for (int i = 0; i < 300; ++i)
-    rays.emplace_back(glm::vec3(r.uniform(b.lo.x, b.hi.x), r.uniform(b.lo.y, b.hi.y), r.uniform(b.lo.z, b.hi.z)), r.unit_vector());
+    rays.push_back(Ray{glm::vec3{r.uniform(b.lo.x, b.hi.x), r.uniform(b.lo.y, b.hi.y), r.uniform(b.lo.z, b.hi.z)},
+                       r.unit_vector()});
   for (int i = 0; i < 60; ++i) {
     const Triangle& t = tris[r.next() % tris.size()];
     const float u = r.uniform() * 0.5f, v = r.uniform() * 0.5f;
@@ -648,9 +651,10 @@ TEST_P(Catalogue, RaysStartingInsideALeafOrCell) {
   check(tris, rays, false);
   std::vector<Ray> inside;
   for (int i = 0; i < 200; ++i) {
-    const glm::vec3 cube(2.0f * static_cast<float>(r.next() % 3), 2.0f * static_cast<float>(r.next() % 3),
-                         2.0f * static_cast<float>(r.next() % 3));
-    inside.emplace_back(cube + glm::vec3(r.uniform(0.1f, 0.9f), r.uniform(0.1f, 0.9f), r.uniform(0.1f, 0.9f)), r.unit_vector());
+    const glm::vec3 cube{2.0f * static_cast<float>(r.next() % 3), 2.0f * static_cast<float>(r.next() % 3),
+                         2.0f * static_cast<float>(r.next() % 3)};
+    inside.push_back(
+        Ray{cube + glm::vec3{r.uniform(0.1f, 0.9f), r.uniform(0.1f, 0.9f), r.uniform(0.1f, 0.9f)}, r.unit_vector()});
   }
   check(tris, inside, true);
 }
@@ -662,7 +666,7 @@ TEST_P(Catalogue, InfiniteAndHugeTmax) {
   std::vector<Ray> rays;
   for (int i = 0; i < 200; ++i) {
     const glm::vec3 o = b.center() + r.unit_vector() * 20.0f;
-    const glm::vec3 target(r.uniform(b.lo.x, b.hi.x), r.uniform(b.lo.y, b.hi.y), r.uniform(b.lo.z, b.hi.z));
+    const glm::vec3 target{r.uniform(b.lo.x, b.hi.x), r.uniform(b.lo.y, b.hi.y), r.uniform(b.lo.z, b.hi.z)};
     const float tmax = i % 3 == 0 ? kInfinity : i % 3 == 1 ? std::numeric_limits<float>::max() : kRayFileUnbounded;
     rays.emplace_back(o, target - o, 0.0f, tmax);
     rays.emplace_back(o, (target - o) * 1e-3f, 1.0f, tmax);  // short direction: large t
@@ -677,7 +681,10 @@ TEST_P(Catalogue, BuilderAllCentroidsEqual) {
   std::vector<Triangle> tris;
   const glm::vec3 c(1.0f, 2.0f, 3.0f);
   for (int i = 0; i < 300; ++i) {
-    const glm::vec3 a = r.unit_vector() * r.uniform(0.1f, 2.0f), b = r.unit_vector() * r.uniform(0.1f, 2.0f);
+    const glm::vec3 da = r.unit_vector();
+    const glm::vec3 a = da * r.uniform(0.1f, 2.0f);
+    const glm::vec3 db = r.unit_vector();
+    const glm::vec3 b = db * r.uniform(0.1f, 2.0f);
     tris.push_back({c + a, c + b, c - a - b});  // centroid c up to rounding
   }
   const auto rays = random_rays_from(c, 300, 32);
@@ -712,8 +719,8 @@ TEST_P(Catalogue, BuilderFlatAxisAlignedWall) {
   Rng r{36};
   std::vector<Ray> hits, other;
   for (int i = 0; i < 300; ++i) {
-    const glm::vec3 p(r.uniform(0.0f, 20.0f), r.uniform(0.0f, 20.0f), 3.0f);
-    const glm::vec3 v(static_cast<float>(r.next() % 21), static_cast<float>(r.next() % 21), 3.0f);
+    const glm::vec3 p{r.uniform(0.0f, 20.0f), r.uniform(0.0f, 20.0f), 3.0f};
+    const glm::vec3 v{static_cast<float>(r.next() % 21), static_cast<float>(r.next() % 21), 3.0f};
     const float side = (i & 1) ? 1.0f : -1.0f;
     hits.emplace_back(p + glm::vec3(0, 0, side * 2.0f), glm::vec3(0, (i & 2) ? 0.0f : -0.0f, -side));
     hits.emplace_back(v + glm::vec3(0.3f, -0.2f, side * 2.0f), glm::vec3(-0.3f, 0.2f, -side * 2.0f));  // at a vertex
@@ -788,8 +795,9 @@ void shadow_rays(const Structure& s, glm::vec3 centre, float scale, float gap, i
   Rng r{41};
   const QueryOptions q;
   for (int i = 0; i < 400; ++i) {
-    const glm::vec3 target = centre + glm::vec3(r.uniform(-0.45f, 0.45f) * scale, r.uniform(-0.45f, 0.45f) * scale, 0.0f);
-    const glm::vec3 eye = centre + glm::vec3(r.uniform(-1, 1), r.uniform(-1, 1), 1.0f) * scale;
+    const glm::vec3 target =
+        centre + glm::vec3{r.uniform(-0.45f, 0.45f) * scale, r.uniform(-0.45f, 0.45f) * scale, 0.0f};
+    const glm::vec3 eye = centre + glm::vec3{r.uniform(-1, 1), r.uniform(-1, 1), 1.0f} * scale;
     const Ray primary(eye, target - eye);
     const Hit h = accel->closest_hit(primary, q);
     if (s.factory == "voxels") {
@@ -808,7 +816,7 @@ void shadow_rays(const Structure& s, glm::vec3 centre, float scale, float gap, i
     const auto largest = [](const glm::vec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); };
     const float coords = std::max(largest(primary.origin), largest(p));
     // Towards a light above: nothing there, own triangle excluded.
-    const glm::vec3 light = centre + glm::vec3(r.uniform(-1, 1), r.uniform(-1, 1), 2.0f) * scale;
+    const glm::vec3 light = centre + glm::vec3{r.uniform(-1, 1), r.uniform(-1, 1), 2.0f} * scale;
     const glm::vec3 o_up = offset_ray_origin(p, nrm, coords);
     const Ray up(o_up, light - o_up, 0.0f, 1.0f);
     const Hit hu = accel->closest_hit(up, q);
@@ -819,7 +827,7 @@ void shadow_rays(const Structure& s, glm::vec3 centre, float scale, float gap, i
     }
     // Into the slab: must hit the bottom layer, not the own triangle.
     const glm::vec3 o_down = offset_ray_origin(p, -nrm, coords);
-    const glm::vec3 dir = glm::normalize(glm::vec3(r.uniform(-0.3f, 0.3f), r.uniform(-0.3f, 0.3f), -1.0f));
+    const glm::vec3 dir = glm::normalize(glm::vec3{r.uniform(-0.3f, 0.3f), r.uniform(-0.3f, 0.3f), -1.0f});
     const Ray down(o_down, dir);
     const Hit hd = accel->closest_hit(down, q);
     if (!hd.valid() || hd.prim < static_cast<std::uint32_t>(n * n * 2)) {
@@ -910,7 +918,7 @@ TEST(CatalogueBuilders, TenMillionPrimitivesBvh) {
   Rng r{51};
   std::vector<Ray> rays;
   for (int i = 0; i < 6; ++i) {
-    const glm::vec3 target(r.uniform(0, nx), r.uniform(0, ny), r.uniform(0, 10));
+    const glm::vec3 target{r.uniform(0, nx), r.uniform(0, ny), r.uniform(0, 10)};
     const glm::vec3 o = target + r.unit_vector() * 50.0f + glm::vec3(0, 0, 30);
     rays.emplace_back(o, target - o);
   }

@@ -26,8 +26,8 @@ std::vector<Triangle> soup(std::size_t n, std::uint32_t seed, float size) {
   std::mt19937 rng(seed);
   std::vector<Triangle> tris(n);
   for (Triangle& t : tris) {
-    const glm::vec3 c(uniform(rng), uniform(rng), uniform(rng));
-    const auto j = [&] { return (glm::vec3(uniform(rng), uniform(rng), uniform(rng)) - 0.5f) * size; };
+    const glm::vec3 c{uniform(rng), uniform(rng), uniform(rng)};
+    const auto j = [&] { return (glm::vec3{uniform(rng), uniform(rng), uniform(rng)} - 0.5f) * size; };
     t = {c + j(), c + j(), c + j()};
   }
   return tris;
@@ -187,7 +187,7 @@ TEST(Epo, ClippedAreaOfKnownCases) {
   std::mt19937 rng(3);
   for (int i = 0; i < 2000; ++i) {
     const auto tri = soup(1, rng(), 1.0f)[0];
-    glm::vec3 a(uniform(rng), uniform(rng), uniform(rng)), b(uniform(rng), uniform(rng), uniform(rng));
+    glm::vec3 a{uniform(rng), uniform(rng), uniform(rng)}, b{uniform(rng), uniform(rng), uniform(rng)};
     const Aabb box{glm::min(a, b), glm::max(a, b)};
     EXPECT_NEAR(clipped_triangle_area(tri, box), reference_clipped_area(tri, box), 1e-9);
   }

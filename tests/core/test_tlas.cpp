@@ -97,10 +97,10 @@ Scene make_instanced_scene(int crowd, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   for (int i = 0; i < crowd; ++i) {
-    const glm::vec3 t(20.0f * u(rng), 20.0f * u(rng), 20.0f * u(rng));
-    const glm::vec3 axis(u(rng), u(rng), u(rng) + 1.5f);
+    const glm::vec3 t{20.0f * u(rng), 20.0f * u(rng), 20.0f * u(rng)};
+    const glm::vec3 axis{u(rng), u(rng), u(rng) + 1.5f};
     const float sc = 0.5f + 0.5f * (u(rng) + 1.0f);
-    const glm::vec3 s3(sc * (u(rng) < 0.0f ? -1.0f : 1.0f), sc * (1.0f + 0.5f * u(rng)), sc);
+    const glm::vec3 s3{sc * (u(rng) < 0.0f ? -1.0f : 1.0f), sc * (1.0f + 0.5f * u(rng)), sc};
     add(i % 3 == 0 ? 1u : 0u, trs(t, 3.0f * u(rng), axis, s3));
   }
   s.flatten();
@@ -117,7 +117,7 @@ std::vector<Ray> make_rays(const Scene& s, std::size_t n, std::uint64_t seed) {
   std::vector<Ray> rays;
   rays.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const glm::vec3 o = c + (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * e * 1.2f;
+    const glm::vec3 o = c + (glm::vec3{u(rng), u(rng), u(rng)} - 0.5f) * e * 1.2f;
     glm::vec3 d;
     if (i % 2 == 0) {
       const Triangle& t = s.triangles[rng() % s.triangles.size()];
@@ -128,7 +128,7 @@ std::vector<Ray> make_rays(const Scene& s, std::size_t n, std::uint64_t seed) {
       }
       d = (t.v0 + a * (t.v1 - t.v0) + bb * (t.v2 - t.v0)) - o;
     } else {
-      d = glm::vec3(u(rng), u(rng), u(rng)) * 2.0f - 1.0f;
+      d = glm::vec3{u(rng), u(rng), u(rng)} * 2.0f - 1.0f;
     }
     if (glm::length(d) == 0.0f) d = glm::vec3(0, 0, 1);
     rays.emplace_back(o, d);

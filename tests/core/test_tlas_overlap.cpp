@@ -62,8 +62,8 @@ TEST(InstanceOverlap, ManyBoxesAgreeWithEveryPairTestedDirectly) {
   };
   std::vector<Aabb> boxes;
   for (int i = 0; i < 1500; ++i) {
-    const glm::vec3 lo(next() * 100.0f, next() * 20.0f, next() * 20.0f);
-    glm::vec3 size(next() * 3.0f, next() * 3.0f, next() * 3.0f);
+    const glm::vec3 lo{next() * 100.0f, next() * 20.0f, next() * 20.0f};
+    glm::vec3 size{next() * 3.0f, next() * 3.0f, next() * 3.0f};
     if (i % 50 == 0) size.x = 60.0f;  // long in x: hundreds of candidates each
     if (i % 7 == 0) size.y = 0.0f;    // flat: overlaps have no volume, and touch-only pairs count nothing
     boxes.push_back(Aabb{lo, lo + size});

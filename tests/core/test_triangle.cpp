@@ -96,7 +96,7 @@ TEST(TriangleHardCases, RayThroughSharedEdgeOfClosedMeshNeverMisses) {
     const Triangle& t = tris[i % 8];
     const float s = rng.next();
     const glm::vec3 target = t.v0 + s * (t.v1 - t.v0);
-    const glm::vec3 o = c + glm::vec3(rng.range(-0.3f, 0.3f), rng.range(-0.3f, 0.3f), rng.range(-0.3f, 0.3f));
+    const glm::vec3 o = c + glm::vec3{rng.range(-0.3f, 0.3f), rng.range(-0.3f, 0.3f), rng.range(-0.3f, 0.3f)};
     const Ray r(o, target - o);
     ASSERT_GE(count_hits(tris, r, true), 1) << "watertight miss through an edge, i=" << i;
     fast_misses += count_hits(tris, r, false) == 0;
@@ -112,7 +112,7 @@ TEST(TriangleHardCases, RayThroughSharedVertexOfClosedMeshNeverMisses) {
   for (int i = 0; i < 6000; ++i) {
     const Triangle& t = tris[i % 8];
     const glm::vec3 target = (i % 3 == 0) ? t.v0 : (i % 3 == 1 ? t.v1 : t.v2);
-    const glm::vec3 o = c + glm::vec3(rng.range(-0.2f, 0.2f), rng.range(-0.2f, 0.2f), rng.range(-0.2f, 0.2f));
+    const glm::vec3 o = c + glm::vec3{rng.range(-0.2f, 0.2f), rng.range(-0.2f, 0.2f), rng.range(-0.2f, 0.2f)};
     ASSERT_GE(count_hits(tris, Ray(o, target - o), true), 1) << "i=" << i;
   }
 }
@@ -196,7 +196,7 @@ TEST(TriangleHardCases, SceneTranslatedBy1e7) {
   for (int i = 0; i < 5000; ++i) {
     const Triangle& t = tris[i % 8];
     const glm::vec3 target = t.v0 + std::floor(rng.next() * 64.0f) / 64.0f * (t.v1 - t.v0);
-    const glm::vec3 o = c + glm::vec3(std::floor(rng.range(-8, 8)), std::floor(rng.range(-8, 8)), 1.0f);
+    const glm::vec3 o = c + glm::vec3{std::floor(rng.range(-8, 8)), std::floor(rng.range(-8, 8)), 1.0f};
     ASSERT_GE(count_hits(tris, Ray(o, target - o), true), 1) << "i=" << i;
   }
 }
