@@ -33,7 +33,7 @@ ctest --preset release -j "$jobs"
 
 if [ "${ACCELVIZ_SKIP_FUZZ:-0}" != "1" ]; then
   # libFuzzer on the glTF/GLB, OBJ and ray-file readers (clang, ASan+UBSan),
-  # ACCELVIZ_FUZZ_SECONDS (default 45) per target, side by side.
+  # ACCELVIZ_FUZZ_SECONDS (default 30) per target, side by side.
   phase "fuzz (tests/fuzz/run.sh)"
   ./tests/fuzz/run.sh
 fi

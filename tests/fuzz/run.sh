@@ -5,13 +5,13 @@
 # report, uncaught exception other than the loader's own error, timeout
 # (-timeout) or memory blow-up (-rss_limit_mb); the reproducer is left in
 # $BUILD/artifacts/<target>/.
-#   ACCELVIZ_FUZZ_SECONDS   seconds per target (default 45)
+#   ACCELVIZ_FUZZ_SECONDS   seconds per target (default 30)
 #   ACCELVIZ_FUZZ_BUILD     build directory (default build/fuzz)
 #   ACCELVIZ_FUZZ_TARGETS   space-separated subset (default: all three)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 
-seconds="${ACCELVIZ_FUZZ_SECONDS:-45}"
+seconds="${ACCELVIZ_FUZZ_SECONDS:-30}"
 build="${ACCELVIZ_FUZZ_BUILD:-build/fuzz}"
 targets="${ACCELVIZ_FUZZ_TARGETS:-fuzz_gltf fuzz_obj fuzz_ray_file}"
 
