@@ -7,8 +7,8 @@
 //
 // Ray count: ACCELVIZ_TLAS_RAYS, else 1,000,000 scaled by ACCELVIZ_VERIFY_SCALE
 // (tests/support/test_scale.h: 50,000 in the sanitizer run, 250,000 in the
-// scalar-path run; the release CI run does the full million); the other differential tests use 1/50 or 1/20 of it (at
-// least 2,000 / 5,000).
+// scalar-path run; the release CI run does the full million); the other
+// differential tests use 1/50 or 1/20 of it (at least 2,000 / 5,000).
 #include <gtest/gtest.h>
 
 #include <algorithm>
