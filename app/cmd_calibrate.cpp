@@ -44,12 +44,15 @@ int run_calibrate(const CalibrateCliOptions& o, const GlobalOptions& global) {
   const ImageSize size = parse_size(o.size);
   const QueryOptions q{parse_triangle_test(o.triangle_test), true};
   Progress progress(global.quiet);
-  // The scene first: a name that does not load is said before seconds of micro-benchmarks.
+  // The scene and its camera first: a name that does not load, or a scene
+  // that cannot be framed, is said before seconds of micro-benchmarks.
   std::optional<Scene> scene;
+  std::vector<Ray> rays;
   if (!o.scene.empty()) {
     progress.begin("loading " + o.scene);
     scene = load_scene_noting_warnings(o.scene, global.quiet);
     require_flattened(*scene, o.scene, "calibrate --scene");
+    rays = primary_rays(camera_for("", *scene, size, /*has_camera_option=*/false), size.width, size.height);
     progress.end(count_of(scene->triangles.size(), "triangle"));
   }
   progress.begin("micro-benchmarks (box, watertight, fast)");
@@ -68,8 +71,6 @@ int run_calibrate(const CalibrateCliOptions& o, const GlobalOptions& global) {
                       {"repeat", o.repeat}};
   CalibrationReport report;
   if (scene) {
-    const std::vector<Ray> rays =
-        primary_rays(camera_for("", *scene, size, /*has_camera_option=*/false), size.width, size.height);
     progress.begin("BVH with the default and the calibrated constants");
     report = compare_calibrated_bvh(scene->triangles, rays, c, q, o.threads, o.repeat);
     progress.end();

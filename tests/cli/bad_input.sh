@@ -219,6 +219,10 @@ expect 1 "$tmp/huge.obj: cannot frame the scene" -- verify "$tmp/huge.obj" --ray
 # refit and calibrate frame the scene themselves: no advice to use an option they do not have.
 expect 1 "would stand beyond the float range (this command has no --camera)" -- refit "$tmp/huge.obj" --out "$tmp/rf"
 expect 1 "would stand beyond the float range (this command has no --camera)" -- calibrate --scene "$tmp/huge.obj"
+# ... and calibrate says so before its seconds of micro-benchmarks (their
+# progress line came first).
+"$accelviz" calibrate --scene "$tmp/huge.obj" >/dev/null 2>"$tmp/stderr"
+if grep -q "micro-benchmarks" "$tmp/stderr"; then echo "FAIL: calibrate measured before framing: $(cat "$tmp/stderr")"; fail=1; fi
 [ ! -e "$tmp/huge.png" ] || { echo "FAIL: a PNG of an unframable scene"; fail=1; }
 
 # export: the extension in any case, -f for --force; a name that is only
