@@ -11,13 +11,29 @@
 
 namespace accelviz::test_referee {
 
-/// True when the reference judges `closest` and `any` (a structure's answers for `ray` over
-/// `tris`) a match or a near tie (classify_closest, classify_any).
+/// The reference's answer for one ray over `tris`, computed once, judging any number of answers.
+class Referee {
+ public:
+  Referee(std::span<const Triangle> tris, const Ray& ray)
+      : tris_(tris), ray_(ray), ref_(ReferenceTracer(tris).closest_hit(ray)) {}
+
+  /// True when the reference judges `closest` and `any` (a structure's answers for the ray) a
+  /// match or a near tie (classify_closest, classify_any).
+  bool accepts(const Hit& closest, bool any) const {
+    const Verdict vc = classify_closest(tris_, ray_, ref_, closest);
+    const Verdict va = classify_any(ref_, any);
+    return (vc == Verdict::match || vc == Verdict::near_tie) && (va == Verdict::match || va == Verdict::near_tie);
+  }
+
+ private:
+  std::span<const Triangle> tris_;
+  Ray ray_;
+  ReferenceHit ref_;
+};
+
+/// Referee(tris, ray).accepts(closest, any): for a ray with one answer to judge.
 inline bool reference_accepts(std::span<const Triangle> tris, const Ray& ray, const Hit& closest, bool any) {
-  const ReferenceHit ref = ReferenceTracer(tris).closest_hit(ray);
-  const Verdict vc = classify_closest(tris, ray, ref, closest);
-  const Verdict va = classify_any(ref, any);
-  return (vc == Verdict::match || vc == Verdict::near_tie) && (va == Verdict::match || va == Verdict::near_tie);
+  return Referee(tris, ray).accepts(closest, any);
 }
 
 }  // namespace accelviz::test_referee
