@@ -26,6 +26,7 @@
 #   HEADLINE_SOUP     the soup's scene (default builtin:soup?size=10000000; "" skips it)
 #   HEADLINE_THREADS  thread counts (default "1 2")
 #   HEADLINE_REPEAT   runs per figure of the meshes (default 5); the soup's is 3 unless this is lower
+#   HEADLINE_SIZE     the meshes' image size, bench's --size (default: bench's own, 800x600)
 #   HEADLINE_FORCE    1: write over the results of an earlier run in OUT_DIR, name by name (the names
 #                     this run writes; an earlier run's other N-*.json stay, beside a table.md of this
 #                     run only). Without it an OUT_DIR that holds any (N-robust.json, N-fast.json,
@@ -73,6 +74,8 @@ meshes="${HEADLINE_MESHES-$assets/bunny.glb $assets/dragon.glb $assets/kitchen_p
 soup="${HEADLINE_SOUP-builtin:soup?size=10000000}"
 threads="${HEADLINE_THREADS:-1 2}"
 repeat="${HEADLINE_REPEAT:-5}"
+mesh_size=()
+if [ -n "${HEADLINE_SIZE:-}" ]; then mesh_size=(--size "$HEADLINE_SIZE"); fi
 soup_repeat=$((repeat < 3 ? repeat : 3))
 
 run() {  # FILE ARGS...: one bench run, its JSON kept
@@ -89,9 +92,9 @@ rows=()
 for scene in $meshes; do
   for t in $threads; do
     i=$((i + 1))
-    run "$i-robust.json" "$scene" -s bvh,embree -n "$repeat" --warmup 1 -j "$t" --no-epo --embree-robust
+    run "$i-robust.json" "$scene" -s bvh,embree -n "$repeat" --warmup 1 -j "$t" --no-epo --embree-robust "${mesh_size[@]}"
     rows+=("$i-robust.json|watertight vs robust")
-    run "$i-fast.json" "$scene" -s bvh,embree -n "$repeat" --warmup 1 -j "$t" --no-epo --triangle-test fast
+    run "$i-fast.json" "$scene" -s bvh,embree -n "$repeat" --warmup 1 -j "$t" --no-epo --triangle-test fast "${mesh_size[@]}"
     rows+=("$i-fast.json|fast vs default")
   done
 done

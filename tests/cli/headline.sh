@@ -36,13 +36,21 @@ if ! grep -q embree-medium "$tmp/help.txt"; then
   exit 0
 fi
 HEADLINE_MESHES='builtin:teapot?size=800' HEADLINE_SOUP='builtin:soup?size=2000' HEADLINE_THREADS='1 2' \
-  HEADLINE_REPEAT=1 bash "$src/bench/headline.sh" "$accelviz" "$tmp/out" > "$tmp/stdout.md" 2> "$tmp/stderr.txt"
+  HEADLINE_REPEAT=1 HEADLINE_SIZE=160x120 bash "$src/bench/headline.sh" "$accelviz" "$tmp/out" > "$tmp/stdout.md" 2> "$tmp/stderr.txt"
 cmp -s "$tmp/stdout.md" "$tmp/out/table.md" || fail "the table printed is not table.md"
 [ "$(ls "$tmp/out"/*.json | wc -l)" -eq 10 ] || fail "expected 10 bench runs: $(ls "$tmp/out")"
 [ "$(ls -A "$tmp/out" | wc -l)" -eq 11 ] || fail "expected the runs and table.md only: $(ls -A "$tmp/out")"
 [ "$(stat -c %a "$tmp/out/table.md")" = "$(printf '%o' $((0666 & ~0$(umask))))" ] ||
   fail "table.md has mode $(stat -c %a "$tmp/out/table.md"), not the umask's"
 grep -q -- "--embree-robust" "$tmp/stderr.txt" || fail "the commands are not echoed"
+# HEADLINE_SIZE is the meshes' image: 160x120 primary rays (the soup keeps its 64x48).
+python3 - "$tmp/out" <<'PY'
+import glob, json, os, sys
+for f in sorted(glob.glob(os.path.join(sys.argv[1], "*.json"))):
+    j = json.load(open(f))
+    want = 64 * 48 if j["scene"].startswith("builtin:soup") else 160 * 120
+    assert j["ray_sets"]["primary"]["rays"] == want, (f, j["scene"], j["ray_sets"]["primary"])
+PY
 python3 - "$tmp/out/table.md" <<'PY'
 import sys
 lines = open(sys.argv[1]).read().splitlines()

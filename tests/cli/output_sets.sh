@@ -87,7 +87,7 @@ failed_set_leaves() {
   [ "$(ls -A "$dir" | wc -l)" -eq "$n" ] || fail "temporaries left: $(ls -A "$dir")"
 }
 # Brute force's image is one colour (every ray tests every triangle): a small PNG beside the BVH's.
-r=(render 'builtin:teapot?size=400' --size 160x120 -m prims --caption none --threads 1)
+r=(render 'builtin:teapot?size=150' --size 160x120 -m prims --caption none --threads 1)
 mkdir "$tmp/probe" "$tmp/several"
 "$bin" -q "${r[@]}" -s brute,bvh --colormap inferno -o "$tmp/probe/T.png" > "$tmp/stdout"
 [ "$(wc -l < "$tmp/stdout")" -eq 3 ] || fail "render -s brute,bvh printed: $(cat "$tmp/stdout")"
