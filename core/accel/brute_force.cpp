@@ -1,7 +1,9 @@
 #include "core/accel/brute_force.h"
-#include "core/util/timing.h"
 
 #include <chrono>
+
+#include "core/accel/bvh/bvh_triangle.h"
+#include "core/util/timing.h"
 
 namespace accelviz {
 
@@ -36,45 +38,117 @@ BruteForce::BruteForce(std::span<const Triangle> triangles, const BruteForceOpti
   }
 }
 
-Hit BruteForce::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, VisitTrace* trace) const {
-  const WatertightRay wr(ray.direction);
+namespace {
+
+/// closest_hit's loop, generic in the triangle test (`test(tri, tmax, hit)`). kCount: stats and
+/// trace may be set (the out-of-line test, as the statistics walks of the trees); otherwise the
+/// fast path, where the BVH's inline tests answer bit for bit as the out-of-line ones
+/// (core/accel/bvh/bvh_triangle.h; verify and the brute-force heatmaps spend their time here).
+template <bool kCount, class Test>
+Hit closest_loop(std::span<const Triangle> tris, const std::vector<Aabb>& boxes, bool bbox_early_out, const Ray& ray,
+                 const Test& test, RayStats* stats, VisitTrace* trace) {
   Hit best;
   float tmax = ray.tmax;
-  for (std::size_t i = 0; i < tris_.size(); ++i) {
-    if (opts_.bbox_early_out) {
+  for (std::size_t i = 0; i < tris.size(); ++i) {
+    if (bbox_early_out) {
       SlabInterval iv;
-      if (stats) ++stats->box_tests, ++stats->nodes_visited;  // a one-triangle leaf's box, as the trees count
-      if (!intersect_slab(boxes_[i], ray.origin, ray.inv_dir, ray.tmin, tmax, iv)) continue;
+      if constexpr (kCount)
+        if (stats) ++stats->box_tests, ++stats->nodes_visited;  // a one-triangle leaf's box, as the trees count
+      if (!intersect_slab(boxes[i], ray.origin, ray.inv_dir, ray.tmin, tmax, iv)) continue;
     }
-    if (stats) ++stats->prim_tests;
+    if constexpr (kCount)
+      if (stats) ++stats->prim_tests;
     Hit h;
-    const bool hit = intersect_triangle(qo.triangle_test, ray, wr, tris_[i], ray.tmin, tmax, h);
-    if (trace)
-      trace->steps.push_back({hit ? VisitStep::Kind::prim_hit : VisitStep::Kind::prim_miss,
-                              static_cast<std::uint32_t>(i), hit ? h.t : kInfinity, kInfinity});
+    const bool hit = test(tris[i], tmax, h);
+    if constexpr (kCount)
+      if (trace)
+        trace->steps.push_back({hit ? VisitStep::Kind::prim_hit : VisitStep::Kind::prim_miss,
+                                static_cast<std::uint32_t>(i), hit ? h.t : kInfinity, kInfinity});
     if (hit && h.t < best.t) {
       best = h;
       best.prim = static_cast<std::uint32_t>(i);
       tmax = h.t;
     }
   }
-  if (best.valid()) best.ng = triangle_normal(tris_[best.prim]);
+  if (best.valid()) best.ng = triangle_normal(tris[best.prim]);
   return best;
 }
 
-bool BruteForce::any_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats) const {
-  const WatertightRay wr(ray.direction);
-  for (std::size_t i = 0; i < tris_.size(); ++i) {
-    if (opts_.bbox_early_out) {
+/// any_hit's loop, as closest_loop.
+template <bool kCount, class Test>
+bool any_loop(std::span<const Triangle> tris, const std::vector<Aabb>& boxes, bool bbox_early_out, const Ray& ray,
+              const Test& test, RayStats* stats) {
+  for (std::size_t i = 0; i < tris.size(); ++i) {
+    if (bbox_early_out) {
       SlabInterval iv;
-      if (stats) ++stats->box_tests, ++stats->nodes_visited;
-      if (!intersect_slab(boxes_[i], ray, iv)) continue;
+      if constexpr (kCount)
+        if (stats) ++stats->box_tests, ++stats->nodes_visited;
+      if (!intersect_slab(boxes[i], ray, iv)) continue;
     }
-    if (stats) ++stats->prim_tests;
+    if constexpr (kCount)
+      if (stats) ++stats->prim_tests;
     Hit h;
-    if (intersect_triangle(qo.triangle_test, ray, wr, tris_[i], ray.tmin, ray.tmax, h)) return true;
+    if (test(tris[i], ray.tmax, h)) return true;
   }
   return false;
+}
+
+}  // namespace
+
+Hit BruteForce::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, VisitTrace* trace) const {
+  const bool bbox = opts_.bbox_early_out;
+  if (stats || trace) {
+    const WatertightRay wr(ray.direction);
+    return closest_loop<true>(
+        tris_, boxes_, bbox, ray,
+        [&](const Triangle& tri, float tmax, Hit& h) {
+          return intersect_triangle(qo.triangle_test, ray, wr, tri, ray.tmin, tmax, h);
+        },
+        stats, trace);
+  }
+  if (qo.triangle_test == TriangleTest::watertight) {
+    const bvh_detail::InlineWatertightRay ir(ray);
+    return closest_loop<false>(
+        tris_, boxes_, bbox, ray,
+        [&](const Triangle& tri, float tmax, Hit& h) {
+          return bvh_detail::intersect_watertight_inline(ray, ir, tri, ray.tmin, tmax, h);
+        },
+        nullptr, nullptr);
+  }
+  return closest_loop<false>(
+      tris_, boxes_, bbox, ray,
+      [&](const Triangle& tri, float tmax, Hit& h) {
+        return intersect_moller_trumbore_inline(ray, tri, ray.tmin, tmax, h);
+      },
+      nullptr, nullptr);
+}
+
+bool BruteForce::any_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats) const {
+  const bool bbox = opts_.bbox_early_out;
+  if (stats) {
+    const WatertightRay wr(ray.direction);
+    return any_loop<true>(
+        tris_, boxes_, bbox, ray,
+        [&](const Triangle& tri, float tmax, Hit& h) {
+          return intersect_triangle(qo.triangle_test, ray, wr, tri, ray.tmin, tmax, h);
+        },
+        stats);
+  }
+  if (qo.triangle_test == TriangleTest::watertight) {
+    const bvh_detail::InlineWatertightRay ir(ray);
+    return any_loop<false>(
+        tris_, boxes_, bbox, ray,
+        [&](const Triangle& tri, float tmax, Hit& h) {
+          return bvh_detail::intersect_watertight_inline(ray, ir, tri, ray.tmin, tmax, h);
+        },
+        nullptr);
+  }
+  return any_loop<false>(
+      tris_, boxes_, bbox, ray,
+      [&](const Triangle& tri, float tmax, Hit& h) {
+        return intersect_moller_trumbore_inline(ray, tri, ray.tmin, tmax, h);
+      },
+      nullptr);
 }
 
 }  // namespace accelviz
