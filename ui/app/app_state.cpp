@@ -281,7 +281,11 @@ bool AppState::settled() const {
   if (!current_ || view_w_ <= 0 || view_h_ <= 0) return true;
   if (!heatmap_requested_ || !(*heatmap_requested_ == heatmap_key(view_w_, view_h_))) return false;
   if (heatmap_on_gpu_) return gpu_frame_shown_;
-  if (heatmaps_.failure().first == heatmaps_.latest_request() && !heatmaps_.busy()) return true;  // failed: said
+  // Failed, and said: update() has taken the failure into the status line. (Reading the worker's
+  // failure here settled a frame early: a failure after that frame's update() left `wait` to
+  // return before the status said it.)
+  if (heatmap_failure_shown_ != 0 && heatmap_failure_shown_ == heatmaps_.latest_request() && !heatmaps_.busy())
+    return true;
   return heatmap_ && heatmap_->id == heatmaps_.latest_request() && heatmap_->complete;
 }
 
