@@ -1,6 +1,7 @@
 #include "core/accel/brute_force.h"
 
 #include <chrono>
+#include <type_traits>
 
 #include "core/accel/bvh/bvh_triangle.h"
 #include "core/util/timing.h"
@@ -40,10 +41,8 @@ BruteForce::BruteForce(std::span<const Triangle> triangles, const BruteForceOpti
 
 namespace {
 
-/// closest_hit's loop, generic in the triangle test (`test(tri, tmax, hit)`). kCount: stats and
-/// trace may be set (the out-of-line test, as the statistics walks of the trees); otherwise the
-/// fast path, where the BVH's inline tests answer bit for bit as the out-of-line ones
-/// (core/accel/bvh/bvh_triangle.h; verify and the brute-force heatmaps spend their time here).
+/// closest_hit's loop, generic in the triangle test (`test(tri, tmax, hit)`; with_triangle_test picks
+/// it). kCount: stats and trace may be set; without it they are never read.
 template <bool kCount, class Test>
 Hit closest_loop(std::span<const Triangle> tris, const std::vector<Aabb>& boxes, bool bbox_early_out, const Ray& ray,
                  const Test& test, RayStats* stats, VisitTrace* trace) {
@@ -93,62 +92,41 @@ bool any_loop(std::span<const Triangle> tris, const std::vector<Aabb>& boxes, bo
   return false;
 }
 
+/// Runs `loop(count, test)` with the ray's triangle test `test(tri, tmax, hit)`. With statistics or a
+/// trace (`count` is std::true_type) the out-of-line dispatch, as the trees' counting walks; otherwise
+/// the BVH walks' inline tests, bit for bit the same results (core/accel/bvh/bvh_triangle.h; verify
+/// and the brute-force heatmaps spend their time here).
+template <class Loop>
+auto with_triangle_test(const Ray& ray, TriangleTest which, bool counting, const Loop& loop) {
+  if (counting) {
+    const WatertightRay wr(ray.direction);
+    return loop(std::true_type{}, [&](const Triangle& tri, float tmax, Hit& h) {
+      return intersect_triangle(which, ray, wr, tri, ray.tmin, tmax, h);
+    });
+  }
+  if (which == TriangleTest::watertight) {
+    const bvh_detail::InlineWatertightRay ir(ray);
+    return loop(std::false_type{}, [&](const Triangle& tri, float tmax, Hit& h) {
+      return bvh_detail::intersect_watertight_inline(ray, ir, tri, ray.tmin, tmax, h);
+    });
+  }
+  return loop(std::false_type{}, [&](const Triangle& tri, float tmax, Hit& h) {
+    return intersect_moller_trumbore_inline(ray, tri, ray.tmin, tmax, h);
+  });
+}
+
 }  // namespace
 
 Hit BruteForce::closest_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats, VisitTrace* trace) const {
-  const bool bbox = opts_.bbox_early_out;
-  if (stats || trace) {
-    const WatertightRay wr(ray.direction);
-    return closest_loop<true>(
-        tris_, boxes_, bbox, ray,
-        [&](const Triangle& tri, float tmax, Hit& h) {
-          return intersect_triangle(qo.triangle_test, ray, wr, tri, ray.tmin, tmax, h);
-        },
-        stats, trace);
-  }
-  if (qo.triangle_test == TriangleTest::watertight) {
-    const bvh_detail::InlineWatertightRay ir(ray);
-    return closest_loop<false>(
-        tris_, boxes_, bbox, ray,
-        [&](const Triangle& tri, float tmax, Hit& h) {
-          return bvh_detail::intersect_watertight_inline(ray, ir, tri, ray.tmin, tmax, h);
-        },
-        nullptr, nullptr);
-  }
-  return closest_loop<false>(
-      tris_, boxes_, bbox, ray,
-      [&](const Triangle& tri, float tmax, Hit& h) {
-        return intersect_moller_trumbore_inline(ray, tri, ray.tmin, tmax, h);
-      },
-      nullptr, nullptr);
+  return with_triangle_test(ray, qo.triangle_test, stats || trace, [&](auto count, const auto& test) {
+    return closest_loop<decltype(count)::value>(tris_, boxes_, opts_.bbox_early_out, ray, test, stats, trace);
+  });
 }
 
 bool BruteForce::any_hit(const Ray& ray, const QueryOptions& qo, RayStats* stats) const {
-  const bool bbox = opts_.bbox_early_out;
-  if (stats) {
-    const WatertightRay wr(ray.direction);
-    return any_loop<true>(
-        tris_, boxes_, bbox, ray,
-        [&](const Triangle& tri, float tmax, Hit& h) {
-          return intersect_triangle(qo.triangle_test, ray, wr, tri, ray.tmin, tmax, h);
-        },
-        stats);
-  }
-  if (qo.triangle_test == TriangleTest::watertight) {
-    const bvh_detail::InlineWatertightRay ir(ray);
-    return any_loop<false>(
-        tris_, boxes_, bbox, ray,
-        [&](const Triangle& tri, float tmax, Hit& h) {
-          return bvh_detail::intersect_watertight_inline(ray, ir, tri, ray.tmin, tmax, h);
-        },
-        nullptr);
-  }
-  return any_loop<false>(
-      tris_, boxes_, bbox, ray,
-      [&](const Triangle& tri, float tmax, Hit& h) {
-        return intersect_moller_trumbore_inline(ray, tri, ray.tmin, tmax, h);
-      },
-      nullptr);
+  return with_triangle_test(ray, qo.triangle_test, stats != nullptr, [&](auto count, const auto& test) {
+    return any_loop<decltype(count)::value>(tris_, boxes_, opts_.bbox_early_out, ray, test, stats);
+  });
 }
 
 }  // namespace accelviz
