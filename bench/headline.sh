@@ -92,9 +92,11 @@ rows=()
 for scene in $meshes; do
   for t in $threads; do
     i=$((i + 1))
-    run "$i-robust.json" "$scene" -s bvh,embree -n "$repeat" --warmup 1 -j "$t" --no-epo --embree-robust "${mesh_size[@]}"
+    run "$i-robust.json" "$scene" -s bvh,embree -n "$repeat" --warmup 1 -j "$t" --no-epo --embree-robust \
+      "${mesh_size[@]}"
     rows+=("$i-robust.json|watertight vs robust")
-    run "$i-fast.json" "$scene" -s bvh,embree -n "$repeat" --warmup 1 -j "$t" --no-epo --triangle-test fast "${mesh_size[@]}"
+    run "$i-fast.json" "$scene" -s bvh,embree -n "$repeat" --warmup 1 -j "$t" --no-epo --triangle-test fast \
+      "${mesh_size[@]}"
     rows+=("$i-fast.json|fast vs default")
   done
 done

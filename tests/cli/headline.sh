@@ -36,7 +36,8 @@ if ! grep -q embree-medium "$tmp/help.txt"; then
   exit 0
 fi
 HEADLINE_MESHES='builtin:teapot?size=800' HEADLINE_SOUP='builtin:soup?size=2000' HEADLINE_THREADS='1 2' \
-  HEADLINE_REPEAT=1 HEADLINE_SIZE=160x120 bash "$src/bench/headline.sh" "$accelviz" "$tmp/out" > "$tmp/stdout.md" 2> "$tmp/stderr.txt"
+  HEADLINE_REPEAT=1 HEADLINE_SIZE=160x120 bash "$src/bench/headline.sh" "$accelviz" "$tmp/out" > "$tmp/stdout.md" \
+  2> "$tmp/stderr.txt"
 cmp -s "$tmp/stdout.md" "$tmp/out/table.md" || fail "the table printed is not table.md"
 [ "$(ls "$tmp/out"/*.json | wc -l)" -eq 10 ] || fail "expected 10 bench runs: $(ls "$tmp/out")"
 [ "$(ls -A "$tmp/out" | wc -l)" -eq 11 ] || fail "expected the runs and table.md only: $(ls -A "$tmp/out")"
