@@ -104,14 +104,13 @@ auto with_triangle_test(const Ray& ray, TriangleTest which, bool counting, const
       return intersect_triangle(which, ray, wr, tri, ray.tmin, tmax, h);
     });
   }
-  if (which == TriangleTest::watertight) {
-    const bvh_detail::InlineWatertightRay ir(ray);
+  const bvh_detail::InlineWatertightRay ir(ray);  // read by the watertight test only
+  if (which == TriangleTest::watertight)
     return loop(std::false_type{}, [&](const Triangle& tri, float tmax, Hit& h) {
-      return bvh_detail::intersect_watertight_inline(ray, ir, tri, ray.tmin, tmax, h);
+      return bvh_detail::test_triangle<TriangleTest::watertight>(ray, ir, tri, ray.tmin, tmax, h);
     });
-  }
   return loop(std::false_type{}, [&](const Triangle& tri, float tmax, Hit& h) {
-    return intersect_moller_trumbore_inline(ray, tri, ray.tmin, tmax, h);
+    return bvh_detail::test_triangle<TriangleTest::moller_trumbore>(ray, ir, tri, ray.tmin, tmax, h);
   });
 }
 

@@ -249,16 +249,7 @@ struct Collector {
 };
 
 using bvh_detail::InlineWatertightRay;
-
-/// The inline twins of triangle.cpp's tests (bvh_triangle.h): same results.
-template <TriangleTest Test>
-[[gnu::always_inline]] inline bool test_triangle(const Ray& ray, const InlineWatertightRay& wr, const Triangle& tri,
-                                                 float tmin, float tmax, Hit& h) {
-  if constexpr (Test == TriangleTest::watertight)
-    return bvh_detail::intersect_watertight_inline(ray, wr, tri, tmin, tmax, h);
-  else
-    return bvh_detail::intersect_moller_trumbore_inline(ray, tri, tmin, tmax, h);
-}
+using bvh_detail::test_triangle;
 
 /// A hit at (t, u, v) on lane l of triangle block `blk`, found in leaf order,
 /// into `best` (best.prim: the lane's leaf position). Any hit records it and

@@ -84,4 +84,14 @@ struct InlineWatertightRay {
 /// core/geometry/triangle_inline.h).
 using accelviz::intersect_moller_trumbore_inline;
 
+/// The inline twin of triangle.cpp's test `Test`: same results (the BVH's leaves, brute force).
+template <TriangleTest Test>
+[[gnu::always_inline]] inline bool test_triangle(const Ray& ray, const InlineWatertightRay& wr, const Triangle& tri,
+                                                 float tmin, float tmax, Hit& h) {
+  if constexpr (Test == TriangleTest::watertight)
+    return intersect_watertight_inline(ray, wr, tri, tmin, tmax, h);
+  else
+    return intersect_moller_trumbore_inline(ray, tri, tmin, tmax, h);
+}
+
 }  // namespace accelviz::bvh_detail
