@@ -22,6 +22,7 @@
 namespace accelviz {
 struct SweepResult;  // core/analysis/sweep.h
 struct LabResult;    // core/analysis/robustness_lab.h
+struct FrameStats;   // core/scene/animation.h
 struct PngText;      // core/analysis/heatmap.h
 }
 
@@ -233,6 +234,11 @@ nlohmann::json sweep_result_json(const SweepResult& r, double budget);
 /// The robustness lab's figures as `robustness --json` prints them (triangles, rays,
 /// rays_by_family, reference_hits, reference_ms, variants); the GUI's dump-robustness too.
 nlohmann::json lab_result_json(const LabResult& r);
+
+/// One animated frame's figures as `animate --json` prints them (frame, time, moved_instances,
+/// refits, rebuilds, tlas_rebuilt, tlas_rebuild_ms, refit_ms, rebuild_ms, sah_refit, sah_rebuilt,
+/// overlap_area, overlap_volume, overlap_pairs); the GUI's dump-dynamics history too.
+nlohmann::json frame_stats_json(const FrameStats& f);
 
 /// One-line JSON on stdout, flushed (animate streams a line per frame).
 void print_json_line(const nlohmann::json& j);

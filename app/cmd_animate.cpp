@@ -12,8 +12,26 @@
 #include "core/accel/tlas/tlas_overlap.h"
 #include "core/scene/animation.h"
 #include "core/scene/effects.h"
+#include "core/util/parallel.h"
 
 namespace accelviz::cli {
+
+nlohmann::json frame_stats_json(const FrameStats& f) {
+  return {{"frame", f.frame},
+          {"time", f.time},
+          {"moved_instances", f.moved_instances},
+          {"refits", f.refits},
+          {"rebuilds", f.rebuilds},
+          {"tlas_rebuilt", f.tlas_rebuilt},
+          {"tlas_rebuild_ms", f.tlas_rebuild_ms},
+          {"refit_ms", f.refit_ms},
+          {"rebuild_ms", f.rebuild_ms},
+          {"sah_refit", f.sah_refit},
+          {"sah_rebuilt", f.sah_rebuilt},
+          {"overlap_area", f.overlap.area_ratio},
+          {"overlap_volume", f.overlap.volume_ratio},
+          {"overlap_pairs", f.overlap.overlapping_pairs}};
+}
 
 namespace {
 
@@ -54,7 +72,21 @@ int run_animate(const AnimateOptions& o, const GlobalOptions& global) {
   AnimatorOptions ao;
   ao.rebuild_ratio = o.rebuild_ratio;
   SceneAnimator animator(scene, tlas, ao);
-  if (!o.json) {
+  if (o.json) {
+    // What the table's heading line says, and the build: the lines after it are the frames.
+    print_json_line({{"scene", o.scene},
+                     {"instances", tlas.instances().size()},
+                     {"blas", tlas.blas_count()},
+                     {"memory_two_level", tlas.memory_two_level()},
+                     {"memory_flattened_estimate", tlas.memory_flattened_estimate()},
+                     {"build_ms", tlas.build_stats().build_ms},
+                     {"threads", resolve_threads(o.threads)},
+                     {"animates", fx.per_frame_updates.on},
+                     {"frames", o.frames},
+                     {"dt", o.dt},
+                     {"rebuild_ratio", o.rebuild_ratio},
+                     {"program", program_json()}});
+  } else {
     std::printf("%s: %s, %zu BLAS, two-level %.1f MiB (flattened estimate %.1f MiB), build %.1f ms\n", o.scene.c_str(),
                 count_of(tlas.instances().size(), "instance").c_str(), tlas.blas_count(),
                 static_cast<double>(tlas.memory_two_level()) / 1048576.0,
@@ -81,23 +113,12 @@ int run_animate(const AnimateOptions& o, const GlobalOptions& global) {
         std::snprintf(when, sizeof when, "frame %d (t = %g s): ", f, f * o.dt);
         throw std::runtime_error(o.scene + ": " + when + what);
       }
-    } else
+    } else {
+      s.frame = static_cast<std::uint32_t>(f);
       s.time = static_cast<float>(f * o.dt);
+    }
     if (o.json) {
-      print_json_line({{"frame", f},
-                       {"time", s.time},
-                       {"moved_instances", s.moved_instances},
-                       {"refits", s.refits},
-                       {"rebuilds", s.rebuilds},
-                       {"tlas_rebuilt", s.tlas_rebuilt},
-                       {"tlas_rebuild_ms", s.tlas_rebuild_ms},
-                       {"refit_ms", s.refit_ms},
-                       {"rebuild_ms", s.rebuild_ms},
-                       {"sah_refit", s.sah_refit},
-                       {"sah_rebuilt", s.sah_rebuilt},
-                       {"overlap_area", s.overlap.area_ratio},
-                       {"overlap_volume", s.overlap.volume_ratio},
-                       {"overlap_pairs", s.overlap.overlapping_pairs}});
+      print_json_line(frame_stats_json(s));
     } else {
       std::printf("%5d %8.3f %7u %6u %8u %9.2f %9.2f %10.2f %10.2f %10.2f %9.4f\n", f, static_cast<double>(s.time),
                   s.moved_instances, s.refits, s.rebuilds, s.tlas_rebuild_ms, s.refit_ms, s.rebuild_ms, s.sah_refit,

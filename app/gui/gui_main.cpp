@@ -930,25 +930,12 @@ ScriptHost::Status Gui::execute(const ScriptCommand& c) {
     case K::dump_dynamics: {
       const SceneEffects* fx = effects();
       if (!fx) throw std::runtime_error("no scene shown yet");
-      nlohmann::json doc = {{"scene", app_.scene_spec()}, {"effects", effects_json(*fx)}};
+      nlohmann::json doc = {
+          {"scene", app_.scene_spec()}, {"effects", effects_json(*fx)}, {"program", cli::program_json()}};
       const std::shared_ptr<const DynamicsSnapshot> snap = dynamics_.latest();
       if (snap && app_.rest() && snap->scene == app_.rest()->scene.get()) {
         nlohmann::json frames = nlohmann::json::array();
-        for (const FrameStats& f : snap->history)
-          frames.push_back({{"frame", f.frame},
-                            {"time", f.time},
-                            {"moved_instances", f.moved_instances},
-                            {"refits", f.refits},
-                            {"rebuilds", f.rebuilds},
-                            {"tlas_rebuilt", f.tlas_rebuilt},
-                            {"tlas_rebuild_ms", f.tlas_rebuild_ms},
-                            {"refit_ms", f.refit_ms},
-                            {"rebuild_ms", f.rebuild_ms},
-                            {"sah_refit", f.sah_refit},
-                            {"sah_rebuilt", f.sah_rebuilt},
-                            {"overlap_area", f.overlap.area_ratio},
-                            {"overlap_volume", f.overlap.volume_ratio},
-                            {"overlap_pairs", f.overlap.overlapping_pairs}});
+        for (const FrameStats& f : snap->history) frames.push_back(cli::frame_stats_json(f));
         doc["dynamics"] = {{"frames_stepped", snap->frames}, {"setup_ms", snap->setup_ms}, {"duration", snap->duration},
                            {"animates", snap->animates},     {"error", snap->error},       {"history", frames}};
         doc["dynamics"]["shown_frame"] = nullptr;

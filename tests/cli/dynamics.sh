@@ -37,8 +37,15 @@ grep -Eq '^  two-level +off ' <<<"$out" || { echo "FAIL: teapot is not instanced
 "$accelviz" -q animate 'builtin:dynamic?size=3000' --frames 3 --json -j 1 > "$tmp/frames.jsonl"
 python3 - "$tmp/frames.jsonl" <<'PY'
 import json, sys
-rows = [json.loads(l) for l in open(sys.argv[1])]
+head, *rows = [json.loads(l) for l in open(sys.argv[1])]
+# The first line is the table's heading: the two-level structure built, and the build that ran.
+assert head["scene"] == "builtin:dynamic?size=3000" and head["animates"], head
+assert head["instances"] > 0 and head["blas"] >= 1 and head["build_ms"] >= 0, head
+assert head["memory_two_level"] > 0 and head["threads"] == 1 and head["frames"] == 3, head
+assert head["program"]["line"].startswith("accelviz "), head
+assert "frame" not in head, head
 assert len(rows) == 3, rows
+assert [r["frame"] for r in rows] == [0, 1, 2], rows
 boxes = (3000 - 3000 // 4) // 12
 for r in rows[1:]:
     assert r["moved_instances"] == boxes, r
@@ -53,7 +60,9 @@ PY
 # and the instance boxes' overlap (it was 0 on every row).
 "$accelviz" -q animate 'builtin:forest?size=2000' --frames 3 --dt 0.5 --json 2> "$tmp/err" | python3 -c '
 import json, sys
-rows = [json.loads(l) for l in sys.stdin]
+head, *rows = [json.loads(l) for l in sys.stdin]
+assert not head["animates"], head
+assert [r["frame"] for r in rows] == [0, 1, 2], rows
 assert all(r["refits"] == 0 and r["moved_instances"] == 0 and not r["tlas_rebuilt"] for r in rows), rows
 assert [r["time"] for r in rows] == [0.0, 0.5, 1.0], rows
 assert all(r["overlap_area"] > 0 and r["overlap_pairs"] > 0 for r in rows), rows

@@ -638,6 +638,9 @@ TEST_F(GuiScript, TwoLevelBoxLevelsInstanceColoursAndPlayedFrames) {
   // The played frames: the animator's own tree, the overlap measured on each.
   const nlohmann::json d = read_json(path("dyn.json"));
   ASSERT_TRUE(d["dynamics"].is_object()) << d.dump();
+  // The build that measured the frames' timings, as animate --json's first line names it.
+  ASSERT_TRUE(d["program"].is_object()) << d.dump();
+  EXPECT_EQ(d["program"]["line"].get<std::string>().rfind("accelviz ", 0), 0u) << d.dump();
   const auto& shown = d["dynamics"]["shown_frame"];
   ASSERT_TRUE(shown.is_object()) << d.dump();
   EXPECT_TRUE(shown["animator_tree"].get<bool>());
