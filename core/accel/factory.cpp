@@ -67,7 +67,11 @@ std::unique_ptr<Accelerator> build_accelerator(std::string_view name, std::span<
     if (bo.threads == 0) bo.threads = opts.threads;
     return std::make_unique<Bvh>(triangles, bo, progress);
   }
-  if (name == "kdtree") return std::make_unique<KdTree>(triangles, opts.kdtree, progress);
+  if (name == "kdtree") {
+    KdTreeOptions ko = opts.kdtree;
+    if (ko.threads == 0) ko.threads = opts.threads;
+    return std::make_unique<KdTree>(triangles, ko, progress);
+  }
   if (name == "grid") return std::make_unique<Grid>(triangles, opts.grid, progress);
   if (name == "octree") return std::make_unique<Octree>(triangles, opts.octree, progress);
   if (name == "voxels") return std::make_unique<Voxels>(triangles, opts.voxels, progress);

@@ -5,6 +5,8 @@
 // overlaps, SAH recomputed independently), options and degenerate inputs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -467,5 +469,62 @@ TEST(KdTree, ProgressAndCancellation) {
   int seen = 0;
   EXPECT_THROW(KdTree(s, {}, [&](double) { return ++seen < 3; }), BuildCancelled);
   EXPECT_EQ(seen, 3);
+}
+
+// A scene large enough for the parallel build (16,384 primitives or more):
+// random triangles and an axis-aligned subdivided cube (planar events, split
+// planes through vertices) give the same node array, references and figures
+// on any thread count as on one.
+TEST(KdTree, SameTreeOnAnyThreadCount) {
+  Scene s = soup(7, 30000, 0.03f);
+  const Scene cube = subdivided_cube(glm::vec3(-0.4f), 0.8f, 20);
+  s.insert(s.end(), cube.begin(), cube.end());
+  ASSERT_GE(s.size(), 16384u);
+  KdTreeOptions o;
+  o.threads = 1;
+  const KdTree one(s, o);
+  for (unsigned t : {2u, 3u, 5u}) {
+    o.threads = t;
+    const KdTree kd(s, o);
+    ASSERT_EQ(kd.nodes().size(), one.nodes().size()) << t << " threads";
+    for (std::size_t i = 0; i < one.nodes().size(); ++i)
+      ASSERT_TRUE(kd.nodes()[i].word == one.nodes()[i].word && kd.nodes()[i].bits == one.nodes()[i].bits)
+          << "node " << i << ", " << t << " threads";
+    ASSERT_TRUE(
+        std::equal(kd.prim_refs().begin(), kd.prim_refs().end(), one.prim_refs().begin(), one.prim_refs().end()))
+        << t << " threads";
+    const BuildStats &a = kd.build_stats(), &b = one.build_stats();
+    EXPECT_EQ(a.sah_cost, b.sah_cost) << t << " threads";  // the same sum in the same order
+    EXPECT_EQ(a.node_count, b.node_count);
+    EXPECT_EQ(a.leaf_count, b.leaf_count);
+    EXPECT_EQ(a.max_depth, b.max_depth);
+    EXPECT_EQ(a.avg_leaf_depth, b.avg_leaf_depth);
+    EXPECT_EQ(a.memory_bytes, b.memory_bytes);
+    EXPECT_EQ(a.extra.at("references"), b.extra.at("references"));
+    EXPECT_EQ(a.extra.at("empty_leaves"), b.extra.at("empty_leaves"));
+  }
+  EXPECT_GT(one.nodes().size(), 1000u);
+}
+
+// The parallel build reports progress in order, from whichever thread, and
+// stops on all threads at the first refusal.
+TEST(KdTree, ParallelBuildProgressAndCancellation) {
+  const Scene s = soup(16, 40000, 0.03f);
+  KdTreeOptions o;
+  o.threads = 2;
+  std::atomic<int> calls{0};
+  double last = 0.0;
+  const KdTree kd(s, o, [&](double f) {
+    EXPECT_GE(f, last);
+    EXPECT_LE(f, 1.0);
+    last = f;
+    ++calls;
+    return true;
+  });
+  EXPECT_GT(calls.load(), 5);
+  EXPECT_DOUBLE_EQ(last, 1.0);
+  std::atomic<int> seen{0};
+  EXPECT_THROW(KdTree(s, o, [&](double) { return ++seen < 3; }), BuildCancelled);
+  EXPECT_EQ(seen.load(), 3);
 }
 }  // namespace unity_test_kdtree

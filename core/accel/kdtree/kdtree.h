@@ -28,6 +28,7 @@ struct KdTreeOptions {
   float empty_bonus = 0.2f;      ///< SAH discount (0..1) for a split with an empty side: cost·(1 - bonus)
   bool perfect_splits = true;    ///< clip triangles to the node box for events and classification (else clamp bounds)
   bool mailboxing = true;        ///< skip primitives this ray already tested (a 16-entry hashed mailbox)
+  unsigned threads = 0;          ///< build threads, 0 = all hardware threads; the tree is the same for any count
 };
 
 /// Throws std::invalid_argument naming the offending option.

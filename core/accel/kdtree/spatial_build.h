@@ -3,8 +3,10 @@
 // trees (K-D tree, octree): the SAH sum, the leaves and their depths, and the
 // build's progress as a share of the whole, gathered while the nodes are made.
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <mutex>
 
 #include "core/accel/accel.h"
 
@@ -48,22 +50,34 @@ struct TreeTally {
 
 /// Progress of a top-down build: each finished leaf adds its share of the
 /// whole (its weight); the callback hears of every further 1 % and may
-/// cancel the build (BuildCancelled).
+/// cancel the build (BuildCancelled). Builders of subtrees on several
+/// threads may share one: one thread at a time calls the callback (a thread
+/// that finds it busy leaves the report to a later leaf), and once it has
+/// cancelled, every thread's next leaf throws too.
 class BuildProgress {
  public:
   explicit BuildProgress(const ProgressCallback& callback) : callback_(callback) {}
 
   void add(double weight) {
-    done_ += weight;
-    if (callback_ && done_ - reported_ >= 0.01) {
-      reported_ = done_;
-      if (!callback_(std::min(done_, 1.0))) throw BuildCancelled();
+    if (!callback_) return;
+    if (cancelled_.load(std::memory_order_relaxed)) throw BuildCancelled();
+    const double done = done_.fetch_add(weight, std::memory_order_relaxed) + weight;
+    if (done - reported_.load(std::memory_order_relaxed) < 0.01) return;
+    std::unique_lock lock(mutex_, std::try_to_lock);
+    if (!lock.owns_lock() || done - reported_.load(std::memory_order_relaxed) < 0.01) return;
+    if (cancelled_.load()) throw BuildCancelled();  // another thread's report cancelled while this one waited
+    reported_.store(done, std::memory_order_relaxed);
+    if (!callback_(std::min(done, 1.0))) {
+      cancelled_.store(true);
+      throw BuildCancelled();
     }
   }
 
  private:
   const ProgressCallback& callback_;
-  double done_ = 0.0, reported_ = 0.0;
+  std::atomic<double> done_{0.0}, reported_{0.0};
+  std::atomic<bool> cancelled_{false};
+  std::mutex mutex_;
 };
 
 }  // namespace accelviz::spatial
