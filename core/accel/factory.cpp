@@ -73,7 +73,11 @@ std::unique_ptr<Accelerator> build_accelerator(std::string_view name, std::span<
     return std::make_unique<KdTree>(triangles, ko, progress);
   }
   if (name == "grid") return std::make_unique<Grid>(triangles, opts.grid, progress);
-  if (name == "octree") return std::make_unique<Octree>(triangles, opts.octree, progress);
+  if (name == "octree") {
+    OctreeOptions oo = opts.octree;
+    if (oo.threads == 0) oo.threads = opts.threads;
+    return std::make_unique<Octree>(triangles, oo, progress);
+  }
   if (name == "voxels") return std::make_unique<Voxels>(triangles, opts.voxels, progress);
   if (name == "embree") {
 #ifdef ACCELVIZ_HAVE_EMBREE

@@ -58,9 +58,6 @@ struct Split {
   double cost = std::numeric_limits<double>::infinity();
 };
 
-/// Below this many primitives the build runs on one thread.
-constexpr std::size_t kParallelBuildMin = 16384;
-
 /// A subtree the top of a parallel build leaves to a thread of its own: its
 /// primitives and their clipped bounds, its cell, depth and share of the
 /// progress, and (once built) its nodes and references, numbered from 0.
@@ -365,7 +362,7 @@ KdTree::KdTree(std::span<const Triangle> triangles, const KdTreeOptions& opts, c
 
   spatial::BuildProgress shared_progress(progress);
   const unsigned threads = resolve_threads(opts_.threads);
-  if (threads <= 1 || n < kParallelBuildMin) {
+  if (threads <= 1 || n < spatial::kParallelBuildMin) {
     KdBuilder builder(tris_, opts_, max_depth, shared_progress, nodes_, prim_refs_);
     if (n > 0) builder.build(prims, cb, bounds_, 0, 1.0);
   } else {

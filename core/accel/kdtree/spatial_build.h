@@ -12,6 +12,10 @@
 
 namespace accelviz::spatial {
 
+/// The K-D tree and the octree build scenes of fewer triangles on one thread
+/// (more: the top of the tree on one, its subtrees as jobs on all).
+inline constexpr std::size_t kParallelBuildMin = 16384;
+
 /// What a top-down build counts as it makes nodes.
 struct TreeTally {
   double sah_sum = 0.0;  ///< inner nodes' C_trav·A plus leaves' C_isect·n·A (half areas A)

@@ -25,6 +25,7 @@ struct OctreeOptions {
   int max_leaf_size = 8;   ///< a cell with more triangles than this is split (while depth < max_depth), >= 1
   bool mailboxing = true;  ///< skip primitives this ray already tested (a 16-entry hashed mailbox)
   bool cost_termination = true;  ///< also stop where the SAH rates the split no cheaper than the leaf: 1 + Σ n_child / 4 >= n (stops runaway splitting where triangles cross)
+  unsigned threads = 0;          ///< build threads, 0 = all hardware threads; the tree is the same for any count
 };
 
 /// Deepest octree any options may ask for.
