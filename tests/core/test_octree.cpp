@@ -4,8 +4,6 @@
 // mid-planes, front-to-back order), options and degenerate inputs.
 #include <gtest/gtest.h>
 
-#include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <stdexcept>
 #include <vector>
@@ -14,6 +12,7 @@
 #include "core/accel/kdtree/spatial_traversal.h"
 #include "core/accel/octree/octree.h"
 #include "core/geometry/tri_box_overlap.h"
+#include "tests/core/spatial_build_checks.h"
 #include "tests/core/spatial_test_scenes.h"
 
 // Own namespace: this file is compiled together with others (tests/CMakeLists.txt, unity build).
@@ -327,23 +326,7 @@ TEST(Octree, SameTreeOnAnyThreadCount) {
   const Octree one(s, o);
   for (unsigned t : {2u, 3u, 5u}) {
     o.threads = t;
-    const Octree oc(s, o);
-    ASSERT_EQ(oc.nodes().size(), one.nodes().size()) << t << " threads";
-    for (std::size_t i = 0; i < one.nodes().size(); ++i)
-      ASSERT_TRUE(oc.nodes()[i].index == one.nodes()[i].index && oc.nodes()[i].count == one.nodes()[i].count)
-          << "node " << i << ", " << t << " threads";
-    ASSERT_TRUE(
-        std::equal(oc.prim_refs().begin(), oc.prim_refs().end(), one.prim_refs().begin(), one.prim_refs().end()))
-        << t << " threads";
-    const BuildStats &a = oc.build_stats(), &b = one.build_stats();
-    EXPECT_EQ(a.sah_cost, b.sah_cost) << t << " threads";  // the same sum in the same order
-    EXPECT_EQ(a.node_count, b.node_count);
-    EXPECT_EQ(a.leaf_count, b.leaf_count);
-    EXPECT_EQ(a.max_depth, b.max_depth);
-    EXPECT_EQ(a.avg_leaf_depth, b.avg_leaf_depth);
-    EXPECT_EQ(a.memory_bytes, b.memory_bytes);
-    EXPECT_EQ(a.extra.at("references"), b.extra.at("references"));
-    EXPECT_EQ(a.extra.at("empty_leaves"), b.extra.at("empty_leaves"));
+    EXPECT_TRUE(same_tree(Octree(s, o), one)) << t << " threads";
   }
   EXPECT_GT(one.nodes().size(), 1000u);
   EXPECT_GT(one.build_stats().extra.at("empty_leaves"), 0.0);  // empty leaves, whose offsets must match too
@@ -352,22 +335,8 @@ TEST(Octree, SameTreeOnAnyThreadCount) {
 // The parallel build reports progress in order, from whichever thread, and
 // stops on all threads at the first refusal.
 TEST(Octree, ParallelBuildProgressAndCancellation) {
-  const Scene s = soup(17, 40000, 0.02f);
   OctreeOptions o;
   o.threads = 2;
-  std::atomic<int> calls{0};
-  double last = 0.0;
-  const Octree oc(s, o, [&](double f) {
-    EXPECT_GE(f, last);
-    EXPECT_LE(f, 1.0);
-    last = f;
-    ++calls;
-    return true;
-  });
-  EXPECT_GT(calls.load(), 5);
-  EXPECT_DOUBLE_EQ(last, 1.0);
-  std::atomic<int> seen{0};
-  EXPECT_THROW(Octree(s, o, [&](double) { return ++seen < 3; }), BuildCancelled);
-  EXPECT_EQ(seen.load(), 3);
+  check_parallel_progress_and_cancellation<Octree>(soup(17, 40000, 0.02f), o);
 }
 }  // namespace unity_test_octree

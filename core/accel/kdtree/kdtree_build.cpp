@@ -376,16 +376,9 @@ KdTree::KdTree(std::span<const Triangle> triangles, const KdTreeOptions& opts, c
     KdBuilder builder(tris_, opts_, max_depth, shared_progress, top, top_refs);
     builder.defer_subtrees(std::max<std::size_t>(n / (4 * std::size_t{threads}), 1), threads, jobs, job_at);
     builder.build(prims, cb, bounds_, 0, 1.0);
-    std::vector<std::size_t> order(jobs.size());
-    for (std::size_t j = 0; j < order.size(); ++j) order[j] = j;
-    std::stable_sort(order.begin(), order.end(),
-                     [&](std::size_t x, std::size_t y) { return jobs[x].prims.size() > jobs[y].prims.size(); });
-    parallel_for(order.size(), threads, 1, [&](std::size_t b, std::size_t e, unsigned) {
-      for (std::size_t k = b; k < e; ++k) {
-        KdJob& j = jobs[order[k]];
-        KdBuilder sub(tris_, opts_, max_depth, shared_progress, j.nodes, j.refs);
-        sub.build(j.prims, j.cb, j.box, j.depth, j.weight);
-      }
+    spatial::build_jobs(jobs, threads, [&](KdJob& j) {
+      KdBuilder sub(tris_, opts_, max_depth, shared_progress, j.nodes, j.refs);
+      sub.build(j.prims, j.cb, j.box, j.depth, j.weight);
     });
     assemble(top, top_refs, job_at, jobs, nodes_, prim_refs_);
   }

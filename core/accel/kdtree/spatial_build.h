@@ -7,14 +7,30 @@
 #include <cstddef>
 #include <cstdint>
 #include <mutex>
+#include <vector>
 
 #include "core/accel/accel.h"
+#include "core/util/parallel.h"
 
 namespace accelviz::spatial {
 
 /// The K-D tree and the octree build scenes of fewer triangles on one thread
 /// (more: the top of the tree on one, its subtrees as jobs on all).
 inline constexpr std::size_t kParallelBuildMin = 16384;
+
+/// Runs build(job) for every job (each with its triangles in `prims`) on
+/// `threads` threads, the jobs with the most triangles first, so that the
+/// long ones do not start last.
+template <class Job, class Build>
+void build_jobs(std::vector<Job>& jobs, unsigned threads, const Build& build) {
+  std::vector<std::size_t> order(jobs.size());
+  for (std::size_t j = 0; j < order.size(); ++j) order[j] = j;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t x, std::size_t y) { return jobs[x].prims.size() > jobs[y].prims.size(); });
+  parallel_for(order.size(), threads, 1, [&](std::size_t b, std::size_t e, unsigned) {
+    for (std::size_t k = b; k < e; ++k) build(jobs[order[k]]);
+  });
+}
 
 /// What a top-down build counts as it makes nodes.
 struct TreeTally {

@@ -302,17 +302,10 @@ Octree::Octree(std::span<const Triangle> triangles, const OctreeOptions& opts, c
     OctreeBuilder builder(tris_, opts_, pad, shared_progress, top, top_refs);
     builder.defer_subtrees(std::max<std::size_t>(n / (4 * std::size_t{threads}), 1), threads, jobs, jobs_before);
     builder.build(0, prims, root_, 0, 1.0);
-    std::vector<std::size_t> order(jobs.size());
-    for (std::size_t j = 0; j < order.size(); ++j) order[j] = j;
-    std::stable_sort(order.begin(), order.end(),
-                     [&](std::size_t x, std::size_t y) { return jobs[x].prims.size() > jobs[y].prims.size(); });
-    parallel_for(order.size(), threads, 1, [&](std::size_t b, std::size_t e, unsigned) {
-      for (std::size_t k = b; k < e; ++k) {
-        OctJob& j = jobs[order[k]];
-        j.nodes.emplace_back();
-        OctreeBuilder sub(tris_, opts_, pad, shared_progress, j.nodes, j.refs);
-        sub.build(0, j.prims, j.box, j.depth, j.weight);
-      }
+    spatial::build_jobs(jobs, threads, [&](OctJob& j) {
+      j.nodes.emplace_back();
+      OctreeBuilder sub(tris_, opts_, pad, shared_progress, j.nodes, j.refs);
+      sub.build(0, j.prims, j.box, j.depth, j.weight);
     });
     assemble(top, top_refs, jobs_before, jobs, nodes_, prim_refs_);
   }
