@@ -60,13 +60,15 @@ struct Split {
 
 /// A subtree the top of a parallel build leaves to a thread of its own: its
 /// primitives and their clipped bounds, its cell, depth and share of the
-/// progress, and (once built) its nodes and references, numbered from 0.
+/// progress, the node of the top array that stands for it, and (once built)
+/// its nodes and references, numbered from 0.
 struct KdJob {
   std::vector<std::uint32_t> prims;
   std::vector<Aabb> cb;
   Aabb box;
   int depth = 0;
   double weight = 0.0;
+  std::uint32_t top_node = 0;
   std::vector<KdNode> nodes;
   std::vector<std::uint32_t> refs;
 };
@@ -79,15 +81,12 @@ class KdBuilder {
 
   /// The top of a parallel build: a node of at most `job_max` primitives
   /// (below the root) becomes one node in `nodes` standing for a job, listed
-  /// in `jobs` and `job_at` (the job's number at that node's index, -1
-  /// elsewhere), to be built on its own; the top's split searches run their
+  /// in `jobs`, to be built on its own; the top's split searches run their
   /// three axes on up to `threads` threads.
-  void defer_subtrees(std::size_t job_max, unsigned threads, std::vector<KdJob>& jobs,
-                      std::vector<std::int32_t>& job_at) {
+  void defer_subtrees(std::size_t job_max, unsigned threads, std::vector<KdJob>& jobs) {
     job_max_ = job_max;
     threads_ = threads;
     jobs_ = &jobs;
-    job_at_ = &job_at;
   }
 
   // Builds the subtree for `prims` (with their bounds clipped to `box`) at
@@ -97,13 +96,9 @@ class KdBuilder {
     const std::uint32_t index = static_cast<std::uint32_t>(nodes_.size());
     if (nodes_.size() >= (1u << 30)) throw std::length_error("kdtree: more than 2^30 nodes");
     nodes_.emplace_back();
-    if (jobs_) {
-      job_at_->push_back(-1);
-      if (depth > 0 && n <= job_max_) {
-        (*job_at_)[index] = static_cast<std::int32_t>(jobs_->size());
-        jobs_->push_back({std::move(prims), std::move(cb), box, depth, weight, {}, {}});
-        return;
-      }
+    if (jobs_ && depth > 0 && n <= job_max_) {
+      jobs_->push_back({std::move(prims), std::move(cb), box, depth, weight, index, {}, {}});
+      return;
     }
     const double area = box.half_area();
 
@@ -265,7 +260,6 @@ class KdBuilder {
   std::size_t job_max_ = 0;
   unsigned threads_ = 1;
   std::vector<KdJob>* jobs_ = nullptr;
-  std::vector<std::int32_t>* job_at_ = nullptr;
 };
 
 /// The final node and reference arrays from the top of a parallel build
@@ -273,8 +267,9 @@ class KdBuilder {
 /// below child next to its parent): each job's nodes where its stand-in
 /// was, their child indices and leaf offsets moved to their new places.
 void assemble(const std::vector<KdNode>& top, const std::vector<std::uint32_t>& top_refs,
-              const std::vector<std::int32_t>& job_at, const std::vector<KdJob>& jobs, std::vector<KdNode>& nodes,
-              std::vector<std::uint32_t>& refs) {
+              const std::vector<KdJob>& jobs, std::vector<KdNode>& nodes, std::vector<std::uint32_t>& refs) {
+  std::vector<std::int32_t> job_at(top.size(), -1);  // the job a top node stands for
+  for (std::size_t j = 0; j < jobs.size(); ++j) job_at[jobs[j].top_node] = static_cast<std::int32_t>(j);
   std::vector<std::uint64_t> at(top.size());  // each top node's final index
   std::uint64_t count = 0, ref_count = top_refs.size();
   for (std::size_t i = 0; i < top.size(); ++i) {
@@ -372,15 +367,14 @@ KdTree::KdTree(std::span<const Triangle> triangles, const KdTreeOptions& opts, c
     std::vector<KdNode> top;
     std::vector<std::uint32_t> top_refs;
     std::vector<KdJob> jobs;
-    std::vector<std::int32_t> job_at;
     KdBuilder builder(tris_, opts_, max_depth, shared_progress, top, top_refs);
-    builder.defer_subtrees(std::max<std::size_t>(n / (4 * std::size_t{threads}), 1), threads, jobs, job_at);
+    builder.defer_subtrees(std::max<std::size_t>(n / (4 * std::size_t{threads}), 1), threads, jobs);
     builder.build(prims, cb, bounds_, 0, 1.0);
     spatial::build_jobs(jobs, threads, [&](KdJob& j) {
       KdBuilder sub(tris_, opts_, max_depth, shared_progress, j.nodes, j.refs);
       sub.build(j.prims, j.cb, j.box, j.depth, j.weight);
     });
-    assemble(top, top_refs, job_at, jobs, nodes_, prim_refs_);
+    assemble(top, top_refs, jobs, nodes_, prim_refs_);
   }
   nodes_.shrink_to_fit();
   prim_refs_.shrink_to_fit();

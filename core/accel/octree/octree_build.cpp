@@ -55,15 +55,12 @@ class OctreeBuilder {
       : tris_(tris), opts_(opts), pad_(pad), progress_(progress), nodes_(nodes), refs_(refs) {}
 
   /// The top of a parallel build: a cell below the root with at most
-  /// `job_max` triangles is left as a job in `jobs`; `jobs_before` gets, for
-  /// each leaf of the top (by node index), how many jobs were left before it;
-  /// the top's cells sort their triangles into octants on up to `threads`.
-  void defer_subtrees(std::size_t job_max, unsigned threads, std::vector<OctJob>& jobs,
-                      std::vector<std::uint32_t>& jobs_before) {
+  /// `job_max` triangles is left as a job in `jobs`; the top's cells sort
+  /// their triangles into octants on up to `threads`.
+  void defer_subtrees(std::size_t job_max, unsigned threads, std::vector<OctJob>& jobs) {
     job_max_ = job_max;
     threads_ = threads;
     jobs_ = &jobs;
-    jobs_before_ = &jobs_before;
   }
 
   // Fills nodes_[node] (already allocated) for the cell `box` holding `prims`.
@@ -145,10 +142,6 @@ class OctreeBuilder {
     if (refs_.size() + prims.size() >= 0xFFFFFFFFull) throw std::length_error("octree: more than 2^32-1 references");
     nodes_[node] = {static_cast<std::uint32_t>(refs_.size()), static_cast<std::uint32_t>(prims.size())};
     refs_.insert(refs_.end(), prims.begin(), prims.end());
-    if (jobs_) {
-      if (jobs_before_->size() <= node) jobs_before_->resize(node + 1);
-      (*jobs_before_)[node] = static_cast<std::uint32_t>(jobs_->size());
-    }
     progress_.add(weight);
   }
 
@@ -162,7 +155,6 @@ class OctreeBuilder {
   std::size_t job_max_ = 0;
   unsigned threads_ = 1;
   std::vector<OctJob>* jobs_ = nullptr;
-  std::vector<std::uint32_t>* jobs_before_ = nullptr;
 };
 
 /// The final node and reference arrays from the top of a parallel build and
@@ -171,8 +163,7 @@ class OctreeBuilder {
 /// stood when it was left, its references likewise, and every child index
 /// and leaf offset moved to the new places.
 void assemble(const std::vector<OctreeNode>& top, const std::vector<std::uint32_t>& top_refs,
-              const std::vector<std::uint32_t>& jobs_before, const std::vector<OctJob>& jobs,
-              std::vector<OctreeNode>& nodes, std::vector<std::uint32_t>& refs) {
+              const std::vector<OctJob>& jobs, std::vector<OctreeNode>& nodes, std::vector<std::uint32_t>& refs) {
   // Nodes and references of the jobs before job j (jobs are left in the
   // order of the walk, so their places in the top's arrays never decrease).
   std::vector<std::uint64_t> nodes_before(jobs.size() + 1, 0), refs_before(jobs.size() + 1, 0);
@@ -197,8 +188,17 @@ void assemble(const std::vector<OctreeNode>& top, const std::vector<std::uint32_
   for (std::size_t i = 0; i < top.size(); ++i) {
     if (is_job[i]) continue;  // written with its job below
     const OctreeNode& n = top[i];
-    nodes[at[i]] = n.is_leaf() ? OctreeNode{static_cast<std::uint32_t>(n.index + refs_before[jobs_before[i]]), n.count}
-                               : OctreeNode{static_cast<std::uint32_t>(at[n.index]), OctreeNode::kInner};
+    if (!n.is_leaf()) {
+      nodes[at[i]] = {static_cast<std::uint32_t>(at[n.index]), OctreeNode::kInner};
+      continue;
+    }
+    // A leaf of the top holds more triangles than a job (a smaller cell is
+    // a job), so none is empty: the jobs left before it are those whose
+    // references start at or before its own.
+    const auto before = std::upper_bound(jobs.begin(), jobs.end(), n.index,
+                                         [](std::uint32_t r, const OctJob& j) { return r < j.top_refs_at; });
+    nodes[at[i]] = {static_cast<std::uint32_t>(n.index + refs_before[static_cast<std::size_t>(before - jobs.begin())]),
+                    n.count};
   }
   refs.clear();
   refs.reserve(ref_count);
@@ -297,17 +297,17 @@ Octree::Octree(std::span<const Triangle> triangles, const OctreeOptions& opts, c
     // n / (4 · threads) triangles as jobs, the largest first, on all threads;
     // then the arrays the one-thread build writes (K-D tree alike).
     std::vector<OctreeNode> top(1);
-    std::vector<std::uint32_t> top_refs, jobs_before;
+    std::vector<std::uint32_t> top_refs;
     std::vector<OctJob> jobs;
     OctreeBuilder builder(tris_, opts_, pad, shared_progress, top, top_refs);
-    builder.defer_subtrees(std::max<std::size_t>(n / (4 * std::size_t{threads}), 1), threads, jobs, jobs_before);
+    builder.defer_subtrees(std::max<std::size_t>(n / (4 * std::size_t{threads}), 1), threads, jobs);
     builder.build(0, prims, root_, 0, 1.0);
     spatial::build_jobs(jobs, threads, [&](OctJob& j) {
       j.nodes.emplace_back();
       OctreeBuilder sub(tris_, opts_, pad, shared_progress, j.nodes, j.refs);
       sub.build(0, j.prims, j.box, j.depth, j.weight);
     });
-    assemble(top, top_refs, jobs_before, jobs, nodes_, prim_refs_);
+    assemble(top, top_refs, jobs, nodes_, prim_refs_);
   }
   nodes_.shrink_to_fit();
   prim_refs_.shrink_to_fit();
